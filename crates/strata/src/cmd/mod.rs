@@ -1,0 +1,10 @@
+//! One module per subcommand: its arguments and its `run`.
+
+pub mod compare;
+pub mod fit;
+pub mod generate;
+pub mod info;
+pub mod merge;
+pub mod metrics;
+pub mod reference;
+pub mod render;

@@ -1,0 +1,8 @@
+//! `strata render` (not implemented yet).
+
+#[derive(clap::Args)]
+pub struct Args {}
+
+pub fn run(_args: Args) -> anyhow::Result<()> {
+    anyhow::bail!("`strata render` is not implemented yet")
+}

@@ -1,0 +1,54 @@
+//! `strata`: render and measure editable multi-layer height fields.
+
+mod cmd;
+mod world_arg;
+
+use clap::{Parser, Subcommand};
+
+#[derive(Parser)]
+#[command(name = "strata", version, about = "Render and measure editable multi-layer height fields (Vangers terrain)")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Write a generated Vangers-like world directory in the real file format.
+    Generate(cmd::generate::Args),
+    /// Print a world's size, dual fraction, height range, terrain types, roughness, decode time.
+    Info(cmd::info::Args),
+    /// CPU reference ray cast of one view (or every view of a file).
+    Reference(cmd::reference::Args),
+    /// Compare a rendered depth/colour pair with the CPU reference.
+    Metrics(cmd::metrics::Args),
+    /// Render one view with one method on the GPU.
+    Render(cmd::render::Args),
+    /// Fit the TIN mesh and report its size, causes, time and memory.
+    Fit(cmd::fit::Args),
+    /// The one-command comparison of every method over the level's views.
+    Compare(cmd::compare::Args),
+    /// Merge results from several machines into one report.
+    Merge(cmd::merge::Args),
+}
+
+fn main() -> std::process::ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Generate(args) => cmd::generate::run(args),
+        Command::Info(args) => cmd::info::run(args),
+        Command::Reference(args) => cmd::reference::run(args),
+        Command::Metrics(args) => cmd::metrics::run(args),
+        Command::Render(args) => cmd::render::run(args),
+        Command::Fit(args) => cmd::fit::run(args),
+        Command::Compare(args) => cmd::compare::run(args),
+        Command::Merge(args) => cmd::merge::run(args),
+    };
+    match result {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(err) => {
+            eprintln!("error: {err:#}");
+            std::process::ExitCode::FAILURE
+        }
+    }
+}
