@@ -1,4 +1,30 @@
 //! Edits: changes to height and meta inside a rectangle, wrapping at the edges.
+//!
+//! An edit is a function from a texel's decoded [`Column`] to the column it
+//! should become. [`edit_columns`] applies it over a rectangle given in
+//! unwrapped integer coordinates (anything, also negative or past the map),
+//! re-encodes the result keeping the pair encoding valid, and returns the
+//! dirty rectangles, split at the map edges and widened to whole pairs.
+//!
+//! Pair rules (DESIGN §1; as the original game, a closed slab leaves the
+//! column single at its top):
+//! - a dual pair is edited once, at its even texel; the result applies to
+//!   both texels;
+//! - a single pair is edited texel by texel; if either result is dual, the
+//!   pair becomes that dual column (the even texel's result first);
+//! - a dual result stays dual only if its cave is at least [`MIN_CAVE`]
+//!   units tall and the slab has thickness (`mid < high`). The gap code is
+//!   the largest whose gap fits under `mid` (the slab never moves up into
+//!   the cave). Otherwise the pair becomes single at `high` with the slab's
+//!   terrain type;
+//! - a single result sets the texel's height to `low`;
+//! - meta bits we do not interpret (shadow, object shadow) are kept.
+
+use crate::model::{
+    Column, Level, META_DELTA_MASK, META_DOUBLE_LEVEL, META_TERRAIN_MASK, META_TERRAIN_SHIFT,
+    MidRule, decode_column,
+};
+use crate::views::EditSite;
 
 /// A rectangle of texels inside the map (never wrapping: an edit across the
 /// map edge yields several).
@@ -8,4 +34,241 @@ pub struct DirtyRect {
     pub y: u32,
     pub width: u32,
     pub height: u32,
+}
+
+impl DirtyRect {
+    pub fn contains(&self, x: u32, y: u32) -> bool {
+        x >= self.x && x - self.x < self.width && y >= self.y && y - self.y < self.height
+    }
+}
+
+/// A rectangle in unwrapped texel coordinates: `x .. x + width`, `y .. y + height`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct EditRect {
+    pub x: i64,
+    pub y: i64,
+    pub width: u32,
+    pub height: u32,
+}
+
+/// The shortest cave a dual column keeps (issue 2: "a cave is at least 8 units tall").
+pub const MIN_CAVE: u32 = 8;
+
+/// The largest gap code whose gap is at most `gap`, if its gap is at least [`MIN_CAVE`].
+fn code_at_most(rule: MidRule, gap: u32) -> Option<u8> {
+    (0..16u8)
+        .rev()
+        .find(|&c| rule.gap(c) <= gap && rule.gap(c) >= MIN_CAVE)
+}
+
+/// Split `start .. start + len` (unwrapped) into in-map spans on an axis of `size`.
+fn spans(start: i64, len: u32, size: u32) -> Vec<(u32, u32)> {
+    let len = len.min(size);
+    let first = start.rem_euclid(i64::from(size)) as u32;
+    let head = len.min(size - first);
+    let mut out = vec![(first, head)];
+    if head < len {
+        out.push((0, len - head));
+    }
+    out.retain(|s| s.1 > 0);
+    out
+}
+
+/// What to write into one texel.
+#[derive(Clone, Copy)]
+enum Write {
+    Single {
+        height: u8,
+        terrain: u8,
+    },
+    /// The even or odd half of a dual pair.
+    Dual {
+        height: u8,
+        terrain: u8,
+        delta: u8,
+    },
+}
+
+fn apply(h: &mut u8, m: &mut u8, write: Write) -> bool {
+    let keep = *m & !(META_DOUBLE_LEVEL | META_TERRAIN_MASK | META_DELTA_MASK);
+    let (height, meta) = match write {
+        Write::Single { height, terrain } => (height, keep | ((terrain & 7) << META_TERRAIN_SHIFT)),
+        Write::Dual {
+            height,
+            terrain,
+            delta,
+        } => (
+            height,
+            keep | META_DOUBLE_LEVEL
+                | ((terrain & 7) << META_TERRAIN_SHIFT)
+                | (delta & META_DELTA_MASK),
+        ),
+    };
+    let changed = (*h, *m) != (height, meta);
+    (*h, *m) = (height, meta);
+    changed
+}
+
+/// The writes for a pair whose result is the dual column `c`.
+fn dual_writes(rule: MidRule, c: Column) -> [Write; 2] {
+    let code = if c.mid < c.high && c.mid >= c.low {
+        code_at_most(rule, u32::from(c.mid - c.low))
+    } else {
+        None
+    };
+    match code {
+        Some(code) => [
+            Write::Dual {
+                height: c.low,
+                terrain: c.lower_type,
+                delta: code >> 2,
+            },
+            Write::Dual {
+                height: c.high,
+                terrain: c.upper_type,
+                delta: code & 3,
+            },
+        ],
+        None => {
+            [Write::Single {
+                height: c.high,
+                terrain: c.upper_type,
+            }; 2]
+        }
+    }
+}
+
+/// Apply `f(x, y, column) -> column` over `rect` (unwrapped coordinates;
+/// `x`, `y` passed to `f` are unwrapped too, so distances from a centre
+/// work across the edges). The rectangle is widened to whole pairs and
+/// clipped to one map's extent. Returns the dirty rectangles (inside the
+/// map, even-aligned in x) that contain every changed texel; rectangles
+/// where nothing changed are left out.
+pub fn edit_columns(
+    level: &mut Level,
+    rect: EditRect,
+    mut f: impl FnMut(i64, i64, Column) -> Column,
+) -> Vec<DirtyRect> {
+    let (w, h) = (level.width(), level.height());
+    let rule = level.mid_rule;
+    // Widen to whole pairs: even start, even end.
+    let x0 = rect.x.div_euclid(2) * 2;
+    let x_end = (rect.x + i64::from(rect.width) + 1).div_euclid(2) * 2;
+    let width = u32::try_from(x_end - x0).unwrap_or(u32::MAX).min(w);
+    let height = rect.height.min(h);
+    if rect.width == 0 || height == 0 {
+        return Vec::new();
+    }
+    let wu = w as usize;
+    let mut dirty = Vec::new();
+    for (sx, sw) in spans(x0, width, w) {
+        for (sy, sh) in spans(rect.y, height, h) {
+            let mut changed = false;
+            for y in sy..sy + sh {
+                // Unwrapped coordinates for `f`: the offset of this span from the rect.
+                let uy = rect.y + (i64::from(y) - rect.y).rem_euclid(i64::from(h));
+                let (hs, ms) = level.planes_mut();
+                let row = y as usize * wu;
+                let (hr, mr) = (&mut hs[row..row + wu], &mut ms[row..row + wu]);
+                for xe in (sx..sx + sw).step_by(2) {
+                    let ux = x0 + (i64::from(xe) - x0).rem_euclid(i64::from(w));
+                    let xe = xe as usize;
+                    let before = decode_column(hr, mr, xe, rule);
+                    let writes = if before.dual {
+                        let after = f(ux, uy, before);
+                        if after == before {
+                            continue;
+                        }
+                        if after.dual {
+                            dual_writes(rule, after)
+                        } else {
+                            [Write::Single {
+                                height: after.low,
+                                terrain: after.lower_type,
+                            }; 2]
+                        }
+                    } else {
+                        let odd_before = decode_column(hr, mr, xe + 1, rule);
+                        let even = f(ux, uy, before);
+                        let odd = f(ux + 1, uy, odd_before);
+                        if even == before && odd == odd_before {
+                            continue;
+                        }
+                        if even.dual {
+                            dual_writes(rule, even)
+                        } else if odd.dual {
+                            dual_writes(rule, odd)
+                        } else {
+                            [
+                                Write::Single {
+                                    height: even.low,
+                                    terrain: even.lower_type,
+                                },
+                                Write::Single {
+                                    height: odd.low,
+                                    terrain: odd.lower_type,
+                                },
+                            ]
+                        }
+                    };
+                    changed |= apply(&mut hr[xe], &mut mr[xe], writes[0]);
+                    changed |= apply(&mut hr[xe + 1], &mut mr[xe + 1], writes[1]);
+                }
+            }
+            if changed {
+                dirty.push(DirtyRect {
+                    x: sx,
+                    y: sy,
+                    width: sw,
+                    height: sh,
+                });
+            }
+        }
+    }
+    dirty
+}
+
+/// Set every texel of `rect` to a single column of `height` and `terrain`
+/// (removing slabs): the simplest general edit.
+pub fn fill_single(level: &mut Level, rect: EditRect, height: u8, terrain: u8) -> Vec<DirtyRect> {
+    let t = terrain & 7;
+    edit_columns(level, rect, |_, _, _| Column {
+        low: height,
+        mid: height,
+        high: height,
+        dual: false,
+        lower_type: t,
+        upper_type: t,
+    })
+}
+
+/// The paper's crater: inside radius `r` of the centre the floor drops by
+/// `depth (1 - d²/r²)` (never below 0) and the upper layer is removed
+/// (dual pairs become single at the lowered floor).
+pub fn crater(level: &mut Level, site: &EditSite) -> Vec<DirtyRect> {
+    let r = i64::from(site.radius);
+    let r2 = (r * r) as f32;
+    let (cx, cy) = (site.centre_x, site.centre_y);
+    let rect = EditRect {
+        x: cx - r,
+        y: cy - r,
+        width: 2 * site.radius + 1,
+        height: 2 * site.radius + 1,
+    };
+    edit_columns(level, rect, |x, y, c| {
+        let d2 = ((x - cx) * (x - cx) + (y - cy) * (y - cy)) as f32;
+        if d2 >= r2 {
+            return c;
+        }
+        let drop = site.depth * (1.0 - d2 / r2);
+        let low = (f32::from(c.low) - drop).round().clamp(0.0, 255.0) as u8;
+        Column {
+            low,
+            mid: low,
+            high: low,
+            dual: false,
+            lower_type: c.lower_type,
+            upper_type: c.lower_type,
+        }
+    })
 }

@@ -1,4 +1,6 @@
-//! Errors reading and writing world files.
+//! Errors reading and writing world files. Every variant names the file.
+
+use std::path::{Path, PathBuf};
 
 #[derive(Debug, thiserror::Error)]
 pub enum LevelError {
@@ -8,5 +10,68 @@ pub enum LevelError {
         source: std::io::Error,
     },
     #[error("{path}: {msg}")]
-    Format { path: std::path::PathBuf, msg: String },
+    Format {
+        path: std::path::PathBuf,
+        msg: String,
+    },
+    /// A `world.ini` key that is missing or does not parse.
+    #[error("{path}: [{section}] {key}: {msg}")]
+    Ini {
+        path: PathBuf,
+        section: String,
+        key: String,
+        msg: String,
+    },
+}
+
+impl LevelError {
+    pub fn io(path: &Path, source: std::io::Error) -> Self {
+        LevelError::Io {
+            path: path.to_path_buf(),
+            source,
+        }
+    }
+
+    pub fn format(path: &Path, msg: impl Into<String>) -> Self {
+        LevelError::Format {
+            path: path.to_path_buf(),
+            msg: msg.into(),
+        }
+    }
+
+    /// The file the error is about.
+    pub fn path(&self) -> &Path {
+        match self {
+            LevelError::Io { path, .. }
+            | LevelError::Format { path, .. }
+            | LevelError::Ini { path, .. } => path,
+        }
+    }
+}
+
+/// Read a whole file, naming it on failure.
+pub fn read_file(path: &Path) -> Result<Vec<u8>, LevelError> {
+    std::fs::read(path).map_err(|e| LevelError::io(path, e))
+}
+
+/// Write a whole file, naming it on failure.
+pub fn write_file(path: &Path, bytes: &[u8]) -> Result<(), LevelError> {
+    std::fs::write(path, bytes).map_err(|e| LevelError::io(path, e))
+}
+
+/// The real Fostral files of the shared data folder, for tests:
+/// `$STRATA_FOSTRAL_DIR`, else `../shared/data/fostral` beside the repository.
+#[cfg(test)]
+pub(crate) fn fostral_file(name: &str) -> PathBuf {
+    let dir = std::env::var_os("STRATA_FOSTRAL_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| {
+            let beside = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/fostral");
+            if beside.exists() {
+                beside
+            } else {
+                PathBuf::from("/work/shared/data/fostral")
+            }
+        });
+    dir.join(name)
 }

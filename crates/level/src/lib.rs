@@ -6,6 +6,7 @@ pub mod config;
 pub mod edit;
 pub mod error;
 pub mod generate;
+pub mod huffman;
 pub mod io;
 pub mod model;
 pub mod palette;

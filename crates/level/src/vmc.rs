@@ -1,1 +1,255 @@
-//! TODO(issue 2)
+//! `.vmc`: the compressed map (DESIGN §1).
+//!
+//! Layout: a row table of `height` entries `(i32 LE absolute offset, i16 LE
+//! byte size)`, then the decode trees `tree1[512]` (heights) and
+//! `tree2[512]` (meta), i32 LE; then the rows. A row is the height stream
+//! (delta-coded: `h[x] = h[x-1] + s`, `h[-1] = 0`, mod 256), then from the
+//! next whole byte the meta stream (XOR-coded: `m[x] = m[x-1] ^ s`,
+//! `m[-1] = 0`); the two streams fill exactly the row's byte size.
+//!
+//! Rows are independent: both directions run in parallel over rows, and
+//! decoding writes straight into the two final planes.
+
+use crate::error::LevelError;
+use crate::huffman::{BitReader, BitWriter, Code, Decoder, TREE_SLOTS, Tree};
+use crate::model::{Level, MidRule};
+use rayon::prelude::*;
+use std::path::Path;
+
+const ENTRY_BYTES: usize = 6;
+const TREES_BYTES: usize = 2 * TREE_SLOTS * 4;
+
+/// Bytes before the first row of a map of `height` rows.
+pub fn header_bytes(height: u32) -> usize {
+    height as usize * ENTRY_BYTES + TREES_BYTES
+}
+
+fn read_tree(bytes: &[u8]) -> Tree {
+    let mut tree = [0i32; TREE_SLOTS];
+    for (t, b) in tree.iter_mut().zip(bytes.chunks_exact(4)) {
+        *t = i32::from_le_bytes([b[0], b[1], b[2], b[3]]);
+    }
+    tree
+}
+
+/// Decode `.vmc` bytes of a `width` x `height` map. `path` names the file in errors.
+pub fn decode_vmc(
+    bytes: &[u8],
+    width: u32,
+    height: u32,
+    mid_rule: MidRule,
+    path: &Path,
+) -> Result<Level, LevelError> {
+    let err = |msg: String| LevelError::format(path, msg);
+    let header = header_bytes(height);
+    if bytes.len() < header {
+        return Err(err(format!(
+            "truncated: {} bytes, but the row table and trees of {height} rows need {header}",
+            bytes.len()
+        )));
+    }
+    let table_end = height as usize * ENTRY_BYTES;
+    let mut rows = Vec::with_capacity(height as usize);
+    for (y, e) in bytes[..table_end].chunks_exact(ENTRY_BYTES).enumerate() {
+        let offset = i32::from_le_bytes([e[0], e[1], e[2], e[3]]);
+        let size = i16::from_le_bytes([e[4], e[5]]);
+        if offset < 0 || size < 0 {
+            return Err(err(format!(
+                "row {y}: negative offset {offset} or size {size} in the row table"
+            )));
+        }
+        let (start, len) = (offset as usize, size as usize);
+        if start < header {
+            return Err(err(format!(
+                "row {y} starts at byte {start}, inside the row table and trees ({header} bytes for \
+                 {height} rows): does the map size in world.ini ({width}x{height}) match the file?"
+            )));
+        }
+        if start + len > bytes.len() {
+            return Err(err(format!(
+                "row {y}: the row table points at bytes {start}..{} past the end of the file \
+                 ({} bytes; truncated?)",
+                start + len,
+                bytes.len()
+            )));
+        }
+        rows.push(start..start + len);
+    }
+    let tree_err = |which: &str, e| err(format!("{which} Huffman tree: {e}"));
+    let heights_dec = Decoder::new(&read_tree(&bytes[table_end..table_end + TREES_BYTES / 2]))
+        .map_err(|e| tree_err("height", e))?;
+    let metas_dec = Decoder::new(&read_tree(&bytes[table_end + TREES_BYTES / 2..header]))
+        .map_err(|e| tree_err("meta", e))?;
+
+    let w = width as usize;
+    let n = w * height as usize;
+    let mut heights = vec![0u8; n];
+    let mut metas = vec![0u8; n];
+    heights
+        .par_chunks_mut(w)
+        .zip(metas.par_chunks_mut(w))
+        .zip(rows.par_iter())
+        .enumerate()
+        .try_for_each(|(y, ((h_row, m_row), range))| {
+            decode_row(
+                &bytes[range.clone()],
+                &heights_dec,
+                &metas_dec,
+                h_row,
+                m_row,
+            )
+            .map_err(|msg| err(format!("row {y}: {msg}")))
+        })?;
+    Level::from_planes(width, height, heights, metas, mid_rule).map_err(|e| err(e.to_string()))
+}
+
+fn decode_row(
+    data: &[u8],
+    heights_dec: &Decoder,
+    metas_dec: &Decoder,
+    h_row: &mut [u8],
+    m_row: &mut [u8],
+) -> Result<(), String> {
+    let size_bits = data.len() * 8;
+    let mut bits = BitReader::new(data, 0);
+    let mut h = 0u8;
+    for out in h_row.iter_mut() {
+        h = h.wrapping_add(heights_dec.symbol(&mut bits));
+        *out = h;
+    }
+    let h_bits = bits.position();
+    if h_bits > size_bits {
+        return Err(format!(
+            "the height stream needs {h_bits} bits, more than the row's {} bytes",
+            data.len()
+        ));
+    }
+    let meta_start = h_bits.div_ceil(8);
+    let mut bits = BitReader::new(data, meta_start);
+    let mut m = 0u8;
+    for out in m_row.iter_mut() {
+        m ^= metas_dec.symbol(&mut bits);
+        *out = m;
+    }
+    let used = bits.position().div_ceil(8);
+    match used.cmp(&data.len()) {
+        std::cmp::Ordering::Equal => Ok(()),
+        std::cmp::Ordering::Greater => Err(format!(
+            "the meta stream runs past the row's {} bytes (needs {used})",
+            data.len()
+        )),
+        std::cmp::Ordering::Less => Err(format!(
+            "the two streams fill only {used} of the row's {} bytes",
+            data.len()
+        )),
+    }
+}
+
+/// Per-symbol counts of the delta-coded heights and XOR-coded metas.
+fn symbol_frequencies(level: &Level) -> ([u64; 256], [u64; 256]) {
+    let w = level.width() as usize;
+    level
+        .heights()
+        .par_chunks(w)
+        .zip(level.metas().par_chunks(w))
+        .fold(
+            || ([0u64; 256], [0u64; 256]),
+            |(mut fh, mut fm), (hr, mr)| {
+                let (mut ph, mut pm) = (0u8, 0u8);
+                for (&h, &m) in hr.iter().zip(mr) {
+                    fh[usize::from(h.wrapping_sub(ph))] += 1;
+                    fm[usize::from(m ^ pm)] += 1;
+                    (ph, pm) = (h, m);
+                }
+                (fh, fm)
+            },
+        )
+        .reduce(
+            || ([0u64; 256], [0u64; 256]),
+            |(mut a, mut b), (c, d)| {
+                a.iter_mut().zip(c).for_each(|(x, y)| *x += y);
+                b.iter_mut().zip(d).for_each(|(x, y)| *x += y);
+                (a, b)
+            },
+        )
+}
+
+fn encode_row(hr: &[u8], mr: &[u8], hc: &Code, mc: &Code) -> Vec<u8> {
+    let mut w = BitWriter::with_capacity(hr.len());
+    let mut p = 0u8;
+    for &h in hr {
+        let s = usize::from(h.wrapping_sub(p));
+        w.put(hc.codes[s], hc.lengths[s]);
+        p = h;
+    }
+    w.align();
+    let mut p = 0u8;
+    for &m in mr {
+        let s = usize::from(m ^ p);
+        w.put(mc.codes[s], mc.lengths[s]);
+        p = m;
+    }
+    w.align();
+    w.bytes
+}
+
+/// Encode a level as `.vmc` bytes with Huffman codes built from its own
+/// symbol statistics (one code for heights, one for meta).
+pub fn encode_vmc(level: &Level, path: &Path) -> Result<Vec<u8>, LevelError> {
+    let (fh, fm) = symbol_frequencies(level);
+    let (hc, mc) = (Code::from_frequencies(&fh), Code::from_frequencies(&fm));
+    let w = level.width() as usize;
+    let rows: Vec<Vec<u8>> = level
+        .heights()
+        .par_chunks(w)
+        .zip(level.metas().par_chunks(w))
+        .map(|(hr, mr)| encode_row(hr, mr, &hc, &mc))
+        .collect();
+    let header = header_bytes(level.height());
+    let total = header + rows.iter().map(Vec::len).sum::<usize>();
+    if total > i32::MAX as usize {
+        return Err(LevelError::format(
+            path,
+            format!("{total} bytes exceed the format's i32 offsets"),
+        ));
+    }
+    let mut out = Vec::with_capacity(total);
+    let mut offset = header;
+    for (y, row) in rows.iter().enumerate() {
+        let size = i16::try_from(row.len()).map_err(|_| {
+            LevelError::format(
+                path,
+                format!(
+                    "row {y} encodes to {} bytes, over the format's i16 row size",
+                    row.len()
+                ),
+            )
+        })?;
+        out.extend_from_slice(&(offset as i32).to_le_bytes());
+        out.extend_from_slice(&size.to_le_bytes());
+        offset += row.len();
+    }
+    for tree in [hc.tree(), mc.tree()] {
+        for v in tree {
+            out.extend_from_slice(&v.to_le_bytes());
+        }
+    }
+    for row in &rows {
+        out.extend_from_slice(row);
+    }
+    Ok(out)
+}
+
+pub fn read_vmc(
+    path: &Path,
+    width: u32,
+    height: u32,
+    mid_rule: MidRule,
+) -> Result<Level, LevelError> {
+    let bytes = crate::error::read_file(path)?;
+    decode_vmc(&bytes, width, height, mid_rule, path)
+}
+
+pub fn write_vmc(path: &Path, level: &Level) -> Result<(), LevelError> {
+    crate::error::write_file(path, &encode_vmc(level, path)?)
+}
