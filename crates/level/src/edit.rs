@@ -152,9 +152,12 @@ pub fn edit_columns(
     let (w, h) = (level.width(), level.height());
     let rule = level.mid_rule;
     // Widen to whole pairs: even start, even end.
+    // (i128: coordinates may be anywhere in i64, also at its ends.)
     let x0 = rect.x.div_euclid(2) * 2;
-    let x_end = (rect.x + i64::from(rect.width) + 1).div_euclid(2) * 2;
-    let width = u32::try_from(x_end - x0).unwrap_or(u32::MAX).min(w);
+    let x_end = (i128::from(rect.x) + i128::from(rect.width) + 1).div_euclid(2) * 2;
+    let width = u32::try_from(x_end - i128::from(x0))
+        .unwrap_or(u32::MAX)
+        .min(w);
     let height = rect.height.min(h);
     if rect.width == 0 || height == 0 {
         return Vec::new();
@@ -166,12 +169,16 @@ pub fn edit_columns(
             let mut changed = false;
             for y in sy..sy + sh {
                 // Unwrapped coordinates for `f`: the offset of this span from the rect.
-                let uy = rect.y + (i64::from(y) - rect.y).rem_euclid(i64::from(h));
+                let uy = rect.y.wrapping_add(
+                    (i64::from(y) - rect.y.rem_euclid(i64::from(h))).rem_euclid(i64::from(h)),
+                );
                 let (hs, ms) = level.planes_mut();
                 let row = y as usize * wu;
                 let (hr, mr) = (&mut hs[row..row + wu], &mut ms[row..row + wu]);
                 for xe in (sx..sx + sw).step_by(2) {
-                    let ux = x0 + (i64::from(xe) - x0).rem_euclid(i64::from(w));
+                    let ux = x0.wrapping_add(
+                        (i64::from(xe) - x0.rem_euclid(i64::from(w))).rem_euclid(i64::from(w)),
+                    );
                     let xe = xe as usize;
                     let before = decode_column(hr, mr, xe, rule);
                     let writes = if before.dual {
@@ -190,7 +197,7 @@ pub fn edit_columns(
                     } else {
                         let odd_before = decode_column(hr, mr, xe + 1, rule);
                         let even = f(ux, uy, before);
-                        let odd = f(ux + 1, uy, odd_before);
+                        let odd = f(ux.wrapping_add(1), uy, odd_before);
                         if even == before && odd == odd_before {
                             continue;
                         }
@@ -247,16 +254,17 @@ pub fn fill_single(level: &mut Level, rect: EditRect, height: u8, terrain: u8) -
 /// (dual pairs become single at the lowered floor).
 pub fn crater(level: &mut Level, site: &EditSite) -> Vec<DirtyRect> {
     let r = i64::from(site.radius);
-    let r2 = (r * r) as f32;
+    let r2 = (site.radius as f32).powi(2);
     let (cx, cy) = (site.centre_x, site.centre_y);
     let rect = EditRect {
-        x: cx - r,
-        y: cy - r,
-        width: 2 * site.radius + 1,
-        height: 2 * site.radius + 1,
+        x: cx.saturating_sub(r),
+        y: cy.saturating_sub(r),
+        width: site.radius.saturating_mul(2).saturating_add(1),
+        height: site.radius.saturating_mul(2).saturating_add(1),
     };
     edit_columns(level, rect, |x, y, c| {
-        let d2 = ((x - cx) * (x - cx) + (y - cy) * (y - cy)) as f32;
+        let (dx, dy) = (x.wrapping_sub(cx) as f32, y.wrapping_sub(cy) as f32);
+        let d2 = dx * dx + dy * dy;
         if d2 >= r2 {
             return c;
         }
