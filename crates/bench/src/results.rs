@@ -1,0 +1,222 @@
+//! The results file (`results-<adapter>.json`): typed, serialised with serde.
+//! Other tools read `rows` and `edit_rows`; the field names are a contract.
+
+use serde::{Deserialize, Serialize};
+use strata_level::ViewSpec;
+
+/// Bumped whenever the meaning of a field or of the protocol changes; `merge`
+/// refuses to combine runs of different versions.
+pub const PROTOCOL_VERSION: u32 = 1;
+
+/// Where the frame time in the report's timing table comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum TimingSource {
+    /// Per-pass GPU timestamps, summed.
+    GpuTimestamps,
+    /// CPU submit-and-wait (the adapter has no timestamps).
+    CpuSubmitWait,
+}
+
+/// One run of `strata compare` on one adapter.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RunResults {
+    pub protocol_version: u32,
+    pub level: LevelInfo,
+    pub adapter: AdapterInfo,
+    pub settings: Settings,
+    /// `git describe` of the source at run time, or "unknown".
+    pub source_revision: String,
+    /// False while the run is in progress or when it was interrupted.
+    pub complete: bool,
+    pub rows: Vec<Row>,
+    pub edit_rows: Vec<EditRow>,
+    /// Why the edit protocol did not run, when it did not.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub edit_skipped: Option<String>,
+}
+
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct LevelInfo {
+    pub name: String,
+    /// `Level::content_hash`: size, mid rule and both planes.
+    pub hash: String,
+    pub width: u32,
+    pub height: u32,
+}
+
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct AdapterInfo {
+    pub name: String,
+    pub backend: String,
+    pub driver: String,
+    pub timestamps: bool,
+}
+
+/// Everything that must agree for two runs to be comparable.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Settings {
+    pub width: u32,
+    pub height: u32,
+    pub far: f32,
+    /// Timed frames per cell.
+    pub frames: u32,
+    pub shadows: bool,
+    /// Method labels in report order (`name` or `name:setting`).
+    pub methods: Vec<String>,
+    pub views: Vec<ViewSpec>,
+    pub edits: bool,
+    /// The cave-ceiling convention (`original` or `vange-rs`).
+    pub mid_rule: String,
+}
+
+/// Mean / median / min / max of a set of frame times, and the samples.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Timing {
+    pub mean: f64,
+    pub median: f64,
+    pub min: f64,
+    pub max: f64,
+    pub samples: Vec<f64>,
+}
+
+/// One (view, method) cell. Percent fields are percent of all pixels.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Row {
+    pub view: String,
+    pub pitch: f32,
+    pub method: String,
+    pub see_through: f64,
+    pub covers_sky: f64,
+    /// World units.
+    pub depth_p50: f64,
+    pub depth_p95: f64,
+    pub coherence: f64,
+    /// Null without timestamp support.
+    pub gpu_ms_mean: Option<f64>,
+    pub cpu_ms_mean: f64,
+    pub gpu_ms: Option<Timing>,
+    pub cpu_ms: Timing,
+    pub timing_source: TimingSource,
+    pub prep_setup_ms: f64,
+    pub prep_first_frame_ms: f64,
+    pub prep_warmup_ms: f64,
+    /// Persistent method-specific bytes (shared resources excluded).
+    pub gpu_bytes: u64,
+    pub cpu_bytes: u64,
+    /// The cell picture, relative to the output directory.
+    pub image: String,
+}
+
+impl Row {
+    /// The frame time the report ranks by: GPU when timed, else CPU.
+    pub fn frame_ms(&self) -> f64 {
+        self.gpu_ms_mean.unwrap_or(self.cpu_ms_mean)
+    }
+
+    /// The samples behind [`Row::frame_ms`].
+    pub fn frame_samples(&self) -> &[f64] {
+        match &self.gpu_ms {
+            Some(t) => &t.samples,
+            None => &self.cpu_ms.samples,
+        }
+    }
+}
+
+/// The disagreement between an edited renderer and a fresh build of the
+/// edited level after some number of post-edit frames.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct EditCheck {
+    pub frames: u32,
+    /// Percent of pixels where one image has terrain and the other sky.
+    pub class_mismatch: f64,
+    /// 95th percentile of |distance difference| where both hit, world units.
+    pub depth_p95: f64,
+    pub consistent: bool,
+}
+
+/// One method under the edit protocol.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct EditRow {
+    pub method: String,
+    /// Median of independent first post-edit frames (each from a fresh renderer).
+    pub first_frame_cpu_ms: f64,
+    pub first_frame_gpu_ms: Option<f64>,
+    pub first_frame_cpu_samples: Vec<f64>,
+    pub first_frame_gpu_samples: Vec<f64>,
+    /// Median of frames of a renderer built fresh from the edited level.
+    pub steady_cpu_ms: f64,
+    pub steady_gpu_ms: Option<f64>,
+    /// First of 1, 2, 4, 8, 16 post-edit frames after which the edited
+    /// renderer matches the fresh one; null if never within 16.
+    pub consistent_after_frames: Option<u32>,
+    pub checks: Vec<EditCheck>,
+}
+
+/// The frame counts at which consistency is checked.
+pub const EDIT_CHECK_FRAMES: [u32; 5] = [1, 2, 4, 8, 16];
+/// Consistency thresholds (paper §Dynamic-edit protocol).
+pub const EDIT_MAX_CLASS_MISMATCH: f64 = 0.01;
+pub const EDIT_MAX_DEPTH_P95: f64 = 0.1;
+
+/// A file-name-safe form of an adapter name: lower-case ASCII letters,
+/// digits and single dashes ("NVIDIA H100 80GB HBM3" -> "nvidia-h100-80gb-hbm3").
+pub fn slug(name: &str) -> String {
+    let mut out = String::new();
+    for c in name.chars() {
+        if c.is_ascii_alphanumeric() {
+            out.push(c.to_ascii_lowercase());
+        } else if !out.is_empty() && !out.ends_with('-') {
+            out.push('-');
+        }
+    }
+    while out.ends_with('-') {
+        out.pop();
+    }
+    if out.is_empty() {
+        "unknown".into()
+    } else {
+        out
+    }
+}
+
+impl RunResults {
+    pub fn file_name(&self) -> String {
+        format!("results-{}.json", slug(&self.adapter.name))
+    }
+
+    pub fn from_json(text: &str) -> anyhow::Result<Self> {
+        Ok(serde_json::from_str(text)?)
+    }
+
+    pub fn to_json(&self) -> anyhow::Result<String> {
+        Ok(serde_json::to_string_pretty(self)?)
+    }
+
+    /// Write atomically (temporary file + rename), so an interrupted run
+    /// never leaves a half-written file in place of the last good one.
+    pub fn write(&self, dir: &std::path::Path) -> anyhow::Result<std::path::PathBuf> {
+        use anyhow::Context;
+        let path = dir.join(self.file_name());
+        let tmp = dir.join(format!(".{}.tmp", self.file_name()));
+        std::fs::write(&tmp, self.to_json()?)
+            .with_context(|| format!("writing {}", tmp.display()))?;
+        std::fs::rename(&tmp, &path).with_context(|| format!("renaming to {}", path.display()))?;
+        Ok(path)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn slugs_are_file_safe() {
+        assert_eq!(slug("NVIDIA H100 80GB HBM3"), "nvidia-h100-80gb-hbm3");
+        assert_eq!(
+            slug("llvmpipe (LLVM 15.0.7, 256 bits)"),
+            "llvmpipe-llvm-15-0-7-256-bits"
+        );
+        assert_eq!(slug("  /../ "), "unknown");
+    }
+}
