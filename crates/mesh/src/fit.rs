@@ -1,0 +1,213 @@
+//! The greedy fit of one chunk (Garland–Heckbert): border vertices first,
+//! then the globally worst sample until every sample is within tolerance.
+//! Greedy insertion never depends on the tolerance until it stops, so the
+//! coarser LODs are prefixes of the finest fit: one run yields all three,
+//! snapshotted when the worst error first drops to 4τ, 2τ and τ.
+
+use std::collections::BinaryHeap;
+
+use strata_level::Level;
+
+use crate::border::{exceeds, fit_border};
+use crate::candidate::{Candidate, barycentric, errors, scan};
+use crate::emit::{ChunkMesh, Emitter};
+use crate::predicates::Pt;
+use crate::samples::{ChunkLayout, ChunkSamples, DUAL_INTERIOR, Sample};
+use crate::triangulation::Triangulation;
+
+/// Number of LODs per chunk; LOD `k` has max error `τ · 2^k`.
+pub const LODS: usize = 3;
+
+/// Why a vertex was inserted (issue 7 accounting).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u8)]
+pub enum Cause {
+    /// `low` had the largest error (ties go to `low`).
+    Floor = 0,
+    /// `mid` or `high` had the largest error and the sample and its eight
+    /// neighbours in the chunk are all dual: the slab's own relief.
+    SlabInterior = 1,
+    /// `mid` or `high` had the largest error and the sample is not inside a
+    /// dual region: it is single, or dual next to a single sample. These are
+    /// the insertions a single↔dual transition forces (a single sample has
+    /// `mid = high = low`, so both step by the slab thickness across it).
+    Boundary = 2,
+    /// A vertex of the 1D fit of a chunk edge.
+    Border = 3,
+}
+
+pub const CAUSES: usize = 4;
+
+/// Reusable scratch for fitting chunks one after another on one thread.
+#[derive(Default)]
+pub struct ChunkFitter {
+    samples: ChunkSamples,
+    tr: Triangulation,
+    heap: BinaryHeap<Candidate>,
+    stamps: Vec<u32>,
+    seen: Vec<u32>,
+    /// Sample index of each vertex.
+    vsample: Vec<u32>,
+    border: Vec<u32>,
+    edge: Vec<Sample>,
+    emitter: Emitter,
+}
+
+impl ChunkFitter {
+    /// Fit chunk `(cx, cy)` of `level` at finest tolerance `tol` (> 0).
+    pub fn fit(
+        &mut self,
+        level: &Level,
+        layout: &ChunkLayout,
+        cx: u32,
+        cy: u32,
+        tol: f64,
+    ) -> ChunkMesh {
+        self.samples.load(level, layout, cx, cy);
+        let (sx, sy) = (layout.size_x as i32, layout.size_y as i32);
+        let stride = self.samples.stride();
+        self.tr.reset(sx, sy);
+        self.vsample.clear();
+        for p in &self.tr.pts {
+            self.vsample
+                .push((p[1] as usize * stride + p[0] as usize) as u32);
+        }
+        let mut causes = [0u32; CAUSES];
+
+        // Borders: the four edges, each fitted in 1D from its own samples.
+        let edges: [(Pt, Pt, i32); 4] = [
+            ([0, 0], [1, 0], sx),
+            ([0, sy], [1, 0], sx),
+            ([0, 0], [0, 1], sy),
+            ([sx, 0], [0, 1], sy),
+        ];
+        for (start, step, len) in edges {
+            self.edge.clear();
+            for k in 0..=len {
+                let p = [start[0] + step[0] * k, start[1] + step[1] * k];
+                self.edge.push(*self.samples.at(p[0], p[1]));
+            }
+            fit_border(&self.edge, tol, &mut self.border);
+            for &k in &self.border {
+                let p = [start[0] + step[0] * k as i32, start[1] + step[1] * k as i32];
+                let Some((t, _)) = self.tr.locate_scan(p) else {
+                    continue;
+                };
+                if self.tr.insert(t, p).is_some() {
+                    self.vsample
+                        .push((p[1] as usize * stride + p[0] as usize) as u32);
+                    causes[Cause::Border as usize] += 1;
+                }
+            }
+        }
+
+        // Candidates of every triangle.
+        self.heap.clear();
+        self.stamps.clear();
+        self.seen.clear();
+        for t in 0..self.tr.tris.len() as u32 {
+            self.stamps.push(0);
+            self.seen.push(0);
+            self.push_candidate(t, tol, [sx, sy]);
+        }
+
+        let lod_tols: [f64; LODS] = [tol, tol * 2.0, tol * 4.0];
+        let mut mesh = ChunkMesh::default();
+        self.emitter.begin(self.samples.size_x, self.samples.size_y);
+        let mut next_lod = LODS; // coarsest first: LOD 2, then 1, then 0
+        let mut epoch = 0u32;
+        loop {
+            while let Some(top) = self.heap.peek() {
+                if self.stamps[top.tri as usize] == top.stamp {
+                    break;
+                }
+                self.heap.pop();
+            }
+            let top = self.heap.peek().copied();
+            while next_lod > 0 && top.is_none_or(|c| !exceeds(c.num, c.den, lod_tols[next_lod - 1]))
+            {
+                next_lod -= 1;
+                self.emitter
+                    .emit_lod(next_lod, &self.tr, &self.vsample, &self.samples);
+            }
+            let Some(c) = top else { break };
+            if next_lod == 0 {
+                break;
+            }
+            self.heap.pop();
+            let stride = stride as u32;
+            let p = [(c.sample % stride) as i32, (c.sample / stride) as i32];
+            causes[self.cause(c.tri, p) as usize] += 1;
+            if self.tr.insert(c.tri, p).is_none() {
+                // Cannot happen for a candidate of a live triangle; drop it.
+                continue;
+            }
+            self.vsample.push(c.sample);
+            epoch += 1;
+            while self.stamps.len() < self.tr.tris.len() {
+                self.stamps.push(0);
+                self.seen.push(0);
+            }
+            for i in 0..self.tr.touched.len() {
+                let t = self.tr.touched[i];
+                if self.seen[t as usize] == epoch {
+                    continue;
+                }
+                self.seen[t as usize] = epoch;
+                self.stamps[t as usize] = self.stamps[t as usize].wrapping_add(1);
+                self.push_candidate(t, tol, [sx, sy]);
+            }
+        }
+        self.emitter
+            .finish(&mut mesh, &self.tr, &self.vsample, &self.samples);
+        mesh.stats.causes = causes;
+        mesh
+    }
+
+    fn push_candidate(&mut self, t: u32, tol: f64, limit: [i32; 2]) {
+        let tri = self.tr.tris[t as usize];
+        let pts = tri.v.map(|v| self.tr.pt(v));
+        let zs = tri
+            .v
+            .map(|v| self.samples.samples[self.vsample[v as usize] as usize].z);
+        let (num, den, sample) = scan(pts, zs, &self.samples.samples, self.samples.stride(), limit);
+        if num > 0 && exceeds(num, den, tol) {
+            self.heap.push(Candidate {
+                num,
+                den,
+                sample,
+                tri: t,
+                stamp: self.stamps[t as usize],
+            });
+        }
+    }
+
+    /// The cause of inserting grid point `p` of triangle `t`.
+    fn cause(&self, t: u32, p: Pt) -> Cause {
+        let tri = self.tr.tris[t as usize];
+        let [a, b, c] = tri.v.map(|v| self.tr.pt(v));
+        let zs = tri
+            .v
+            .map(|v| self.samples.samples[self.vsample[v as usize] as usize].z);
+        let den = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+        let s = self.samples.at(p[0], p[1]);
+        let e = errors(barycentric(a, b, c, p), den, zs, s.z);
+        if e[0] >= e[1] && e[0] >= e[2] {
+            Cause::Floor
+        } else if s.flags & DUAL_INTERIOR != 0 {
+            Cause::SlabInterior
+        } else {
+            Cause::Boundary
+        }
+    }
+
+    /// The working triangulation of the last fit (tests inspect it).
+    pub fn triangulation(&self) -> &Triangulation {
+        &self.tr
+    }
+
+    /// The samples of the last fitted chunk.
+    pub fn samples(&self) -> &ChunkSamples {
+        &self.samples
+    }
+}

@@ -1,0 +1,203 @@
+//! The whole level: every chunk fitted in parallel, exact local refit after
+//! edits, and the level-wide statistics `strata fit` reports.
+
+use std::time::Instant;
+
+use rayon::prelude::*;
+use serde::Serialize;
+use strata_level::{DirtyRect, Level};
+
+use crate::emit::ChunkMesh;
+use crate::fit::{CAUSES, ChunkFitter, LODS};
+use crate::samples::ChunkLayout;
+
+/// Max vertical error for quality `q` in [0, 1]: `2^(4(1 - q))` height
+/// units (q 0 → 16, 0.5 → 4, 1 → 1). `None` outside [0, 1] or for NaN.
+pub fn tolerance_for_quality(q: f64) -> Option<f64> {
+    (0.0..=1.0).contains(&q).then(|| (4.0 * (1.0 - q)).exp2())
+}
+
+/// The fitted mesh of a level: one [`ChunkMesh`] per chunk, row-major.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct LevelMesh {
+    pub layout: ChunkLayout,
+    /// Finest-LOD max error; LOD k has `tolerance · 2^k`.
+    pub tolerance_bits: u64,
+    pub chunks: Vec<ChunkMesh>,
+}
+
+impl LevelMesh {
+    pub fn tolerance(&self) -> f64 {
+        f64::from_bits(self.tolerance_bits)
+    }
+
+    /// Fit every chunk of `level` at finest max error `tolerance` (> 0),
+    /// in parallel on the current rayon pool. The result does not depend on
+    /// the number of threads: chunks are independent and collected in order.
+    pub fn fit(level: &Level, tolerance: f64) -> Self {
+        let layout = ChunkLayout::of(level);
+        let tol = sanitize(tolerance);
+        let chunks = (0..layout.count())
+            .into_par_iter()
+            .map_init(ChunkFitter::default, |f, i| {
+                let (cx, cy) = layout.coords(i);
+                f.fit(level, &layout, cx, cy, tol)
+            })
+            .collect();
+        LevelMesh {
+            layout,
+            tolerance_bits: tol.to_bits(),
+            chunks,
+        }
+    }
+
+    /// Refit every chunk whose samples intersect `dirty` from scratch, so the
+    /// result equals a fresh [`fit`](Self::fit) of the edited level. Returns
+    /// the indices (ascending) of the chunks whose mesh actually changed.
+    pub fn refit(&mut self, level: &Level, dirty: &[DirtyRect]) -> Vec<usize> {
+        let layout = ChunkLayout::of(level);
+        if layout != self.layout {
+            // A different map size: nothing local survives.
+            *self = Self::fit(level, self.tolerance());
+            return (0..self.chunks.len()).collect();
+        }
+        let ids = dirty_chunks(&layout, level.width(), level.height(), dirty);
+        let tol = self.tolerance();
+        let fresh: Vec<(usize, ChunkMesh)> = ids
+            .par_iter()
+            .map_init(ChunkFitter::default, |f, &i| {
+                let (cx, cy) = layout.coords(i);
+                (i, f.fit(level, &layout, cx, cy, tol))
+            })
+            .collect();
+        let mut changed = Vec::new();
+        for (i, mesh) in fresh {
+            if self.chunks[i] != mesh {
+                self.chunks[i] = mesh;
+                changed.push(i);
+            }
+        }
+        changed
+    }
+
+    /// Level-wide totals.
+    pub fn stats(&self) -> MeshStats {
+        let mut s = MeshStats {
+            chunks: self.chunks.len(),
+            tolerance: self.tolerance(),
+            ..MeshStats::default()
+        };
+        for c in &self.chunks {
+            s.planar_vertices += u64::from(c.stats.planar_vertices);
+            s.gpu_vertices += c.vertices.len() as u64;
+            s.gpu_indices += c.indices.len() as u64;
+            for k in 0..LODS {
+                let l = &c.stats.lods[k];
+                s.lods[k].planar += u64::from(l.planar);
+                s.lods[k].slab += u64::from(l.slab);
+                s.lods[k].wall += u64::from(l.wall);
+                s.lods[k].border_walls += u64::from(l.border_walls);
+                s.lods[k].emitted += u64::from(l.emitted());
+            }
+            for k in 0..CAUSES {
+                s.causes[k] += u64::from(c.stats.causes[k]);
+            }
+        }
+        s.gpu_bytes = s.gpu_vertices * 4 + s.gpu_indices * 2;
+        s.cpu_bytes = (self.chunks.len() * std::mem::size_of::<ChunkRange>()) as u64;
+        s
+    }
+}
+
+/// What the renderer keeps on the CPU per chunk once the buffers are
+/// uploaded: where its data lives. The fit itself is not retained — a refit
+/// recomputes the dirty chunks from the level.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ChunkRange {
+    pub first_vertex: u32,
+    pub first_index: u32,
+    pub lods: [(u32, u32); LODS],
+}
+
+fn sanitize(tol: f64) -> f64 {
+    if tol.is_finite() && tol > 0.0 {
+        tol
+    } else {
+        1.0
+    }
+}
+
+/// Chunks whose sample square (including the shared last row and column)
+/// contains a texel of a dirty rectangle. A texel's column depends on its
+/// pair partner, so rectangles are widened to whole pairs first.
+pub fn dirty_chunks(
+    layout: &ChunkLayout,
+    width: u32,
+    height: u32,
+    dirty: &[DirtyRect],
+) -> Vec<usize> {
+    let mut mark = vec![false; layout.count()];
+    let axis = |lo: i64, hi: i64, size: i64, n: i64| -> Vec<i64> {
+        // Chunk c holds samples [c·size, c·size + size]: c from ceil(lo/size) - 1 to floor(hi/size).
+        let first = (lo + size - 1).div_euclid(size) - 1;
+        let last = hi.div_euclid(size);
+        let mut cs: Vec<i64> = (first..=last).map(|c| c.rem_euclid(n)).collect();
+        cs.sort_unstable();
+        cs.dedup();
+        cs
+    };
+    for r in dirty {
+        if r.width == 0 || r.height == 0 {
+            continue;
+        }
+        let x0 = i64::from(r.x.min(width - 1) & !1);
+        let x1 = (i64::from(r.x) + i64::from(r.width) - 1).min(i64::from(width) - 1) | 1;
+        let y0 = i64::from(r.y.min(height - 1));
+        let y1 = (i64::from(r.y) + i64::from(r.height) - 1).min(i64::from(height) - 1);
+        let xs = axis(x0, x1, i64::from(layout.size_x), i64::from(layout.chunks_x));
+        let ys = axis(y0, y1, i64::from(layout.size_y), i64::from(layout.chunks_y));
+        for &cy in &ys {
+            for &cx in &xs {
+                mark[layout.index(cx as u32, cy as u32)] = true;
+            }
+        }
+    }
+    mark.iter()
+        .enumerate()
+        .filter_map(|(i, &m)| m.then_some(i))
+        .collect()
+}
+
+/// Per-LOD totals.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct LodTotals {
+    pub planar: u64,
+    pub slab: u64,
+    pub wall: u64,
+    pub border_walls: u64,
+    pub emitted: u64,
+}
+
+/// Level-wide totals of a fit.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct MeshStats {
+    pub chunks: usize,
+    pub tolerance: f64,
+    /// Sum over chunks of finest planar vertices (border vertices counted in
+    /// both chunks that share them, as they are uploaded).
+    pub planar_vertices: u64,
+    pub gpu_vertices: u64,
+    pub gpu_indices: u64,
+    pub lods: [LodTotals; LODS],
+    /// Insertions: floor, slab interior, single/double boundary, chunk border.
+    pub causes: [u64; CAUSES],
+    pub gpu_bytes: u64,
+    pub cpu_bytes: u64,
+}
+
+/// Fit `level` and time it (wall clock, current rayon pool).
+pub fn timed_fit(level: &Level, tolerance: f64) -> (LevelMesh, f64) {
+    let t = Instant::now();
+    let mesh = LevelMesh::fit(level, tolerance);
+    (mesh, t.elapsed().as_secs_f64())
+}

@@ -1,0 +1,128 @@
+//! The samples one chunk sees: its `(size + 1)²` decoded columns, the last
+//! row and column wrapping into the next chunk (the map is a torus).
+
+use strata_level::Level;
+
+/// Flag bit of [`Sample::flags`]: the column is dual (has a slab).
+pub const DUAL: u8 = 1;
+/// Flag bit: the column and its eight neighbours inside the chunk are all dual.
+pub const DUAL_INTERIOR: u8 = 2;
+
+/// One decoded column, laid out for the fitter's inner loop.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Sample {
+    /// `[low, mid, high]`.
+    pub z: [u8; 3],
+    pub flags: u8,
+    pub lower_type: u8,
+    pub upper_type: u8,
+}
+
+impl Sample {
+    #[inline]
+    pub fn dual(&self) -> bool {
+        self.flags & DUAL != 0
+    }
+}
+
+/// Chunk geometry of a level: chunk side per axis (128, or the map side when
+/// the map is smaller) and the chunk counts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct ChunkLayout {
+    pub size_x: u32,
+    pub size_y: u32,
+    pub chunks_x: u32,
+    pub chunks_y: u32,
+}
+
+/// The chunk side of the fit (DESIGN / issue 7).
+pub const CHUNK: u32 = 128;
+
+impl ChunkLayout {
+    pub fn of(level: &Level) -> Self {
+        let size_x = CHUNK.min(level.width());
+        let size_y = CHUNK.min(level.height());
+        ChunkLayout {
+            size_x,
+            size_y,
+            chunks_x: level.width() / size_x,
+            chunks_y: level.height() / size_y,
+        }
+    }
+
+    pub fn count(&self) -> usize {
+        self.chunks_x as usize * self.chunks_y as usize
+    }
+
+    /// Chunk index (row-major) of chunk `(cx, cy)`.
+    pub fn index(&self, cx: u32, cy: u32) -> usize {
+        cy as usize * self.chunks_x as usize + cx as usize
+    }
+
+    /// `(cx, cy)` of a chunk index.
+    pub fn coords(&self, index: usize) -> (u32, u32) {
+        let cx = (index % self.chunks_x as usize) as u32;
+        let cy = (index / self.chunks_x as usize) as u32;
+        (cx, cy)
+    }
+}
+
+/// The samples of one chunk, row-major with stride `size_x + 1`.
+#[derive(Clone, Debug, Default)]
+pub struct ChunkSamples {
+    pub size_x: u32,
+    pub size_y: u32,
+    pub samples: Vec<Sample>,
+}
+
+impl ChunkSamples {
+    #[inline]
+    pub fn stride(&self) -> usize {
+        self.size_x as usize + 1
+    }
+
+    #[inline]
+    pub fn at(&self, x: i32, y: i32) -> &Sample {
+        &self.samples[y as usize * self.stride() + x as usize]
+    }
+
+    /// Decode chunk `(cx, cy)` of `level` into `self`, reusing the buffer.
+    pub fn load(&mut self, level: &Level, layout: &ChunkLayout, cx: u32, cy: u32) {
+        self.size_x = layout.size_x;
+        self.size_y = layout.size_y;
+        let (nx, ny) = (layout.size_x as usize + 1, layout.size_y as usize + 1);
+        self.samples.clear();
+        self.samples.reserve(nx * ny);
+        let x0 = i64::from(cx * layout.size_x);
+        let y0 = i64::from(cy * layout.size_y);
+        for j in 0..ny as i64 {
+            for i in 0..nx as i64 {
+                let c = level.column(x0 + i, y0 + j);
+                self.samples.push(Sample {
+                    z: [c.low, c.mid, c.high],
+                    flags: if c.dual { DUAL } else { 0 },
+                    lower_type: c.lower_type,
+                    upper_type: c.upper_type,
+                });
+            }
+        }
+        // Interior of a dual region, judged inside the chunk only so that a
+        // chunk's fit (and its accounting) depends on its own samples alone.
+        for j in 0..ny {
+            for i in 0..nx {
+                if self.samples[j * nx + i].flags & DUAL == 0 {
+                    continue;
+                }
+                let mut all = true;
+                for jj in j.saturating_sub(1)..(j + 2).min(ny) {
+                    for ii in i.saturating_sub(1)..(i + 2).min(nx) {
+                        all &= self.samples[jj * nx + ii].flags & DUAL != 0;
+                    }
+                }
+                if all {
+                    self.samples[j * nx + i].flags |= DUAL_INTERIOR;
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,67 @@
+//! Helpers shared by the integration tests.
+#![allow(dead_code)]
+
+use strata_level::model::META_DOUBLE_LEVEL;
+use strata_level::{DirtyRect, Level};
+use strata_mesh::emit::KIND_FLOOR;
+use strata_mesh::{ChunkMesh, unpack};
+
+/// Floor triangles of one LOD as local grid points.
+pub fn floor_triangles(mesh: &ChunkMesh, lod: usize) -> Vec<[[i32; 2]; 3]> {
+    mesh.lod_indices(lod)
+        .chunks_exact(3)
+        .filter_map(|t| {
+            let vs = [0, 1, 2].map(|i| unpack(mesh.vertices[t[i] as usize]));
+            vs.iter()
+                .all(|v| v.4 == KIND_FLOOR)
+                .then(|| vs.map(|v| [v.0 as i32, v.1 as i32]))
+        })
+        .collect()
+}
+
+/// A crater like the paper's: altitude lowered by `depth (1 - d²/r²)`, the
+/// upper layer removed inside. Returns the dirty rectangles (split at the
+/// map edge).
+pub fn dig(level: &mut Level, cx: i64, cy: i64, r: i64, depth: f64) -> Vec<DirtyRect> {
+    let (w, h) = (i64::from(level.width()), i64::from(level.height()));
+    let (heights, metas) = level.planes_mut();
+    for y in cy - r..=cy + r {
+        for x in ((cx - r) & !1..=cx + r).step_by(2) {
+            let d2 = ((x - cx).pow(2) + (y - cy).pow(2)) as f64;
+            if d2 > (r * r) as f64 {
+                continue;
+            }
+            let (wx, wy) = (x.rem_euclid(w), y.rem_euclid(h));
+            let even = (wy * w + wx) as usize;
+            let cut = (depth * (1.0 - d2 / (r * r) as f64)) as i64;
+            let low = (i64::from(heights[even]) - cut).max(0) as u8;
+            heights[even] = low;
+            heights[even + 1] = low;
+            metas[even] &= !META_DOUBLE_LEVEL;
+            metas[even + 1] &= !META_DOUBLE_LEVEL;
+        }
+    }
+    // Dirty rectangles, split where the crater crosses the map edge.
+    let mut rects = Vec::new();
+    let split = |lo: i64, hi: i64, n: i64| -> Vec<(u32, u32)> {
+        let (lo, hi) = (lo - 1, hi + 1);
+        let a = lo.rem_euclid(n);
+        let len = hi - lo + 1;
+        if a + len <= n {
+            vec![(a as u32, len as u32)]
+        } else {
+            vec![(a as u32, (n - a) as u32), (0, (a + len - n) as u32)]
+        }
+    };
+    for (x, width) in split(cx - r, cx + r, w) {
+        for &(y, height) in &split(cy - r, cy + r, h) {
+            rects.push(DirtyRect {
+                x,
+                y,
+                width,
+                height,
+            });
+        }
+    }
+    rects
+}
