@@ -1,0 +1,44 @@
+// The shared frame: bind group 0, seen by every method. Rust twin: `frame::Globals`
+// and `frame::ShadingParams` (field order and sizes must match).
+
+struct Globals {
+    view_proj: mat4x4<f32>,
+    // xyz eye position, w focal length in pixels
+    eye: vec4<f32>,
+    // xyz view axis, w near
+    forward: vec4<f32>,
+    // xyz camera `right` (the image x axis runs along -right), w far
+    right: vec4<f32>,
+    // xyz camera up
+    up: vec4<f32>,
+    // width, height in pixels, 1/width, 1/height
+    screen: vec4<f32>,
+    // xyz direction the light travels (unit, pointing down), w 1 = shadows on
+    light_dir: vec4<f32>,
+    // xyz a corner of the shadow map's plane (normal = light_dir), w texel size
+    shadow_origin: vec4<f32>,
+    // xyz shadow map u axis (unit), w shadow map side in texels
+    shadow_u: vec4<f32>,
+    // xyz shadow map v axis (unit), w depth bias in world units
+    shadow_v: vec4<f32>,
+    // rgb sky colour, w unused
+    sky: vec4<f32>,
+    // map width, map height (powers of two), log2 rows per texture layer,
+    // added to the gap code before << 3 (1 original, 0 vange-rs)
+    level: vec4<u32>,
+}
+
+struct ShadingParams {
+    // the world's palette, rgb in 0..1
+    palette: array<vec4<f32>, 256>,
+    // per terrain type: x first palette index, y last palette index
+    ranges: array<vec4<u32>, 8>,
+}
+
+@group(0) @binding(0) var<uniform> globals: Globals;
+@group(0) @binding(1) var<uniform> shading: ShadingParams;
+// One texel per dual pair: (height even, meta even, height odd, meta odd);
+// rows wrap across square-ish layers (see terrain.rs).
+@group(0) @binding(2) var terrain: texture_2d_array<u32>;
+// Distance along the light from the shadow plane to the first solid point.
+@group(0) @binding(3) var shadow_map: texture_2d<f32>;

@@ -1,0 +1,84 @@
+// The height-field ray march shared by `ray`, `ray-compute` and the shadow map.
+// Needs frame.wgsl and surface.wgsl.
+#include "frame.wgsl"
+#include "surface.wgsl"
+
+const BISECTIONS: u32 = 4u;
+
+struct MarchHit {
+    hit: bool,
+    // ray parameter of the first solid point found
+    t: f32,
+}
+
+// Unnormalised ray through the image point (px, py) in pixels from the top-left
+// (a pixel centre is i + 0.5): the twin of `Camera::image_direction`. Its
+// component along the view axis is the focal length, so view depth = t * focal.
+fn camera_ray(px: f32, py: f32) -> vec3<f32> {
+    let sx = px - globals.screen.x * 0.5;
+    let sy = globals.screen.y * 0.5 - py;
+    return globals.forward.xyz * globals.eye.w - globals.right.xyz * sx + globals.up.xyz * sy;
+}
+
+// Clip [t0, t1] of o + t d to the altitude slab [0, 255]; nothing is solid
+// above 255 and everything is solid at and below 0. Empty when x > y.
+fn clip_to_altitudes(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32) -> vec2<f32> {
+    if (abs(d.z) < 1e-9) {
+        if (o.z > MAX_ALTITUDE) {
+            return vec2<f32>(1.0, 0.0);
+        }
+        return vec2<f32>(t0, t1);
+    }
+    let ta = (0.0 - o.z) / d.z;
+    let tb = (MAX_ALTITUDE - o.z) / d.z;
+    return vec2<f32>(max(t0, min(ta, tb)), min(t1, max(ta, tb)));
+}
+
+// The paper's RAYMARCH: `steps` uniform samples over [t0, t1] until one is
+// solid, then four bisections between the last empty and first solid sample.
+fn march(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, steps: u32) -> MarchHit {
+    var result: MarchHit;
+    result.hit = false;
+    result.t = t1;
+    if (t1 <= t0) {
+        return result;
+    }
+    if (is_solid(o + d * t0)) {
+        result.hit = true;
+        result.t = t0;
+        return result;
+    }
+    let dt = (t1 - t0) / f32(steps);
+    var a = t0;
+    var b = t1;
+    for (var i = 1u; i <= steps; i = i + 1u) {
+        let t = t0 + dt * f32(i);
+        if (is_solid(o + d * t)) {
+            b = t;
+            result.hit = true;
+            break;
+        }
+        a = t;
+    }
+    if (!result.hit) {
+        return result;
+    }
+    for (var i = 0u; i < BISECTIONS; i = i + 1u) {
+        let c = 0.5 * (a + b);
+        if (is_solid(o + d * c)) {
+            b = c;
+        } else {
+            a = c;
+        }
+    }
+    result.t = b;
+    return result;
+}
+
+// Depth-buffer value of a point at view depth `view_z`: the twin of
+// `Camera::view_z_to_depth`, so depth compares across methods.
+fn view_z_to_depth(view_z: f32) -> f32 {
+    let n = globals.forward.w;
+    let f = globals.right.w;
+    return f / (f - n) * (1.0 - n / view_z);
+}

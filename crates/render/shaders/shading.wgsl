@@ -1,0 +1,123 @@
+// Shared shading, used by every method: palette colour of the terrain type,
+// a normal that knows which interval it is on, diffuse light, 0.25 cave
+// ambient below a slab, a PCF-sampled shadow map, and fog over the last
+// 50 units before the far plane. Needs frame.wgsl and surface.wgsl.
+#include "frame.wgsl"
+#include "surface.wgsl"
+
+const AMBIENT: f32 = 0.3;
+const CAVE_AMBIENT: f32 = 0.25;
+const FOG_RANGE: f32 = 50.0;
+
+const SURFACE_FLOOR: u32 = 0u;
+const SURFACE_SLAB_TOP: u32 = 1u;
+const SURFACE_CEILING: u32 = 2u;
+
+// The palette colour of terrain type `t` at altitude `z`: the type's
+// begin..end range, picked by altitude (low = begin, 255 = end).
+fn terrain_color(t: u32, z: f32) -> vec3<f32> {
+    let r = shading.ranges[t & 7u];
+    let idx = round(mix(f32(r.x), f32(r.y), clamp(z / MAX_ALTITUDE, 0.0, 1.0)));
+    return shading.palette[u32(clamp(idx, 0.0, 255.0))].rgb;
+}
+
+// Which interval a point on the surface of column `c` belongs to. `dir_z` is
+// the vertical component of the ray that found it (a ray going up that hits
+// the lower face of the slab has hit the cave ceiling).
+fn surface_kind(c: Column, z: f32, dir_z: f32) -> u32 {
+    if (!c.dual || z < 0.5 * (c.low + c.mid)) {
+        return SURFACE_FLOOR;
+    }
+    if (dir_z > 0.0 && z - c.mid < c.high - z) {
+        return SURFACE_CEILING;
+    }
+    return SURFACE_SLAB_TOP;
+}
+
+// The altitude field of one interval at texel (x, y); where a neighbour has
+// no slab, the slab fields take `fallback` so its edge does not tilt.
+fn interval_field(x: i32, y: i32, kind: u32, fallback: f32) -> f32 {
+    let c = decode_column(x, y);
+    if (kind == SURFACE_FLOOR) {
+        return c.low;
+    }
+    if (!c.dual) {
+        return fallback;
+    }
+    return select(c.high, c.mid, kind == SURFACE_CEILING);
+}
+
+// Normal from central height differences of the interval's own field: up for
+// floors and slab tops, down for cave ceilings. Steep differences tilt it
+// towards horizontal, which is what a wall gets.
+fn surface_normal(x: i32, y: i32, kind: u32, here: f32) -> vec3<f32> {
+    let gx = 0.5 * (interval_field(x + 1, y, kind, here) - interval_field(x - 1, y, kind, here));
+    let gy = 0.5 * (interval_field(x, y + 1, kind, here) - interval_field(x, y - 1, kind, here));
+    if (kind == SURFACE_CEILING) {
+        return normalize(vec3<f32>(gx, gy, -1.0));
+    }
+    return normalize(vec3<f32>(-gx, -gy, 1.0));
+}
+
+// One shadow-map test: 1 lit, 0 shadowed.
+fn shadow_tap(ij: vec2<i32>, t: f32) -> f32 {
+    let side = i32(globals.shadow_u.w);
+    if (any(ij < vec2<i32>(0)) || any(ij >= vec2<i32>(side))) {
+        return 1.0;
+    }
+    let blocker = textureLoad(shadow_map, ij, 0).r;
+    return select(0.0, 1.0, t <= blocker + globals.shadow_v.w);
+}
+
+// 4-tap PCF with bilinear weights over the shadow map.
+fn shadow_factor(p: vec3<f32>) -> f32 {
+    if (globals.light_dir.w == 0.0) {
+        return 1.0;
+    }
+    let rel = p - globals.shadow_origin.xyz;
+    let texel = globals.shadow_origin.w;
+    let uv = vec2<f32>(dot(rel, globals.shadow_u.xyz), dot(rel, globals.shadow_v.xyz)) / texel - 0.5;
+    let t = dot(rel, globals.light_dir.xyz);
+    let base = floor(uv);
+    let f = uv - base;
+    let ij = vec2<i32>(base);
+    let s00 = shadow_tap(ij, t);
+    let s10 = shadow_tap(ij + vec2<i32>(1, 0), t);
+    let s01 = shadow_tap(ij + vec2<i32>(0, 1), t);
+    let s11 = shadow_tap(ij + vec2<i32>(1, 1), t);
+    return mix(mix(s00, s10, f.x), mix(s01, s11, f.x), f.y);
+}
+
+// Fog factor: 0 up to 50 units before the far plane, 1 at it.
+fn fog_factor(p: vec3<f32>) -> f32 {
+    let view_z = dot(p - globals.eye.xyz, globals.forward.xyz);
+    let far = globals.right.w;
+    return clamp((view_z - (far - FOG_RANGE)) / FOG_RANGE, 0.0, 1.0);
+}
+
+// Shade a surface point `p` found along a ray of direction `dir` (any length).
+fn shade_with_normal(p: vec3<f32>, c: Column, kind: u32, n: vec3<f32>) -> vec3<f32> {
+    let t = select(c.upper_type, c.lower_type, kind == SURFACE_FLOOR);
+    var light: f32;
+    if (c.dual && (p.z < c.mid || kind == SURFACE_CEILING)) {
+        // Under a slab (and its underside): the cave ambient, in every method.
+        light = CAVE_AMBIENT;
+    } else {
+        let diffuse = max(dot(n, -globals.light_dir.xyz), 0.0);
+        light = AMBIENT + (1.0 - AMBIENT) * diffuse * shadow_factor(p);
+    }
+    let color = terrain_color(t, p.z) * light;
+    return mix(color, globals.sky.rgb, fog_factor(p));
+}
+
+// Shade with the height-field normal (every method but the mesh, which passes
+// its geometric normal to `shade_with_normal`).
+fn shade(p: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
+    let x = i32(floor(p.x));
+    let y = i32(floor(p.y));
+    let c = decode_column(x, y);
+    let kind = surface_kind(c, p.z, dir.z);
+    let here = select(c.high, c.mid, kind == SURFACE_CEILING);
+    let n = surface_normal(x, y, kind, here);
+    return shade_with_normal(p, c, kind, n);
+}

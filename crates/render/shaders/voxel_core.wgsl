@@ -1,0 +1,141 @@
+// `voxel` / `voxel-compute`: the hierarchical DDA over the occupancy pyramid
+// (paper §3.2). An empty cell is skipped to its exit; an occupied cell is
+// descended into; an occupied leaf voxel is sampled with the exact
+// two-interval test (`is_solid`) and a hit is refined by bisection.
+#include "frame.wgsl"
+#include "surface.wgsl"
+#include "shading.wgsl"
+#include "ray_core.wgsl"
+#include "ray_pixel.wgsl"
+#include "voxel_occupancy.wgsl"
+
+const VOXEL_BISECTIONS: u32 = 5u;
+// Leaf samples are at most this far apart (world units) along the ray.
+const VOXEL_SAMPLE_SPACING: f32 = 0.5;
+
+// Sample the leaf segment [ta, tb] (ta is known empty); on a solid sample,
+// bisect between it and the last empty one.
+fn voxel_leaf(o: vec3<f32>, d: vec3<f32>, ta: f32, tb: f32) -> MarchHit {
+    var r: MarchHit;
+    r.hit = false;
+    r.t = tb;
+    if (tb <= ta) {
+        return r;
+    }
+    let len = (tb - ta) * length(d);
+    let n = clamp(u32(ceil(len / VOXEL_SAMPLE_SPACING)), 1u, vparams.config.z);
+    let dt = (tb - ta) / f32(n);
+    var a = ta;
+    var b = tb;
+    for (var i = 1u; i <= n; i = i + 1u) {
+        let t = ta + dt * f32(i);
+        if (is_solid(o + d * t)) {
+            b = t;
+            r.hit = true;
+            break;
+        }
+        a = t;
+    }
+    if (!r.hit) {
+        return r;
+    }
+    for (var i = 0u; i < VOXEL_BISECTIONS; i = i + 1u) {
+        let c = 0.5 * (a + b);
+        if (is_solid(o + d * c)) {
+            b = c;
+        } else {
+            a = c;
+        }
+    }
+    r.t = b;
+    return r;
+}
+
+// The first solid point of o + t d in [t0, t1] (already clipped to the
+// altitude slab), or a miss when none is found within `steps` DDA steps.
+fn voxel_march(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, steps: u32) -> MarchHit {
+    var result: MarchHit;
+    result.hit = false;
+    result.t = t1;
+    if (t1 <= t0) {
+        return result;
+    }
+    if (is_solid(o + d * t0)) {
+        result.hit = true;
+        result.t = t0;
+        return result;
+    }
+    let top = vparams.config.y - 1u;
+    let dir_pos = d > vec3<f32>(0.0);
+    let step = select(vec3<i32>(-1), vec3<i32>(1), dir_pos);
+    // An axis the ray does not move along never gives the exit.
+    let inv = select(1.0 / d, vec3<f32>(3.0e38), abs(d) < vec3<f32>(1e-12));
+    var lod = top;
+    var size = voxel_cell_size(lod);
+    var t = t0;
+    var cell = vec3<i32>(floor((o + d * t0) / size));
+    cell.z = max(cell.z, 0);
+    for (var i = 0u; i < steps; i = i + 1u) {
+        if (t > t1) {
+            break;
+        }
+        let occupied = voxel_occupied(lod, cell);
+        if (occupied && lod > 0u) {
+            // Descend into the child that holds the current point.
+            lod = lod - 1u;
+            size = voxel_cell_size(lod);
+            let child = vec3<i32>(floor((o + d * t) / size));
+            cell = clamp(child, cell * 2, cell * 2 + vec3<i32>(1));
+            continue;
+        }
+        let far_face = (vec3<f32>(cell) + select(vec3<f32>(0.0), vec3<f32>(1.0), dir_pos)) * size;
+        let te = (far_face - o) * inv;
+        let t_exit = min(te.x, min(te.y, te.z));
+        if (occupied) {
+            let h = voxel_leaf(o, d, t, min(t_exit, t1));
+            if (h.hit) {
+                return h;
+            }
+        }
+        t = max(t, t_exit);
+        // Step to the neighbour across the exit face, by integers (no epsilon).
+        var axis = 2u;
+        if (te.x <= te.y && te.x <= te.z) {
+            axis = 0u;
+        } else if (te.y <= te.z) {
+            axis = 1u;
+        }
+        var old_c = cell[axis];
+        var new_c = old_c + step[axis];
+        cell[axis] = new_c;
+        // Climb while the step also left the parent: the next parent may be empty.
+        while (lod < top && (new_c >> 1u) != (old_c >> 1u)) {
+            cell = cell >> vec3<u32>(1u);
+            old_c = old_c >> 1u;
+            new_c = new_c >> 1u;
+            lod = lod + 1u;
+        }
+        size = voxel_cell_size(lod);
+    }
+    return result;
+}
+
+// March the camera ray of image point (px, py) through the pyramid and shade
+// it: the whole of `voxel` and `voxel-compute` per pixel (same output as `ray_pixel`).
+fn voxel_pixel(px: f32, py: f32) -> PixelSample {
+    let o = globals.eye.xyz;
+    let d = camera_ray(px, py);
+    let focal = globals.eye.w;
+    let seg = clip_to_altitudes(o, d, globals.forward.w / focal, globals.right.w / focal);
+    let h = voxel_march(o, d, seg.x, seg.y, vparams.config.x);
+    var out: PixelSample;
+    if (!h.hit) {
+        out.color = vec4<f32>(globals.sky.rgb, 1.0);
+        out.depth = 1.0;
+        return out;
+    }
+    let p = o + d * h.t;
+    out.color = vec4<f32>(shade(p, d), 1.0);
+    out.depth = view_z_to_depth(h.t * focal);
+    return out;
+}

@@ -1,0 +1,410 @@
+//! The shared frame resources every method reads: terrain texture, camera and
+//! light uniforms, palette + terrain colour ranges, the shadow map, and the
+//! colour + depth targets. Bind group 0 of every method's pipelines is
+//! [`Shared::frame_layout`]; `shaders/frame.wgsl` declares it.
+
+use crate::terrain::TerrainTexture;
+use bytemuck::{Pod, Zeroable};
+use strata_camera::Camera;
+use strata_level::{Level, World};
+
+/// Colour target format: 8-bit RGBA, written raw to `color.png`.
+pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+/// Depth target format: the depth-buffer values `depth.f32` holds.
+pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+/// Side of the shared shadow map, texels.
+pub const SHADOW_SIZE: u32 = 1024;
+/// Background colour where rays miss (linear 0..1 RGB).
+pub const SKY: [f32; 3] = [0.62, 0.74, 0.86];
+
+/// The sky as a clear colour, for the first pass of object-order methods.
+pub fn sky_clear() -> wgpu::Color {
+    wgpu::Color {
+        r: f64::from(SKY[0]),
+        g: f64::from(SKY[1]),
+        b: f64::from(SKY[2]),
+        a: 1.0,
+    }
+}
+
+/// Palette and per-type colour ranges (the world's `Begin/End Colors`).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct TerrainColors {
+    pub palette: [[u8; 3]; 256],
+    pub begin: [u8; 8],
+    pub end: [u8; 8],
+}
+
+impl TerrainColors {
+    pub fn from_world(world: &World) -> Self {
+        TerrainColors {
+            palette: world.palette.colors,
+            begin: world.config.begin_colors,
+            end: world.config.end_colors,
+        }
+    }
+
+    /// A stand-in for tests: eight hues, 32 entries each, dark to bright.
+    pub fn test_ramps() -> Self {
+        const HUES: [[f32; 3]; 8] = [
+            [0.2, 0.4, 0.9],
+            [0.5, 0.8, 0.3],
+            [0.8, 0.7, 0.4],
+            [0.6, 0.5, 0.4],
+            [0.9, 0.4, 0.3],
+            [0.7, 0.7, 0.7],
+            [0.4, 0.7, 0.7],
+            [0.8, 0.5, 0.8],
+        ];
+        let mut palette = [[0u8; 3]; 256];
+        for (i, c) in palette.iter_mut().enumerate() {
+            let hue = HUES[i / 32];
+            let k = 0.35 + 0.65 * (i % 32) as f32 / 31.0;
+            *c = hue.map(|h| (h * k * 255.0) as u8);
+        }
+        TerrainColors {
+            palette,
+            begin: std::array::from_fn(|t| (t * 32) as u8),
+            end: std::array::from_fn(|t| (t * 32 + 31) as u8),
+        }
+    }
+}
+
+/// Twin of `Globals` in `frame.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct Globals {
+    pub view_proj: [[f32; 4]; 4],
+    pub eye: [f32; 4],
+    pub forward: [f32; 4],
+    pub right: [f32; 4],
+    pub up: [f32; 4],
+    pub screen: [f32; 4],
+    pub light_dir: [f32; 4],
+    pub shadow_origin: [f32; 4],
+    pub shadow_u: [f32; 4],
+    pub shadow_v: [f32; 4],
+    pub sky: [f32; 4],
+    pub level: [u32; 4],
+}
+
+/// Twin of `ShadingParams` in `frame.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+pub struct ShadingParams {
+    pub palette: [[f32; 4]; 256],
+    pub ranges: [[u32; 4]; 8],
+}
+
+impl ShadingParams {
+    pub fn new(colors: &TerrainColors) -> Self {
+        ShadingParams {
+            palette: colors.palette.map(|c| {
+                let [r, g, b] = c.map(|v| f32::from(v) / 255.0);
+                [r, g, b, 1.0]
+            }),
+            ranges: std::array::from_fn(|t| {
+                [u32::from(colors.begin[t]), u32::from(colors.end[t]), 0, 0]
+            }),
+        }
+    }
+}
+
+/// What the globals need of a level: its size and mid rule.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LevelShape {
+    pub width: u32,
+    pub height: u32,
+    pub mid_rule: strata_level::MidRule,
+}
+
+impl LevelShape {
+    pub fn of(level: &Level) -> Self {
+        LevelShape {
+            width: level.width(),
+            height: level.height(),
+            mid_rule: level.mid_rule,
+        }
+    }
+}
+
+fn v4(v: glam::Vec3, w: f32) -> [f32; 4] {
+    [v.x, v.y, v.z, w]
+}
+
+impl Globals {
+    /// Camera, light and level parameters of one frame.
+    pub fn new(camera: &Camera, level: &LevelShape, shadow: &crate::shadow::ShadowFrame) -> Self {
+        let b = camera.basis();
+        let (w, h) = (camera.width as f32, camera.height as f32);
+        let mid_add = match level.mid_rule {
+            strata_level::MidRule::Original => 1,
+            strata_level::MidRule::VangeRs => 0,
+        };
+        let layer_rows = level.height.min(crate::terrain::MAX_LAYER_ROWS);
+        Globals {
+            view_proj: camera.view_proj().to_cols_array_2d(),
+            eye: v4(camera.position, camera.focal_px),
+            forward: v4(b.forward, camera.near),
+            right: v4(b.right, camera.far),
+            up: v4(b.up, 0.0),
+            screen: [w, h, 1.0 / w, 1.0 / h],
+            light_dir: v4(shadow.light, if shadow.enabled { 1.0 } else { 0.0 }),
+            shadow_origin: v4(shadow.origin, shadow.texel),
+            shadow_u: v4(shadow.u, SHADOW_SIZE as f32),
+            shadow_v: v4(shadow.v, shadow.bias),
+            sky: [SKY[0], SKY[1], SKY[2], 1.0],
+            level: [
+                level.width,
+                level.height,
+                layer_rows.trailing_zeros(),
+                mid_add,
+            ],
+        }
+    }
+}
+
+/// The resources shared by all methods, and the helpers methods build with.
+pub struct Shared {
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    /// Render target size, pixels.
+    pub width: u32,
+    pub height: u32,
+    pub terrain: TerrainTexture,
+    pub globals: wgpu::Buffer,
+    pub shading: wgpu::Buffer,
+    pub shadow_map: wgpu::Texture,
+    pub shadow_view: wgpu::TextureView,
+    pub color: wgpu::Texture,
+    pub color_view: wgpu::TextureView,
+    pub depth: wgpu::Texture,
+    pub depth_view: wgpu::TextureView,
+    /// Bind group 0 of every method pipeline (`frame.wgsl`).
+    pub frame_layout: wgpu::BindGroupLayout,
+    pub frame_group: wgpu::BindGroup,
+}
+
+fn uniform_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::all(),
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+/// A layout entry for a read-only texture of the given sample type and view dimension.
+pub fn texture_entry(
+    binding: u32,
+    sample_type: wgpu::TextureSampleType,
+    view_dimension: wgpu::TextureViewDimension,
+) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::all(),
+        ty: wgpu::BindingType::Texture {
+            sample_type,
+            view_dimension,
+            multisampled: false,
+        },
+        count: None,
+    }
+}
+
+/// A layout entry for a write-only 2D storage texture (compute stage).
+pub fn storage_texture_entry(
+    binding: u32,
+    format: wgpu::TextureFormat,
+) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::StorageTexture {
+            access: wgpu::StorageTextureAccess::WriteOnly,
+            format,
+            view_dimension: wgpu::TextureViewDimension::D2,
+        },
+        count: None,
+    }
+}
+
+/// A layout entry for a uniform buffer visible to all stages.
+pub fn uniform_layout_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    uniform_entry(binding)
+}
+
+impl Shared {
+    pub(crate) fn new(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        level: &Level,
+        colors: &TerrainColors,
+        width: u32,
+        height: u32,
+    ) -> anyhow::Result<Self> {
+        let max = device.limits().max_texture_dimension_2d;
+        if width == 0 || height == 0 || width > max || height > max {
+            anyhow::bail!(
+                "render size {width}x{height} is outside this adapter's 1..={max} pixels per side"
+            );
+        }
+        let terrain = TerrainTexture::new(device, queue, level)?;
+        let globals = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("globals"),
+            size: std::mem::size_of::<Globals>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let shading = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("shading"),
+            size: std::mem::size_of::<ShadingParams>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        queue.write_buffer(&shading, 0, bytemuck::bytes_of(&ShadingParams::new(colors)));
+        let texture = |label, w, h, format, usage| {
+            let t = device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d {
+                    width: w,
+                    height: h,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage,
+                view_formats: &[],
+            });
+            let v = t.create_view(&Default::default());
+            (t, v)
+        };
+        use wgpu::TextureUsages as U;
+        let (shadow_map, shadow_view) = texture(
+            "shadow map",
+            SHADOW_SIZE,
+            SHADOW_SIZE,
+            wgpu::TextureFormat::R32Float,
+            U::STORAGE_BINDING | U::TEXTURE_BINDING,
+        );
+        let (color, color_view) = texture(
+            "color",
+            width,
+            height,
+            COLOR_FORMAT,
+            U::RENDER_ATTACHMENT | U::STORAGE_BINDING | U::TEXTURE_BINDING | U::COPY_SRC,
+        );
+        let (depth, depth_view) = texture(
+            "depth",
+            width,
+            height,
+            DEPTH_FORMAT,
+            U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC,
+        );
+        let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("frame"),
+            entries: &[
+                uniform_entry(0),
+                uniform_entry(1),
+                texture_entry(
+                    2,
+                    wgpu::TextureSampleType::Uint,
+                    wgpu::TextureViewDimension::D2Array,
+                ),
+                texture_entry(
+                    3,
+                    wgpu::TextureSampleType::Float { filterable: false },
+                    wgpu::TextureViewDimension::D2,
+                ),
+            ],
+        });
+        let frame_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("frame"),
+            layout: &frame_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: globals.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: shading.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: wgpu::BindingResource::TextureView(&terrain.view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: wgpu::BindingResource::TextureView(&shadow_view),
+                },
+            ],
+        });
+        Ok(Shared {
+            device: device.clone(),
+            queue: queue.clone(),
+            width,
+            height,
+            terrain,
+            globals,
+            shading,
+            shadow_map,
+            shadow_view,
+            color,
+            color_view,
+            depth,
+            depth_view,
+            frame_layout,
+            frame_group,
+        })
+    }
+
+    /// Compose and compile one of `shaders/*.wgsl`.
+    pub fn shader(&self, name: &str) -> anyhow::Result<wgpu::ShaderModule> {
+        crate::shaders::create_module(&self.device, name)
+    }
+
+    /// A pipeline layout whose group 0 is the frame and groups 1.. are the method's.
+    pub fn pipeline_layout(
+        &self,
+        label: &str,
+        method_groups: &[&wgpu::BindGroupLayout],
+    ) -> wgpu::PipelineLayout {
+        let mut groups = vec![Some(&self.frame_layout)];
+        groups.extend(method_groups.iter().map(|g| Some(*g)));
+        self.device
+            .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some(label),
+                bind_group_layouts: &groups,
+                immediate_size: 0,
+            })
+    }
+
+    /// A uniform buffer initialised with `data`.
+    pub fn uniform_buffer(&self, label: &str, data: &[u8]) -> wgpu::Buffer {
+        let buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: data.len() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        self.queue.write_buffer(&buffer, 0, data);
+        buffer
+    }
+
+    /// Bytes of the shared GPU resources (not charged to any method).
+    pub fn gpu_bytes(&self) -> u64 {
+        let px = u64::from(self.width) * u64::from(self.height);
+        self.terrain.layout.bytes()
+            + std::mem::size_of::<Globals>() as u64
+            + std::mem::size_of::<ShadingParams>() as u64
+            + u64::from(SHADOW_SIZE * SHADOW_SIZE) * 4
+            + px * 8
+    }
+}

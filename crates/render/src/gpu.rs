@@ -1,0 +1,222 @@
+//! Device setup: one headless (or surface-compatible) wgpu device, the adapter
+//! it runs on, and the error sinks that turn validation errors and a lost
+//! device into `Err` values instead of panics or hangs.
+
+use serde::Serialize;
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+
+/// How long a single wait for the GPU may take before we call the device hung.
+pub const GPU_WAIT_TIMEOUT: Duration = Duration::from_secs(120);
+
+/// The adapter a result was produced on: printed in every output.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct AdapterReport {
+    pub name: String,
+    pub backend: String,
+    pub driver: String,
+    pub driver_info: String,
+    pub device_type: String,
+    /// Whether per-pass GPU timestamps are available on this device.
+    pub timestamps: bool,
+}
+
+/// Errors reported by the device asynchronously (validation, out of memory,
+/// device lost). Shared with every renderer built on the device.
+#[derive(Clone, Default)]
+pub struct ErrorSink(Arc<Mutex<Vec<String>>>);
+
+impl ErrorSink {
+    fn push(&self, msg: String) {
+        if let Ok(mut v) = self.0.lock() {
+            v.push(msg);
+        }
+    }
+
+    /// Drain collected errors into one `Err`, if any.
+    pub fn check(&self) -> anyhow::Result<()> {
+        let errors: Vec<String> = match self.0.lock() {
+            Ok(mut v) => std::mem::take(&mut *v),
+            Err(_) => vec!["GPU error sink poisoned".into()],
+        };
+        if errors.is_empty() {
+            Ok(())
+        } else {
+            anyhow::bail!("GPU error: {}", errors.join("\n"))
+        }
+    }
+}
+
+/// A device, its queue and the adapter it came from.
+pub struct Gpu {
+    pub instance: wgpu::Instance,
+    pub adapter: wgpu::Adapter,
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    pub report: AdapterReport,
+    pub errors: ErrorSink,
+}
+
+const NO_ADAPTER_HELP: &str = "no GPU adapter found. On a machine without a GPU install Mesa's \
+     software Vulkan driver (`apt install mesa-vulkan-drivers`, the lavapipe adapter); \
+     WGPU_BACKEND=vulkan|gl|metal|dx12 selects a backend, WGPU_ADAPTER_NAME a named adapter";
+
+impl Gpu {
+    /// A headless device. Honours `WGPU_BACKEND` (backend list),
+    /// `WGPU_ADAPTER_NAME` (substring of the adapter name, case-insensitive)
+    /// and `WGPU_POWER_PREF`.
+    pub fn headless() -> anyhow::Result<Self> {
+        let instance =
+            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        Self::with_instance(instance, None)
+    }
+
+    /// A device able to present to `surface` (for a future viewer), chosen by the
+    /// same environment variables.
+    pub fn with_instance(
+        instance: wgpu::Instance,
+        surface: Option<&wgpu::Surface<'_>>,
+    ) -> anyhow::Result<Self> {
+        let adapter = pollster::block_on(pick_adapter(&instance, surface))?;
+        let info = adapter.get_info();
+        let timestamps = adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
+        let features = if timestamps {
+            wgpu::Features::TIMESTAMP_QUERY
+        } else {
+            wgpu::Features::empty()
+        };
+        let limits = device_limits(&adapter.limits());
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("strata"),
+            required_features: features,
+            required_limits: limits,
+            experimental_features: wgpu::ExperimentalFeatures::disabled(),
+            memory_hints: wgpu::MemoryHints::Performance,
+            trace: wgpu::Trace::Off,
+        }))
+        .map_err(|e| anyhow::anyhow!("adapter `{}` refused a device: {e}", info.name))?;
+
+        let errors = ErrorSink::default();
+        let sink = errors.clone();
+        device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| sink.push(e.to_string())));
+        let sink = errors.clone();
+        device.set_device_lost_callback(move |reason, msg| {
+            // A deliberate drop of the device is not an error.
+            if reason != wgpu::DeviceLostReason::Destroyed {
+                sink.push(format!("device lost ({reason:?}): {msg}"));
+            }
+        });
+
+        let report = AdapterReport {
+            name: info.name.clone(),
+            backend: format!("{:?}", info.backend).to_lowercase(),
+            driver: info.driver.clone(),
+            driver_info: info.driver_info.clone(),
+            device_type: format!("{:?}", info.device_type),
+            timestamps,
+        };
+        Ok(Gpu {
+            instance,
+            adapter,
+            device,
+            queue,
+            report,
+            errors,
+        })
+    }
+
+    /// Wait for all submitted work, turning a timeout or a lost device into an error.
+    pub fn wait(&self) -> anyhow::Result<()> {
+        wait_device(&self.device, &self.errors)
+    }
+}
+
+/// Block until the device is idle, then report any collected error.
+pub fn wait_device(device: &wgpu::Device, errors: &ErrorSink) -> anyhow::Result<()> {
+    let polled = device.poll(wgpu::PollType::Wait {
+        submission_index: None,
+        timeout: Some(GPU_WAIT_TIMEOUT),
+    });
+    errors.check()?;
+    polled.map_err(|e| anyhow::anyhow!("waiting for the GPU failed: {e}"))?;
+    Ok(())
+}
+
+/// WebGPU default limits (so what runs here runs in a browser), except the
+/// sizes that only bound image and buffer dimensions, which follow the adapter
+/// so large render targets and method buffers work where the hardware allows.
+fn device_limits(adapter: &wgpu::Limits) -> wgpu::Limits {
+    let mut limits = wgpu::Limits::default();
+    if limits.check_limits(adapter) {
+        limits.max_texture_dimension_2d = adapter.max_texture_dimension_2d;
+        limits.max_buffer_size = adapter.max_buffer_size;
+        limits.max_storage_buffer_binding_size = adapter.max_storage_buffer_binding_size;
+        limits
+    } else {
+        // A downlevel adapter (e.g. GL): take what it has.
+        adapter.clone()
+    }
+}
+
+async fn pick_adapter(
+    instance: &wgpu::Instance,
+    surface: Option<&wgpu::Surface<'_>>,
+) -> anyhow::Result<wgpu::Adapter> {
+    if let Ok(wanted) = std::env::var("WGPU_ADAPTER_NAME") {
+        let wanted = wanted.to_lowercase();
+        let adapters = instance.enumerate_adapters(wgpu::Backends::all()).await;
+        let mut names = Vec::new();
+        for adapter in adapters {
+            let info = adapter.get_info();
+            if surface.is_some_and(|s| !adapter.is_surface_supported(s)) {
+                continue;
+            }
+            if info.name.to_lowercase().contains(&wanted) {
+                return Ok(adapter);
+            }
+            names.push(format!("{} ({:?})", info.name, info.backend));
+        }
+        anyhow::bail!(
+            "WGPU_ADAPTER_NAME=`{wanted}` matches no adapter; available: {}",
+            if names.is_empty() {
+                NO_ADAPTER_HELP.to_string()
+            } else {
+                names.join(", ")
+            }
+        );
+    }
+    instance
+        .request_adapter(&wgpu::RequestAdapterOptions {
+            power_preference: wgpu::PowerPreference::from_env()
+                .unwrap_or(wgpu::PowerPreference::HighPerformance),
+            force_fallback_adapter: false,
+            compatible_surface: surface,
+            apply_limit_buckets: false,
+        })
+        .await
+        .map_err(|e| anyhow::anyhow!("{NO_ADAPTER_HELP} ({e})"))
+}
+
+/// Map `buffer`'s first `size` bytes and copy them out.
+pub fn read_buffer(
+    device: &wgpu::Device,
+    errors: &ErrorSink,
+    buffer: &wgpu::Buffer,
+    size: u64,
+) -> anyhow::Result<Vec<u8>> {
+    let slice = buffer.slice(..size);
+    let (tx, rx) = std::sync::mpsc::channel();
+    slice.map_async(wgpu::MapMode::Read, move |r| {
+        let _ = tx.send(r);
+    });
+    wait_device(device, errors)?;
+    rx.recv()
+        .map_err(|_| anyhow::anyhow!("buffer map callback never ran"))?
+        .map_err(|e| anyhow::anyhow!("mapping a readback buffer failed: {e}"))?;
+    let data = slice
+        .get_mapped_range()
+        .map_err(|e| anyhow::anyhow!("reading a mapped buffer failed: {e}"))?
+        .to_vec();
+    buffer.unmap();
+    Ok(data)
+}

@@ -1,0 +1,143 @@
+//! The methods: one module each, behind one trait.
+//!
+//! # Adding a method
+//! 1. Write `src/methods/<name>.rs` with a struct implementing [`Method`] and a
+//!    `pub fn create(shared: &Shared, level: &Level, settings: &MethodSettings)
+//!    -> anyhow::Result<Box<dyn Method>>` that validates its own settings field
+//!    (clear error on 0 etc.) and builds its pipelines.
+//! 2. Put its WGSL in `shaders/<name>.wgsl`, starting with
+//!    `#include "frame.wgsl"`, `"surface.wgsl"`, `"shading.wgsl"` (and
+//!    `"ray_core.wgsl"`, `"fullscreen.wgsl"` as needed); add the file to
+//!    `shaders::SOURCES` and `shaders::ENTRY_SHADERS` (the naga test validates it).
+//! 3. Add one line to [`METHODS`] below: the only place a name maps to code.
+//!
+//! # The contract
+//! - Group 0 of every pipeline is the shared frame ([`Shared::frame_layout`],
+//!   bind [`Shared::frame_group`]); build layouts with [`Shared::pipeline_layout`].
+//!   Your own bindings go in groups 1 and up.
+//! - Draw into [`Shared::color_view`] ([`crate::COLOR_FORMAT`]) and
+//!   [`Shared::depth_view`] ([`crate::DEPTH_FORMAT`], depth 0 near .. 1 far
+//!   from `Camera::view_proj`, `Less` test). Your first pass that touches them
+//!   must clear them: colour to [`crate::frame::sky_clear`], depth to 1.0.
+//!   Every pixel ends with a colour and a depth (sky = 1.0).
+//! - Shade every surface point with `shade(p, ray_dir)` from `shading.wgsl`
+//!   (the mesh: `shade_with_normal`), so palette, light, cave ambient,
+//!   shadow and fog are the same in every method.
+//! - Every pass you begin takes its timestamp writes from
+//!   `frame.timer.render("label")` / `.compute("label")`, so the frame's GPU
+//!   time is the sum over passes.
+//! - `apply_edit` runs after the shared terrain texture has been updated;
+//!   methods that only read the texture need not override it.
+//! - `retained_bytes` counts only what the method allocates beyond [`Shared`].
+
+pub mod ray;
+pub mod ray_compute;
+
+use crate::frame::Shared;
+use crate::timing::PassTimer;
+use serde::{Deserialize, Serialize};
+use strata_camera::Camera;
+use strata_level::{DirtyRect, Level};
+
+/// One settings struct for all methods; each reads its own field.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct MethodSettings {
+    /// `ray`, `ray-compute`: forward samples per ray (the paper's 128).
+    pub ray_steps: u32,
+    /// `voxel*`: occupancy voxel size in texels (x, y, z); the paper's (4, 8, 2).
+    pub voxel_size: [u32; 3],
+    /// `voxel*`: traversal step budget (the paper's 100).
+    pub voxel_steps: u32,
+    /// `sliced`: horizontal slices (the paper's 512).
+    pub slices: u32,
+    /// `scattered`: footprint grid density (x, y, z); the paper's (4, 4, 4).
+    pub scatter_density: [f32; 3],
+    /// `mesh`: fit quality q in [0, 1]; max error 2^(4(1 - q)) (0.5 → 4).
+    pub mesh_quality: f32,
+    /// The shared shadow map (`--no-shadows` turns it off).
+    pub shadows: bool,
+}
+
+impl Default for MethodSettings {
+    fn default() -> Self {
+        MethodSettings {
+            ray_steps: 128,
+            voxel_size: [4, 8, 2],
+            voxel_steps: 100,
+            slices: 512,
+            scatter_density: [4.0, 4.0, 4.0],
+            mesh_quality: 0.5,
+            shadows: true,
+        }
+    }
+}
+
+/// Memory a method keeps beyond the shared resources.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct RetainedBytes {
+    pub gpu: u64,
+    pub cpu: u64,
+}
+
+/// What a method gets while recording one frame.
+pub struct Frame<'a> {
+    pub camera: &'a Camera,
+    /// Timestamp writes for each pass.
+    pub timer: &'a PassTimer,
+    /// Frames rendered before this one by this renderer.
+    pub index: u64,
+}
+
+/// One way of drawing the terrain.
+pub trait Method {
+    /// The name the factory knows it by.
+    fn name(&self) -> &'static str;
+
+    /// The level changed inside `rects` (already uploaded to the shared
+    /// terrain texture); update derived data.
+    fn apply_edit(
+        &mut self,
+        _shared: &Shared,
+        _level: &Level,
+        _rects: &[DirtyRect],
+    ) -> anyhow::Result<()> {
+        Ok(())
+    }
+
+    /// CPU work and uploads before recording a frame (the frame's globals are
+    /// already written).
+    fn prepare(&mut self, _shared: &Shared, _camera: &Camera) -> anyhow::Result<()> {
+        Ok(())
+    }
+
+    /// Record this frame's passes.
+    fn record(&self, shared: &Shared, frame: &Frame<'_>, encoder: &mut wgpu::CommandEncoder);
+
+    /// GPU and CPU bytes owned beyond the shared resources.
+    fn retained_bytes(&self) -> RetainedBytes;
+}
+
+/// Builds a method.
+pub type Constructor = fn(&Shared, &Level, &MethodSettings) -> anyhow::Result<Box<dyn Method>>;
+
+/// Every method by name: the only place a name maps to code.
+pub const METHODS: &[(&str, Constructor)] =
+    &[("ray", ray::create), ("ray-compute", ray_compute::create)];
+
+/// The names [`create`] accepts.
+pub fn names() -> Vec<&'static str> {
+    METHODS.iter().map(|(n, _)| *n).collect()
+}
+
+/// Build the method called `name`.
+pub fn create(
+    name: &str,
+    shared: &Shared,
+    level: &Level,
+    settings: &MethodSettings,
+) -> anyhow::Result<Box<dyn Method>> {
+    let Some((_, ctor)) = METHODS.iter().find(|(n, _)| *n == name) else {
+        anyhow::bail!("unknown method `{name}`; known: {}", names().join(", "));
+    };
+    ctor(shared, level, settings)
+}

@@ -1,0 +1,177 @@
+//! GPU tests of `voxel` / `voxel-compute`: the GPU pyramid against its CPU
+//! twin (before and after an edit, bit for bit), images against the CPU
+//! reference over several pitches, and the first frame after the crater
+//! edit against a fresh build. Small images: lavapipe is slow.
+
+use super::super::voxel_build::GpuPyramid;
+use crate::frame::{Shared, TerrainColors};
+use crate::{Gpu, MethodSettings, Renderer};
+use strata_camera::Camera;
+use strata_level::generate::{GenerateParams, generate};
+use strata_level::{DirtyRect, Level, World};
+use strata_occupancy::{Pyramid, VoxelSize};
+use strata_reference::metrics::{Metrics, compare, distance_from_depth};
+use strata_reference::render_reference;
+
+const W: u32 = 160;
+const H: u32 = 100;
+
+fn gpu() -> Option<Gpu> {
+    match Gpu::headless() {
+        Ok(g) => Some(g),
+        Err(e) => {
+            eprintln!("\n\n*** SKIPPED: no GPU adapter ({e}) ***\n");
+            None
+        }
+    }
+}
+
+fn world(width: u32, height: u32) -> World {
+    generate(&GenerateParams {
+        seed: 6,
+        width,
+        height,
+    })
+    .expect("generated world")
+}
+
+/// Dig the world's crater into `level`; its dirty rectangles.
+fn dig(world: &World, level: &mut Level) -> Vec<DirtyRect> {
+    let site = world.edit.clone().expect("generated worlds carry an edit site");
+    strata_level::edit::crater(level, &site)
+}
+
+/// Run queued pyramid work to completion, one budgeted "frame" per submission.
+fn drain(p: &mut GpuPyramid, shared: &Shared) -> u32 {
+    let mut frames = 0;
+    while p.is_pending() {
+        p.prepare(shared);
+        let mut encoder = shared.device.create_command_encoder(&Default::default());
+        p.record(&mut encoder, None);
+        shared.queue.submit([encoder.finish()]);
+        frames += 1;
+    }
+    frames
+}
+
+#[test]
+fn gpu_pyramid_equals_cpu_twin_before_and_after_an_edit() {
+    let Some(gpu) = gpu() else { return };
+    let w = world(256, 512);
+    for voxel in [VoxelSize::COARSE, VoxelSize::FINE] {
+        let mut level = w.level.clone();
+        let shared = Shared::new(&gpu.device, &gpu.queue, &level, &TerrainColors::test_ramps(), 8, 8).unwrap();
+        // A small budget so the initial build really runs in several submissions.
+        let mut gp = GpuPyramid::new(&shared, &level, voxel, 20_000).unwrap();
+        let mut cpu = Pyramid::build(&level, voxel).unwrap();
+        let got = gp.read_back(&shared).unwrap();
+        assert!(got == cpu.words, "({voxel}) GPU build differs from the CPU twin: {}", diff(&got, &cpu.words));
+
+        let rects = dig(&w, &mut level);
+        shared.terrain.upload(&shared.queue, &level, &rects).unwrap();
+        gp.enqueue(&rects).unwrap();
+        let frames = drain(&mut gp, &shared);
+        cpu.update(&level, &rects).unwrap();
+        let fresh = Pyramid::build(&level, voxel).unwrap();
+        assert!(cpu.words == fresh.words);
+        let got = gp.read_back(&shared).unwrap();
+        assert!(got == fresh.words, "({voxel}) GPU after the edit differs: {}", diff(&got, &fresh.words));
+        eprintln!("({voxel}) GPU == CPU before and after the crater ({frames} budgeted frames)");
+        gpu.errors.check().unwrap();
+    }
+}
+
+fn diff(a: &[u32], b: &[u32]) -> String {
+    let bad: Vec<usize> = (0..a.len().min(b.len())).filter(|&i| a[i] != b[i]).collect();
+    format!("{} of {} words differ, first at {:?}", bad.len(), a.len(), bad.first())
+}
+
+/// Render one view with a method and score it against the CPU reference.
+fn score(r: &mut Renderer, level: &Level, camera: &Camera) -> Metrics {
+    r.render_frame(camera).unwrap();
+    let depth = r.read_depth().unwrap();
+    let reference = render_reference(level, camera);
+    compare(&reference, &distance_from_depth(camera, &depth))
+}
+
+#[test]
+fn voxel_matches_the_reference_over_pitches() {
+    let Some(gpu) = gpu() else { return };
+    let w = world(512, 1024);
+    let colors = TerrainColors::from_world(&w);
+    let settings = MethodSettings::default();
+    for method in ["voxel", "voxel-compute"] {
+        let mut r = Renderer::new(&gpu, &w.level, &colors, method, &settings, W, H).unwrap();
+        let mut worst = Metrics::default();
+        for view in &w.views {
+            let camera = Camera::from_view(&w.level, view, W, H).unwrap();
+            let m = score(&mut r, &w.level, &camera);
+            eprintln!(
+                "{method} {:>12} pitch {:>4}: see-through {:.3}% covers-sky {:.3}% coherence {:.3}% p50 {:.3} p95 {:.3}",
+                view.name, view.pitch, m.see_through, m.covers_sky, m.coherence, m.depth_p50, m.depth_p95
+            );
+            worst.see_through = worst.see_through.max(m.see_through);
+            worst.coherence = worst.coherence.max(m.coherence);
+        }
+        assert!(worst.see_through <= 0.5, "{method}: see-through {:.3}%", worst.see_through);
+        assert!(worst.coherence <= 0.5, "{method}: coherence {:.3}%", worst.coherence);
+    }
+}
+
+#[test]
+fn first_frame_after_the_crater_matches_a_fresh_build() {
+    let Some(gpu) = gpu() else { return };
+    let w = world(512, 1024);
+    let colors = TerrainColors::from_world(&w);
+    let settings = MethodSettings::default();
+    let site = w.edit.clone().unwrap();
+    let mut level = w.level.clone();
+    let mut r = Renderer::new(&gpu, &level, &colors, "voxel", &settings, W, H).unwrap();
+    let rects = dig(&w, &mut level);
+    let camera = Camera::from_view(&level, &site.camera, W, H).unwrap();
+    r.apply_edit(&level, &rects).unwrap();
+    r.render_frame(&camera).unwrap();
+    let edited = r.read_depth().unwrap();
+    let mut fresh = Renderer::new(&gpu, &level, &colors, "voxel", &settings, W, H).unwrap();
+    fresh.render_frame(&camera).unwrap();
+    let clean = fresh.read_depth().unwrap();
+    let a = distance_from_depth(&camera, &edited);
+    let b = distance_from_depth(&camera, &clean);
+    let class_mismatch = a.iter().zip(&b).filter(|(x, y)| x.is_finite() != y.is_finite()).count();
+    let mut d: Vec<f32> = a
+        .iter()
+        .zip(&b)
+        .filter(|(x, y)| x.is_finite() && y.is_finite())
+        .map(|(x, y)| (x - y).abs())
+        .collect();
+    d.sort_by(f32::total_cmp);
+    let p95 = d.get(d.len() * 95 / 100).copied().unwrap_or(0.0);
+    let pct = 100.0 * class_mismatch as f64 / a.len() as f64;
+    eprintln!("crater first frame vs fresh build: class mismatch {pct:.4}%, p95 {p95:.4}");
+    assert!(pct <= 0.01, "class mismatch {pct}%");
+    assert!(p95 <= 0.1, "p95 {p95}");
+    // The edit is visible: the view changed where the crater is.
+    let mut before = Renderer::new(&gpu, &w.level, &colors, "voxel", &settings, W, H).unwrap();
+    before.render_frame(&camera).unwrap();
+    let old = before.read_depth().unwrap();
+    assert!(old.iter().zip(&edited).any(|(x, y)| (x - y).abs() > 1e-4), "the crater left no trace");
+}
+
+#[test]
+fn bad_settings_are_clear_errors() {
+    let Some(gpu) = gpu() else { return };
+    let level = Level::flat(256, 256, 40, 1).unwrap();
+    let colors = TerrainColors::test_ramps();
+    let zero = MethodSettings {
+        voxel_steps: 0,
+        ..MethodSettings::default()
+    };
+    let e = Renderer::new(&gpu, &level, &colors, "voxel", &zero, W, H).err().unwrap();
+    assert!(e.to_string().contains("voxel steps"), "{e}");
+    let odd = MethodSettings {
+        voxel_size: [3, 8, 2],
+        ..MethodSettings::default()
+    };
+    let e = Renderer::new(&gpu, &level, &colors, "voxel-compute", &odd, W, H).err().unwrap();
+    assert!(e.to_string().contains("powers of two"), "{e}");
+}

@@ -1,0 +1,141 @@
+//! WGSL composition: shaders live in `crates/render/shaders/*.wgsl`, embedded
+//! at build time. A line `#include "name.wgsl"` is replaced by that module's
+//! text, recursively; each module is included at most once per shader, so
+//! modules may include their own dependencies safely. Add a new file to
+//! [`SOURCES`]; `tests::every_shader_validates` checks it with naga.
+
+/// Every WGSL file: name and text. Top-level shaders (with entry points) and
+/// shared modules alike.
+pub const SOURCES: &[(&str, &str)] = &[
+    ("frame.wgsl", include_str!("../shaders/frame.wgsl")),
+    ("surface.wgsl", include_str!("../shaders/surface.wgsl")),
+    ("shading.wgsl", include_str!("../shaders/shading.wgsl")),
+    ("ray_core.wgsl", include_str!("../shaders/ray_core.wgsl")),
+    ("ray_pixel.wgsl", include_str!("../shaders/ray_pixel.wgsl")),
+    (
+        "fullscreen.wgsl",
+        include_str!("../shaders/fullscreen.wgsl"),
+    ),
+    ("ray.wgsl", include_str!("../shaders/ray.wgsl")),
+    (
+        "ray_compute.wgsl",
+        include_str!("../shaders/ray_compute.wgsl"),
+    ),
+    (
+        "depth_blit.wgsl",
+        include_str!("../shaders/depth_blit.wgsl"),
+    ),
+    ("shadow.wgsl", include_str!("../shaders/shadow.wgsl")),
+    (
+        "decode_test.wgsl",
+        include_str!("../shaders/decode_test.wgsl"),
+    ),
+];
+
+/// Shaders with entry points (the rest are modules); the naga test validates these.
+pub const ENTRY_SHADERS: &[&str] = &[
+    "ray.wgsl",
+    "ray_compute.wgsl",
+    "depth_blit.wgsl",
+    "shadow.wgsl",
+    "decode_test.wgsl",
+];
+
+#[derive(Debug, thiserror::Error, PartialEq, Eq)]
+pub enum ShaderError {
+    #[error("unknown WGSL module `{0}` (add it to shaders::SOURCES)")]
+    Unknown(String),
+    #[error("{file}:{line}: malformed include (expected `#include \"name.wgsl\"`)")]
+    BadInclude { file: String, line: usize },
+}
+
+fn source(name: &str) -> Result<&'static str, ShaderError> {
+    SOURCES
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|(_, s)| *s)
+        .ok_or_else(|| ShaderError::Unknown(name.to_string()))
+}
+
+/// The full WGSL text of shader `name`, includes resolved.
+pub fn compose(name: &str) -> Result<String, ShaderError> {
+    let mut out = String::new();
+    let mut seen = Vec::new();
+    compose_into(name, &mut out, &mut seen)?;
+    Ok(out)
+}
+
+fn compose_into(name: &str, out: &mut String, seen: &mut Vec<String>) -> Result<(), ShaderError> {
+    if seen.iter().any(|s| s == name) {
+        return Ok(());
+    }
+    seen.push(name.to_string());
+    let text = source(name)?;
+    for (i, line) in text.lines().enumerate() {
+        if let Some(rest) = line.trim_start().strip_prefix("#include") {
+            let inner = rest
+                .trim()
+                .strip_prefix('"')
+                .and_then(|r| r.strip_suffix('"'))
+                .ok_or_else(|| ShaderError::BadInclude {
+                    file: name.to_string(),
+                    line: i + 1,
+                })?;
+            compose_into(inner, out, seen)?;
+        } else {
+            out.push_str(line);
+            out.push('\n');
+        }
+    }
+    Ok(())
+}
+
+/// Compose and create a shader module, turning a WGSL or validation error
+/// into an `Err` (wgpu would otherwise report it asynchronously).
+pub fn create_module(device: &wgpu::Device, name: &str) -> anyhow::Result<wgpu::ShaderModule> {
+    let text = compose(name)?;
+    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(name),
+        source: wgpu::ShaderSource::Wgsl(text.into()),
+    });
+    if let Some(err) = pollster::block_on(scope.pop()) {
+        anyhow::bail!("shader `{name}` failed to compile: {err}");
+    }
+    Ok(module)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_shader_validates() {
+        for name in ENTRY_SHADERS {
+            let text = compose(name).unwrap();
+            let module = naga::front::wgsl::parse_str(&text)
+                .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&text)));
+            naga::valid::Validator::new(
+                naga::valid::ValidationFlags::all(),
+                naga::valid::Capabilities::default(),
+            )
+            .validate(&module)
+            .unwrap_or_else(|e| panic!("{name}: {e:?}"));
+        }
+    }
+
+    #[test]
+    fn includes_resolve_once() {
+        let text = compose("ray.wgsl").unwrap();
+        assert_eq!(text.matches("struct Globals").count(), 1);
+        assert!(!text.contains("#include"));
+    }
+
+    #[test]
+    fn unknown_module_is_an_error() {
+        assert_eq!(
+            compose("nope.wgsl"),
+            Err(ShaderError::Unknown("nope.wgsl".into()))
+        );
+    }
+}
