@@ -77,6 +77,9 @@ pub fn run(adapter: &str) -> RunResults {
             frames: 4,
             shadows: true,
             methods: vec!["ray".into(), "mesh".into()],
+            method_settings: vec!["ray steps=128".into(), "mesh q=0.5".into()],
+            warmup_first_view: 4,
+            warmup_frames: 3,
             views,
             edits: true,
             mid_rule: "original".into(),
@@ -105,6 +108,7 @@ pub fn run(adapter: &str) -> RunResults {
                 consistent: true,
             }],
         }],
+        failures: Vec::new(),
         edit_skipped: None,
     }
 }

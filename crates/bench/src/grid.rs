@@ -10,7 +10,6 @@ pub const THUMB_MAX_WIDTH: u32 = 320;
 const BACKGROUND: Rgba<u8> = Rgba([24, 24, 28, 255]);
 const LABEL: Rgba<u8> = Rgba([230, 230, 230, 255]);
 const MISSING: Rgba<u8> = Rgba([90, 30, 60, 255]);
-const SKY: Rgba<u8> = Rgba([70, 110, 170, 255]);
 
 /// Box-filter an image down by the integer factor that brings it to at most
 /// [`THUMB_MAX_WIDTH`] wide.
@@ -37,24 +36,6 @@ pub fn thumbnail(img: &RgbaImage) -> RgbaImage {
         }
         let n = n.max(1);
         Rgba(sum.map(|s| (s / n) as u8))
-    })
-}
-
-/// A distance picture: near is bright, the far plane dark, sky blue.
-/// Used for the reference column (and available for depth pictures).
-pub fn distance_picture(distance: &[f32], width: u32, height: u32, far: f32) -> RgbaImage {
-    RgbaImage::from_fn(width, height, |x, y| {
-        let d = distance
-            .get((y * width + x) as usize)
-            .copied()
-            .unwrap_or(f32::INFINITY);
-        if !d.is_finite() {
-            return SKY;
-        }
-        // Square-root tone curve: most of the picture's detail is near.
-        let t = (d / far.max(1.0)).clamp(0.0, 1.0).sqrt();
-        let v = (255.0 * (1.0 - t)) as u8;
-        Rgba([v, v, v, 255])
     })
 }
 
@@ -141,13 +122,5 @@ mod tests {
         assert_eq!(g.get_pixel(left + 1, top + 1).0, [255, 0, 0, 255]);
         assert_eq!(g.get_pixel(left + 11, top + 1), &MISSING);
         assert_eq!(g.get_pixel(left + 11, top + 9).0, [0, 255, 0, 255]);
-    }
-
-    #[test]
-    fn distance_picture_shades_near_bright_and_sky_blue() {
-        let p = distance_picture(&[0.0, 600.0, f32::INFINITY], 3, 1, 600.0);
-        assert_eq!(p.get_pixel(0, 0).0, [255, 255, 255, 255]);
-        assert_eq!(p.get_pixel(1, 0).0, [0, 0, 0, 255]);
-        assert_eq!(p.get_pixel(2, 0), &SKY);
     }
 }

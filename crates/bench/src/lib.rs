@@ -1,12 +1,16 @@
 //! The measurement harness behind `strata compare` and `strata merge`: typed
 //! results, statistics, the report and picture grid, and the protocol runner.
 
+pub mod edits;
 pub mod font;
 pub mod grid;
 pub mod merge;
+pub mod methods;
 pub mod plan;
 pub mod report;
 pub mod results;
+pub mod run;
+pub mod session;
 pub mod stats;
 
 #[cfg(test)]

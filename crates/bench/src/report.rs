@@ -80,6 +80,16 @@ pub fn render(runs: &[RunResults], pictures: &Pictures, disagreements: &[Disagre
         );
     }
 
+    for run in runs {
+        if !run.failures.is_empty() {
+            let _ = writeln!(md, "**Failures on {}:**\n", cell_text(&run.adapter.name));
+            for f in &run.failures {
+                let _ = writeln!(md, "- {} at {}: {}", f.method, f.view, cell_text(&f.error));
+            }
+            md.push('\n');
+        }
+    }
+
     accuracy_tables(&mut md, base);
     if runs.len() > 1 {
         cross_check(&mut md, runs, disagreements);

@@ -31,9 +31,20 @@ pub struct RunResults {
     pub complete: bool,
     pub rows: Vec<Row>,
     pub edit_rows: Vec<EditRow>,
+    /// Cells or methods that failed (the run goes on without them).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub failures: Vec<Failure>,
     /// Why the edit protocol did not run, when it did not.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub edit_skipped: Option<String>,
+}
+
+/// A method that could not be measured at a view (or anywhere: view "*").
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Failure {
+    pub view: String,
+    pub method: String,
+    pub error: String,
 }
 
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -64,7 +75,14 @@ pub struct Settings {
     pub shadows: bool,
     /// Method labels in report order (`name` or `name:setting`).
     pub methods: Vec<String>,
+    /// Each method's effective knob, same order (`voxel grid=(4,8,2) steps=100`).
+    pub method_settings: Vec<String>,
     pub views: Vec<ViewSpec>,
+    /// Pre-timing frames at a renderer's first view: the minimum plus enough
+    /// for the largest incremental build budget to cover the level.
+    pub warmup_first_view: u32,
+    /// Pre-timing frames at every later view.
+    pub warmup_frames: u32,
     pub edits: bool,
     /// The cave-ceiling convention (`original` or `vange-rs`).
     pub mid_rule: String,

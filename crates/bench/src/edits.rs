@@ -1,0 +1,174 @@
+//! The dynamic-edit protocol (paper §Dynamic-edit protocol): per method, the
+//! median of independent first post-edit frames, the steady frame of a
+//! renderer built fresh from the edited level, and after how many post-edit
+//! frames the edited renderer agrees with that fresh build.
+
+use crate::results::{
+    EDIT_CHECK_FRAMES, EDIT_MAX_CLASS_MISMATCH, EDIT_MAX_DEPTH_P95, EditCheck, EditRow,
+};
+use crate::run::ms;
+use crate::stats::{median, percentile};
+use std::time::Instant;
+use strata_camera::Camera;
+use strata_level::{DirtyRect, Level};
+use strata_render::{Gpu, MethodSettings, Renderer, TerrainColors};
+
+/// Independent first post-edit frames per method.
+pub const FIRST_FRAME_SAMPLES: usize = 5;
+
+pub struct EditInput<'a> {
+    pub gpu: &'a Gpu,
+    pub original: &'a Level,
+    pub edited: &'a Level,
+    pub rects: &'a [DirtyRect],
+    pub colors: &'a TerrainColors,
+    pub camera: &'a Camera,
+    /// Frames before the edit (and before the fresh build is sampled): enough
+    /// for incremental builds to finish, so the edit meets a settled renderer.
+    pub warmup: u32,
+    /// Frames of the fresh edited build whose median is the steady time.
+    pub steady_frames: u32,
+}
+
+/// Percent of pixels where exactly one image has terrain, and the 95th
+/// percentile of |a - b| where both do (0 when none do).
+pub fn disagreement(a: &[f32], b: &[f32]) -> (f64, f64) {
+    let n = a.len().min(b.len()).max(1);
+    let mut mismatch = 0usize;
+    let mut diffs = Vec::new();
+    for (x, y) in a.iter().zip(b) {
+        match (x.is_finite(), y.is_finite()) {
+            (true, true) => diffs.push(f64::from((x - y).abs())),
+            (false, false) => {}
+            _ => mismatch += 1,
+        }
+    }
+    (
+        100.0 * mismatch as f64 / n as f64,
+        percentile(&diffs, 0.95).unwrap_or(0.0),
+    )
+}
+
+/// The first checked frame count at which the images agree, if any.
+pub fn consistent_after(checks: &[EditCheck]) -> Option<u32> {
+    checks.iter().find(|c| c.consistent).map(|c| c.frames)
+}
+
+fn build(
+    input: &EditInput<'_>,
+    level: &Level,
+    name: &str,
+    settings: &MethodSettings,
+) -> anyhow::Result<Renderer> {
+    let mut r = Renderer::new(
+        input.gpu,
+        level,
+        input.colors,
+        name,
+        settings,
+        input.camera.width,
+        input.camera.height,
+    )?;
+    for _ in 0..input.warmup.max(1) {
+        r.render_frame(input.camera)?;
+    }
+    Ok(r)
+}
+
+fn distance(r: &Renderer, camera: &Camera) -> anyhow::Result<Vec<f32>> {
+    Ok(strata_reference::distance_from_depth(
+        camera,
+        &r.read_depth()?,
+    ))
+}
+
+/// Run the protocol for one method.
+pub fn edit_row(
+    input: &EditInput<'_>,
+    name: &str,
+    settings: &MethodSettings,
+) -> anyhow::Result<EditRow> {
+    let cam = input.camera;
+    // The fresh build of the already-edited level: steady time and the target image.
+    let mut fresh = build(input, input.edited, name, settings)?;
+    let (mut steady_cpu, mut steady_gpu) = (Vec::new(), Vec::new());
+    for _ in 0..input.steady_frames.max(1) {
+        let t = fresh.render_frame(cam)?;
+        steady_cpu.push(t.cpu_ms);
+        steady_gpu.extend(t.gpu_ms);
+    }
+    let target = distance(&fresh, cam)?;
+    drop(fresh);
+
+    let (mut first_cpu, mut first_gpu) = (Vec::new(), Vec::new());
+    let mut checks = Vec::new();
+    for sample in 0..FIRST_FRAME_SAMPLES {
+        let mut r = build(input, input.original, name, settings)?;
+        // The latency a player waits: upload + any rebuild + the frame + round trip.
+        let start = Instant::now();
+        r.apply_edit(input.edited, input.rects)?;
+        let t = r.render_frame(cam)?;
+        first_cpu.push(ms(start));
+        first_gpu.extend(t.gpu_ms);
+        if sample == 0 {
+            let mut done = 1;
+            for frames in EDIT_CHECK_FRAMES {
+                while done < frames {
+                    r.render_frame(cam)?;
+                    done += 1;
+                }
+                let (class_mismatch, depth_p95) = disagreement(&distance(&r, cam)?, &target);
+                checks.push(EditCheck {
+                    frames,
+                    class_mismatch,
+                    depth_p95,
+                    consistent: class_mismatch <= EDIT_MAX_CLASS_MISMATCH
+                        && depth_p95 <= EDIT_MAX_DEPTH_P95,
+                });
+            }
+        }
+    }
+    let all_timed = |g: &Vec<f64>, c: &Vec<f64>| if g.len() == c.len() { median(g) } else { None };
+    Ok(EditRow {
+        method: name.to_string(),
+        first_frame_cpu_ms: median(&first_cpu).unwrap_or(f64::NAN),
+        first_frame_gpu_ms: all_timed(&first_gpu, &first_cpu),
+        steady_cpu_ms: median(&steady_cpu).unwrap_or(f64::NAN),
+        steady_gpu_ms: all_timed(&steady_gpu, &steady_cpu),
+        first_frame_cpu_samples: first_cpu,
+        first_frame_gpu_samples: first_gpu,
+        consistent_after_frames: consistent_after(&checks),
+        checks,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn disagreement_counts_class_flips_and_depth() {
+        let inf = f32::INFINITY;
+        let a = [1.0, 2.0, inf, inf, 10.0];
+        let b = [1.0, 2.5, inf, 3.0, 10.0];
+        let (mismatch, p95) = disagreement(&a, &b);
+        assert!((mismatch - 20.0).abs() < 1e-9);
+        assert_eq!(p95, 0.5);
+        assert_eq!(disagreement(&[inf], &[inf]), (0.0, 0.0));
+    }
+
+    #[test]
+    fn first_consistent_check_wins() {
+        let c = |frames, consistent| EditCheck {
+            frames,
+            class_mismatch: 0.0,
+            depth_p95: 0.0,
+            consistent,
+        };
+        assert_eq!(
+            consistent_after(&[c(1, false), c(2, true), c(4, true)]),
+            Some(2)
+        );
+        assert_eq!(consistent_after(&[c(1, false), c(16, false)]), None);
+    }
+}

@@ -1,0 +1,403 @@
+//! `strata compare`: check every input, then measure every (view, method)
+//! cell and the edit protocol. One renderer per method serves all views (its
+//! setup is paid once and recorded on each of its rows); each view gets its
+//! own warm-up before the timed frames.
+
+use crate::edits;
+use crate::methods::{describe, settings_for};
+use crate::plan::{MethodChoice, check_view_names, file_part, prepare_out_dir, source_revision};
+use crate::results::*;
+use crate::session::{Session, color_image, reference_image};
+use crate::stats::summarize;
+use anyhow::Context;
+use indicatif::{ProgressBar, ProgressStyle};
+use std::path::PathBuf;
+use std::time::Instant;
+use strata_camera::Camera;
+use strata_level::{EditSite, ViewSpec, World};
+use strata_reference::{Reference, ReferenceCache};
+use strata_render::{Gpu, MethodSettings, Renderer, TerrainColors};
+
+/// Texels the incremental voxel build processes per frame
+/// (`voxel_build::DEFAULT_BUDGET_TEXELS`): the first view's warm-up covers a
+/// whole-level build at this budget, so no method is timed mid-build.
+pub const INCREMENTAL_BUDGET_TEXELS: u64 = 1 << 20;
+
+/// Whether to run the edit protocol.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum EditMode {
+    /// Run it when the level has an edit site (the default run).
+    Auto,
+    /// `--edits`: the level must have one.
+    Required,
+    /// `--no-edits`.
+    Off,
+}
+
+#[derive(Clone, Debug)]
+pub struct Options {
+    pub out: PathBuf,
+    pub methods: Vec<MethodChoice>,
+    /// The views to render (the level's own unless `--views`).
+    pub views: Vec<ViewSpec>,
+    pub width: u32,
+    pub height: u32,
+    pub frames: u32,
+    /// Pre-timing frames at every view (the first view adds the build budget).
+    pub min_warmup: u32,
+    pub shadows: bool,
+    pub edits: EditMode,
+    pub cache_dir: PathBuf,
+}
+
+/// A checked comparison, ready to run: nothing here touches the GPU.
+pub struct Plan {
+    world: World,
+    colors: TerrainColors,
+    opts: Options,
+    cameras: Vec<Camera>,
+    settings: Vec<MethodSettings>,
+    edit: Option<(EditSite, Camera)>,
+    edit_skipped: Option<String>,
+    warmup_first: u32,
+}
+
+impl Plan {
+    /// Validate everything a run needs: output directory, views, cameras,
+    /// method settings, edit site. Errors name the bad input.
+    pub fn new(world: World, opts: Options) -> anyhow::Result<Plan> {
+        prepare_out_dir(&opts.out)?;
+        check_view_names(&opts.views)?;
+        if opts.frames == 0 {
+            anyhow::bail!("--frames must be at least 1");
+        }
+        let cameras = opts
+            .views
+            .iter()
+            .map(|v| {
+                Camera::from_view(&world.level, v, opts.width, opts.height)
+                    .with_context(|| format!("view `{}`", v.name))
+            })
+            .collect::<anyhow::Result<Vec<_>>>()?;
+        let settings = opts
+            .methods
+            .iter()
+            .map(|m| settings_for(m, opts.shadows))
+            .collect::<anyhow::Result<Vec<_>>>()?;
+        let (edit, edit_skipped) = match (&world.edit, opts.edits) {
+            (_, EditMode::Off) => (None, Some("--no-edits".to_string())),
+            (None, EditMode::Required) => anyhow::bail!(
+                "--edits: level `{}` has no edit site (edit.txt)",
+                world.name
+            ),
+            (None, EditMode::Auto) => (
+                None,
+                Some(format!("level `{}` has no edit site", world.name)),
+            ),
+            (Some(site), _) => {
+                let cam = Camera::from_view(&world.level, &site.camera, opts.width, opts.height)
+                    .context("the edit camera")?;
+                (Some((site.clone(), cam)), None)
+            }
+        };
+        let texels = u64::from(world.level.width()) * u64::from(world.level.height());
+        let build_frames =
+            u32::try_from(texels.div_ceil(INCREMENTAL_BUDGET_TEXELS)).unwrap_or(u32::MAX);
+        let warmup_first = opts.min_warmup.saturating_add(build_frames);
+        let colors = TerrainColors::from_world(&world);
+        Ok(Plan {
+            world,
+            colors,
+            opts,
+            cameras,
+            settings,
+            edit,
+            edit_skipped,
+            warmup_first,
+        })
+    }
+
+    fn results_header(&self, gpu: &Gpu) -> RunResults {
+        let level = &self.world.level;
+        RunResults {
+            protocol_version: PROTOCOL_VERSION,
+            level: LevelInfo {
+                name: self.world.name.clone(),
+                hash: level.content_hash(),
+                width: level.width(),
+                height: level.height(),
+            },
+            adapter: AdapterInfo {
+                name: gpu.report.name.clone(),
+                backend: gpu.report.backend.clone(),
+                driver: format!("{} {}", gpu.report.driver, gpu.report.driver_info)
+                    .trim()
+                    .to_string(),
+                timestamps: gpu.report.timestamps,
+            },
+            settings: Settings {
+                width: self.opts.width,
+                height: self.opts.height,
+                far: self
+                    .cameras
+                    .first()
+                    .map_or(strata_camera::DEFAULT_FAR, |c| c.far),
+                frames: self.opts.frames,
+                shadows: self.opts.shadows,
+                methods: self.opts.methods.iter().map(MethodChoice::label).collect(),
+                method_settings: self
+                    .opts
+                    .methods
+                    .iter()
+                    .zip(&self.settings)
+                    .map(|(m, s)| describe(&m.name, s))
+                    .collect(),
+                views: self.opts.views.clone(),
+                warmup_first_view: self.warmup_first,
+                warmup_frames: self.opts.min_warmup,
+                edits: self.edit.is_some(),
+                mid_rule: format!("{:?}", level.mid_rule).to_lowercase(),
+            },
+            source_revision: source_revision(),
+            complete: false,
+            rows: Vec::new(),
+            edit_rows: Vec::new(),
+            failures: Vec::new(),
+            edit_skipped: self.edit_skipped.clone(),
+        }
+    }
+
+    /// Run the protocol on `gpu`, writing into the output directory as it goes.
+    /// Returns the results file and the report.
+    pub fn run(self, gpu: &Gpu) -> anyhow::Result<(PathBuf, PathBuf)> {
+        let mut session = Session::new(&self.opts.out, self.results_header(gpu));
+        let json = session.save_json()?;
+        let references = self.references(&mut session)?;
+
+        let n_methods = self.opts.methods.len();
+        let total =
+            self.cameras.len() * n_methods + if self.edit.is_some() { n_methods } else { 0 };
+        let bar = ProgressBar::new(total as u64);
+        bar.set_style(
+            ProgressStyle::with_template(
+                "{bar:30} {pos}/{len} cells  {msg}  [{elapsed_precise}, {eta_precise} left]",
+            )
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        );
+        for (m, choice) in self.opts.methods.iter().enumerate() {
+            if let Err(e) = self.method_column(gpu, &mut session, &references, m, &bar) {
+                bar.println(format!("{}: {e:#}", choice.label()));
+                session.results.failures.push(Failure {
+                    view: "*".into(),
+                    method: choice.label(),
+                    error: format!("{e:#}"),
+                });
+                session.save_json()?;
+            }
+            session.save_report()?;
+        }
+        if let Some((site, camera)) = &self.edit {
+            let mut edited = self.world.level.clone();
+            let rects = strata_level::edit::crater(&mut edited, site);
+            for (choice, settings) in self.opts.methods.iter().zip(&self.settings) {
+                bar.set_message(format!("edit / {}", choice.label()));
+                let input = edits::EditInput {
+                    gpu,
+                    original: &self.world.level,
+                    edited: &edited,
+                    rects: &rects,
+                    colors: &self.colors,
+                    camera,
+                    warmup: self.warmup_first,
+                    steady_frames: self.opts.frames.min(10),
+                };
+                match edits::edit_row(&input, &choice.name, settings) {
+                    Ok(mut row) => {
+                        row.method = choice.label();
+                        session.results.edit_rows.push(row);
+                    }
+                    Err(e) => {
+                        bar.println(format!("edit / {}: {e:#}", choice.label()));
+                        session.results.failures.push(Failure {
+                            view: "edit".into(),
+                            method: choice.label(),
+                            error: format!("{e:#}"),
+                        });
+                    }
+                }
+                session.save_json()?;
+                bar.inc(1);
+            }
+        }
+        bar.finish_and_clear();
+        session.results.complete = true;
+        session.save_json()?;
+        let report = session.save_report()?;
+        Ok((json, report))
+    }
+
+    /// The reference of every view (from the cache when present) and its picture.
+    fn references(&self, session: &mut Session) -> anyhow::Result<Vec<Reference>> {
+        let cache = ReferenceCache::new(&self.opts.cache_dir);
+        let bar = ProgressBar::new(self.cameras.len() as u64);
+        bar.set_style(
+            ProgressStyle::with_template(
+                "{bar:30} {pos}/{len} references  {msg}  [{elapsed_precise}]",
+            )
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        );
+        let mut out = Vec::new();
+        for (v, (view, camera)) in self.opts.views.iter().zip(&self.cameras).enumerate() {
+            bar.set_message(view.name.clone());
+            let r = cache
+                .get_or_compute(&self.world.level, camera)
+                .with_context(|| format!("reference of view `{}`", view.name))?;
+            session.save_picture(
+                v,
+                0,
+                &format!("{}-reference", view.name),
+                reference_image(&r, camera.far),
+            )?;
+            out.push(r);
+            bar.inc(1);
+        }
+        bar.finish_and_clear();
+        Ok(out)
+    }
+
+    /// Every view of method `m`, one renderer.
+    fn method_column(
+        &self,
+        gpu: &Gpu,
+        session: &mut Session,
+        references: &[Reference],
+        m: usize,
+        bar: &ProgressBar,
+    ) -> anyhow::Result<()> {
+        let choice = &self.opts.methods[m];
+        let label = choice.label();
+        bar.set_message(format!("{label}: setup"));
+        let start = Instant::now();
+        let mut renderer = Renderer::new(
+            gpu,
+            &self.world.level,
+            &self.colors,
+            &choice.name,
+            &self.settings[m],
+            self.opts.width,
+            self.opts.height,
+        )?;
+        let setup_ms = ms(start);
+        for (v, (view, camera)) in self.opts.views.iter().zip(&self.cameras).enumerate() {
+            bar.set_message(format!("{} / {label}", view.name));
+            let warmup = if v == 0 {
+                self.warmup_first
+            } else {
+                self.opts.min_warmup
+            };
+            match self.cell(
+                session,
+                &mut renderer,
+                &references[v],
+                v,
+                m,
+                camera,
+                warmup,
+                setup_ms,
+            ) {
+                Ok(row) => session.results.rows.push(row),
+                Err(e) => {
+                    bar.println(format!("{} / {label}: {e:#}", view.name));
+                    session.results.failures.push(Failure {
+                        view: view.name.clone(),
+                        method: label.clone(),
+                        error: format!("{e:#}"),
+                    });
+                }
+            }
+            session.save_json()?;
+            bar.inc(1);
+        }
+        Ok(())
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn cell(
+        &self,
+        session: &mut Session,
+        renderer: &mut Renderer,
+        reference: &Reference,
+        v: usize,
+        m: usize,
+        camera: &Camera,
+        warmup: u32,
+        setup_ms: f64,
+    ) -> anyhow::Result<Row> {
+        let view = &self.opts.views[v];
+        let label = self.opts.methods[m].label();
+        // First frame at this view (lazy builds land here), then the rest of warm-up.
+        let start = Instant::now();
+        renderer.render_frame(camera)?;
+        let first_ms = ms(start);
+        for _ in 1..warmup.max(1) {
+            renderer.render_frame(camera)?;
+        }
+        let warmup_ms = ms(start);
+        let mut gpu = Vec::new();
+        let mut cpu = Vec::new();
+        for _ in 0..self.opts.frames {
+            let t = renderer.render_frame(camera)?;
+            cpu.push(t.cpu_ms);
+            if let Some(g) = t.gpu_ms {
+                gpu.push(g);
+            }
+        }
+        // Timestamps on some frames only would mix sources: keep GPU only when every frame has it.
+        let gpu_t = if gpu.len() == cpu.len() {
+            summarize(&gpu)
+        } else {
+            None
+        };
+        let cpu_t = summarize(&cpu).context("no timed frames")?;
+        let depth = renderer.read_depth()?;
+        let distance = strata_reference::distance_from_depth(camera, &depth);
+        let metrics = strata_reference::metrics::try_compare(reference, &distance)?;
+        let color = color_image(camera.width, camera.height, renderer.read_color()?)?;
+        let image = session.save_picture(
+            v,
+            m + 1,
+            &format!("{}-{}", view.name, file_part(&label)),
+            color,
+        )?;
+        let retained = renderer.retained_bytes();
+        Ok(Row {
+            view: view.name.clone(),
+            pitch: view.pitch,
+            method: label,
+            see_through: metrics.see_through,
+            covers_sky: metrics.covers_sky,
+            depth_p50: f64::from(metrics.depth_p50),
+            depth_p95: f64::from(metrics.depth_p95),
+            coherence: metrics.coherence,
+            gpu_ms_mean: gpu_t.as_ref().map(|t| t.mean),
+            cpu_ms_mean: cpu_t.mean,
+            timing_source: if gpu_t.is_some() {
+                TimingSource::GpuTimestamps
+            } else {
+                TimingSource::CpuSubmitWait
+            },
+            gpu_ms: gpu_t,
+            cpu_ms: cpu_t,
+            prep_setup_ms: setup_ms,
+            prep_first_frame_ms: first_ms,
+            prep_warmup_ms: warmup_ms,
+            gpu_bytes: retained.gpu,
+            cpu_bytes: retained.cpu,
+            image,
+        })
+    }
+}
+
+pub fn ms(since: Instant) -> f64 {
+    since.elapsed().as_secs_f64() * 1e3
+}
