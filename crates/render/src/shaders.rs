@@ -30,6 +30,23 @@ pub const SOURCES: &[(&str, &str)] = &[
         "decode_test.wgsl",
         include_str!("../shaders/decode_test.wgsl"),
     ),
+    (
+        "voxel_occupancy.wgsl",
+        include_str!("../shaders/voxel_occupancy.wgsl"),
+    ),
+    (
+        "voxel_core.wgsl",
+        include_str!("../shaders/voxel_core.wgsl"),
+    ),
+    ("voxel.wgsl", include_str!("../shaders/voxel.wgsl")),
+    (
+        "voxel_compute.wgsl",
+        include_str!("../shaders/voxel_compute.wgsl"),
+    ),
+    (
+        "voxel_build.wgsl",
+        include_str!("../shaders/voxel_build.wgsl"),
+    ),
 ];
 
 /// Shaders with entry points (the rest are modules); the naga test validates these.
@@ -39,6 +56,9 @@ pub const ENTRY_SHADERS: &[&str] = &[
     "depth_blit.wgsl",
     "shadow.wgsl",
     "decode_test.wgsl",
+    "voxel.wgsl",
+    "voxel_compute.wgsl",
+    "voxel_build.wgsl",
 ];
 
 #[derive(Debug, thiserror::Error, PartialEq, Eq)]

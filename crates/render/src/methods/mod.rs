@@ -32,6 +32,8 @@
 
 pub mod ray;
 pub mod ray_compute;
+pub mod voxel;
+pub mod voxel_build;
 
 use crate::frame::Shared;
 use crate::timing::PassTimer;
@@ -121,8 +123,12 @@ pub trait Method {
 pub type Constructor = fn(&Shared, &Level, &MethodSettings) -> anyhow::Result<Box<dyn Method>>;
 
 /// Every method by name: the only place a name maps to code.
-pub const METHODS: &[(&str, Constructor)] =
-    &[("ray", ray::create), ("ray-compute", ray_compute::create)];
+pub const METHODS: &[(&str, Constructor)] = &[
+    ("ray", ray::create),
+    ("ray-compute", ray_compute::create),
+    ("voxel", voxel::create),
+    ("voxel-compute", voxel::create_compute),
+];
 
 /// The names [`create`] accepts.
 pub fn names() -> Vec<&'static str> {

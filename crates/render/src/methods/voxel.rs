@@ -9,7 +9,9 @@
 
 use super::voxel_build::{DEFAULT_BUDGET_TEXELS, GpuPyramid};
 use super::{Frame, Method, MethodSettings, RetainedBytes};
-use crate::frame::{COLOR_FORMAT, DEPTH_FORMAT, Shared, sky_clear, storage_texture_entry, texture_entry};
+use crate::frame::{
+    COLOR_FORMAT, DEPTH_FORMAT, Shared, sky_clear, storage_texture_entry, texture_entry,
+};
 use strata_camera::Camera;
 use strata_level::{DirtyRect, Level};
 use strata_occupancy::VoxelSize;
@@ -60,12 +62,32 @@ fn voxel_size(settings: &MethodSettings) -> anyhow::Result<VoxelSize> {
     Ok(VoxelSize { x, y, z })
 }
 
-pub fn create(shared: &Shared, level: &Level, settings: &MethodSettings) -> anyhow::Result<Box<dyn Method>> {
-    Ok(Box::new(build(shared, level, settings, false, DEFAULT_BUDGET_TEXELS)?))
+pub fn create(
+    shared: &Shared,
+    level: &Level,
+    settings: &MethodSettings,
+) -> anyhow::Result<Box<dyn Method>> {
+    Ok(Box::new(build(
+        shared,
+        level,
+        settings,
+        false,
+        DEFAULT_BUDGET_TEXELS,
+    )?))
 }
 
-pub fn create_compute(shared: &Shared, level: &Level, settings: &MethodSettings) -> anyhow::Result<Box<dyn Method>> {
-    Ok(Box::new(build(shared, level, settings, true, DEFAULT_BUDGET_TEXELS)?))
+pub fn create_compute(
+    shared: &Shared,
+    level: &Level,
+    settings: &MethodSettings,
+) -> anyhow::Result<Box<dyn Method>> {
+    Ok(Box::new(build(
+        shared,
+        level,
+        settings,
+        true,
+        DEFAULT_BUDGET_TEXELS,
+    )?))
 }
 
 /// Build either variant with a given per-frame build budget (texels).
@@ -88,11 +110,20 @@ pub fn build(
         );
     }
     let mut params = VoxelParams {
-        config: [settings.voxel_steps, layout.levels.len() as u32, LEAF_SAMPLES, 0],
+        config: [
+            settings.voxel_steps,
+            layout.levels.len() as u32,
+            LEAF_SAMPLES,
+            0,
+        ],
         voxel: [voxel.x, voxel.y, voxel.z, 0],
         levels: [[0; 8]; MAX_LEVELS],
     };
-    for (slot, row) in params.levels.iter_mut().zip(layout.level_table().chunks_exact(8)) {
+    for (slot, row) in params
+        .levels
+        .iter_mut()
+        .zip(layout.level_table().chunks_exact(8))
+    {
         slot.copy_from_slice(row);
     }
     let params = shared.uniform_buffer("voxel params", bytemuck::bytes_of(&params));
@@ -238,7 +269,10 @@ fn depth_always() -> wgpu::DepthStencilState {
 }
 
 /// The core's `fs_depth_blit` over this method's R32Float depth image.
-fn depth_blit(shared: &Shared, depth: &wgpu::TextureView) -> anyhow::Result<(wgpu::RenderPipeline, wgpu::BindGroup)> {
+fn depth_blit(
+    shared: &Shared,
+    depth: &wgpu::TextureView,
+) -> anyhow::Result<(wgpu::RenderPipeline, wgpu::BindGroup)> {
     let device = &shared.device;
     let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("voxel depth blit"),
@@ -259,11 +293,13 @@ fn depth_blit(shared: &Shared, depth: &wgpu::TextureView) -> anyhow::Result<(wgp
     let module = shared.shader("depth_blit.wgsl")?;
     let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some("voxel depth blit"),
-        layout: Some(&device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("voxel depth blit"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        })),
+        layout: Some(
+            &device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("voxel depth blit"),
+                bind_group_layouts: &[Some(&layout)],
+                immediate_size: 0,
+            }),
+        ),
         vertex: wgpu::VertexState {
             module: &module,
             entry_point: Some("vs_fullscreen"),
@@ -290,7 +326,12 @@ impl Method for Voxel {
         self.name
     }
 
-    fn apply_edit(&mut self, _shared: &Shared, _level: &Level, rects: &[DirtyRect]) -> anyhow::Result<()> {
+    fn apply_edit(
+        &mut self,
+        _shared: &Shared,
+        _level: &Level,
+        rects: &[DirtyRect],
+    ) -> anyhow::Result<()> {
         self.pyramid.enqueue(rects)
     }
 
@@ -301,7 +342,8 @@ impl Method for Voxel {
 
     fn record(&self, shared: &Shared, frame: &Frame<'_>, encoder: &mut wgpu::CommandEncoder) {
         if self.pyramid.has_work() {
-            self.pyramid.record(encoder, frame.timer.compute("voxel occupancy update"));
+            self.pyramid
+                .record(encoder, frame.timer.compute("voxel occupancy update"));
         }
         if let Some(pipeline) = &self.fragment {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {

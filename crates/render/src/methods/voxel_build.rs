@@ -61,11 +61,18 @@ pub struct GpuPyramid {
 impl GpuPyramid {
     /// Create the buffer and build the whole pyramid, in submissions of at
     /// most `budget_texels` level-0 texels each.
-    pub fn new(shared: &Shared, level: &Level, voxel: VoxelSize, budget_texels: u64) -> anyhow::Result<Self> {
+    pub fn new(
+        shared: &Shared,
+        level: &Level,
+        voxel: VoxelSize,
+        budget_texels: u64,
+    ) -> anyhow::Result<Self> {
         let layout = Layout::new(level.width(), level.height(), voxel)?;
         let limits = shared.device.limits();
         let bytes = layout.bytes();
-        let max = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
+        let max = limits
+            .max_storage_buffer_binding_size
+            .min(limits.max_buffer_size);
         if bytes > max {
             anyhow::bail!(
                 "voxel grid ({voxel}) on a {}x{} map needs a {:.1} MiB occupancy buffer, but this adapter \
@@ -103,7 +110,9 @@ impl GpuPyramid {
                     ty: wgpu::BindingType::Buffer {
                         ty: wgpu::BufferBindingType::Uniform,
                         has_dynamic_offset: true,
-                        min_binding_size: wgpu::BufferSize::new(std::mem::size_of::<BuildParams>() as u64),
+                        min_binding_size: wgpu::BufferSize::new(
+                            std::mem::size_of::<BuildParams>() as u64
+                        ),
                     },
                     count: None,
                 },
@@ -205,7 +214,9 @@ impl GpuPyramid {
         let mut leaves = Vec::new();
         // Each leaf piece brings one dispatch per level: stop while slots remain.
         while leaves.len() + 1 <= MAX_SLOTS / levels {
-            let Some(mut r) = self.pending.pop_front() else { break };
+            let Some(mut r) = self.pending.pop_front() else {
+                break;
+            };
             let cols = u64::from(r.x1 - r.x0 + 1);
             // Whole tile rows fit while they fit; a lone row wider than the budget is split.
             let rows_fit = budget / (cols * per_column);
@@ -264,7 +275,8 @@ impl GpuPyramid {
         for (i, d) in self.scheduled.iter().enumerate() {
             let p = self.params(d);
             let at = i * self.slot_stride as usize;
-            data[at..at + std::mem::size_of::<BuildParams>()].copy_from_slice(bytemuck::bytes_of(&p));
+            data[at..at + std::mem::size_of::<BuildParams>()]
+                .copy_from_slice(bytemuck::bytes_of(&p));
         }
         if !data.is_empty() {
             shared.queue.write_buffer(&self.slots, 0, &data);
@@ -291,7 +303,11 @@ impl GpuPyramid {
 
     /// Record the dispatches `prepare` chose, in one compute pass (wgpu puts
     /// a barrier between dispatches that write and read the buffer).
-    pub fn record(&self, encoder: &mut wgpu::CommandEncoder, timestamps: Option<wgpu::ComputePassTimestampWrites<'_>>) {
+    pub fn record(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        timestamps: Option<wgpu::ComputePassTimestampWrites<'_>>,
+    ) {
         if self.scheduled.is_empty() {
             return;
         }

@@ -37,7 +37,10 @@ fn world(width: u32, height: u32) -> World {
 
 /// Dig the world's crater into `level`; its dirty rectangles.
 fn dig(world: &World, level: &mut Level) -> Vec<DirtyRect> {
-    let site = world.edit.clone().expect("generated worlds carry an edit site");
+    let site = world
+        .edit
+        .clone()
+        .expect("generated worlds carry an edit site");
     strata_level::edit::crater(level, &site)
 }
 
@@ -60,30 +63,56 @@ fn gpu_pyramid_equals_cpu_twin_before_and_after_an_edit() {
     let w = world(256, 512);
     for voxel in [VoxelSize::COARSE, VoxelSize::FINE] {
         let mut level = w.level.clone();
-        let shared = Shared::new(&gpu.device, &gpu.queue, &level, &TerrainColors::test_ramps(), 8, 8).unwrap();
+        let shared = Shared::new(
+            &gpu.device,
+            &gpu.queue,
+            &level,
+            &TerrainColors::test_ramps(),
+            8,
+            8,
+        )
+        .unwrap();
         // A small budget so the initial build really runs in several submissions.
         let mut gp = GpuPyramid::new(&shared, &level, voxel, 20_000).unwrap();
         let mut cpu = Pyramid::build(&level, voxel).unwrap();
         let got = gp.read_back(&shared).unwrap();
-        assert!(got == cpu.words, "({voxel}) GPU build differs from the CPU twin: {}", diff(&got, &cpu.words));
+        assert!(
+            got == cpu.words,
+            "({voxel}) GPU build differs from the CPU twin: {}",
+            diff(&got, &cpu.words)
+        );
 
         let rects = dig(&w, &mut level);
-        shared.terrain.upload(&shared.queue, &level, &rects).unwrap();
+        shared
+            .terrain
+            .upload(&shared.queue, &level, &rects)
+            .unwrap();
         gp.enqueue(&rects).unwrap();
         let frames = drain(&mut gp, &shared);
         cpu.update(&level, &rects).unwrap();
         let fresh = Pyramid::build(&level, voxel).unwrap();
         assert!(cpu.words == fresh.words);
         let got = gp.read_back(&shared).unwrap();
-        assert!(got == fresh.words, "({voxel}) GPU after the edit differs: {}", diff(&got, &fresh.words));
+        assert!(
+            got == fresh.words,
+            "({voxel}) GPU after the edit differs: {}",
+            diff(&got, &fresh.words)
+        );
         eprintln!("({voxel}) GPU == CPU before and after the crater ({frames} budgeted frames)");
         gpu.errors.check().unwrap();
     }
 }
 
 fn diff(a: &[u32], b: &[u32]) -> String {
-    let bad: Vec<usize> = (0..a.len().min(b.len())).filter(|&i| a[i] != b[i]).collect();
-    format!("{} of {} words differ, first at {:?}", bad.len(), a.len(), bad.first())
+    let bad: Vec<usize> = (0..a.len().min(b.len()))
+        .filter(|&i| a[i] != b[i])
+        .collect();
+    format!(
+        "{} of {} words differ, first at {:?}",
+        bad.len(),
+        a.len(),
+        bad.first()
+    )
 }
 
 /// Render one view with a method and score it against the CPU reference.
@@ -108,13 +137,27 @@ fn voxel_matches_the_reference_over_pitches() {
             let m = score(&mut r, &w.level, &camera);
             eprintln!(
                 "{method} {:>12} pitch {:>4}: see-through {:.3}% covers-sky {:.3}% coherence {:.3}% p50 {:.3} p95 {:.3}",
-                view.name, view.pitch, m.see_through, m.covers_sky, m.coherence, m.depth_p50, m.depth_p95
+                view.name,
+                view.pitch,
+                m.see_through,
+                m.covers_sky,
+                m.coherence,
+                m.depth_p50,
+                m.depth_p95
             );
             worst.see_through = worst.see_through.max(m.see_through);
             worst.coherence = worst.coherence.max(m.coherence);
         }
-        assert!(worst.see_through <= 0.5, "{method}: see-through {:.3}%", worst.see_through);
-        assert!(worst.coherence <= 0.5, "{method}: coherence {:.3}%", worst.coherence);
+        assert!(
+            worst.see_through <= 0.5,
+            "{method}: see-through {:.3}%",
+            worst.see_through
+        );
+        assert!(
+            worst.coherence <= 0.5,
+            "{method}: coherence {:.3}%",
+            worst.coherence
+        );
     }
 }
 
@@ -137,7 +180,11 @@ fn first_frame_after_the_crater_matches_a_fresh_build() {
     let clean = fresh.read_depth().unwrap();
     let a = distance_from_depth(&camera, &edited);
     let b = distance_from_depth(&camera, &clean);
-    let class_mismatch = a.iter().zip(&b).filter(|(x, y)| x.is_finite() != y.is_finite()).count();
+    let class_mismatch = a
+        .iter()
+        .zip(&b)
+        .filter(|(x, y)| x.is_finite() != y.is_finite())
+        .count();
     let mut d: Vec<f32> = a
         .iter()
         .zip(&b)
@@ -154,7 +201,10 @@ fn first_frame_after_the_crater_matches_a_fresh_build() {
     let mut before = Renderer::new(&gpu, &w.level, &colors, "voxel", &settings, W, H).unwrap();
     before.render_frame(&camera).unwrap();
     let old = before.read_depth().unwrap();
-    assert!(old.iter().zip(&edited).any(|(x, y)| (x - y).abs() > 1e-4), "the crater left no trace");
+    assert!(
+        old.iter().zip(&edited).any(|(x, y)| (x - y).abs() > 1e-4),
+        "the crater left no trace"
+    );
 }
 
 #[test]
@@ -166,12 +216,16 @@ fn bad_settings_are_clear_errors() {
         voxel_steps: 0,
         ..MethodSettings::default()
     };
-    let e = Renderer::new(&gpu, &level, &colors, "voxel", &zero, W, H).err().unwrap();
+    let e = Renderer::new(&gpu, &level, &colors, "voxel", &zero, W, H)
+        .err()
+        .unwrap();
     assert!(e.to_string().contains("voxel steps"), "{e}");
     let odd = MethodSettings {
         voxel_size: [3, 8, 2],
         ..MethodSettings::default()
     };
-    let e = Renderer::new(&gpu, &level, &colors, "voxel-compute", &odd, W, H).err().unwrap();
+    let e = Renderer::new(&gpu, &level, &colors, "voxel-compute", &odd, W, H)
+        .err()
+        .unwrap();
     assert!(e.to_string().contains("powers of two"), "{e}");
 }
