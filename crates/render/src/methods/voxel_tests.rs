@@ -161,6 +161,12 @@ fn voxel_matches_the_reference_over_pitches() {
     }
 }
 
+/// The crater fixture's camera stands 158 units back, 40 up, pitch -30: with
+/// the fixed 512 px focal length the crater (about 14 degrees down) is only
+/// in frame when the image is tall enough.
+const EW: u32 = 160;
+const EH: u32 = 400;
+
 #[test]
 fn first_frame_after_the_crater_matches_a_fresh_build() {
     let Some(gpu) = gpu() else { return };
@@ -169,13 +175,13 @@ fn first_frame_after_the_crater_matches_a_fresh_build() {
     let settings = MethodSettings::default();
     let site = w.edit.clone().unwrap();
     let mut level = w.level.clone();
-    let mut r = Renderer::new(&gpu, &level, &colors, "voxel", &settings, W, H).unwrap();
+    let mut r = Renderer::new(&gpu, &level, &colors, "voxel", &settings, EW, EH).unwrap();
     let rects = dig(&w, &mut level);
-    let camera = Camera::from_view(&level, &site.camera, W, H).unwrap();
+    let camera = Camera::from_view(&level, &site.camera, EW, EH).unwrap();
     r.apply_edit(&level, &rects).unwrap();
     r.render_frame(&camera).unwrap();
     let edited = r.read_depth().unwrap();
-    let mut fresh = Renderer::new(&gpu, &level, &colors, "voxel", &settings, W, H).unwrap();
+    let mut fresh = Renderer::new(&gpu, &level, &colors, "voxel", &settings, EW, EH).unwrap();
     fresh.render_frame(&camera).unwrap();
     let clean = fresh.read_depth().unwrap();
     let a = distance_from_depth(&camera, &edited);
@@ -198,12 +204,18 @@ fn first_frame_after_the_crater_matches_a_fresh_build() {
     assert!(pct <= 0.01, "class mismatch {pct}%");
     assert!(p95 <= 0.1, "p95 {p95}");
     // The edit is visible: the view changed where the crater is.
-    let mut before = Renderer::new(&gpu, &w.level, &colors, "voxel", &settings, W, H).unwrap();
+    let mut before = Renderer::new(&gpu, &w.level, &colors, "voxel", &settings, EW, EH).unwrap();
     before.render_frame(&camera).unwrap();
     let old = before.read_depth().unwrap();
+    let changed = old
+        .iter()
+        .zip(&edited)
+        .filter(|(x, y)| (*x - *y).abs() > 1e-4)
+        .count();
+    eprintln!("pixels changed by the crater: {changed} of {}", old.len());
     assert!(
-        old.iter().zip(&edited).any(|(x, y)| (x - y).abs() > 1e-4),
-        "the crater left no trace"
+        changed > 100,
+        "the crater left (almost) no trace: {changed} pixels"
     );
 }
 
