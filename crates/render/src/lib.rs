@@ -19,6 +19,7 @@ pub mod frame;
 pub mod gpu;
 pub mod methods;
 pub mod renderer;
+pub mod report;
 pub mod shaders;
 pub mod shadow;
 pub mod terrain;

@@ -10,6 +10,14 @@ use std::time::Instant;
 use strata_camera::Camera;
 use strata_level::{DirtyRect, Level};
 
+/// What [`Renderer::measure`] saw.
+#[derive(Clone, Debug, Default)]
+pub struct Measured {
+    pub first_frame_ms: f64,
+    pub warmup_ms: f64,
+    pub timings: Vec<FrameTimings>,
+}
+
 /// One method rendering one level at one size.
 pub struct Renderer {
     shared: Shared,
@@ -173,6 +181,33 @@ impl Renderer {
             record_ms,
             passes,
             untimed_passes: self.timer.untimed(),
+        })
+    }
+
+    /// The protocol's frame loop: one first frame, `warmup` untimed frames,
+    /// then `frames` timed ones (wall-clock ms of the first frame and of the
+    /// warm-up as a whole, as preparation costs).
+    pub fn measure(
+        &mut self,
+        camera: &Camera,
+        warmup: u32,
+        frames: u32,
+    ) -> anyhow::Result<Measured> {
+        let start = Instant::now();
+        self.render_frame(camera)?;
+        let first_frame_ms = ms(start);
+        let start = Instant::now();
+        for _ in 0..warmup {
+            self.render_frame(camera)?;
+        }
+        let warmup_ms = ms(start);
+        let timings = (0..frames)
+            .map(|_| self.render_frame(camera))
+            .collect::<anyhow::Result<Vec<_>>>()?;
+        Ok(Measured {
+            first_frame_ms,
+            warmup_ms,
+            timings,
         })
     }
 

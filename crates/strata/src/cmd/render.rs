@@ -1,8 +1,236 @@
-//! `strata render` (not implemented yet).
+//! `strata render`: one method, one or more views, on the GPU. Writes
+//! `color.png`, `depth.f32` (little-endian f32 depth-buffer values, row-major,
+//! 1.0 = sky) and `render.json` per view; `--json` prints one line per view.
+
+use crate::world_arg::WorldArgs;
+use anyhow::{Context, bail};
+use std::path::PathBuf;
+use std::time::Instant;
+use strata_camera::Camera;
+use strata_level::{ViewSpec, views::parse_views};
+use strata_render::report::{Prep, RenderReport, write_outputs};
+use strata_render::{Gpu, MethodSettings, Renderer, Stats, TerrainColors};
 
 #[derive(clap::Args)]
-pub struct Args {}
+pub struct Args {
+    #[command(flatten)]
+    pub world: WorldArgs,
+    /// Method: ray, ray-compute (and whatever else `strata_render::methods::METHODS` lists).
+    #[arg(long, default_value = "ray")]
+    pub method: String,
+    /// One view `X,Y:YAW:EYE[:under]` (needs --pitch).
+    #[arg(long, value_name = "SPEC", conflicts_with_all = ["views", "view_name"], requires = "pitch")]
+    pub view: Option<String>,
+    /// Pitch of --view, degrees (negative looks down).
+    #[arg(long, allow_hyphen_values = true)]
+    pub pitch: Option<f32>,
+    /// Every view of a views file (`NAME X,Y:YAW:EYE[:under] PITCH` per line).
+    #[arg(long, value_name = "FILE", conflicts_with = "view_name")]
+    pub views: Option<PathBuf>,
+    /// One of the world's own views, by name. With no view option: all of them.
+    #[arg(long, value_name = "NAME")]
+    pub view_name: Option<String>,
+    /// Image size.
+    #[arg(long, default_value = "1280x800", value_parser = parse_size)]
+    pub size: (u32, u32),
+    /// Timed frames per view.
+    #[arg(long, default_value_t = 40)]
+    pub frames: u32,
+    /// Untimed warm-up frames after the first.
+    #[arg(long, default_value_t = 3)]
+    pub warmup: u32,
+    /// Forward samples per ray (`ray`, `ray-compute`).
+    #[arg(long, default_value_t = 128)]
+    pub ray_steps: u32,
+    /// Turn the shared shadow map off.
+    #[arg(long)]
+    pub no_shadows: bool,
+    /// Output directory (one sub-directory per view when there are several).
+    #[arg(long, default_value = "render-out")]
+    pub out: PathBuf,
+    /// Print one JSON line per view instead of a table.
+    #[arg(long)]
+    pub json: bool,
+}
 
-pub fn run(_args: Args) -> anyhow::Result<()> {
-    anyhow::bail!("`strata render` is not implemented yet")
+fn parse_size(text: &str) -> Result<(u32, u32), String> {
+    let (w, h) = text
+        .split_once('x')
+        .ok_or("size must be WxH, e.g. 1280x800")?;
+    let w: u32 = w
+        .trim()
+        .parse()
+        .map_err(|_| format!("width `{w}` is not a number"))?;
+    let h: u32 = h
+        .trim()
+        .parse()
+        .map_err(|_| format!("height `{h}` is not a number"))?;
+    if w == 0 || h == 0 {
+        return Err(format!("size {w}x{h} must be positive"));
+    }
+    Ok((w, h))
+}
+
+// TODO(world_arg): switch to `WorldArgs::load` once it lands.
+fn load_world(args: &WorldArgs) -> anyhow::Result<strata_level::World> {
+    let rule = if args.vange_rs_mid {
+        strata_level::MidRule::VangeRs
+    } else {
+        strata_level::MidRule::Original
+    };
+    match &args.level {
+        Some(dir) => strata_level::io::load_world(dir, rule)
+            .with_context(|| format!("loading the world in {}", dir.display())),
+        None => bail!("no --level DIR given and the built-in generated world is not wired up yet"),
+    }
+}
+
+fn select_views(args: &Args, world: &strata_level::World) -> anyhow::Result<Vec<ViewSpec>> {
+    let views = match (&args.view, &args.views, &args.view_name) {
+        (Some(spec), _, _) => {
+            let pitch = args.pitch.context("--view needs --pitch DEG")?;
+            vec![ViewSpec::parse("view", spec, pitch).context("--view")?]
+        }
+        (None, Some(file), _) => {
+            let text = std::fs::read_to_string(file)
+                .with_context(|| format!("reading views file {}", file.display()))?;
+            parse_views(&text).with_context(|| format!("views file {}", file.display()))?
+        }
+        (None, None, Some(name)) => {
+            let v = world.views.iter().find(|v| &v.name == name).cloned();
+            let names: Vec<&str> = world.views.iter().map(|v| v.name.as_str()).collect();
+            vec![v.with_context(|| {
+                format!(
+                    "the world has no view `{name}`; it has: {}",
+                    names.join(", ")
+                )
+            })?]
+        }
+        (None, None, None) => world.views.clone(),
+    };
+    if views.is_empty() {
+        bail!("no views: give --view SPEC --pitch DEG, --views FILE or --view-name NAME");
+    }
+    for v in &views {
+        if v.name.is_empty() || v.name.contains(['/', '\\']) || v.name == "." || v.name == ".." {
+            bail!("view name `{}` cannot be a directory name", v.name);
+        }
+    }
+    Ok(views)
+}
+
+pub fn run(args: Args) -> anyhow::Result<()> {
+    if args.frames == 0 {
+        bail!("--frames must be at least 1");
+    }
+    let world = load_world(&args.world)?;
+    let views = select_views(&args, &world)?;
+    let (w, h) = args.size;
+    let cameras = views
+        .iter()
+        .map(|v| {
+            Camera::from_view(&world.level, v, w, h).with_context(|| format!("view `{}`", v.name))
+        })
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    let settings = MethodSettings {
+        ray_steps: args.ray_steps,
+        shadows: !args.no_shadows,
+        ..Default::default()
+    };
+    let gpu = Gpu::headless()?;
+    let start = Instant::now();
+    let mut renderer = Renderer::new(
+        &gpu,
+        &world.level,
+        &TerrainColors::from_world(&world),
+        &args.method,
+        &settings,
+        w,
+        h,
+    )?;
+    let setup_ms = start.elapsed().as_secs_f64() * 1e3;
+    if !args.json {
+        let r = &gpu.report;
+        println!(
+            "adapter: {} ({}, driver {} {})",
+            r.name, r.backend, r.driver, r.driver_info
+        );
+        if !r.timestamps {
+            println!(
+                "no GPU timestamps on this adapter: gpu_ms is null, CPU submit-and-wait reported"
+            );
+        }
+        println!(
+            "{:<14} {:>10} {:>10} {:>10} {:>10} {:>12}",
+            "view", "gpu ms", "cpu ms", "first ms", "setup ms", "gpu bytes"
+        );
+    }
+    let retained = renderer.retained_bytes();
+    for (view, camera) in views.iter().zip(&cameras) {
+        let m = renderer.measure(camera, args.warmup, args.frames)?;
+        let gpu_ms: Vec<f64> = m.timings.iter().filter_map(|t| t.gpu_ms).collect();
+        let cpu_ms: Vec<f64> = m.timings.iter().map(|t| t.cpu_ms).collect();
+        let mut passes: Vec<(String, f64)> = Vec::new();
+        for t in &m.timings {
+            for (label, ms) in &t.passes {
+                match passes.iter_mut().find(|(l, _)| l == label) {
+                    Some(p) => p.1 += ms / m.timings.len() as f64,
+                    None => passes.push((label.clone(), ms / m.timings.len() as f64)),
+                }
+            }
+        }
+        let timestamps = gpu_ms.len() == m.timings.len();
+        let report = RenderReport {
+            adapter: gpu.report.name.clone(),
+            backend: gpu.report.backend.clone(),
+            driver: gpu.report.driver.clone(),
+            adapter_info: gpu.report.clone(),
+            world: world.name.clone(),
+            method: renderer.method_name().to_string(),
+            view: view.clone(),
+            camera: *camera,
+            size: [w, h],
+            settings: settings.clone(),
+            shadows: settings.shadows,
+            frames: args.frames,
+            timing_source: if timestamps {
+                "gpu-timestamps-per-pass"
+            } else {
+                "cpu-submit-and-wait"
+            },
+            gpu_ms: if timestamps { Stats::of(&gpu_ms) } else { None },
+            cpu_ms: Stats::of(&cpu_ms).unwrap_or_default(),
+            passes,
+            prep: Prep {
+                setup_ms,
+                first_frame_ms: m.first_frame_ms,
+                warmup_ms: m.warmup_ms,
+                warmup_frames: args.warmup,
+            },
+            gpu_bytes: retained.gpu,
+            cpu_bytes: retained.cpu,
+            shared_gpu_bytes: renderer.shared_gpu_bytes(),
+        };
+        let dir = if views.len() == 1 {
+            args.out.clone()
+        } else {
+            args.out.join(&view.name)
+        };
+        let color = renderer.read_color()?;
+        let depth = renderer.read_depth()?;
+        write_outputs(&dir, &report, &color, &depth)?;
+        if args.json {
+            println!("{}", serde_json::to_string(&report)?);
+        } else {
+            let gpu = report
+                .gpu_ms
+                .map(|s| format!("{:.3}", s.mean))
+                .unwrap_or_else(|| "n/a".into());
+            println!(
+                "{:<14} {:>10} {:>10.3} {:>10.1} {:>10.1} {:>12}",
+                view.name, gpu, report.cpu_ms.mean, m.first_frame_ms, setup_ms, retained.gpu
+            );
+        }
+    }
+    Ok(())
 }
