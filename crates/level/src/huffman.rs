@@ -13,8 +13,7 @@ pub const TREE_SLOTS: usize = 512;
 /// Longest code the encoder emits.
 pub const MAX_CODE_LEN: u32 = 24;
 /// Bits resolved by one lookup in the decoder's table.
-const LOOKUP_BITS: u32 = 11;
-const LEAF: u32 = 1 << 31;
+const LOOKUP_BITS: u32 = 12;
 
 pub type Tree = [i32; TREE_SLOTS];
 
@@ -162,12 +161,29 @@ pub enum TreeError {
     Cycle { node: usize, target: i32 },
 }
 
-/// A checked decode tree plus a lookup table resolving [`LOOKUP_BITS`] bits at once.
+/// A checked decode tree plus a lookup table resolving [`LOOKUP_BITS`] bits
+/// at once: up to two whole symbols per lookup (delta-coded terrain is
+/// mostly short codes, so two per lookup halves the work).
 pub struct Decoder {
     tree: Tree,
-    /// Per `LOOKUP_BITS`-bit prefix: `LEAF | len << 8 | symbol`, or
-    /// `LOOKUP_BITS << 8 | node` to continue the walk at `node`.
+    /// Per `LOOKUP_BITS`-bit prefix, packed: `sym1 | sym2 << 8 | len1 << 16
+    /// | len_total << 21 | count << 26`. `count` 0 means no symbol ends
+    /// inside the prefix: the walk continues at node `sym1`.
     table: Vec<u32>,
+}
+
+/// Walk from `node` along the low `n` bits of `prefix` (MSB first).
+/// Returns `(symbol, bits used)` when a leaf is reached, else `Err(node)`.
+fn walk(tree: &Tree, mut node: usize, prefix: u32, n: u32) -> Result<(u8, u32), usize> {
+    for i in 0..n {
+        let bit = ((prefix >> (n - 1 - i)) & 1) as usize;
+        let v = tree[2 * node + bit];
+        if v <= 0 {
+            return Ok((v.wrapping_neg() as u8, i + 1));
+        }
+        node = v as usize;
+    }
+    Err(node)
 }
 
 impl Decoder {
@@ -194,36 +210,65 @@ impl Decoder {
                 stack.push(t);
             }
         }
-        // Every path now ends in a leaf within 255 steps: the walks below terminate.
+        // Every path now ends in a leaf within 255 steps: walks terminate.
         let table = (0..1u32 << LOOKUP_BITS)
-            .map(|prefix| {
-                let mut node = 1usize;
-                for i in 0..LOOKUP_BITS {
-                    let bit = ((prefix >> (LOOKUP_BITS - 1 - i)) & 1) as usize;
-                    let v = tree[2 * node + bit];
-                    if v <= 0 {
-                        return LEAF | (i + 1) << 8 | (v.wrapping_neg() as u32 & 0xff);
+            .map(|prefix| match walk(tree, 1, prefix, LOOKUP_BITS) {
+                Err(node) => LOOKUP_BITS << 21 | node as u32,
+                Ok((s1, l1)) => {
+                    let rest = LOOKUP_BITS - l1;
+                    let mask = (1u32 << rest) - 1;
+                    match walk(tree, 1, prefix & mask, rest) {
+                        Ok((s2, l2)) => {
+                            2 << 26
+                                | (l1 + l2) << 21
+                                | l1 << 16
+                                | u32::from(s2) << 8
+                                | u32::from(s1)
+                        }
+                        Err(_) => 1 << 26 | l1 << 21 | l1 << 16 | u32::from(s1),
                     }
-                    node = v as usize;
                 }
-                LOOKUP_BITS << 8 | node as u32
             })
             .collect();
         Ok(Decoder { tree: *tree, table })
     }
 
-    /// Decode one symbol.
+    /// Decode `out.len()` symbols into `out`.
     #[inline]
-    pub fn symbol(&self, bits: &mut BitReader<'_>) -> u8 {
-        bits.refill();
-        let entry = self.table[(bits.buf >> (64 - LOOKUP_BITS)) as usize];
-        let len = (entry >> 8) & 0xff;
-        bits.consume(len);
-        if entry & LEAF != 0 {
-            return entry as u8;
+    pub fn decode_into(&self, bits: &mut BitReader<'_>, out: &mut [u8]) {
+        let n = out.len();
+        let mut i = 0;
+        while i < n {
+            bits.refill();
+            let e = self.table[(bits.buf >> (64 - LOOKUP_BITS)) as usize];
+            let count = e >> 26;
+            if count == 2 && i + 1 < n {
+                bits.consume((e >> 21) & 31);
+                out[i] = e as u8;
+                out[i + 1] = (e >> 8) as u8;
+                i += 2;
+            } else if count != 0 {
+                bits.consume((e >> 16) & 31);
+                out[i] = e as u8;
+                i += 1;
+            } else {
+                bits.consume(LOOKUP_BITS);
+                out[i] = self.walk_rest((e & 0xff) as usize, bits);
+                i += 1;
+            }
         }
-        // Rare long code: walk the rest of the (checked) tree bit by bit.
-        let mut node = (entry & 0x1ff) as usize;
+    }
+
+    /// Decode one symbol.
+    pub fn symbol(&self, bits: &mut BitReader<'_>) -> u8 {
+        let mut s = [0u8];
+        self.decode_into(bits, &mut s);
+        s[0]
+    }
+
+    /// Rare long code: walk the rest of the (checked) tree bit by bit.
+    #[cold]
+    fn walk_rest(&self, mut node: usize, bits: &mut BitReader<'_>) -> u8 {
         loop {
             bits.refill();
             let bit = (bits.buf >> 63) as usize;

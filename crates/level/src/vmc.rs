@@ -112,10 +112,12 @@ fn decode_row(
 ) -> Result<(), String> {
     let size_bits = data.len() * 8;
     let mut bits = BitReader::new(data, 0);
+    // Symbols first, then undo the delta / XOR coding in place.
+    heights_dec.decode_into(&mut bits, h_row);
     let mut h = 0u8;
-    for out in h_row.iter_mut() {
-        h = h.wrapping_add(heights_dec.symbol(&mut bits));
-        *out = h;
+    for v in h_row.iter_mut() {
+        h = h.wrapping_add(*v);
+        *v = h;
     }
     let h_bits = bits.position();
     if h_bits > size_bits {
@@ -126,10 +128,11 @@ fn decode_row(
     }
     let meta_start = h_bits.div_ceil(8);
     let mut bits = BitReader::new(data, meta_start);
+    metas_dec.decode_into(&mut bits, m_row);
     let mut m = 0u8;
-    for out in m_row.iter_mut() {
-        m ^= metas_dec.symbol(&mut bits);
-        *out = m;
+    for v in m_row.iter_mut() {
+        m ^= *v;
+        *v = m;
     }
     let used = bits.position().div_ceil(8);
     match used.cmp(&data.len()) {

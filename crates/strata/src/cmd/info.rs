@@ -1,8 +1,158 @@
-//! `strata info` (not implemented yet).
+//! `strata info`: a world's size, dual fraction, height range, terrain
+//! types, roughness, pair disagreements, and how long its map takes to decode.
+
+use anyhow::{Context, bail};
+use serde::Serialize;
+use std::path::Path;
+use std::time::Instant;
+use strata_level::model::MidRule;
+use strata_level::stats::LevelStats;
+use strata_level::{Level, io, vmc};
 
 #[derive(clap::Args)]
-pub struct Args {}
+pub struct Args {
+    #[command(flatten)]
+    world: crate::world_arg::WorldArgs,
+    /// Print one JSON object instead of text.
+    #[arg(long)]
+    json: bool,
+    /// Also encode the map as `.vmc` in memory and time decoding that
+    /// (done anyway when the world's own map is not a `.vmc`).
+    #[arg(long)]
+    reencode: bool,
+}
 
-pub fn run(_args: Args) -> anyhow::Result<()> {
-    anyhow::bail!("`strata info` is not implemented yet")
+/// How the map file loaded.
+#[derive(Serialize)]
+struct MapFile {
+    path: String,
+    bytes: u64,
+    read_ms: f64,
+    decode_ms: f64,
+}
+
+/// The map encoded as `.vmc` in memory, then decoded again.
+#[derive(Serialize)]
+struct VmcRoundTrip {
+    bytes: u64,
+    encode_ms: f64,
+    decode_ms: f64,
+}
+
+#[derive(Serialize)]
+struct Info {
+    world: String,
+    mid_rule: MidRule,
+    map_file: Option<MapFile>,
+    vmc_round_trip: Option<VmcRoundTrip>,
+    stats_ms: f64,
+    stats: LevelStats,
+}
+
+fn ms_since(t: Instant) -> f64 {
+    t.elapsed().as_secs_f64() * 1e3
+}
+
+fn vmc_round_trip(level: &Level) -> anyhow::Result<VmcRoundTrip> {
+    let path = Path::new("<in memory>.vmc");
+    let t = Instant::now();
+    let bytes = vmc::encode_vmc(level, path)?;
+    let encode_ms = ms_since(t);
+    let t = Instant::now();
+    let back = vmc::decode_vmc(&bytes, level.width(), level.height(), level.mid_rule, path)?;
+    let decode_ms = ms_since(t);
+    if back.heights() != level.heights() || back.metas() != level.metas() {
+        bail!("the in-memory .vmc round trip changed the map (encoder bug)");
+    }
+    Ok(VmcRoundTrip {
+        bytes: bytes.len() as u64,
+        encode_ms,
+        decode_ms,
+    })
+}
+
+pub fn run(args: Args) -> anyhow::Result<()> {
+    let mid_rule = if args.world.vange_rs_mid {
+        MidRule::VangeRs
+    } else {
+        MidRule::Original
+    };
+    let Some(dir) = &args.world.level else {
+        bail!(
+            "`strata info` needs --level DIR for now (the built-in world comes with `strata generate`)"
+        );
+    };
+    let (world, load) = io::load_world_timed(dir, mid_rule)
+        .with_context(|| format!("loading the world in {}", dir.display()))?;
+    let is_vmc = world.config.compressed;
+    let map_file = Some(MapFile {
+        path: load.path.display().to_string(),
+        bytes: load.bytes,
+        read_ms: load.read_ms,
+        decode_ms: load.decode_ms,
+    });
+    let vmc_round_trip = if args.reencode || !is_vmc {
+        Some(vmc_round_trip(&world.level)?)
+    } else {
+        None
+    };
+    let t = Instant::now();
+    let stats = LevelStats::compute(&world.level);
+    let info = Info {
+        world: world.name.clone(),
+        mid_rule,
+        map_file,
+        vmc_round_trip,
+        stats_ms: ms_since(t),
+        stats,
+    };
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&info)?);
+    } else {
+        print_text(&info);
+    }
+    Ok(())
+}
+
+fn print_text(info: &Info) {
+    let s = &info.stats;
+    println!("world        {} ({:?} mid rule)", info.world, info.mid_rule);
+    println!("size         {} x {}", s.width, s.height);
+    if let Some(m) = &info.map_file {
+        println!(
+            "map file     {} ({:.2} MB): read {:.0} ms, decode {:.0} ms",
+            m.path,
+            m.bytes as f64 / 1e6,
+            m.read_ms,
+            m.decode_ms
+        );
+    }
+    if let Some(r) = &info.vmc_round_trip {
+        println!(
+            "as .vmc      {:.2} MB: encode {:.0} ms, decode {:.0} ms",
+            r.bytes as f64 / 1e6,
+            r.encode_ms,
+            r.decode_ms
+        );
+    }
+    println!("dual         {:.2} % of texels", s.dual_percent);
+    println!("heights      {} .. {}", s.height_min, s.height_max);
+    let pct = |p: &[f64; 8]| {
+        p.iter()
+            .enumerate()
+            .map(|(t, v)| format!("{t}:{v:.1}"))
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    println!("floor types  {} (% of texels)", pct(&s.floor_type_percent));
+    println!(
+        "slab types   {} (% of dual texels)",
+        pct(&s.slab_type_percent)
+    );
+    println!(
+        "roughness    floor {:.2}, surface {:.2} (Fostral: 3.44, 6.54)",
+        s.roughness_floor, s.roughness_surface
+    );
+    println!("pair disagreements {}", s.pair_disagreements);
+    println!("stats        {:.0} ms", info.stats_ms);
 }
