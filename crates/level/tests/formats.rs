@@ -236,3 +236,62 @@ fn fostral_directory_without_map_names_the_missing_file() {
     assert_eq!(world.water.as_deref().map(|w| w.len()), Some(128));
     assert!(world.level == level);
 }
+
+#[test]
+fn world_directory_errors_name_the_file() {
+    use strata_level::io::{load_world, write_world};
+    use strata_level::{World, WorldConfig};
+    let dir = temp_dir("world_errors");
+    let world = World {
+        name: "x".into(),
+        level: synthetic(64, 32, 13),
+        config: WorldConfig {
+            map_power_x: 6,
+            map_power_y: 5,
+            ..WorldConfig::default()
+        },
+        palette: strata_level::Palette {
+            colors: [[4, 8, 12]; 256],
+        },
+        water: None,
+        views: Vec::new(),
+        edit: None,
+    };
+    write_world(&dir, &world).unwrap();
+    assert!(!dir.join("views.txt").exists() && !dir.join("output.vpr").exists());
+    let back = load_world(&dir, MidRule::Original).unwrap();
+    assert!(back.views.is_empty() && back.edit.is_none() && back.water.is_none());
+
+    let load_err = || load_world(&dir, MidRule::Original).unwrap_err().to_string();
+    std::fs::write(dir.join("views.txt"), "river 1,2:3 0\n").unwrap();
+    let e = load_err();
+    assert!(e.contains("views.txt") && e.contains("line 1"), "{e}");
+    std::fs::remove_file(dir.join("views.txt")).unwrap();
+
+    std::fs::write(dir.join("output.vpr"), [0u8; 3]).unwrap();
+    let e = load_err();
+    assert!(e.contains("output.vpr") && e.contains("too short"), "{e}");
+    std::fs::remove_file(dir.join("output.vpr")).unwrap();
+
+    std::fs::write(dir.join("harmony.pal"), [0u8; 10]).unwrap();
+    let e = load_err();
+    assert!(e.contains("harmony.pal") && e.contains("10 bytes"), "{e}");
+
+    let ini = std::fs::read_to_string(dir.join("world.ini")).unwrap();
+    std::fs::write(
+        dir.join("world.ini"),
+        ini.replace("Map Power Y=5", "Map Power Y=6"),
+    )
+    .unwrap();
+    let e = load_err();
+    assert!(e.contains("output.vmc"), "{e}");
+    std::fs::remove_file(dir.join("world.ini")).unwrap();
+    let e = load_err();
+    assert!(e.contains("world.ini"), "{e}");
+
+    // Writing refuses a config whose size disagrees with the level.
+    let mut bad = world.clone();
+    bad.config.map_power_x = 7;
+    let e = write_world(&dir, &bad).unwrap_err().to_string();
+    assert!(e.contains("world.ini") && e.contains("disagrees"), "{e}");
+}
