@@ -1,0 +1,279 @@
+//! The built-in Vangers-like world: terraced plateaus with vertical cliffs,
+//! a river valley at sea level 80, roads that ramp between levels, districts
+//! of pits, furrows, pillared halls and hangars, slabs (bridges, arches,
+//! overhangs, roofs) and ten named landmarks with twelve default views.
+//!
+//! Every texel is a pure function of (seed, size, x, y), evaluated row by row
+//! in parallel, so the bytes are the same at any thread count.
+
+mod assets;
+pub mod landmarks;
+mod noise;
+pub mod preview;
+pub mod terrain;
+
+use crate::World;
+use crate::model::{
+    Level, META_DELTA_MASK, META_DOUBLE_LEVEL, META_TERRAIN_SHIFT, MidRule, ShapeError,
+};
+use rayon::prelude::*;
+
+pub use assets::{BEGIN_COLORS, END_COLORS, palette, world_config};
+pub use terrain::SEA;
+
+/// Bumped whenever the output for a given seed and size changes (cache key).
+pub const GENERATOR_VERSION: u32 = 1;
+/// Smallest side the generator accepts (the landmarks need the room).
+pub const MIN_SIDE: u32 = 256;
+/// Largest side (the `world.ini` reader refuses map powers above 15).
+pub const MAX_SIDE: u32 = 1 << 15;
+/// Largest map, in texels (two bytes each in memory).
+pub const MAX_TEXELS: u64 = 1 << 28;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct GenerateParams {
+    pub seed: u64,
+    pub width: u32,
+    pub height: u32,
+}
+
+impl Default for GenerateParams {
+    /// The built-in default world: Fostral's size, a fixed seed.
+    fn default() -> Self {
+        GenerateParams {
+            seed: 1997,
+            width: 2048,
+            height: 16384,
+        }
+    }
+}
+
+#[derive(Debug, thiserror::Error, PartialEq, Eq)]
+pub enum GenerateError {
+    #[error("map size {width}x{height}: {reason}")]
+    Size {
+        width: u32,
+        height: u32,
+        reason: String,
+    },
+    #[error("size `{0}` is not WIDTHxHEIGHT (e.g. 2048x16384)")]
+    SizeSyntax(String),
+    #[error("map {width}x{height} has no room left for the `{landmark}` landmark")]
+    NoRoom {
+        width: u32,
+        height: u32,
+        landmark: &'static str,
+    },
+    #[error(transparent)]
+    Shape(#[from] ShapeError),
+}
+
+/// Parse `WIDTHxHEIGHT`; the size itself is checked by [`check_size`].
+pub fn parse_size(text: &str) -> Result<(u32, u32), GenerateError> {
+    let bad = || GenerateError::SizeSyntax(text.to_string());
+    let (w, h) = text.trim().split_once(['x', 'X']).ok_or_else(bad)?;
+    Ok((
+        w.trim().parse().map_err(|_| bad())?,
+        h.trim().parse().map_err(|_| bad())?,
+    ))
+}
+
+/// Powers of two from 256 to 65536 a side, at most 2^28 texels.
+pub fn check_size(width: u32, height: u32) -> Result<(), GenerateError> {
+    let err = |reason: &str| GenerateError::Size {
+        width,
+        height,
+        reason: reason.to_string(),
+    };
+    if !width.is_power_of_two() || !height.is_power_of_two() {
+        return Err(err("each side must be a power of two"));
+    }
+    if width < MIN_SIDE || height < MIN_SIDE {
+        return Err(err("each side must be at least 256"));
+    }
+    if width > MAX_SIDE || height > MAX_SIDE {
+        return Err(err("each side must be at most 32768"));
+    }
+    if u64::from(width) * u64::from(height) > MAX_TEXELS {
+        return Err(err("at most 2^28 texels"));
+    }
+    Ok(())
+}
+
+/// An overhead solid layer over a texel: wanted cave ceiling and slab top.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Slab {
+    pub ceiling: i32,
+    pub high: i32,
+    pub ty: u8,
+}
+
+/// What the generator wants at one texel, before pair encoding.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Texel {
+    pub floor: i32,
+    pub ty: u8,
+    pub slab: Option<Slab>,
+}
+
+impl Texel {
+    #[inline]
+    pub fn single(floor: i32, ty: u8) -> Self {
+        Texel {
+            floor,
+            ty,
+            slab: None,
+        }
+    }
+
+    #[inline]
+    pub fn with_slab(self, ceiling: i32, high: i32, ty: u8) -> Self {
+        Texel {
+            slab: Some(Slab { ceiling, high, ty }),
+            ..self
+        }
+    }
+}
+
+#[inline]
+fn byte(v: i32) -> u8 {
+    v.clamp(0, 255) as u8
+}
+
+/// Encode a horizontal texel pair (DESIGN §1). A slab wanted by either texel
+/// makes the pair dual; the gap code rounds the ceiling down to the 8-unit
+/// steps of the original mid rule, so every cave is at least 8 tall, and a
+/// slab too thin to keep a cave and 2 units of roof is dropped.
+#[inline]
+fn encode_pair(a: Texel, b: Texel, heights: &mut [u8], metas: &mut [u8]) {
+    let carrier = if a.slab.is_some() {
+        Some(a)
+    } else if b.slab.is_some() {
+        Some(b)
+    } else {
+        None
+    };
+    if let Some(t) = carrier {
+        let s = t.slab.expect("carrier has a slab");
+        let low = byte(t.floor);
+        let high = byte(s.high);
+        let want = s.ceiling - i32::from(low);
+        let code = (want / 8 - 1).clamp(0, 15) as u8;
+        let mid = i32::from(low) + MidRule::Original.gap(code) as i32;
+        if i32::from(high) - mid >= 2 {
+            heights[0] = low;
+            heights[1] = high;
+            metas[0] = META_DOUBLE_LEVEL | ((t.ty & 7) << META_TERRAIN_SHIFT) | (code >> 2);
+            metas[1] =
+                META_DOUBLE_LEVEL | ((s.ty & 7) << META_TERRAIN_SHIFT) | (code & META_DELTA_MASK);
+            return;
+        }
+    }
+    for (i, t) in [a, b].into_iter().enumerate() {
+        heights[i] = byte(t.floor);
+        metas[i] = (t.ty & 7) << META_TERRAIN_SHIFT;
+    }
+}
+
+/// Generate the world for `params`.
+pub fn generate(params: &GenerateParams) -> Result<World, GenerateError> {
+    let GenerateParams {
+        seed,
+        width,
+        height,
+    } = *params;
+    check_size(width, height)?;
+    let terrain = terrain::Terrain::new(seed, width, height);
+    let layout = landmarks::place(&terrain)?;
+    let w = width as usize;
+    let mut heights = vec![0u8; w * height as usize];
+    let mut metas = vec![0u8; w * height as usize];
+    heights
+        .par_chunks_mut(w)
+        .zip(metas.par_chunks_mut(w))
+        .enumerate()
+        .for_each(|(y, (hrow, mrow))| {
+            let y = y as u32;
+            let sites: Vec<&landmarks::Landmark> =
+                layout.list.iter().filter(|l| l.covers_row(y)).collect();
+            let row = terrain.row(y);
+            let texel = |x: u32| match sites.iter().find(|l| l.covers_x(x)) {
+                Some(site) => site.texel(&terrain, x, y),
+                None => terrain.texel(x, &row),
+            };
+            for x in (0..width).step_by(2) {
+                let i = x as usize;
+                encode_pair(
+                    texel(x),
+                    texel(x + 1),
+                    &mut hrow[i..i + 2],
+                    &mut mrow[i..i + 2],
+                );
+            }
+        });
+    let level = Level::from_planes(width, height, heights, metas, MidRule::Original)?;
+    Ok(World {
+        name: format!("generated-{seed}"),
+        config: world_config(width, height)?,
+        palette: palette(),
+        water: Some(vec![SEA; (height as usize).div_ceil(128)]),
+        views: layout.views(&terrain),
+        edit: Some(layout.edit_site()),
+        level,
+    })
+}
+
+/// The landmarks of the world `params` would generate: name, description,
+/// centre, without generating the map.
+pub fn landmark_list(
+    params: &GenerateParams,
+) -> Result<Vec<(String, String, u32, u32)>, GenerateError> {
+    check_size(params.width, params.height)?;
+    let terrain = terrain::Terrain::new(params.seed, params.width, params.height);
+    let layout = landmarks::place(&terrain)?;
+    Ok(layout
+        .list
+        .iter()
+        .map(|l| {
+            (
+                l.kind.name().to_string(),
+                l.kind.describe().to_string(),
+                l.x0 + l.w / 2,
+                l.y0 + l.h / 2,
+            )
+        })
+        .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes_are_checked() {
+        assert_eq!(parse_size("512x2048"), Ok((512, 2048)));
+        assert!(parse_size("512").is_err());
+        assert!(parse_size("ax2").is_err());
+        assert!(check_size(300, 512).is_err());
+        assert!(check_size(128, 512).is_err());
+        assert!(check_size(256, 256).is_ok());
+        assert!(check_size(65536, 65536).is_err());
+    }
+
+    #[test]
+    fn pair_encoding_keeps_caves_at_least_8_tall() {
+        let (mut h, mut m) = ([0u8; 2], [0u8; 2]);
+        let a = Texel::single(100, 2).with_slab(103, 140, 5);
+        encode_pair(a, Texel::single(100, 2), &mut h, &mut m);
+        let c = crate::model::decode_column(&h, &m, 0, MidRule::Original);
+        assert!(c.dual && c.low == 100 && c.mid == 108 && c.high == 140);
+        assert_eq!((c.lower_type, c.upper_type), (2, 5));
+        // Too thin: dropped, both texels single.
+        let thin = Texel::single(100, 2).with_slab(104, 108, 5);
+        encode_pair(thin, Texel::single(90, 1), &mut h, &mut m);
+        assert_eq!(
+            (h, m[0] & META_DOUBLE_LEVEL, m[1] & META_DOUBLE_LEVEL),
+            ([100, 90], 0, 0)
+        );
+    }
+}
