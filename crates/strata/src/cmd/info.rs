@@ -20,6 +20,10 @@ pub struct Args {
     /// (done anyway when the world's own map is not a `.vmc`).
     #[arg(long)]
     reencode: bool,
+    /// Decode the map file this many times and report the fastest and the
+    /// median (a small benchmark; the first decode may pay for page faults).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=100))]
+    repeat: u32,
 }
 
 /// How the map file loaded.
@@ -28,7 +32,14 @@ struct MapFile {
     path: String,
     bytes: u64,
     read_ms: f64,
+    /// The first decode, as part of loading the world.
     decode_ms: f64,
+    /// With `--repeat N` (N > 1): fastest and median of N more decodes.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    decode_min_ms: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    decode_median_ms: Option<f64>,
+    decodes: u32,
 }
 
 /// The map encoded as `.vmc` in memory, then decoded again.
@@ -85,11 +96,29 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let (world, load) = io::load_world_timed(dir, mid_rule)
         .with_context(|| format!("loading the world in {}", dir.display()))?;
     let is_vmc = world.config.compressed;
+    let (decode_min_ms, decode_median_ms) = if args.repeat > 1 {
+        let bytes = std::fs::read(&load.path)
+            .with_context(|| format!("reading {}", load.path.display()))?;
+        let mut times = Vec::new();
+        for _ in 0..args.repeat {
+            let t = Instant::now();
+            let level = io::decode_map(&bytes, &world.config, mid_rule, &load.path)?;
+            times.push(ms_since(t));
+            drop(level);
+        }
+        times.sort_by(f64::total_cmp);
+        (Some(times[0]), Some(times[times.len() / 2]))
+    } else {
+        (None, None)
+    };
     let map_file = Some(MapFile {
         path: load.path.display().to_string(),
         bytes: load.bytes,
         read_ms: load.read_ms,
         decode_ms: load.decode_ms,
+        decode_min_ms,
+        decode_median_ms,
+        decodes: args.repeat,
     });
     let vmc_round_trip = if args.reencode || !is_vmc {
         Some(vmc_round_trip(&world.level)?)
@@ -126,6 +155,12 @@ fn print_text(info: &Info) {
             m.read_ms,
             m.decode_ms
         );
+        if let (Some(min), Some(median)) = (m.decode_min_ms, m.decode_median_ms) {
+            println!(
+                "             {} more decodes: fastest {min:.0} ms, median {median:.0} ms",
+                m.decodes
+            );
+        }
     }
     if let Some(r) = &info.vmc_round_trip {
         println!(
