@@ -112,10 +112,14 @@ pub fn percentile(sorted: &[f32], p: f64) -> f32 {
 /// count is the mean of the middle two, so a pixel with no solid neighbour
 /// is its own median and coherent.
 pub fn incoherent_mask(distance: &[f32], width: usize, height: usize) -> Vec<bool> {
+    use rayon::prelude::*;
     let mut out = vec![false; distance.len()];
-    let mut window = [0f32; 9];
-    for y in 0..height {
-        for x in 0..width {
+    if width == 0 || height == 0 || distance.len() < width * height {
+        return out;
+    }
+    out.par_chunks_mut(width).enumerate().for_each(|(y, row)| {
+        let mut window = [0f32; 9];
+        for (x, flag) in row.iter_mut().enumerate() {
             let d = distance[x + y * width];
             if !d.is_finite() {
                 continue;
@@ -137,9 +141,9 @@ pub fn incoherent_mask(distance: &[f32], width: usize, height: usize) -> Vec<boo
             } else {
                 0.5 * (vals[count / 2 - 1] + vals[count / 2])
             };
-            out[x + y * width] = (d - median).abs() > COHERENCE_TOLERANCE * d.max(1.0);
+            *flag = (d - median).abs() > COHERENCE_TOLERANCE * d.max(1.0);
         }
-    }
+    });
     out
 }
 
