@@ -47,6 +47,8 @@ pub const SOURCES: &[(&str, &str)] = &[
         "voxel_build.wgsl",
         include_str!("../shaders/voxel_build.wgsl"),
     ),
+    ("forward.wgsl", include_str!("../shaders/forward.wgsl")),
+    ("painted.wgsl", include_str!("../shaders/painted.wgsl")),
 ];
 
 /// Shaders with entry points (the rest are modules); the naga test validates these.
@@ -59,6 +61,7 @@ pub const ENTRY_SHADERS: &[&str] = &[
     "voxel.wgsl",
     "voxel_compute.wgsl",
     "voxel_build.wgsl",
+    "painted.wgsl",
 ];
 
 #[derive(Debug, thiserror::Error, PartialEq, Eq)]

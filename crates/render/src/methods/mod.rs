@@ -30,6 +30,8 @@
 //!   methods that only read the texture need not override it.
 //! - `retained_bytes` counts only what the method allocates beyond [`Shared`].
 
+pub mod forward;
+pub mod painted;
 pub mod ray;
 pub mod ray_compute;
 pub mod voxel;
@@ -128,6 +130,7 @@ pub const METHODS: &[(&str, Constructor)] = &[
     ("ray-compute", ray_compute::create),
     ("voxel", voxel::create),
     ("voxel-compute", voxel::create_compute),
+    ("painted", painted::create),
 ];
 
 /// The names [`create`] accepts.

@@ -1,0 +1,151 @@
+//! `painted` and `sliced` against the CPU reference (the hand-built level and
+//! a small generated world, pitches 0, -30, -60, -90), the first frame after a
+//! crater against a fresh renderer, and bad settings.
+
+mod common;
+
+use strata_camera::Camera;
+use strata_level::generate::{GenerateParams, generate};
+use strata_level::{Level, ViewSpec};
+use strata_reference::metrics::{self, Metrics};
+use strata_reference::render_reference;
+use strata_render::{Gpu, MethodSettings, Renderer, TerrainColors};
+
+const W: u32 = 160;
+const H: u32 = 100;
+
+/// Worst metrics of `method` over `views`, printing each view's.
+fn worst_over(
+    gpu: &Gpu,
+    level: &Level,
+    colors: &TerrainColors,
+    views: &[ViewSpec],
+    method: &str,
+) -> Metrics {
+    let mut r =
+        Renderer::new(gpu, level, colors, method, &MethodSettings::default(), W, H).unwrap();
+    let mut worst = Metrics::default();
+    for view in views {
+        let camera = Camera::from_view(level, view, W, H).unwrap();
+        let t = r.render_frame(&camera).unwrap();
+        let depth = r.read_depth().unwrap();
+        let reference = render_reference(level, &camera);
+        let m = metrics::compare(&reference, &metrics::distance_from_depth(&camera, &depth));
+        eprintln!(
+            "{method:8} {:12} pitch {:4}: see-through {:.3} % covers-sky {:.3} % coherence {:.3} % p50 {:.3} p95 {:.3} gpu {:?} ms",
+            view.name,
+            view.pitch,
+            m.see_through,
+            m.covers_sky,
+            m.coherence,
+            m.depth_p50,
+            m.depth_p95,
+            t.gpu_ms.map(|g| (g * 10.0).round() / 10.0),
+        );
+        worst.see_through = worst.see_through.max(m.see_through);
+        worst.covers_sky = worst.covers_sky.max(m.covers_sky);
+        worst.coherence = worst.coherence.max(m.coherence);
+        worst.depth_p50 = worst.depth_p50.max(m.depth_p50);
+        worst.depth_p95 = worst.depth_p95.max(m.depth_p95);
+    }
+    worst
+}
+
+fn world() -> strata_level::World {
+    generate(&GenerateParams {
+        seed: 6,
+        width: 512,
+        height: 1024,
+    })
+    .expect("generated world")
+}
+
+#[test]
+fn painted_matches_the_reference() {
+    let Some(gpu) = common::gpu() else { return };
+    let level = common::synthetic_level();
+    let m = worst_over(
+        &gpu,
+        &level,
+        &TerrainColors::test_ramps(),
+        &common::synthetic_views(),
+        "painted",
+    );
+    eprintln!("painted worst (synthetic): {m:?}");
+    assert!(m.see_through <= 1.0, "{m:?}");
+    assert!(m.covers_sky <= 0.2, "{m:?}");
+}
+
+#[test]
+fn painted_matches_the_reference_on_a_generated_world() {
+    let Some(gpu) = common::gpu() else { return };
+    let w = world();
+    let m = worst_over(
+        &gpu,
+        &w.level,
+        &TerrainColors::from_world(&w),
+        &w.views,
+        "painted",
+    );
+    eprintln!("painted worst (generated): {m:?}");
+    assert!(m.see_through <= 1.0, "{m:?}");
+    assert!(m.covers_sky <= 0.2, "{m:?}");
+}
+
+/// The world's crater, dug after the first frame: the next frame's distances
+/// against a renderer built fresh from the edited level (class mismatch %, p95).
+fn crater_against_fresh(gpu: &Gpu, method: &str) -> (f64, f32, usize) {
+    // The fixture's camera stands 158 back and 40 up at pitch -30: the crater
+    // is about 14 degrees down, in frame only in a tall image.
+    let (w_px, h_px) = (160, 400);
+    let w = world();
+    let colors = TerrainColors::from_world(&w);
+    let settings = MethodSettings::default();
+    let site = w.edit.clone().expect("generated worlds carry an edit site");
+    let mut level = w.level.clone();
+    let camera = Camera::from_view(&level, &site.camera, w_px, h_px).unwrap();
+    let mut r = Renderer::new(gpu, &level, &colors, method, &settings, w_px, h_px).unwrap();
+    r.render_frame(&camera).unwrap();
+    let before = r.read_depth().unwrap();
+    let rects = strata_level::edit::crater(&mut level, &site);
+    r.apply_edit(&level, &rects).unwrap();
+    r.render_frame(&camera).unwrap();
+    let after = metrics::distance_from_depth(&camera, &r.read_depth().unwrap());
+    let mut fresh = Renderer::new(gpu, &level, &colors, method, &settings, w_px, h_px).unwrap();
+    fresh.render_frame(&camera).unwrap();
+    let want = metrics::distance_from_depth(&camera, &fresh.read_depth().unwrap());
+    let changed = metrics::distance_from_depth(&camera, &before)
+        .iter()
+        .zip(&after)
+        .filter(|(a, b)| a.is_finite() != b.is_finite() || (*a - *b).abs() > 1e-3)
+        .count();
+    let mismatch = after
+        .iter()
+        .zip(&want)
+        .filter(|(a, b)| a.is_finite() != b.is_finite())
+        .count();
+    let mut d: Vec<f32> = after
+        .iter()
+        .zip(&want)
+        .filter(|(a, b)| a.is_finite() && b.is_finite())
+        .map(|(a, b)| (a - b).abs())
+        .collect();
+    d.sort_by(f32::total_cmp);
+    let p95 = d.get(d.len() * 95 / 100).copied().unwrap_or(0.0);
+    let pct = 100.0 * mismatch as f64 / after.len() as f64;
+    eprintln!(
+        "{method}: crater changed {changed} pixels; vs fresh: class mismatch {pct:.4} %, p95 {p95:.4}"
+    );
+    (pct, p95, changed)
+}
+
+#[test]
+fn painted_shows_a_crater_in_the_next_frame() {
+    let Some(gpu) = common::gpu() else { return };
+    let (pct, p95, changed) = crater_against_fresh(&gpu, "painted");
+    assert!(
+        changed > 100,
+        "the crater left (almost) no trace: {changed}"
+    );
+    assert!(pct <= 0.01 && p95 <= 0.1, "mismatch {pct} %, p95 {p95}");
+}
