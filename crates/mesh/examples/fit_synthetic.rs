@@ -5,6 +5,7 @@ use std::time::Instant;
 
 use strata_level::DirtyRect;
 use strata_level::model::META_DOUBLE_LEVEL;
+use strata_mesh::cpu_time::process_cpu_seconds;
 use strata_mesh::synthetic::synthetic_level;
 use strata_mesh::{LevelMesh, timed_fit};
 
@@ -15,14 +16,33 @@ fn main() {
     let tol = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(4.0f64);
     let t = Instant::now();
     let mut level = synthetic_level(w, h, 1);
-    println!("generated {w}x{h} in {:.2} s, dual texels {:.1}%", t.elapsed().as_secs_f64(), 100.0 * level.dual_texel_count() as f64 / (f64::from(w) * f64::from(h)));
+    println!(
+        "generated {w}x{h} in {:.2} s, dual texels {:.1}%",
+        t.elapsed().as_secs_f64(),
+        100.0 * level.dual_texel_count() as f64 / (f64::from(w) * f64::from(h))
+    );
+    // Start the pool first so its threads exist for both CPU readings.
+    rayon::broadcast(|_| ());
+    let cpu0 = process_cpu_seconds().unwrap_or(0.0);
     let (mut mesh, secs) = timed_fit(&level, tol);
+    let cpu = process_cpu_seconds().unwrap_or(0.0) - cpu0;
+    println!("fit cpu {cpu:.3} s (all threads)");
     let s = mesh.stats();
-    println!("fit {secs:.3} s on {} threads", rayon::current_num_threads());
+    println!(
+        "fit {secs:.3} s on {} threads",
+        rayon::current_num_threads()
+    );
     println!("{s:#?}");
     let tris = s.lods[0].planar as f64;
-    println!("finest planar tris {tris}, tris/s/core {:.0}", tris / secs / rayon::current_num_threads() as f64);
-    println!("gpu bytes / finest planar tri {:.2}, / finest emitted tri {:.2}", s.gpu_bytes as f64 / tris, s.gpu_bytes as f64 / s.lods[0].emitted as f64);
+    println!(
+        "finest planar tris {tris}, tris/s/core {:.0}",
+        tris / secs / rayon::current_num_threads() as f64
+    );
+    println!(
+        "gpu bytes / finest planar tri {:.2}, / finest emitted tri {:.2}",
+        s.gpu_bytes as f64 / tris,
+        s.gpu_bytes as f64 / s.lods[0].emitted as f64
+    );
     // Crater refit, r = 48 at the map centre.
     let (cx, cy, r) = (i64::from(w / 2), i64::from(h / 2), 48i64);
     {
@@ -34,7 +54,8 @@ fn main() {
                     continue;
                 }
                 let i = (y * i64::from(w) + x) as usize;
-                let low = (f64::from(heights[i]) - 90.0 * (1.0 - d2 / (r * r) as f64)).max(0.0) as u8;
+                let low =
+                    (f64::from(heights[i]) - 90.0 * (1.0 - d2 / (r * r) as f64)).max(0.0) as u8;
                 heights[i] = low;
                 heights[i + 1] = low;
                 metas[i] &= !META_DOUBLE_LEVEL;
@@ -42,10 +63,22 @@ fn main() {
             }
         }
     }
-    let dirty = [DirtyRect { x: (cx - r) as u32, y: (cy - r) as u32, width: 2 * r as u32 + 1, height: 2 * r as u32 + 1 }];
+    let dirty = [DirtyRect {
+        x: (cx - r) as u32,
+        y: (cy - r) as u32,
+        width: 2 * r as u32 + 1,
+        height: 2 * r as u32 + 1,
+    }];
     let t = Instant::now();
+    let cpu0 = process_cpu_seconds().unwrap_or(0.0);
     let changed = mesh.refit(&level, &dirty);
-    println!("crater refit {:.2} ms, {} chunks changed", t.elapsed().as_secs_f64() * 1e3, changed.len());
+    let cpu = process_cpu_seconds().unwrap_or(0.0) - cpu0;
+    println!(
+        "crater refit {:.2} ms wall, {:.2} ms cpu, {} chunks changed",
+        t.elapsed().as_secs_f64() * 1e3,
+        cpu * 1e3,
+        changed.len()
+    );
     let fresh = LevelMesh::fit(&level, tol);
     println!("refit == fresh fit: {}", fresh == mesh);
 }

@@ -4,7 +4,7 @@
 use std::cmp::Ordering;
 
 use crate::predicates::Pt;
-use crate::samples::Sample;
+use crate::samples::ChunkSamples;
 
 /// The worst sample of a triangle. Its error is `num / den` height units
 /// (`den` is twice the triangle's area), compared exactly across triangles.
@@ -59,38 +59,81 @@ pub fn errors(w: [i32; 3], den: i32, zs: [[u8; 3]; 3], s: [u8; 3]) -> [i32; 3] {
 }
 
 /// The worst sample strictly inside the chunk (borders are fitted
-/// separately) and inside or on the boundary of triangle `(a, b, c)`.
-/// Returns `(num, den, sample index)`; `num == 0` when nothing deviates.
-/// `limit` is the chunk side `(sx, sy)`; `stride` the sample row stride.
-pub fn scan(
-    pts: [Pt; 3],
-    zs: [[u8; 3]; 3],
-    samples: &[Sample],
-    stride: usize,
-    limit: [i32; 2],
-) -> (i64, i64, u32) {
+/// separately) and inside or on the boundary of triangle `(a, b, c)`, with
+/// vertex values `zs`. Returns `(num, den, sample index)`; `num == 0` when
+/// nothing deviates. Ties go to the first sample in row-major order.
+pub fn scan(pts: [Pt; 3], zs: [[u8; 3]; 3], chunk: &ChunkSamples) -> (i64, i64, u32) {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU supports AVX2 (checked just above).
+        return unsafe { scan_avx2(pts, zs, chunk) };
+    }
+    scan_generic(pts, zs, chunk)
+}
+
+/// The same code compiled with AVX2, so the row kernels vectorise.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn scan_avx2(pts: [Pt; 3], zs: [[u8; 3]; 3], chunk: &ChunkSamples) -> (i64, i64, u32) {
+    scan_generic(pts, zs, chunk)
+}
+
+#[inline(always)]
+fn scan_generic(pts: [Pt; 3], zs: [[u8; 3]; 3], chunk: &ChunkSamples) -> (i64, i64, u32) {
     let [a, b, c] = pts;
     let den = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
     if den <= 0 {
         return (0, 1, 0);
     }
+    let (sx, sy) = (chunk.size_x as i32, chunk.size_y as i32);
     let x0 = a[0].min(b[0]).min(c[0]).max(1);
-    let x1 = a[0].max(b[0]).max(c[0]).min(limit[0] - 1);
+    let x1 = a[0].max(b[0]).max(c[0]).min(sx - 1);
     let y0 = a[1].min(b[1]).min(c[1]).max(1);
-    let y1 = a[1].max(b[1]).max(c[1]).min(limit[1] - 1);
+    let y1 = a[1].max(b[1]).max(c[1]).min(sy - 1);
     if x0 > x1 || y0 > y1 {
         return (0, i64::from(den), 0);
     }
+    // Where the vertices and every sample are single, mid = high = low and
+    // the three fields have identical errors: scan one.
+    let single =
+        zs.iter().all(|z| z[0] == z[1] && z[1] == z[2]) && chunk.duals_in(x0, y0, x1, y1) == 0;
+    let (best, at) = if single {
+        scan_rows::<1>(pts, zs, den, [x0, y0, x1, y1], chunk)
+    } else {
+        scan_rows::<3>(pts, zs, den, [x0, y0, x1, y1], chunk)
+    };
+    (i64::from(best), i64::from(den), at)
+}
+
+const NUDGE: f64 = 1.0 / 4096.0;
+
+#[inline(always)]
+fn scan_rows<const F: usize>(
+    pts: [Pt; 3],
+    zs: [[u8; 3]; 3],
+    den: i32,
+    bbox: [i32; 4],
+    chunk: &ChunkSamples,
+) -> (i32, u32) {
+    let [a, b, c] = pts;
+    let [x0, y0, x1, y1] = bbox;
+    let stride = chunk.stride();
     // w_i(x, y) = w_i(x0, y0) + dx[i] (x - x0) + dy[i] (y - y0).
-    let verts = [a, b, c];
     let mut dx = [0i32; 3];
     let mut dy = [0i32; 3];
     for i in 0..3 {
-        let (u, v) = (verts[(i + 1) % 3], verts[(i + 2) % 3]);
+        let (u, v) = (pts[(i + 1) % 3], pts[(i + 2) % 3]);
         dx[i] = u[1] - v[1];
         dy[i] = v[0] - u[0];
     }
     let mut w_row = barycentric(a, b, c, [x0, y0]);
+    let inv = dx.map(|d| {
+        if d == 0 {
+            0.0
+        } else {
+            1.0 / f64::from(d.abs())
+        }
+    });
     // Interpolant numerators change by a constant per step in x.
     let mut dn = [0i32; 3];
     for (f, d) in dn.iter_mut().enumerate() {
@@ -99,20 +142,19 @@ pub fn scan(
     let mut best = (0i32, 0u32);
     for y in y0..=y1 {
         // The span of x where all three w_i >= 0 (exact integer bounds).
+        // Quotients via reciprocals: |d| <= 2^8 and |w| < 2^20, so a
+        // non-integer quotient is >= 2^-8 from an integer while the float
+        // error is < 2^-30; the 2^-12 nudge makes ceil/floor exact.
         let (mut lo, mut hi) = (x0, x1);
         for i in 0..3 {
             let (w, d) = (w_row[i], dx[i]);
-            if d > 0 {
-                if w < 0 {
-                    lo = lo.max(x0 + (-w + d - 1) / d);
+            if w >= 0 {
+                if d < 0 {
+                    hi = hi.min(x0 + (f64::from(w) * inv[i] + NUDGE).floor() as i32);
                 }
-            } else if d < 0 {
-                if w < 0 {
-                    hi = -1;
-                } else {
-                    hi = hi.min(x0 + w / -d);
-                }
-            } else if w < 0 {
+            } else if d > 0 {
+                lo = lo.max(x0 + (f64::from(-w) * inv[i] - NUDGE).ceil() as i32);
+            } else {
                 hi = -1;
             }
         }
@@ -127,24 +169,60 @@ pub fn scan(
             for (f, nf) in n.iter_mut().enumerate() {
                 *nf = (0..3).map(|i| w[i] * i32::from(zs[i][f])).sum();
             }
-            let row = y as usize * stride;
-            for x in lo..=hi {
-                let s = &samples[row + x as usize].z;
-                let e0 = (n[0] - i32::from(s[0]) * den).abs();
-                let e1 = (n[1] - i32::from(s[1]) * den).abs();
-                let e2 = (n[2] - i32::from(s[2]) * den).abs();
-                let e = e0.max(e1).max(e2);
-                if e > best.0 {
-                    best = (e, (row + x as usize) as u32);
-                }
-                n[0] += dn[0];
-                n[1] += dn[1];
-                n[2] += dn[2];
+            let start = y as usize * stride + lo as usize;
+            let len = (hi - lo + 1) as usize;
+            let rows = [
+                &chunk.planes[0][start..start + len],
+                &chunk.planes[1][start..start + len],
+                &chunk.planes[2][start..start + len],
+            ];
+            let m = row_max::<F>(rows, n, dn, den);
+            if m > best.0 {
+                // Rare: locate the first sample of the row with that error.
+                let k = (0..len)
+                    .find(|&k| err_at::<F>(rows, n, dn, den, k) == m)
+                    .unwrap_or(0);
+                best = (m, (start + k) as u32);
             }
         }
         for i in 0..3 {
             w_row[i] += dy[i];
         }
     }
-    (i64::from(best.0), i64::from(den), best.1)
+    best
+}
+
+#[inline(always)]
+fn err_at<const F: usize>(rows: [&[u8]; 3], n: [i32; 3], dn: [i32; 3], den: i32, k: usize) -> i32 {
+    let kk = k as i32;
+    let mut e = (n[0] + kk * dn[0] - i32::from(rows[0][k]) * den).abs();
+    if F == 3 {
+        e = e
+            .max((n[1] + kk * dn[1] - i32::from(rows[1][k]) * den).abs())
+            .max((n[2] + kk * dn[2] - i32::from(rows[2][k]) * den).abs());
+    }
+    e
+}
+
+/// Largest error of a row span: branch-free so that it vectorises.
+#[inline(always)]
+fn row_max<const F: usize>(rows: [&[u8]; 3], n: [i32; 3], dn: [i32; 3], den: i32) -> i32 {
+    let len = rows[0].len();
+    let (r0, r1, r2) = (rows[0], &rows[1][..len], &rows[2][..len]);
+    let mut m = 0;
+    if F == 1 {
+        for (k, &z) in r0.iter().enumerate() {
+            let kk = k as i32;
+            m = m.max((n[0] + kk * dn[0] - i32::from(z) * den).abs());
+        }
+    } else {
+        for k in 0..len {
+            let kk = k as i32;
+            let e0 = (n[0] + kk * dn[0] - i32::from(r0[k]) * den).abs();
+            let e1 = (n[1] + kk * dn[1] - i32::from(r1[k]) * den).abs();
+            let e2 = (n[2] + kk * dn[2] - i32::from(r2[k]) * den).abs();
+            m = m.max(e0.max(e1).max(e2));
+        }
+    }
+    m
 }

@@ -1,47 +1,53 @@
-//! Emission: the compact per-chunk vertex and index data the GPU draws.
+//! Emission: the compact per-chunk index data the GPU draws.
 //!
-//! One vertex buffer per chunk serves all three LODs (the coarse LODs'
-//! vertices are a subset of the finest's); each LOD is a range of one u16
-//! index buffer. A vertex is one `u32`: see [`pack`].
+//! There is no vertex buffer. Every vertex is a grid sample of the chunk,
+//! and its altitude and terrain type are in the decoded terrain the GPU
+//! already holds, so an index names the vertex completely:
+//! `index = kind * positions + y * (size_x + 1) + x`, with local `x, y` in
+//! `0..=size`, `positions = (size_x + 1) * (size_y + 1)` (16 641 for
+//! 128-chunks, so the largest index is 49 922) and `kind` 0 floor (`low`,
+//! lower terrain type), 1 slab top (`high`, upper type), 2 cave ceiling
+//! (`mid`, upper type). The vertex shader reads `@builtin(vertex_index)` (the
+//! index value in an indexed draw), decodes the column at chunk origin +
+//! (x, y) (wrapping) and picks the field. Normals are flat: derived per
+//! triangle on the GPU. Triangle lists only (no primitive restart).
 //!
-//! Per planar triangle: the floor (`low`, counter-clockwise seen from +z).
-//! Where all three vertices are dual, also the slab top (`high`, same
-//! winding) and the cave ceiling (`mid`, reversed winding, seen from below).
-//! Walls (`mid` to `high`) close the slab on each edge of a slab triangle
-//! whose neighbour has no slab, facing away from the slab. On a chunk-border
-//! edge the neighbour lives in another chunk, so a slab triangle always gets
-//! a wall there: when the other side has a slab too the wall lies inside the
-//! solid slab and is hidden by it; this keeps every chunk's output a function
-//! of its own samples (exact local refit). Winding: counter-clockwise seen from
-//! outside the solid, in the right-handed (x, y, z-up) grid frame.
+//! Per planar triangle: the floor (counter-clockwise seen from +z). Where all
+//! three vertices are dual, also the slab top (same winding) and the cave
+//! ceiling (reversed winding, seen from below). Walls (`mid` to `high`) close
+//! the slab on each edge of a slab triangle whose neighbour has no slab,
+//! facing away from the slab. On a chunk-border edge the neighbour lives in
+//! another chunk, so a slab triangle always gets a wall there: when the
+//! other side has a slab too the wall lies inside the solid slab and is
+//! hidden by it; this keeps every chunk's output a function of its own
+//! samples (exact local refit). Winding: counter-clockwise seen from outside
+//! the solid, in the right-handed (x, y, z-up) grid frame.
+//!
+//! LODs share triangles (greedy insertion leaves untouched regions alone),
+//! so the three lists are stored once, in blocks by LOD membership:
+//! `[2 only][1,2][0,1,2][0,1][0 only][1 only]`. LOD 2 and LOD 0 are one range
+//! each, LOD 1 is two ranges.
 
 use crate::fit::LODS;
 use crate::samples::ChunkSamples;
 use crate::triangulation::{NONE, Triangulation};
 
-/// Vertex kinds, stored in bits 27..28 of a packed vertex.
-pub const KIND_FLOOR: u32 = 0;
-pub const KIND_TOP: u32 = 1;
-pub const KIND_CEILING: u32 = 2;
+pub const KIND_FLOOR: u16 = 0;
+pub const KIND_TOP: u16 = 1;
+pub const KIND_CEILING: u16 = 2;
 
-/// Pack a vertex: bits 0..7 local x (0..=128), 8..15 local y, 16..23
-/// altitude, 24..26 terrain type, 27..28 kind. World position =
-/// chunk origin + (x, y). Normals are flat: the GPU derives them per triangle.
+/// Encode a vertex index (see the module docs); `stride = size_x + 1`,
+/// `positions = (size_x + 1) * (size_y + 1)`.
 #[inline]
-pub fn pack(x: u32, y: u32, z: u8, terrain: u8, kind: u32) -> u32 {
-    x | (y << 8) | (u32::from(z) << 16) | (u32::from(terrain & 7) << 24) | (kind << 27)
+pub fn encode(x: u32, y: u32, stride: u32, positions: u32, kind: u16) -> u16 {
+    (u32::from(kind) * positions + y * stride + x) as u16
 }
 
-/// Inverse of [`pack`]: `(x, y, z, terrain, kind)`.
+/// Decode a vertex index: `(x, y, kind)`.
 #[inline]
-pub fn unpack(v: u32) -> (u32, u32, u8, u8, u32) {
-    (
-        v & 0xff,
-        (v >> 8) & 0xff,
-        (v >> 16) as u8,
-        ((v >> 24) & 7) as u8,
-        (v >> 27) & 3,
-    )
+pub fn decode(index: u16, stride: u32, positions: u32) -> (u32, u32, u16) {
+    let (kind, pos) = (u32::from(index) / positions, u32::from(index) % positions);
+    (pos % stride, pos / stride, kind as u16)
 }
 
 /// Triangle counts of one LOD of a chunk.
@@ -75,70 +81,62 @@ pub struct ChunkStats {
 /// One chunk's drawable data.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct ChunkMesh {
-    /// Packed vertices ([`pack`]), shared by all LODs.
-    pub vertices: Vec<u32>,
-    /// Triangle lists of all LODs, back to back.
+    /// Encoded vertex indices ([`encode`]) of all LODs' triangle lists.
     pub indices: Vec<u16>,
-    /// `[start, end)` of each LOD's indices; LOD 0 is the finest.
-    pub lods: [(u32, u32); LODS],
+    /// Up to two `[start, end)` index ranges per LOD (LOD 0 the finest);
+    /// an unused range is empty.
+    pub lods: [[(u32, u32); 2]; LODS],
     pub stats: ChunkStats,
 }
 
 impl ChunkMesh {
     /// Bytes this chunk uploads to the GPU.
     pub fn gpu_bytes(&self) -> usize {
-        self.vertices.len() * 4 + self.indices.len() * 2
+        self.indices.len() * 2
     }
 
-    /// The indices of one LOD.
-    pub fn lod_indices(&self, lod: usize) -> &[u16] {
-        let (s, e) = self.lods[lod];
-        &self.indices[s as usize..e as usize]
+    /// The triangles (index triples) of one LOD.
+    pub fn lod_triangles(&self, lod: usize) -> impl Iterator<Item = [u16; 3]> + '_ {
+        self.lods[lod]
+            .iter()
+            .flat_map(|&(s, e)| self.indices[s as usize..e as usize].chunks_exact(3))
+            .map(|t| [t[0], t[1], t[2]])
     }
 }
 
 /// Emission scratch, reused across chunks.
 #[derive(Default)]
 pub struct Emitter {
-    remap: Vec<u32>,
-    vertices: Vec<u32>,
-    indices: Vec<u16>,
-    lods: [(u32, u32); LODS],
+    stride: u32,
+    positions: u32,
+    /// Each LOD's triangles as keys (three indices, smallest first).
+    lists: [Vec<u64>; LODS],
+    sorted: [Vec<u64>; LODS],
     stats: [LodStats; LODS],
 }
 
-impl Emitter {
-    pub fn begin(&mut self, _sx: u32, _sy: u32) {
-        self.remap.clear();
-        self.vertices.clear();
-        self.indices.clear();
-        self.lods = [(0, 0); LODS];
-        self.stats = [LodStats::default(); LODS];
-    }
+#[inline]
+fn key(t: [u16; 3]) -> u64 {
+    // Rotate the smallest index first (keeps the winding) so that the same
+    // triangle has the same key in every LOD.
+    let r = if t[0] <= t[1] && t[0] <= t[2] {
+        t
+    } else if t[1] <= t[2] {
+        [t[1], t[2], t[0]]
+    } else {
+        [t[2], t[0], t[1]]
+    };
+    u64::from(r[0]) | u64::from(r[1]) << 16 | u64::from(r[2]) << 32
+}
 
-    #[inline]
-    fn vertex(
-        &mut self,
-        v: u32,
-        kind: u32,
-        tr: &Triangulation,
-        vsample: &[u32],
-        samples: &ChunkSamples,
-    ) -> u16 {
-        let slot = v as usize * 3 + kind as usize;
-        if self.remap[slot] == NONE {
-            let p = tr.pt(v);
-            let s = &samples.samples[vsample[v as usize] as usize];
-            let (z, ty) = match kind {
-                KIND_FLOOR => (s.z[0], s.lower_type),
-                KIND_TOP => (s.z[2], s.upper_type),
-                _ => (s.z[1], s.upper_type),
-            };
-            self.remap[slot] = self.vertices.len() as u32;
-            self.vertices
-                .push(pack(p[0] as u32, p[1] as u32, z, ty, kind));
+impl Emitter {
+    pub fn begin(&mut self, size_x: u32, size_y: u32) {
+        self.stride = size_x + 1;
+        self.positions = (size_x + 1) * (size_y + 1);
+        for l in &mut self.lists {
+            l.clear();
         }
-        self.remap[slot] as u16
+        self.stats = [LodStats::default(); LODS];
     }
 
     /// Emit LOD `lod` from the current state of the triangulation.
@@ -149,30 +147,25 @@ impl Emitter {
         vsample: &[u32],
         samples: &ChunkSamples,
     ) {
-        self.remap.resize(tr.pts.len() * 3, NONE);
-        let start = self.indices.len() as u32;
-        let dual = |v: u32| samples.samples[vsample[v as usize] as usize].dual();
-        let slab = |t: u32| tr.tris[t as usize].v.iter().all(|&v| dual(v));
+        let (stride, positions) = (self.stride, self.positions);
+        let sample = |v: u32| &samples.samples[vsample[v as usize] as usize];
+        let slab = |t: u32| tr.tris[t as usize].v.iter().all(|&v| sample(v).dual());
+        let idx = |v: u32, kind: u16| {
+            let p = tr.pt(v);
+            encode(p[0] as u32, p[1] as u32, stride, positions, kind)
+        };
+        let out = &mut self.lists[lod];
         let mut st = LodStats::default();
         for t in 0..tr.tris.len() as u32 {
             let tri = tr.tris[t as usize];
             let [a, b, c] = tri.v;
-            for v in [a, b, c] {
-                let i = self.vertex(v, KIND_FLOOR, tr, vsample, samples);
-                self.indices.push(i);
-            }
+            out.push(key([a, b, c].map(|v| idx(v, KIND_FLOOR))));
             st.planar += 1;
             if !slab(t) {
                 continue;
             }
-            for v in [a, b, c] {
-                let i = self.vertex(v, KIND_TOP, tr, vsample, samples);
-                self.indices.push(i);
-            }
-            for v in [a, c, b] {
-                let i = self.vertex(v, KIND_CEILING, tr, vsample, samples);
-                self.indices.push(i);
-            }
+            out.push(key([a, b, c].map(|v| idx(v, KIND_TOP))));
+            out.push(key([a, c, b].map(|v| idx(v, KIND_CEILING))));
             st.slab += 2;
             for i in 0..3 {
                 let nb = tri.n[i];
@@ -180,19 +173,18 @@ impl Emitter {
                     continue;
                 }
                 let (ea, eb) = (tri.v[(i + 1) % 3], tri.v[(i + 2) % 3]);
-                let za = samples.samples[vsample[ea as usize] as usize].z;
-                let zb = samples.samples[vsample[eb as usize] as usize].z;
-                let am = self.vertex(ea, KIND_CEILING, tr, vsample, samples);
-                let ah = self.vertex(ea, KIND_TOP, tr, vsample, samples);
-                let bm = self.vertex(eb, KIND_CEILING, tr, vsample, samples);
-                let bh = self.vertex(eb, KIND_TOP, tr, vsample, samples);
+                let (za, zb) = (sample(ea).z, sample(eb).z);
+                let (am, ah) = (idx(ea, KIND_CEILING), idx(ea, KIND_TOP));
+                let (bm, bh) = (idx(eb, KIND_CEILING), idx(eb, KIND_TOP));
                 let mut n = 0;
+                // Skip the half of the quad that is degenerate where the
+                // slab has no thickness (mid == high).
                 if zb[1] != zb[2] {
-                    self.indices.extend([am, bm, bh]);
+                    out.push(key([am, bm, bh]));
                     n += 1;
                 }
                 if za[1] != za[2] {
-                    self.indices.extend([am, bh, ah]);
+                    out.push(key([am, bh, ah]));
                     n += 1;
                 }
                 st.wall += n;
@@ -201,23 +193,56 @@ impl Emitter {
                 }
             }
         }
-        self.lods[lod] = (start, self.indices.len() as u32);
         self.stats[lod] = st;
     }
 
-    /// Move the emitted data into `mesh`.
-    pub fn finish(
-        &mut self,
-        mesh: &mut ChunkMesh,
-        tr: &Triangulation,
-        _vsample: &[u32],
-        _samples: &ChunkSamples,
-    ) {
-        mesh.vertices = std::mem::take(&mut self.vertices);
-        mesh.vertices.shrink_to_fit();
-        mesh.indices = std::mem::take(&mut self.indices);
-        mesh.indices.shrink_to_fit();
-        mesh.lods = self.lods;
+    /// Lay the three LODs out by membership blocks and move them into `mesh`.
+    pub fn finish(&mut self, mesh: &mut ChunkMesh, tr: &Triangulation) {
+        for l in 0..LODS {
+            self.sorted[l].clear();
+            self.sorted[l].extend_from_slice(&self.lists[l]);
+            self.sorted[l].sort_unstable();
+        }
+        let member = |sorted: &[Vec<u64>; LODS], k: u64| {
+            (0..LODS).fold(0u8, |m, l| {
+                m | (u8::from(sorted[l].binary_search(&k).is_ok()) << l)
+            })
+        };
+        // Blocks by membership mask, in layout order; each triangle is placed
+        // once, from the first LOD list it appears in (emission order).
+        const ORDER: [u8; 6] = [0b100, 0b110, 0b111, 0b011, 0b001, 0b010];
+        let mut blocks: [Vec<u64>; 8] = Default::default();
+        for l in 0..LODS {
+            for &k in &self.lists[l] {
+                let m = member(&self.sorted, k);
+                // Placed by the lowest LOD holding it. A triangle in LODs 0
+                // and 2 but not 1 (possible, rare) is stored twice.
+                if m.trailing_zeros() as usize != l {
+                    continue;
+                }
+                if m == 0b101 {
+                    blocks[0b001].push(k);
+                    blocks[0b100].push(k);
+                } else {
+                    blocks[m as usize].push(k);
+                }
+            }
+        }
+        let mut indices = Vec::with_capacity(blocks.iter().map(|b| b.len() * 3).sum());
+        let mut range = [(0u32, 0u32); 8];
+        for m in ORDER {
+            let start = indices.len() as u32;
+            for &k in &blocks[m as usize] {
+                indices.extend([k as u16, (k >> 16) as u16, (k >> 32) as u16]);
+            }
+            range[m as usize] = (start, indices.len() as u32);
+        }
+        mesh.lods = [
+            [(range[0b111].0, range[0b001].1), (0, 0)],
+            [(range[0b110].0, range[0b011].1), range[0b010]],
+            [(range[0b100].0, range[0b111].1), (0, 0)],
+        ];
+        mesh.indices = indices;
         mesh.stats.lods = self.stats;
         mesh.stats.planar_vertices = tr.pts.len() as u32;
     }

@@ -108,7 +108,7 @@ impl ChunkFitter {
         for t in 0..self.tr.tris.len() as u32 {
             self.stamps.push(0);
             self.seen.push(0);
-            self.push_candidate(t, tol, [sx, sy]);
+            self.push_candidate(t, tol);
         }
 
         let lod_tols: [f64; LODS] = [tol, tol * 2.0, tol * 4.0];
@@ -155,22 +155,21 @@ impl ChunkFitter {
                 }
                 self.seen[t as usize] = epoch;
                 self.stamps[t as usize] = self.stamps[t as usize].wrapping_add(1);
-                self.push_candidate(t, tol, [sx, sy]);
+                self.push_candidate(t, tol);
             }
         }
-        self.emitter
-            .finish(&mut mesh, &self.tr, &self.vsample, &self.samples);
+        self.emitter.finish(&mut mesh, &self.tr);
         mesh.stats.causes = causes;
         mesh
     }
 
-    fn push_candidate(&mut self, t: u32, tol: f64, limit: [i32; 2]) {
+    fn push_candidate(&mut self, t: u32, tol: f64) {
         let tri = self.tr.tris[t as usize];
         let pts = tri.v.map(|v| self.tr.pt(v));
         let zs = tri
             .v
             .map(|v| self.samples.samples[self.vsample[v as usize] as usize].z);
-        let (num, den, sample) = scan(pts, zs, &self.samples.samples, self.samples.stride(), limit);
+        let (num, den, sample) = scan(pts, zs, &self.samples);
         if num > 0 && exceeds(num, den, tol) {
             self.heap.push(Candidate {
                 num,

@@ -89,7 +89,6 @@ impl LevelMesh {
         };
         for c in &self.chunks {
             s.planar_vertices += u64::from(c.stats.planar_vertices);
-            s.gpu_vertices += c.vertices.len() as u64;
             s.gpu_indices += c.indices.len() as u64;
             for k in 0..LODS {
                 let l = &c.stats.lods[k];
@@ -103,20 +102,21 @@ impl LevelMesh {
                 s.causes[k] += u64::from(c.stats.causes[k]);
             }
         }
-        s.gpu_bytes = s.gpu_vertices * 4 + s.gpu_indices * 2;
+        s.gpu_bytes = s.gpu_indices * 2;
         s.cpu_bytes = (self.chunks.len() * std::mem::size_of::<ChunkRange>()) as u64;
         s
     }
 }
 
 /// What the renderer keeps on the CPU per chunk once the buffers are
-/// uploaded: where its data lives. The fit itself is not retained — a refit
+/// uploaded: where its data lives and its LOD ranges. The fit itself is not retained — a refit
 /// recomputes the dirty chunks from the level.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct ChunkRange {
-    pub first_vertex: u32,
     pub first_index: u32,
-    pub lods: [(u32, u32); LODS],
+    pub index_count: u32,
+    /// [`ChunkMesh::lods`], relative to `first_index`.
+    pub lods: [[(u32, u32); 2]; LODS],
 }
 
 fn sanitize(tol: f64) -> f64 {
@@ -186,7 +186,6 @@ pub struct MeshStats {
     /// Sum over chunks of finest planar vertices (border vertices counted in
     /// both chunks that share them, as they are uploaded).
     pub planar_vertices: u64,
-    pub gpu_vertices: u64,
     pub gpu_indices: u64,
     pub lods: [LodTotals; LODS],
     /// Insertions: floor, slab interior, single/double boundary, chunk border.

@@ -11,6 +11,7 @@
 
 pub mod border;
 pub mod candidate;
+pub mod cpu_time;
 pub mod emit;
 pub mod fit;
 pub mod level_mesh;
@@ -19,7 +20,7 @@ pub mod samples;
 pub mod synthetic;
 pub mod triangulation;
 
-pub use emit::{ChunkMesh, ChunkStats, LodStats, pack, unpack};
+pub use emit::{ChunkMesh, ChunkStats, LodStats, decode, encode};
 pub use fit::{CAUSES, Cause, ChunkFitter, LODS};
 pub use level_mesh::{
     ChunkRange, LevelMesh, MeshStats, dirty_chunks, timed_fit, tolerance_for_quality,

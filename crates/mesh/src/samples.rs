@@ -2,6 +2,7 @@
 //! row and column wrapping into the next chunk (the map is a torus).
 
 use strata_level::Level;
+use strata_level::model::decode_column;
 
 /// Flag bit of [`Sample::flags`]: the column is dual (has a slab).
 pub const DUAL: u8 = 1;
@@ -73,12 +74,26 @@ pub struct ChunkSamples {
     pub size_x: u32,
     pub size_y: u32,
     pub samples: Vec<Sample>,
+    /// `low`, `mid`, `high` as separate planes (same indexing as `samples`),
+    /// for the vectorised candidate scan.
+    pub planes: [Vec<u8>; 3],
+    /// Summed-area table of dual samples, stride `size_x + 2`:
+    /// `dual_sum[(y + 1) * (sx + 2) + x + 1]` counts duals in `[0, x] x [0, y]`.
+    pub dual_sum: Vec<u32>,
 }
 
 impl ChunkSamples {
     #[inline]
     pub fn stride(&self) -> usize {
         self.size_x as usize + 1
+    }
+
+    /// Number of dual samples in `[x0, x1] x [y0, y1]` (inclusive, in range).
+    #[inline]
+    pub fn duals_in(&self, x0: i32, y0: i32, x1: i32, y1: i32) -> u32 {
+        let sw = self.size_x as usize + 2;
+        let at = |x: i32, y: i32| self.dual_sum[y as usize * sw + x as usize];
+        (at(x1 + 1, y1 + 1) + at(x0, y0)).wrapping_sub(at(x0, y1 + 1) + at(x1 + 1, y0))
     }
 
     #[inline]
@@ -93,17 +108,33 @@ impl ChunkSamples {
         let (nx, ny) = (layout.size_x as usize + 1, layout.size_y as usize + 1);
         self.samples.clear();
         self.samples.reserve(nx * ny);
-        let x0 = i64::from(cx * layout.size_x);
-        let y0 = i64::from(cy * layout.size_y);
-        for j in 0..ny as i64 {
-            for i in 0..nx as i64 {
-                let c = level.column(x0 + i, y0 + j);
+        let x0 = cx * layout.size_x;
+        let y0 = cy * layout.size_y;
+        let wmask = level.width() - 1;
+        for j in 0..ny as u32 {
+            let (heights, metas) = level.row((y0 + j) & (level.height() - 1));
+            for i in 0..nx as u32 {
+                let c = decode_column(heights, metas, ((x0 + i) & wmask) as usize, level.mid_rule);
                 self.samples.push(Sample {
                     z: [c.low, c.mid, c.high],
                     flags: if c.dual { DUAL } else { 0 },
                     lower_type: c.lower_type,
                     upper_type: c.upper_type,
                 });
+            }
+        }
+        for (f, plane) in self.planes.iter_mut().enumerate() {
+            plane.clear();
+            plane.extend(self.samples.iter().map(|s| s.z[f]));
+        }
+        let sw = nx + 1;
+        self.dual_sum.clear();
+        self.dual_sum.resize(sw * (ny + 1), 0);
+        for j in 0..ny {
+            let mut run = 0;
+            for i in 0..nx {
+                run += u32::from(self.samples[j * nx + i].flags & DUAL);
+                self.dual_sum[(j + 1) * sw + i + 1] = self.dual_sum[j * sw + i + 1] + run;
             }
         }
         // Interior of a dual region, judged inside the chunk only so that a

@@ -4,16 +4,15 @@
 use strata_level::model::META_DOUBLE_LEVEL;
 use strata_level::{DirtyRect, Level};
 use strata_mesh::emit::KIND_FLOOR;
-use strata_mesh::{ChunkMesh, unpack};
+use strata_mesh::{ChunkMesh, decode};
 
-/// Floor triangles of one LOD as local grid points.
+/// Floor triangles of one LOD as local grid points (128-chunks).
 pub fn floor_triangles(mesh: &ChunkMesh, lod: usize) -> Vec<[[i32; 2]; 3]> {
-    mesh.lod_indices(lod)
-        .chunks_exact(3)
+    mesh.lod_triangles(lod)
         .filter_map(|t| {
-            let vs = [0, 1, 2].map(|i| unpack(mesh.vertices[t[i] as usize]));
+            let vs = t.map(|i| decode(i, 129, 129 * 129));
             vs.iter()
-                .all(|v| v.4 == KIND_FLOOR)
+                .all(|v| v.2 == KIND_FLOOR)
                 .then(|| vs.map(|v| [v.0 as i32, v.1 as i32]))
         })
         .collect()
