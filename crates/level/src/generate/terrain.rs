@@ -20,7 +20,11 @@ pub const WATER: u8 = 0;
 pub const ROAD: u8 = 3;
 pub const METAL: u8 = 7;
 
-/// Distance between parallel roads, and their half width.
+/// Share of slab pairs that crumble away, and of cave ceilings that sag a step.
+const EROSION_PERCENT: u32 = 30;
+const SAG_PERCENT: u32 = 50;
+
+/// Half width of the roads.
 const ROAD_HALF: i32 = 5;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -137,10 +141,10 @@ impl Terrain {
             .map(|(dx, dy)| {
                 let hash = hash2(self.seed ^ 0xd15c, dx, dy);
                 let kind = match hash % 100 {
-                    0..=47 => District::Natural,
-                    48..=61 => District::Pits,
-                    62..=79 => District::Furrows,
-                    80..=91 => District::Hall,
+                    0..=44 => District::Natural,
+                    45..=58 => District::Pits,
+                    59..=76 => District::Furrows,
+                    77..=91 => District::Hall,
                     _ => District::Hangars,
                 };
                 // A pattern covers a random part of its district, not all of it.
@@ -173,8 +177,8 @@ impl Terrain {
     #[inline]
     pub fn fine(&self, x: f32, y: f32) -> i32 {
         let v = self.fine.at(x, y);
-        let speck = (hash2(self.seed ^ 0xf1e, x as u32, y as u32) & 7 == 0) as i32;
-        fast_round((v - 0.5) * 7.0) + speck
+        let speck = (hash2(self.seed ^ 0xf1e, x as u32, y as u32) & 15 == 0) as i32;
+        fast_round((v - 0.5) * 5.0) + speck
     }
 
     /// Terrain type of the region around (x, y): 1..=7 in broad patches.
@@ -239,7 +243,7 @@ impl Terrain {
         let mut t = Texel::single(floor, if floor < SEA { WATER } else { ty });
         // Overhangs: the higher band "reaches" this texel if nudging the noise
         // by `reach` crosses an edge; the nudge varies so edges overhang in stretches.
-        let reach = (self.over_mask.at(xf, yf) - 0.42).max(0.0) * 0.11;
+        let reach = (self.over_mask.at(xf, yf) - 0.45).max(0.0) * 0.12;
         if !ramp && reach > 0.0 && band < EDGES.len() {
             let up = Self::band(n + reach);
             if up > band {
@@ -257,13 +261,34 @@ impl Terrain {
 
     /// The procedural texel at (x, y), landmarks aside.
     pub fn texel(&self, x: u32, row: &Row) -> Texel {
-        let t = self.texel_whole(x, row);
-        // Slabs crumble: a few pairs drop out, leaving ragged holes and edges.
+        let mut t = self.texel_whole(x, row);
+        // Water is exactly the ground below sea level.
+        if (t.ty == WATER) != (t.floor < SEA) {
+            t.ty = if t.floor < SEA { WATER } else { self.region_type(x as f32, row.y as f32) };
+        }
         match t.slab {
-            Some(_) if hash2(self.seed ^ 0xc7, x >> 1, row.y) % 100 < 9 => {
-                Texel { slab: None, ..t }
-            }
-            _ => t,
+            Some(s) => self.weather(t, s, x >> 1, row.y),
+            None => t,
+        }
+    }
+
+    /// Slabs are not machined: some pairs crumble away (ragged holes and
+    /// edges), cave ceilings sag by a gap step here and there, and roofs
+    /// carry rubble. Per pair, so both texels of a pair agree.
+    fn weather(&self, t: Texel, s: Slab, pair: u32, y: u32) -> Texel {
+        let h = hash2(self.seed ^ 0xc7, pair, y);
+        if h % 100 < EROSION_PERCENT {
+            return Texel { slab: None, ..t };
+        }
+        let sag = if (h >> 8) % 100 < SAG_PERCENT { 8 } else { 0 };
+        let rubble = ((h >> 16) % 8) as i32;
+        Texel {
+            slab: Some(Slab {
+                ceiling: s.ceiling - sag,
+                high: s.high + rubble,
+                ..s
+            }),
+            ..t
         }
     }
 
