@@ -1,0 +1,40 @@
+//! Per-pass timestamps: one interval per pass, summed; none without support.
+
+mod common;
+
+use strata_camera::Camera;
+use strata_render::{MethodSettings, Renderer, TerrainColors};
+
+#[test]
+fn every_pass_is_timed() {
+    let Some(gpu) = common::gpu() else { return };
+    let level = common::synthetic_level();
+    let view = strata_level::ViewSpec::parse("v", "128,100:10:60", -30.0).unwrap();
+    let camera = Camera::from_view(&level, &view, 160, 100).unwrap();
+    for (method, shadows, want) in [
+        ("ray", true, vec!["shadow", "ray"]),
+        ("ray", false, vec!["ray"]),
+        ("ray-compute", true, vec!["shadow", "ray-compute march", "ray-compute depth copy"]),
+    ] {
+        let settings = MethodSettings {
+            shadows,
+            ..Default::default()
+        };
+        let mut r = Renderer::new(&gpu, &level, &TerrainColors::test_ramps(), method, &settings, 160, 100).unwrap();
+        let m = r.measure(&camera, 1, 3).unwrap();
+        for t in &m.timings {
+            eprintln!("{method} shadows={shadows}: {t:?}");
+            assert!(t.cpu_ms > 0.0);
+            if gpu.report.timestamps {
+                let labels: Vec<&str> = t.passes.iter().map(|p| p.0.as_str()).collect();
+                assert_eq!(labels, want);
+                let sum: f64 = t.passes.iter().map(|p| p.1).sum();
+                assert_eq!(t.gpu_ms, Some(sum));
+                assert!(t.passes.iter().all(|p| p.1 >= 0.0));
+            } else {
+                eprintln!("NOTE: adapter has no timestamps; gpu_ms must be None");
+                assert_eq!(t.gpu_ms, None);
+            }
+        }
+    }
+}
