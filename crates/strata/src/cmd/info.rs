@@ -1,13 +1,15 @@
 //! `strata info`: a world's size, dual fraction, height range, terrain
 //! types, roughness, pair disagreements, and how long its map takes to decode.
 
+use crate::world_arg;
 use anyhow::{Context, bail};
 use serde::Serialize;
 use std::path::Path;
 use std::time::Instant;
+use strata_level::generate::GenerateParams;
 use strata_level::model::MidRule;
 use strata_level::stats::LevelStats;
-use strata_level::{Level, io, vmc};
+use strata_level::{Level, World, io, vmc};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -20,8 +22,8 @@ pub struct Args {
     /// (done anyway when the world's own map is not a `.vmc`).
     #[arg(long)]
     reencode: bool,
-    /// Decode the map file this many times and report the fastest and the
-    /// median (a small benchmark; the first decode may pay for page faults).
+    /// Decode the map file this many more times and report the fastest and
+    /// the median (a small benchmark; the first decode may pay for page faults).
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=100))]
     repeat: u32,
 }
@@ -82,44 +84,80 @@ fn vmc_round_trip(level: &Level) -> anyhow::Result<VmcRoundTrip> {
     })
 }
 
-pub fn run(args: Args) -> anyhow::Result<()> {
-    let mid_rule = if args.world.vange_rs_mid {
-        MidRule::VangeRs
-    } else {
-        MidRule::Original
-    };
-    let Some(dir) = &args.world.level else {
-        bail!(
-            "`strata info` needs --level DIR for now (the built-in world comes with `strata generate`)"
-        );
-    };
-    let (world, load) = io::load_world_timed(dir, mid_rule)
-        .with_context(|| format!("loading the world in {}", dir.display()))?;
-    let is_vmc = world.config.compressed;
-    let (decode_min_ms, decode_median_ms) = if args.repeat > 1 {
+/// Read and decode a world directory's map file, timed.
+fn time_map(dir: &Path, world: &World, mid_rule: MidRule) -> anyhow::Result<io::MapLoad> {
+    let path = io::map_path(dir, &world.config);
+    let t0 = Instant::now();
+    let bytes = std::fs::read(&path).with_context(|| format!("reading {}", path.display()))?;
+    let read_ms = ms_since(t0);
+    let t1 = Instant::now();
+    io::decode_map(&bytes, &world.config, mid_rule, &path)?;
+    Ok(io::MapLoad {
+        bytes: bytes.len() as u64,
+        read_ms,
+        decode_ms: ms_since(t1),
+        path,
+    })
+}
+
+/// The map file's figures, with `repeat - 1` more timed decodes when asked.
+fn map_file(
+    load: io::MapLoad,
+    world: &World,
+    mid_rule: MidRule,
+    repeat: u32,
+) -> anyhow::Result<MapFile> {
+    let (mut decode_min_ms, mut decode_median_ms) = (None, None);
+    if repeat > 1 {
         let bytes = std::fs::read(&load.path)
             .with_context(|| format!("reading {}", load.path.display()))?;
         let mut times = Vec::new();
-        for _ in 0..args.repeat {
+        for _ in 0..repeat {
             let t = Instant::now();
             let level = io::decode_map(&bytes, &world.config, mid_rule, &load.path)?;
             times.push(ms_since(t));
             drop(level);
         }
         times.sort_by(f64::total_cmp);
-        (Some(times[0]), Some(times[times.len() / 2]))
-    } else {
-        (None, None)
-    };
-    let map_file = Some(MapFile {
+        decode_min_ms = times.first().copied();
+        decode_median_ms = times.get(times.len() / 2).copied();
+    }
+    Ok(MapFile {
         path: load.path.display().to_string(),
         bytes: load.bytes,
         read_ms: load.read_ms,
         decode_ms: load.decode_ms,
         decode_min_ms,
         decode_median_ms,
-        decodes: args.repeat,
-    });
+        decodes: repeat,
+    })
+}
+
+pub fn run(args: Args) -> anyhow::Result<()> {
+    let mid_rule = args.world.mid_rule();
+    let (world, load) = match &args.world.level {
+        Some(dir) => io::load_world_timed(dir, mid_rule)
+            .map(|(world, load)| (world, Some(load)))
+            .with_context(|| format!("loading the world in {}", dir.display()))?,
+        None => {
+            // The built-in world: from its on-disk cache when there is one,
+            // whose map file is then timed; else an in-memory .vmc round trip.
+            let world = args.world.load()?;
+            let cached = world_arg::cache_root()
+                .map(|root| world_arg::cache_dir(&root, &GenerateParams::default()))
+                .filter(|dir| dir.join(io::WORLD_INI).exists());
+            let load = match cached {
+                Some(dir) => Some(time_map(&dir, &world, mid_rule)?),
+                None => None,
+            };
+            (world, load)
+        }
+    };
+    let is_vmc = world.config.compressed && load.is_some();
+    let map_file = match load {
+        Some(load) => Some(map_file(load, &world, mid_rule, args.repeat)?),
+        None => None,
+    };
     let vmc_round_trip = if args.reencode || !is_vmc {
         Some(vmc_round_trip(&world.level)?)
     } else {
