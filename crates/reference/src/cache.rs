@@ -35,7 +35,7 @@ pub fn default_cache_dir() -> PathBuf {
 
 #[derive(Debug, thiserror::Error)]
 pub enum CacheError {
-    #[error("reference cache {path}: {source}")]
+    #[error("reference cache {path}")]
     Io { path: PathBuf, source: io::Error },
 }
 
