@@ -241,3 +241,80 @@ fn bad_settings_are_clear_errors() {
         .unwrap();
     assert!(e.to_string().contains("powers of two"), "{e}");
 }
+
+/// Preparation and frame times on a Fostral-sized generated world. Ignored
+/// by default (minutes on lavapipe); `STRATA_VOXEL_BENCH=WxH` sets the image
+/// size (default 320x200). Prints one line per measurement.
+#[test]
+#[ignore]
+fn fostral_sized_build_and_frame_times() {
+    let Some(gpu) = gpu() else { return };
+    let (iw, ih) = std::env::var("STRATA_VOXEL_BENCH")
+        .ok()
+        .and_then(|s| {
+            let (a, b) = s.split_once('x')?;
+            Some((a.parse().ok()?, b.parse().ok()?))
+        })
+        .unwrap_or((320, 200));
+    let start = std::time::Instant::now();
+    let w = world(2048, 16384);
+    eprintln!("adapter: {} ({})", gpu.report.name, gpu.report.backend);
+    eprintln!(
+        "generated 2048x16384 in {:.0} ms",
+        start.elapsed().as_secs_f64() * 1e3
+    );
+    let colors = TerrainColors::from_world(&w);
+    let shared = Shared::new(&gpu.device, &gpu.queue, &w.level, &colors, 8, 8).unwrap();
+    for voxel in [VoxelSize::COARSE, VoxelSize::FINE] {
+        let start = std::time::Instant::now();
+        match GpuPyramid::new(
+            &shared,
+            &w.level,
+            voxel,
+            super::super::voxel_build::DEFAULT_BUDGET_TEXELS,
+        ) {
+            Ok(p) => {
+                let cpu = std::time::Instant::now();
+                let twin = Pyramid::build(&w.level, voxel).unwrap();
+                let cpu_ms = cpu.elapsed().as_secs_f64() * 1e3;
+                let same = p.read_back(&shared).unwrap() == twin.words;
+                eprintln!(
+                    "({voxel}) {:.2} MiB: GPU build {:.1} ms in budgeted submissions ({:.1} ms with setup), CPU twin {cpu_ms:.0} ms, equal: {same}",
+                    p.layout.bytes() as f64 / (1024.0 * 1024.0),
+                    p.build_ms,
+                    start.elapsed().as_secs_f64() * 1e3
+                );
+            }
+            Err(e) => eprintln!("({voxel}) refused: {e}"),
+        }
+    }
+    let settings = MethodSettings::default();
+    for method in ["voxel", "voxel-compute", "ray", "ray-compute"] {
+        let start = std::time::Instant::now();
+        let mut r = Renderer::new(&gpu, &w.level, &colors, method, &settings, iw, ih).unwrap();
+        let setup_ms = start.elapsed().as_secs_f64() * 1e3;
+        let mut by_pitch: Vec<(f32, Vec<f64>)> = Vec::new();
+        for view in &w.views {
+            let camera = Camera::from_view(&w.level, view, iw, ih).unwrap();
+            r.render_frame(&camera).unwrap();
+            let mut t = Vec::new();
+            for _ in 0..5 {
+                let f = r.render_frame(&camera).unwrap();
+                t.push(f.gpu_ms.unwrap_or(f.cpu_ms));
+            }
+            t.sort_by(f64::total_cmp);
+            match by_pitch.iter_mut().find(|(p, _)| *p == view.pitch) {
+                Some((_, v)) => v.push(t[2]),
+                None => by_pitch.push((view.pitch, vec![t[2]])),
+            }
+        }
+        let row: Vec<String> = by_pitch
+            .iter()
+            .map(|(p, v)| format!("{p}: {:.3}", v.iter().sum::<f64>() / v.len() as f64))
+            .collect();
+        eprintln!(
+            "{method} {iw}x{ih}: setup {setup_ms:.0} ms; mean frame ms by pitch {}",
+            row.join(", ")
+        );
+    }
+}
