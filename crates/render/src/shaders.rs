@@ -49,6 +49,7 @@ pub const SOURCES: &[(&str, &str)] = &[
     ),
     ("forward.wgsl", include_str!("../shaders/forward.wgsl")),
     ("painted.wgsl", include_str!("../shaders/painted.wgsl")),
+    ("sliced.wgsl", include_str!("../shaders/sliced.wgsl")),
 ];
 
 /// Shaders with entry points (the rest are modules); the naga test validates these.
@@ -62,6 +63,7 @@ pub const ENTRY_SHADERS: &[&str] = &[
     "voxel_compute.wgsl",
     "voxel_build.wgsl",
     "painted.wgsl",
+    "sliced.wgsl",
 ];
 
 #[derive(Debug, thiserror::Error, PartialEq, Eq)]

@@ -35,9 +35,9 @@ pub struct FootprintParams {
 /// Bytes of the footprint uniform (what `painted` and `sliced` retain).
 pub const PARAMS_BYTES: u64 = std::mem::size_of::<FootprintParams>() as u64;
 
-/// The xy bound of the part of the frustum (near to far) with altitude in
+/// The xy bound of the part of the frustum (near to `far`) with altitude in
 /// `0..=Z_MAX`, or `None` when the frustum misses that range.
-pub fn footprint_bounds(camera: &Camera) -> Option<([f32; 2], [f32; 2])> {
+pub fn footprint_bounds(camera: &Camera, far: f32) -> Option<([f32; 2], [f32; 2])> {
     let (w, h) = (camera.width as f32, camera.height as f32);
     let image = [(0.0, 0.0), (w, 0.0), (w, h), (0.0, h)];
     // Corners at view depth `d`: the image direction's forward part is the focal length.
@@ -47,7 +47,7 @@ pub fn footprint_bounds(camera: &Camera) -> Option<([f32; 2], [f32; 2])> {
         })
     };
     let near = corners(camera.near);
-    let far = corners(camera.far);
+    let far = corners(far);
     let mut points: Vec<Vec3> = near
         .iter()
         .chain(&far)
@@ -78,17 +78,47 @@ pub fn footprint_bounds(camera: &Camera) -> Option<([f32; 2], [f32; 2])> {
     Some((lo, hi))
 }
 
+/// Samples in the bound of the frustum cut at `far`: the bound's corners.
+fn bound_samples(camera: &Camera, far: f32) -> Option<(i64, i64, i64, i64)> {
+    let (lo, hi) = footprint_bounds(camera, far)?;
+    // One texel of margin: a bar's column starts at floor(x).
+    // (Float to int casts saturate; so do the margins, for absurd cameras.)
+    let x0 = (lo[0].floor() as i64).saturating_sub(1);
+    let y0 = (lo[1].floor() as i64).saturating_sub(1);
+    let x1 = (hi[0].ceil() as i64).saturating_add(1);
+    let y1 = (hi[1].ceil() as i64).saturating_add(1);
+    Some((x0, y0, x1.max(x0), y1.max(y0)))
+}
+
 /// The footprint's samples and their front-to-back order for this camera.
-/// Clamps to [`MAX_SAMPLES`] (dropping the farthest rows) with a warning.
-pub fn footprint(camera: &Camera, method: &str) -> FootprintParams {
-    let Some((lo, hi)) = footprint_bounds(camera) else {
+/// Where the bound would exceed [`MAX_SAMPLES`], the footprint is cut at a
+/// nearer plane that fits, with a warning naming `warn_as` when given.
+pub fn footprint(camera: &Camera, warn_as: Option<&str>) -> FootprintParams {
+    let area = |b: (i64, i64, i64, i64)| (b.2 as f64 - b.0 as f64) * (b.3 as f64 - b.1 as f64);
+    let mut far = camera.far;
+    let Some(mut b) = bound_samples(camera, far) else {
         return FootprintParams::default();
     };
-    // One texel of margin: a bar's column starts at floor(x).
-    let x0 = lo[0].floor() as i64 - 1;
-    let y0 = lo[1].floor() as i64 - 1;
-    let x1 = hi[0].ceil() as i64 + 1;
-    let y1 = hi[1].ceil() as i64 + 1;
+    let full = area(b);
+    // The bound grows about with far^2: shrink far until it fits.
+    let fits = |b| area(b) <= MAX_SAMPLES as f64;
+    while !fits(b) && far > camera.near {
+        far = (far * (MAX_SAMPLES as f64 / area(b)).sqrt() as f32 * 0.95).max(camera.near);
+        match bound_samples(camera, far) {
+            Some(nb) => b = nb,
+            None => return FootprintParams::default(),
+        }
+    }
+    if let Some(method) = warn_as
+        && far < camera.far
+    {
+        eprintln!(
+            "warning: {method}: the footprint holds {full} samples (over {MAX_SAMPLES}); \
+             drawing the part nearer than {far:.0} of the far plane's {:.0}",
+            camera.far
+        );
+    }
+    let (x0, y0, x1, y1) = b;
     let flat = camera.basis().flat;
     // Rows across the axis the view mostly runs along, so row rank ~ distance.
     let rows_along_x = flat.y.abs() >= flat.x.abs();
@@ -106,12 +136,6 @@ pub fn footprint(camera: &Camera, method: &str) -> FootprintParams {
         (eye_x, eye_y)
     };
     let total = rows * row_len;
-    if total > MAX_SAMPLES {
-        eprintln!(
-            "warning: {method}: the footprint holds {total} samples ({len_x} x {len_y}); \
-             drawing the nearest {MAX_SAMPLES}"
-        );
-    }
     // Row lengths and row counts are under 2^32 whenever `total` fits the clamp;
     // saturate so an absurd camera cannot wrap.
     let sat = |v: u64| v.min(u64::from(u32::MAX)) as u32;
@@ -166,7 +190,7 @@ mod tests {
     fn footprint_contains_what_the_camera_sees() {
         for (pitch, yaw) in [(0.0, 0.0), (-30.0, 45.0), (-60.0, 200.0), (-90.0, 10.0)] {
             let cam = Camera::new(Vec3::new(300.0, 500.0, 120.0), yaw, pitch, 160, 100).unwrap();
-            let f = footprint(&cam, "test");
+            let f = footprint(&cam, None);
             let (x0, y0) = (f.origin[0] as f32, f.origin[1] as f32);
             let (lx, ly) = if f.origin[2] == 0 {
                 (f.size[1], f.size[0])
@@ -191,14 +215,19 @@ mod tests {
     #[test]
     fn a_frustum_above_the_terrain_has_no_footprint() {
         let cam = Camera::new(Vec3::new(0.0, 0.0, 5000.0), 0.0, 30.0, 160, 100).unwrap();
-        assert_eq!(footprint(&cam, "test").count[0], 0);
+        assert_eq!(footprint(&cam, None).count[0], 0);
     }
 
     #[test]
     fn a_huge_footprint_is_clamped() {
         let mut cam = Camera::new(Vec3::new(0.0, 0.0, 100.0), 45.0, 0.0, 160, 100).unwrap();
         cam.far = 100_000.0;
-        let f = footprint(&cam, "test");
-        assert_eq!(u64::from(f.count[0]), MAX_SAMPLES);
+        let f = footprint(&cam, None);
+        let n = u64::from(f.count[0]);
+        assert!(n <= MAX_SAMPLES && n > MAX_SAMPLES / 4, "{n}");
+        // The nearest part is kept: the eye's row is in the bound.
+        assert!(f.size[2] < f.size[0]);
+        cam.far = f32::INFINITY;
+        assert!(u64::from(footprint(&cam, None).count[0]) <= MAX_SAMPLES);
     }
 }

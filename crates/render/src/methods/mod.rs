@@ -34,6 +34,7 @@ pub mod forward;
 pub mod painted;
 pub mod ray;
 pub mod ray_compute;
+pub mod sliced;
 pub mod voxel;
 pub mod voxel_build;
 
@@ -131,6 +132,7 @@ pub const METHODS: &[(&str, Constructor)] = &[
     ("voxel", voxel::create),
     ("voxel-compute", voxel::create_compute),
     ("painted", painted::create),
+    ("sliced", sliced::create),
 ];
 
 /// The names [`create`] accepts.

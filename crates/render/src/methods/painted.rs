@@ -148,7 +148,7 @@ impl Method for Painted {
     }
 
     fn prepare(&mut self, shared: &Shared, camera: &Camera) -> anyhow::Result<()> {
-        let f = forward::footprint(camera, "painted");
+        let f = forward::footprint(camera, Some("painted"));
         self.samples = f.count[0];
         shared
             .queue

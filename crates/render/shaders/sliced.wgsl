@@ -1,0 +1,50 @@
+// `sliced`: N horizontal quads over the camera's footprint at
+// z_k = 256 - k * 256 / N (k = 1..N); a fragment keeps its point only where
+// the decoded column is solid at that altitude, else discards it.
+#include "frame.wgsl"
+#include "surface.wgsl"
+#include "shading.wgsl"
+#include "forward.wgsl"
+
+// count.y: slices N; count.z: the slice nearest the eye's altitude.
+@group(1) @binding(0) var<uniform> footprint: Footprint;
+
+// Top of the sliced range (Rust: `forward::Z_MAX`).
+const SLICE_TOP: f32 = 256.0;
+
+struct VertexOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) world: vec3<f32>,
+}
+
+@vertex
+fn vs_sliced(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) -> VertexOut {
+    let n = footprint.count.y;
+    // Slices nearest the eye's altitude first: near to far for the floors
+    // below and the ceilings above, so the depth test rejects early.
+    let j = outward(i, footprint.count.z, n);
+    let z = SLICE_TOP - f32(j + 1u) * (SLICE_TOP / f32(n));
+    var corners = array<vec2<f32>, 6>(
+        vec2<f32>(0.0, 0.0), vec2<f32>(1.0, 0.0), vec2<f32>(0.0, 1.0),
+        vec2<f32>(0.0, 1.0), vec2<f32>(1.0, 0.0), vec2<f32>(1.0, 1.0),
+    );
+    // The bound's extent in x and y (rows run along x when origin.z is 0).
+    var extent = vec2<f32>(f32(footprint.size.y), f32(footprint.size.x));
+    if (footprint.origin.z != 0) {
+        extent = extent.yx;
+    }
+    let xy = vec2<f32>(footprint.origin.xy) + corners[v] * extent;
+    var out: VertexOut;
+    out.world = vec3<f32>(xy, z);
+    out.clip = globals.view_proj * vec4<f32>(out.world, 1.0);
+    return out;
+}
+
+@fragment
+fn fs_sliced(in: VertexOut) -> @location(0) vec4<f32> {
+    let p = in.world;
+    if (!is_solid(p)) {
+        discard;
+    }
+    return vec4<f32>(shade(p, p - globals.eye.xyz), 1.0);
+}

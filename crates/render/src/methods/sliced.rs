@@ -1,0 +1,108 @@
+//! `sliced` (§3.3): `slices` horizontal quads over the camera's footprint at
+//! z = 256 - k·256/N (k = 1..N), one instanced draw; each fragment keeps its
+//! point where the decoded column is solid (floor column or slab) and
+//! discards it elsewhere. Depth-tested like any geometry.
+
+use super::forward::{self, Z_MAX};
+use super::painted::{begin_pass, footprint_binding, forward_pipeline};
+use super::{Frame, Method, MethodSettings, RetainedBytes};
+use crate::frame::Shared;
+use strata_camera::Camera;
+use strata_level::Level;
+
+/// More slices than this sample far below the 256 quantised altitudes and
+/// only multiply overdraw; refuse them rather than draw for seconds.
+pub const MAX_SLICES: u32 = 1 << 16;
+
+pub struct Sliced {
+    pipeline: wgpu::RenderPipeline,
+    group: wgpu::BindGroup,
+    params: wgpu::Buffer,
+    slices: u32,
+    /// Whether the footprint is empty this frame (nothing to draw).
+    empty: bool,
+}
+
+pub fn create(
+    shared: &Shared,
+    _level: &Level,
+    settings: &MethodSettings,
+) -> anyhow::Result<Box<dyn Method>> {
+    let slices = settings.slices;
+    if slices == 0 || slices > MAX_SLICES {
+        anyhow::bail!("slices must be in 1..={MAX_SLICES} (got {slices})");
+    }
+    let (params, layout, group) = footprint_binding(shared, "sliced");
+    let pipeline = forward_pipeline(
+        shared,
+        "sliced",
+        "sliced.wgsl",
+        &layout,
+        ("vs_sliced", "fs_sliced"),
+    )?;
+    Ok(Box::new(Sliced {
+        pipeline,
+        group,
+        params,
+        slices,
+        empty: true,
+    }))
+}
+
+/// The slice index (0 = the top one, z = 256 - 256/N) nearest altitude `z`.
+fn slice_near(z: f32, slices: u32) -> u32 {
+    let k = ((Z_MAX - z) * slices as f32 / Z_MAX).round() - 1.0;
+    k.clamp(0.0, (slices - 1) as f32) as u32
+}
+
+impl Method for Sliced {
+    fn name(&self) -> &'static str {
+        "sliced"
+    }
+
+    fn prepare(&mut self, shared: &Shared, camera: &Camera) -> anyhow::Result<()> {
+        // The quads span the bound; the sample count clamp is painted's concern.
+        let mut f = forward::footprint(camera, None);
+        self.empty = f.size[0] == 0 || f.size[1] == 0;
+        f.count[1] = self.slices;
+        f.count[2] = slice_near(camera.position.z, self.slices);
+        shared
+            .queue
+            .write_buffer(&self.params, 0, bytemuck::bytes_of(&f));
+        Ok(())
+    }
+
+    fn record(&self, shared: &Shared, frame: &Frame<'_>, encoder: &mut wgpu::CommandEncoder) {
+        let mut pass = begin_pass(shared, frame, encoder, "sliced");
+        if self.empty {
+            return;
+        }
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &shared.frame_group, &[]);
+        pass.set_bind_group(1, &self.group, &[]);
+        pass.draw(0..6, 0..self.slices);
+    }
+
+    fn retained_bytes(&self) -> RetainedBytes {
+        // The 48-byte footprint uniform; the quads come from indices.
+        RetainedBytes {
+            gpu: forward::PARAMS_BYTES,
+            cpu: 0,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn slice_altitudes_follow_the_paper() {
+        // N = 256: slice k sits at 256 - k, so index j at 255 - j.
+        assert_eq!(slice_near(255.0, 256), 0);
+        assert_eq!(slice_near(0.0, 256), 255);
+        assert_eq!(slice_near(100.0, 512), 311);
+        assert_eq!(slice_near(1000.0, 512), 0);
+        assert_eq!(slice_near(-5.0, 512), 511);
+    }
+}
