@@ -31,6 +31,8 @@ pub struct Renderer {
     errors: ErrorSink,
     level_shape: LevelShape,
     frames: u64,
+    adapter: crate::gpu::AdapterReport,
+    setup_ms: f64,
 }
 
 impl Renderer {
@@ -44,6 +46,7 @@ impl Renderer {
         width: u32,
         height: u32,
     ) -> anyhow::Result<Self> {
+        let start = Instant::now();
         // Unknown names fail before any GPU work.
         if !methods::names().contains(&method) {
             anyhow::bail!(
@@ -71,7 +74,7 @@ impl Renderer {
             });
             (resolve, read)
         });
-        let renderer = Renderer {
+        let mut renderer = Renderer {
             shared,
             method,
             shadow,
@@ -82,13 +85,27 @@ impl Renderer {
             errors: gpu.errors.clone(),
             level_shape: LevelShape::of(level),
             frames: 0,
+            adapter: gpu.report.clone(),
+            setup_ms: 0.0,
         };
         wait_device(&renderer.shared.device, &renderer.errors)?;
+        renderer.setup_ms = ms(start);
         Ok(renderer)
     }
 
     pub fn method_name(&self) -> &'static str {
         self.method.name()
+    }
+
+    /// The adapter this renderer runs on.
+    pub fn adapter(&self) -> &crate::gpu::AdapterReport {
+        &self.adapter
+    }
+
+    /// Wall-clock ms `new` took: terrain upload, pipelines, method data,
+    /// waiting for the GPU to finish them (the protocol's "setup").
+    pub fn setup_ms(&self) -> f64 {
+        self.setup_ms
     }
 
     pub fn settings(&self) -> &MethodSettings {

@@ -3,6 +3,7 @@
 
 use crate::gpu::AdapterReport;
 use crate::methods::MethodSettings;
+use crate::renderer::Renderer;
 use crate::timing::Stats;
 use anyhow::Context;
 use serde::Serialize;
@@ -79,4 +80,71 @@ pub fn write_outputs(
     let json = serde_json::to_string_pretty(report)?;
     let path = dir.join("render.json");
     std::fs::write(&path, json + "\n").with_context(|| format!("writing {}", path.display()))
+}
+
+/// Measure one view: a first frame, `warmup` untimed frames, `frames` timed
+/// ones; then the report (adapter, timings, prep, memory) and the last
+/// frame's colour and depth.
+pub fn measure_view(
+    renderer: &mut Renderer,
+    world: &str,
+    view: &ViewSpec,
+    camera: &Camera,
+    warmup: u32,
+    frames: u32,
+) -> anyhow::Result<(RenderReport, Vec<u8>, Vec<f32>)> {
+    let adapter = renderer.adapter().clone();
+    if frames == 0 {
+        anyhow::bail!("at least one timed frame is needed");
+    }
+    let m = renderer.measure(camera, warmup, frames)?;
+    let gpu_ms: Vec<f64> = m.timings.iter().filter_map(|t| t.gpu_ms).collect();
+    let cpu_ms: Vec<f64> = m.timings.iter().map(|t| t.cpu_ms).collect();
+    let n = m.timings.len() as f64;
+    let mut passes: Vec<(String, f64)> = Vec::new();
+    for t in &m.timings {
+        for (label, ms) in &t.passes {
+            match passes.iter_mut().find(|(l, _)| l == label) {
+                Some(p) => p.1 += ms / n,
+                None => passes.push((label.clone(), ms / n)),
+            }
+        }
+    }
+    let timestamps = gpu_ms.len() == m.timings.len();
+    let settings = renderer.settings().clone();
+    let retained = renderer.retained_bytes();
+    let report = RenderReport {
+        adapter: adapter.name.clone(),
+        backend: adapter.backend.clone(),
+        driver: adapter.driver.clone(),
+        adapter_info: adapter.clone(),
+        world: world.to_string(),
+        method: renderer.method_name().to_string(),
+        view: view.clone(),
+        camera: *camera,
+        size: [camera.width, camera.height],
+        shadows: settings.shadows,
+        settings,
+        frames,
+        timing_source: if timestamps {
+            "gpu-timestamps-per-pass"
+        } else {
+            "cpu-submit-and-wait"
+        },
+        gpu_ms: if timestamps { Stats::of(&gpu_ms) } else { None },
+        cpu_ms: Stats::of(&cpu_ms).unwrap_or_default(),
+        passes,
+        prep: Prep {
+            setup_ms: renderer.setup_ms(),
+            first_frame_ms: m.first_frame_ms,
+            warmup_ms: m.warmup_ms,
+            warmup_frames: warmup,
+        },
+        gpu_bytes: retained.gpu,
+        cpu_bytes: retained.cpu,
+        shared_gpu_bytes: renderer.shared_gpu_bytes(),
+    };
+    let color = renderer.read_color()?;
+    let depth = renderer.read_depth()?;
+    Ok((report, color, depth))
 }

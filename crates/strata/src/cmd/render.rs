@@ -5,11 +5,10 @@
 use crate::world_arg::WorldArgs;
 use anyhow::{Context, bail};
 use std::path::PathBuf;
-use std::time::Instant;
 use strata_camera::Camera;
 use strata_level::{ViewSpec, views::parse_views};
-use strata_render::report::{Prep, RenderReport, write_outputs};
-use strata_render::{Gpu, MethodSettings, Renderer, Stats, TerrainColors};
+use strata_render::report::{measure_view, write_outputs};
+use strata_render::{Gpu, MethodSettings, Renderer, TerrainColors};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -81,7 +80,8 @@ fn load_world(args: &WorldArgs) -> anyhow::Result<strata_level::World> {
     match &args.level {
         Some(dir) => strata_level::io::load_world(dir, rule)
             .with_context(|| format!("loading the world in {}", dir.display())),
-        None => bail!("no --level DIR given and the built-in generated world is not wired up yet"),
+        // The built-in generated world (Fostral's size, fixed seed).
+        None => Ok(strata_level::generate::generate(&Default::default())?),
     }
 }
 
@@ -138,7 +138,6 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         ..Default::default()
     };
     let gpu = Gpu::headless()?;
-    let start = Instant::now();
     let mut renderer = Renderer::new(
         &gpu,
         &world.level,
@@ -148,7 +147,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         w,
         h,
     )?;
-    let setup_ms = start.elapsed().as_secs_f64() * 1e3;
+    let setup_ms = renderer.setup_ms();
     if !args.json {
         let r = &gpu.report;
         println!(
@@ -165,59 +164,20 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             "view", "gpu ms", "cpu ms", "first ms", "setup ms", "gpu bytes"
         );
     }
-    let retained = renderer.retained_bytes();
     for (view, camera) in views.iter().zip(&cameras) {
-        let m = renderer.measure(camera, args.warmup, args.frames)?;
-        let gpu_ms: Vec<f64> = m.timings.iter().filter_map(|t| t.gpu_ms).collect();
-        let cpu_ms: Vec<f64> = m.timings.iter().map(|t| t.cpu_ms).collect();
-        let mut passes: Vec<(String, f64)> = Vec::new();
-        for t in &m.timings {
-            for (label, ms) in &t.passes {
-                match passes.iter_mut().find(|(l, _)| l == label) {
-                    Some(p) => p.1 += ms / m.timings.len() as f64,
-                    None => passes.push((label.clone(), ms / m.timings.len() as f64)),
-                }
-            }
-        }
-        let timestamps = gpu_ms.len() == m.timings.len();
-        let report = RenderReport {
-            adapter: gpu.report.name.clone(),
-            backend: gpu.report.backend.clone(),
-            driver: gpu.report.driver.clone(),
-            adapter_info: gpu.report.clone(),
-            world: world.name.clone(),
-            method: renderer.method_name().to_string(),
-            view: view.clone(),
-            camera: *camera,
-            size: [w, h],
-            settings: settings.clone(),
-            shadows: settings.shadows,
-            frames: args.frames,
-            timing_source: if timestamps {
-                "gpu-timestamps-per-pass"
-            } else {
-                "cpu-submit-and-wait"
-            },
-            gpu_ms: if timestamps { Stats::of(&gpu_ms) } else { None },
-            cpu_ms: Stats::of(&cpu_ms).unwrap_or_default(),
-            passes,
-            prep: Prep {
-                setup_ms,
-                first_frame_ms: m.first_frame_ms,
-                warmup_ms: m.warmup_ms,
-                warmup_frames: args.warmup,
-            },
-            gpu_bytes: retained.gpu,
-            cpu_bytes: retained.cpu,
-            shared_gpu_bytes: renderer.shared_gpu_bytes(),
-        };
+        let (report, color, depth) = measure_view(
+            &mut renderer,
+            &world.name,
+            view,
+            camera,
+            args.warmup,
+            args.frames,
+        )?;
         let dir = if views.len() == 1 {
             args.out.clone()
         } else {
             args.out.join(&view.name)
         };
-        let color = renderer.read_color()?;
-        let depth = renderer.read_depth()?;
         write_outputs(&dir, &report, &color, &depth)?;
         if args.json {
             println!("{}", serde_json::to_string(&report)?);
@@ -228,7 +188,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                 .unwrap_or_else(|| "n/a".into());
             println!(
                 "{:<14} {:>10} {:>10.3} {:>10.1} {:>10.1} {:>12}",
-                view.name, gpu, report.cpu_ms.mean, m.first_frame_ms, setup_ms, retained.gpu
+                view.name,
+                gpu,
+                report.cpu_ms.mean,
+                report.prep.first_frame_ms,
+                setup_ms,
+                report.gpu_bytes
             );
         }
     }
