@@ -200,3 +200,38 @@ pub fn timed_fit(level: &Level, tolerance: f64) -> (LevelMesh, f64) {
     let mesh = LevelMesh::fit(level, tolerance);
     (mesh, t.elapsed().as_secs_f64())
 }
+
+/// How long a fit took.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct FitTiming {
+    pub threads: usize,
+    pub wall_seconds: f64,
+    /// CPU time of all threads (the machine may be shared), where known.
+    pub cpu_seconds: Option<f64>,
+}
+
+/// Fit on a pool of `threads` workers (0: one per core) and time it.
+pub fn fit_on_threads(
+    level: &Level,
+    tolerance: f64,
+    threads: usize,
+) -> Result<(LevelMesh, FitTiming), rayon::ThreadPoolBuildError> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()?;
+    // Start the workers first so one CPU reading covers them all.
+    pool.broadcast(|_| ());
+    Ok(pool.install(|| {
+        let cpu0 = crate::cpu_time::process_cpu_seconds();
+        let (mesh, wall_seconds) = timed_fit(level, tolerance);
+        let cpu_seconds = crate::cpu_time::process_cpu_seconds()
+            .zip(cpu0)
+            .map(|(b, a)| b - a);
+        let timing = FitTiming {
+            threads: rayon::current_num_threads(),
+            wall_seconds,
+            cpu_seconds,
+        };
+        (mesh, timing)
+    }))
+}

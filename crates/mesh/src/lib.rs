@@ -23,6 +23,7 @@ pub mod triangulation;
 pub use emit::{ChunkMesh, ChunkStats, LodStats, decode, encode};
 pub use fit::{CAUSES, Cause, ChunkFitter, LODS};
 pub use level_mesh::{
-    ChunkRange, LevelMesh, MeshStats, dirty_chunks, timed_fit, tolerance_for_quality,
+    ChunkRange, FitTiming, LevelMesh, MeshStats, dirty_chunks, fit_on_threads, timed_fit,
+    tolerance_for_quality,
 };
 pub use samples::{CHUNK, ChunkLayout};

@@ -1,8 +1,232 @@
-//! `strata fit` (not implemented yet).
+//! `strata fit`: fit the TIN mesh (issue 7) and report its size, where the
+//! vertex budget went, fit time and retained memory.
+
+use anyhow::{Context, bail};
+use serde::Serialize;
+use strata_level::{Level, MidRule, io};
+use strata_mesh::synthetic::synthetic_level;
+use strata_mesh::{LODS, MeshStats, fit_on_threads, tolerance_for_quality};
 
 #[derive(clap::Args)]
-pub struct Args {}
+pub struct Args {
+    #[command(flatten)]
+    world: crate::world_arg::WorldArgs,
+    /// Mesh quality q in [0, 1]: max vertical error 2^(4(1-q)) height units.
+    #[arg(long, default_value_t = 0.5)]
+    quality: f64,
+    /// Print one JSON object instead of text.
+    #[arg(long)]
+    json: bool,
+    /// Fit a synthetic WxH level (terraces, cliffs, ~10% slabs) instead of a world.
+    #[arg(long, value_name = "WxH")]
+    synthetic: Option<String>,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    threads: Option<usize>,
+}
 
-pub fn run(_args: Args) -> anyhow::Result<()> {
-    anyhow::bail!("`strata fit` is not implemented yet")
+#[derive(Serialize)]
+struct LodReport {
+    max_error: f64,
+    /// Planar triangles (= floor triangles).
+    triangles: u64,
+    slab_triangles: u64,
+    wall_triangles: u64,
+    /// Everything drawn for this LOD.
+    emitted_triangles: u64,
+}
+
+#[derive(Serialize)]
+struct Causes {
+    floor: u64,
+    slab_interior: u64,
+    single_double_boundary: u64,
+    chunk_border: u64,
+    /// Shares of all insertions, in percent, same order.
+    shares_percent: [f64; 4],
+}
+
+#[derive(Serialize)]
+struct Report {
+    world: String,
+    width: u32,
+    height: u32,
+    quality: f64,
+    max_error: f64,
+    chunks: usize,
+    threads: usize,
+    /// Sum over chunks of finest-LOD vertices (shared border vertices in both chunks).
+    vertices: u64,
+    /// Finest-LOD planar triangles.
+    triangles: u64,
+    /// 2 triangles per texel.
+    full_grid_triangles: u64,
+    reduction: f64,
+    lods: Vec<LodReport>,
+    insertions: Causes,
+    fit_seconds: f64,
+    /// CPU time of all threads during the fit (the machine may be shared).
+    fit_cpu_seconds: Option<f64>,
+    triangles_per_second_per_core: f64,
+    gpu_bytes: u64,
+    cpu_bytes: u64,
+    gpu_bytes_per_triangle: f64,
+    cpu_bytes_per_triangle: f64,
+}
+
+fn load(args: &Args) -> anyhow::Result<(String, Level)> {
+    if let Some(spec) = &args.synthetic {
+        let (w, h) = spec
+            .split_once('x')
+            .and_then(|(w, h)| Some((w.parse::<u32>().ok()?, h.parse::<u32>().ok()?)))
+            .context("--synthetic wants WxH, e.g. 2048x16384")?;
+        if !w.is_power_of_two() || !h.is_power_of_two() || w < 2 || w > 1 << 15 || h > 1 << 15 {
+            bail!("--synthetic {w}x{h}: sides must be powers of two, 2..=32768");
+        }
+        return Ok((format!("synthetic-{w}x{h}"), synthetic_level(w, h, 1)));
+    }
+    let mid_rule = if args.world.vange_rs_mid {
+        MidRule::VangeRs
+    } else {
+        MidRule::Original
+    };
+    let Some(dir) = &args.world.level else {
+        bail!(
+            "`strata fit` needs --level DIR or --synthetic WxH for now (the built-in world is not wired in yet)"
+        );
+    };
+    let world = io::load_world(dir, mid_rule)
+        .with_context(|| format!("loading the world in {}", dir.display()))?;
+    Ok((world.name, world.level))
+}
+
+pub fn run(args: Args) -> anyhow::Result<()> {
+    let Some(tolerance) = tolerance_for_quality(args.quality) else {
+        bail!("--quality {} is outside [0, 1]", args.quality);
+    };
+    let (name, level) = load(&args)?;
+    let (mesh, timing) = fit_on_threads(&level, tolerance, args.threads.unwrap_or(0))
+        .context("starting the worker threads")?;
+    let (seconds, cpu, threads) = (timing.wall_seconds, timing.cpu_seconds, timing.threads);
+    let report = report(
+        &name,
+        &level,
+        args.quality,
+        &mesh.stats(),
+        seconds,
+        cpu,
+        threads,
+    );
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        print_text(&report);
+    }
+    Ok(())
+}
+
+fn report(
+    name: &str,
+    level: &Level,
+    quality: f64,
+    s: &MeshStats,
+    seconds: f64,
+    cpu: Option<f64>,
+    threads: usize,
+) -> Report {
+    let full = 2 * u64::from(level.width()) * u64::from(level.height());
+    let tris = s.lods[0].planar;
+    let total: u64 = s.causes.iter().sum();
+    let share = |n: u64| {
+        if total == 0 {
+            0.0
+        } else {
+            100.0 * n as f64 / total as f64
+        }
+    };
+    let per_tri = |b: u64| {
+        if tris == 0 {
+            0.0
+        } else {
+            b as f64 / tris as f64
+        }
+    };
+    Report {
+        world: name.to_string(),
+        width: level.width(),
+        height: level.height(),
+        quality,
+        max_error: s.tolerance,
+        chunks: s.chunks,
+        threads,
+        vertices: s.planar_vertices,
+        triangles: tris,
+        full_grid_triangles: full,
+        reduction: if tris == 0 {
+            0.0
+        } else {
+            full as f64 / tris as f64
+        },
+        lods: (0..LODS)
+            .map(|k| LodReport {
+                max_error: s.tolerance * f64::from(1u32 << k),
+                triangles: s.lods[k].planar,
+                slab_triangles: s.lods[k].slab,
+                wall_triangles: s.lods[k].wall,
+                emitted_triangles: s.lods[k].emitted,
+            })
+            .collect(),
+        insertions: Causes {
+            floor: s.causes[0],
+            slab_interior: s.causes[1],
+            single_double_boundary: s.causes[2],
+            chunk_border: s.causes[3],
+            shares_percent: s.causes.map(share),
+        },
+        fit_seconds: seconds,
+        fit_cpu_seconds: cpu,
+        triangles_per_second_per_core: tris as f64 / seconds.max(1e-9) / threads.max(1) as f64,
+        gpu_bytes: s.gpu_bytes,
+        cpu_bytes: s.cpu_bytes,
+        gpu_bytes_per_triangle: per_tri(s.gpu_bytes),
+        cpu_bytes_per_triangle: per_tri(s.cpu_bytes),
+    }
+}
+
+fn print_text(r: &Report) {
+    let mib = |b: u64| b as f64 / (1024.0 * 1024.0);
+    println!(
+        "{} ({}x{}), q={} (max error {}), {} chunks",
+        r.world, r.width, r.height, r.quality, r.max_error, r.chunks
+    );
+    println!(
+        "finest LOD: {} vertices, {} triangles; full grid {} -> reduction {:.1}x",
+        r.vertices, r.triangles, r.full_grid_triangles, r.reduction
+    );
+    for (k, l) in r.lods.iter().enumerate() {
+        println!(
+            "  LOD {k} (max error {:>4}): {:>10} triangles, drawn {:>10} (slab {}, walls {})",
+            l.max_error, l.triangles, l.emitted_triangles, l.slab_triangles, l.wall_triangles
+        );
+    }
+    let c = &r.insertions;
+    let s = c.shares_percent;
+    println!(
+        "insertions: floor {} ({:.1}%), slab interior {} ({:.1}%), single/double boundary {} ({:.1}%), chunk border {} ({:.1}%)",
+        c.floor, s[0], c.slab_interior, s[1], c.single_double_boundary, s[2], c.chunk_border, s[3]
+    );
+    let cpu = r
+        .fit_cpu_seconds
+        .map_or(String::from("n/a"), |c| format!("{c:.2} s"));
+    println!(
+        "fit: {:.2} s wall on {} threads (CPU {cpu}), {:.0} triangles/s per core",
+        r.fit_seconds, r.threads, r.triangles_per_second_per_core
+    );
+    println!(
+        "retained: GPU {:.1} MiB ({:.1} B/triangle, all LODs), CPU {:.2} MiB ({:.2} B/triangle)",
+        mib(r.gpu_bytes),
+        r.gpu_bytes_per_triangle,
+        mib(r.cpu_bytes),
+        r.cpu_bytes_per_triangle
+    );
 }
