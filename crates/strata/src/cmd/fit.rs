@@ -3,7 +3,7 @@
 
 use anyhow::{Context, bail};
 use serde::Serialize;
-use strata_level::{Level, MidRule, io};
+use strata_level::Level;
 use strata_mesh::synthetic::synthetic_level;
 use strata_mesh::{LODS, MeshStats, fit_on_threads, tolerance_for_quality};
 
@@ -85,18 +85,7 @@ fn load(args: &Args) -> anyhow::Result<(String, Level)> {
         }
         return Ok((format!("synthetic-{w}x{h}"), synthetic_level(w, h, 1)));
     }
-    let mid_rule = if args.world.vange_rs_mid {
-        MidRule::VangeRs
-    } else {
-        MidRule::Original
-    };
-    let Some(dir) = &args.world.level else {
-        bail!(
-            "`strata fit` needs --level DIR or --synthetic WxH for now (the built-in world is not wired in yet)"
-        );
-    };
-    let world = io::load_world(dir, mid_rule)
-        .with_context(|| format!("loading the world in {}", dir.display()))?;
+    let world = args.world.load()?;
     Ok((world.name, world.level))
 }
 
