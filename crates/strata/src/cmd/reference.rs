@@ -89,21 +89,8 @@ pub fn parse_image_size(text: &str) -> Result<(u32, u32), String> {
     Ok((w, h))
 }
 
-fn load_world(args: &WorldArgs) -> anyhow::Result<strata_level::World> {
-    let rule = if args.vange_rs_mid {
-        strata_level::MidRule::VangeRs
-    } else {
-        strata_level::MidRule::Original
-    };
-    match &args.level {
-        Some(dir) => strata_level::io::load_world(dir, rule)
-            .with_context(|| format!("loading the world in {}", dir.display())),
-        None => bail!("no --level DIR given and the built-in generated world is not wired up yet"),
-    }
-}
-
 pub fn run(args: Args) -> anyhow::Result<()> {
-    let world = load_world(&args.world)?;
+    let world = args.world.load()?;
     let views: Vec<ViewSpec> = match (&args.view, &args.views) {
         (Some(spec), _) => {
             let pitch = args.pitch.context("--view needs --pitch DEG")?;
