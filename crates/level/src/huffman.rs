@@ -161,15 +161,17 @@ pub enum TreeError {
     Cycle { node: usize, target: i32 },
 }
 
-/// A checked decode tree plus a lookup table resolving [`LOOKUP_BITS`] bits
-/// at once: up to two whole symbols per lookup (delta-coded terrain is
-/// mostly short codes, so two per lookup halves the work).
+/// A checked decode tree plus lookup tables resolving [`LOOKUP_BITS`] bits
+/// at once: up to three whole symbols per lookup (delta-coded terrain is
+/// mostly 1-3 bit codes, so this cuts the per-symbol work), and one symbol
+/// per lookup for the last few symbols of a stream.
 pub struct Decoder {
     tree: Tree,
-    /// Per `LOOKUP_BITS`-bit prefix, packed: `sym1 | sym2 << 8 | len1 << 16
-    /// | len_total << 21 | count << 26`. `count` 0 means no symbol ends
-    /// inside the prefix: the walk continues at node `sym1`.
-    table: Vec<u32>,
+    /// Per prefix: `s1 | s2 << 8 | s3 << 16 | bits << 24 | count << 28`.
+    /// `count` 0: no symbol ends inside the prefix; the walk continues at node `s1`.
+    multi: Vec<u32>,
+    /// Per prefix: `symbol | bits << 8 | 1 << 16`, or `node` (no leaf yet).
+    single: Vec<u32>,
 }
 
 /// Walk from `node` along the low `n` bits of `prefix` (MSB first).
@@ -211,26 +213,35 @@ impl Decoder {
             }
         }
         // Every path now ends in a leaf within 255 steps: walks terminate.
-        let table = (0..1u32 << LOOKUP_BITS)
+        let single = (0..1u32 << LOOKUP_BITS)
             .map(|prefix| match walk(tree, 1, prefix, LOOKUP_BITS) {
-                Err(node) => LOOKUP_BITS << 21 | node as u32,
-                Ok((s1, l1)) => {
-                    let rest = LOOKUP_BITS - l1;
-                    let mask = (1u32 << rest) - 1;
-                    match walk(tree, 1, prefix & mask, rest) {
-                        Ok((s2, l2)) => {
-                            2 << 26
-                                | (l1 + l2) << 21
-                                | l1 << 16
-                                | u32::from(s2) << 8
-                                | u32::from(s1)
-                        }
-                        Err(_) => 1 << 26 | l1 << 21 | l1 << 16 | u32::from(s1),
-                    }
-                }
+                Ok((sym, len)) => u32::from(sym) | len << 8 | 1 << 16,
+                Err(node) => node as u32,
             })
             .collect();
-        Ok(Decoder { tree: *tree, table })
+        let multi = (0..1u32 << LOOKUP_BITS)
+            .map(|prefix| {
+                let (mut entry, mut used, mut count) = (0u32, 0u32, 0u32);
+                while count < 3 {
+                    let rest = LOOKUP_BITS - used;
+                    match walk(tree, 1, prefix & ((1u32 << rest) - 1), rest) {
+                        Ok((sym, len)) => {
+                            entry |= u32::from(sym) << (8 * count);
+                            used += len;
+                            count += 1;
+                        }
+                        Err(node) if count == 0 => return node as u32,
+                        Err(_) => break,
+                    }
+                }
+                entry | used << 24 | count << 28
+            })
+            .collect();
+        Ok(Decoder {
+            tree: *tree,
+            multi,
+            single,
+        })
     }
 
     /// Decode `out.len()` symbols into `out`.
@@ -238,24 +249,32 @@ impl Decoder {
     pub fn decode_into(&self, bits: &mut BitReader<'_>, out: &mut [u8]) {
         let n = out.len();
         let mut i = 0;
-        while i < n {
+        // Bulk: three bytes are written per lookup, `count` of them are kept.
+        while i + 3 <= n {
             bits.refill();
-            let e = self.table[(bits.buf >> (64 - LOOKUP_BITS)) as usize];
-            let count = e >> 26;
-            if count == 2 && i + 1 < n {
-                bits.consume((e >> 21) & 31);
-                out[i] = e as u8;
-                out[i + 1] = (e >> 8) as u8;
-                i += 2;
-            } else if count != 0 {
-                bits.consume((e >> 16) & 31);
-                out[i] = e as u8;
-                i += 1;
-            } else {
+            let e = self.multi[(bits.buf >> (64 - LOOKUP_BITS)) as usize];
+            let count = (e >> 28) as usize;
+            if count == 0 {
                 bits.consume(LOOKUP_BITS);
                 out[i] = self.walk_rest((e & 0xff) as usize, bits);
                 i += 1;
+                continue;
             }
+            bits.consume((e >> 24) & 15);
+            out[i..i + 3].copy_from_slice(&e.to_le_bytes()[..3]);
+            i += count;
+        }
+        while i < n {
+            bits.refill();
+            let e = self.single[(bits.buf >> (64 - LOOKUP_BITS)) as usize];
+            if e >> 16 != 0 {
+                bits.consume((e >> 8) & 0xff);
+                out[i] = e as u8;
+            } else {
+                bits.consume(LOOKUP_BITS);
+                out[i] = self.walk_rest((e & 0xff) as usize, bits);
+            }
+            i += 1;
         }
     }
 

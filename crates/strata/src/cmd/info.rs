@@ -41,6 +41,11 @@ struct MapFile {
     decode_min_ms: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     decode_median_ms: Option<f64>,
+    /// With `--repeat N`: process CPU time per decode, all threads, averaged
+    /// (Linux `/proc/self/stat`, 10 ms ticks). Unlike wall time it does not
+    /// grow when other processes compete for the cores.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    decode_cpu_ms: Option<f64>,
     decodes: u32,
 }
 
@@ -100,6 +105,15 @@ fn time_map(dir: &Path, world: &World, mid_rule: MidRule) -> anyhow::Result<io::
     })
 }
 
+/// User + system CPU time of this process so far (Linux only; `USER_HZ` 100).
+fn process_cpu_ms() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // Fields after the command name, which is in parentheses and may hold spaces.
+    let fields: Vec<&str> = stat.rsplit_once(')')?.1.split_whitespace().collect();
+    let ticks = |i: usize| fields.get(i)?.parse::<f64>().ok();
+    Some((ticks(11)? + ticks(12)?) * 10.0)
+}
+
 /// The map file's figures, with `repeat - 1` more timed decodes when asked.
 fn map_file(
     load: io::MapLoad,
@@ -107,16 +121,20 @@ fn map_file(
     mid_rule: MidRule,
     repeat: u32,
 ) -> anyhow::Result<MapFile> {
-    let (mut decode_min_ms, mut decode_median_ms) = (None, None);
+    let (mut decode_min_ms, mut decode_median_ms, mut decode_cpu_ms) = (None, None, None);
     if repeat > 1 {
         let bytes = std::fs::read(&load.path)
             .with_context(|| format!("reading {}", load.path.display()))?;
         let mut times = Vec::new();
+        let cpu0 = process_cpu_ms();
         for _ in 0..repeat {
             let t = Instant::now();
             let level = io::decode_map(&bytes, &world.config, mid_rule, &load.path)?;
             times.push(ms_since(t));
             drop(level);
+        }
+        if let (Some(a), Some(b)) = (cpu0, process_cpu_ms()) {
+            decode_cpu_ms = Some((b - a) / f64::from(repeat));
         }
         times.sort_by(f64::total_cmp);
         decode_min_ms = times.first().copied();
@@ -129,6 +147,7 @@ fn map_file(
         decode_ms: load.decode_ms,
         decode_min_ms,
         decode_median_ms,
+        decode_cpu_ms,
         decodes: repeat,
     })
 }
@@ -194,8 +213,12 @@ fn print_text(info: &Info) {
             m.decode_ms
         );
         if let (Some(min), Some(median)) = (m.decode_min_ms, m.decode_median_ms) {
+            let cpu = m
+                .decode_cpu_ms
+                .map(|c| format!(", CPU {c:.0} ms each"))
+                .unwrap_or_default();
             println!(
-                "             {} more decodes: fastest {min:.0} ms, median {median:.0} ms",
+                "             {} more decodes: fastest {min:.0} ms, median {median:.0} ms{cpu}",
                 m.decodes
             );
         }
