@@ -213,7 +213,7 @@ impl GpuPyramid {
         let mut budget = self.budget_texels;
         let mut leaves = Vec::new();
         // Each leaf piece brings one dispatch per level: stop while slots remain.
-        while leaves.len() + 1 <= MAX_SLOTS / levels {
+        while leaves.len() < MAX_SLOTS / levels {
             let Some(mut r) = self.pending.pop_front() else {
                 break;
             };
