@@ -326,3 +326,34 @@ fn fostral_sized_build_and_frame_times() {
         );
     }
 }
+
+/// The step budget is live: a horizon view with a handful of steps runs out
+/// before reaching distant terrain, and the default budget does not.
+#[test]
+fn step_budget_is_honoured() {
+    let Some(gpu) = gpu() else { return };
+    let w = world(512, 1024);
+    let colors = TerrainColors::from_world(&w);
+    let view = w
+        .views
+        .iter()
+        .find(|v| v.pitch == 0.0)
+        .expect("a horizon view");
+    let camera = Camera::from_view(&w.level, view, W, H).unwrap();
+    let mut see_through = Vec::new();
+    for steps in [4, 100] {
+        let settings = MethodSettings {
+            voxel_steps: steps,
+            ..MethodSettings::default()
+        };
+        let mut r =
+            Renderer::new(&gpu, &w.level, &colors, "voxel-compute", &settings, W, H).unwrap();
+        let m = score(&mut r, &w.level, &camera);
+        eprintln!(
+            "{} steps {steps}: see-through {:.3}%",
+            view.name, m.see_through
+        );
+        see_through.push(m.see_through);
+    }
+    assert!(see_through[0] > see_through[1] + 1.0, "{see_through:?}");
+}
