@@ -49,6 +49,7 @@ pub fn decode_vmc(
         )));
     }
     let table_end = height as usize * ENTRY_BYTES;
+    let min_row = 2 * (width as usize).div_ceil(8);
     let mut rows = Vec::with_capacity(height as usize);
     for (y, e) in bytes[..table_end].chunks_exact(ENTRY_BYTES).enumerate() {
         let offset = i32::from_le_bytes([e[0], e[1], e[2], e[3]]);
@@ -59,6 +60,15 @@ pub fn decode_vmc(
             )));
         }
         let (start, len) = (offset as usize, size as usize);
+        // Codes are at least one bit: each stream takes at least W/8 bytes.
+        // Checked before the planes are allocated, so a world.ini naming a
+        // huge map over a small file fails here, not in the allocator.
+        if len < min_row {
+            return Err(err(format!(
+                "row {y}: {len} bytes cannot hold {width} heights and {width} metas (at least \
+                 {min_row}): does the map size in world.ini ({width}x{height}) match the file?"
+            )));
+        }
         if start < header {
             return Err(err(format!(
                 "row {y} starts at byte {start}, inside the row table and trees ({header} bytes for \

@@ -110,7 +110,7 @@ fn row_table_past_the_end_is_an_error() {
     let level = synthetic(64, 32, 6);
     let mut bytes = encode_vmc(&level, Path::new(P)).unwrap();
     let len = bytes.len() as i32;
-    set_row_entry(&mut bytes, 3, len - 2, 10);
+    set_row_entry(&mut bytes, 3, len - 2, 100);
     let e = err_text(decode(&bytes, 64, 32));
     assert!(e.contains("row 3") && e.contains("past the end"), "{e}");
     set_row_entry(&mut bytes, 3, -5, 10);
@@ -126,9 +126,15 @@ fn rows_must_fill_exactly_their_size() {
     set_row_entry(&mut bytes, 5, off as i32, size as i16 + 1);
     let e = err_text(decode(&bytes, 64, 32));
     assert!(e.contains("row 5") && e.contains("fill only"), "{e}");
+    // One byte short: the meta stream runs past the row.
+    assert!(size > 16, "the fixture's rows are longer than the minimum");
+    set_row_entry(&mut bytes, 5, off as i32, size as i16 - 1);
+    let e = err_text(decode(&bytes, 64, 32));
+    assert!(e.contains("row 5") && e.contains("runs past"), "{e}");
+    // Below the minimum a row can hold at all.
     set_row_entry(&mut bytes, 5, off as i32, 1);
     let e = err_text(decode(&bytes, 64, 32));
-    assert!(e.contains("row 5") && e.contains("stream"), "{e}");
+    assert!(e.contains("row 5") && e.contains("cannot hold"), "{e}");
 }
 
 #[test]
@@ -158,6 +164,12 @@ fn map_size_disagreeing_with_the_file_is_an_error() {
     // Wider rows: the streams do not fit.
     let e = err_text(decode(&bytes, 128, 32));
     assert!(e.contains("row 0"), "{e}");
+    // Far wider rows: refused from the table alone, before allocating.
+    let e = err_text(decode(&bytes, 1 << 15, 32));
+    assert!(
+        e.contains("row 0") && e.contains("cannot hold 32768 heights"),
+        "{e}"
+    );
     let e = err_text(decode_vmp(
         &encode_vmp(&level),
         64,
