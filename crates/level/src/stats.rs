@@ -77,6 +77,21 @@ struct Row {
     high: Vec<i32>,
 }
 
+/// Accumulate the per-texel figures of row `y` into `acc`.
+fn count_row(level: &Level, y: u32, acc: &mut Acc) {
+    let (hr, mr) = level.row(y);
+    for x in 0..hr.len() {
+        let c = decode_column(hr, mr, x, level.mid_rule);
+        acc.min = acc.min.min(c.low);
+        acc.max = acc.max.max(c.top());
+        acc.floor_types[usize::from(c.lower_type & 7)] += 1;
+        if c.dual {
+            acc.dual += 1;
+            acc.slab_types[usize::from(c.upper_type & 7)] += 1;
+        }
+    }
+}
+
 fn decode_row(level: &Level, y: u32) -> Row {
     let (h, m) = level.row(y & (level.height() - 1));
     let w = h.len();
@@ -97,11 +112,15 @@ fn decode_row(level: &Level, y: u32) -> Row {
 /// Sum over a row of |lap| of one plane, given the rows above and below.
 fn lap_sum(up: &[i32], cur: &[i32], down: &[i32]) -> u64 {
     let w = cur.len();
-    let mut sum = 0u64;
-    for x in 0..w {
-        let l = cur[(x + w - 1) % w];
-        let r = cur[(x + 1) % w];
-        sum += u64::from((l + r + up[x] + down[x] - 4 * cur[x]).unsigned_abs());
+    let lap =
+        |l: i32, r: i32, x: usize| u64::from((l + r + up[x] + down[x] - 4 * cur[x]).unsigned_abs());
+    if w < 2 {
+        return (0..w).map(|x| lap(cur[x], cur[x], x)).sum();
+    }
+    // Interior without wrap arithmetic; the two edge texels wrap.
+    let mut sum = lap(cur[w - 1], cur[1], 0) + lap(cur[w - 2], cur[0], w - 1);
+    for x in 1..w - 1 {
+        sum += lap(cur[x - 1], cur[x + 1], x);
     }
     sum
 }
@@ -123,17 +142,7 @@ impl LevelStats {
                 let mut cur = decode_row(level, y0);
                 for y in y0..y1 {
                     let down = decode_row(level, y + 1);
-                    let (hr, mr) = level.row(y);
-                    for x in 0..w as usize {
-                        let c = decode_column(hr, mr, x, level.mid_rule);
-                        acc.min = acc.min.min(c.low);
-                        acc.max = acc.max.max(c.top());
-                        acc.floor_types[usize::from(c.lower_type & 7)] += 1;
-                        if c.dual {
-                            acc.dual += 1;
-                            acc.slab_types[usize::from(c.upper_type & 7)] += 1;
-                        }
-                    }
+                    count_row(level, y, &mut acc);
                     let low = lap_sum(&up.low, &cur.low, &down.low);
                     acc.lap_low += low;
                     acc.lap_all += low
