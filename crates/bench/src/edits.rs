@@ -23,9 +23,11 @@ pub struct EditInput<'a> {
     pub rects: &'a [DirtyRect],
     pub colors: &'a TerrainColors,
     pub camera: &'a Camera,
-    /// Frames before the edit (and before the fresh build is sampled): enough
-    /// for incremental builds to finish, so the edit meets a settled renderer.
-    pub warmup: u32,
+    /// Most frames before the edit (and before the fresh build is sampled):
+    /// one frame, continued while an incremental build is in flight, so the
+    /// edit meets a settled renderer.
+    pub warmup_cap: u32,
+    pub timestamps: bool,
     /// Frames of the fresh edited build whose median is the steady time.
     pub steady_frames: u32,
 }
@@ -69,9 +71,7 @@ fn build(
         input.camera.width,
         input.camera.height,
     )?;
-    for _ in 0..input.warmup.max(1) {
-        r.render_frame(input.camera)?;
-    }
+    crate::run::warm_up(&mut r, input.camera, 1, input.warmup_cap, input.timestamps)?;
     Ok(r)
 }
 

@@ -208,7 +208,8 @@ impl Plan {
                     rects: &rects,
                     colors: &self.colors,
                     camera,
-                    warmup: self.warmup_first,
+                    warmup_cap: self.warmup_first,
+                    timestamps: gpu.report.timestamps,
                     steady_frames: self.opts.frames.min(10),
                 };
                 match edits::edit_row(&input, &choice.name, settings) {
@@ -335,14 +336,13 @@ impl Plan {
     ) -> anyhow::Result<Row> {
         let view = &self.opts.views[v];
         let label = self.opts.methods[m].label();
-        // First frame at this view (lazy builds land here), then the rest of warm-up.
-        let start = Instant::now();
-        renderer.render_frame(camera)?;
-        let first_ms = ms(start);
-        for _ in 1..warmup.max(1) {
-            renderer.render_frame(camera)?;
-        }
-        let warmup_ms = ms(start);
+        let warm = warm_up(
+            renderer,
+            camera,
+            self.opts.min_warmup,
+            warmup,
+            session.results.adapter.timestamps,
+        )?;
         let mut gpu = Vec::new();
         let mut cpu = Vec::new();
         for _ in 0..self.opts.frames {
@@ -389,13 +389,59 @@ impl Plan {
             gpu_ms: gpu_t,
             cpu_ms: cpu_t,
             prep_setup_ms: setup_ms,
-            prep_first_frame_ms: first_ms,
-            prep_warmup_ms: warmup_ms,
+            prep_first_frame_ms: warm.first_ms,
+            prep_warmup_ms: warm.total_ms,
             gpu_bytes: retained.gpu,
             cpu_bytes: retained.cpu,
             image,
         })
     }
+}
+
+/// What warming a renderer up at one view cost.
+pub struct WarmUp {
+    /// The first frame (lazy builds land here).
+    pub first_ms: f64,
+    /// Every pre-timing frame, the first included.
+    pub total_ms: f64,
+    pub frames: u32,
+}
+
+/// Does a frame carry derived-data work (an incremental build or update)?
+/// Methods label such passes `… update` / `… build` / `… bake`.
+fn building(t: &strata_render::FrameTimings) -> bool {
+    t.passes.iter().any(|(label, _)| {
+        ["update", "build", "bake"]
+            .iter()
+            .any(|w| label.contains(w))
+    })
+}
+
+/// Render `min` frames (at least one), then go on while the last frame still
+/// did incremental build work, up to `cap`. Without timestamps the passes are
+/// not reported, so the cap (enough for a whole-level build) is always used.
+pub fn warm_up(
+    renderer: &mut Renderer,
+    camera: &Camera,
+    min: u32,
+    cap: u32,
+    timestamps: bool,
+) -> anyhow::Result<WarmUp> {
+    let start = Instant::now();
+    let mut last = renderer.render_frame(camera)?;
+    let first_ms = ms(start);
+    let mut frames = 1;
+    let min = min.max(1);
+    let cap = cap.max(min);
+    while frames < cap && (frames < min || !timestamps || building(&last)) {
+        last = renderer.render_frame(camera)?;
+        frames += 1;
+    }
+    Ok(WarmUp {
+        first_ms,
+        total_ms: ms(start),
+        frames,
+    })
 }
 
 pub fn ms(since: Instant) -> f64 {
