@@ -22,7 +22,8 @@ pub struct Args {
         long,
         value_name = "SPEC",
         conflicts_with = "views",
-        requires = "pitch"
+        requires = "pitch",
+        allow_hyphen_values = true
     )]
     pub view: Option<String>,
     /// Pitch of `--view`, degrees in [-90, 90] (negative looks down).
@@ -117,9 +118,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     // Resolve every camera first, so a bad view fails before any work.
     let cameras = views
         .iter()
-        .map(|v| {
-            Camera::from_view(&world.level, v, w, h).with_context(|| format!("view `{}`", v.name))
-        })
+        .map(|v| Camera::from_view(&world.level, v, w, h).context("resolving the camera"))
         .collect::<anyhow::Result<Vec<_>>>()?;
     let level_hash = world.level.content_hash();
     let tracer = Tracer::new(&world.level);
