@@ -4,28 +4,22 @@
 
 use strata_level::generate::{GenerateParams, generate, preview};
 
-fn lap_figures(level: &strata_level::Level) -> (f64, f64) {
-    let (w, h) = (level.width() as i64, level.height() as i64);
-    let (mut low, mut comp) = (0f64, 0f64);
-    let cols: Vec<_> = (0..h)
-        .flat_map(|y| (0..w).map(move |x| (x, y)))
-        .map(|(x, y)| level.column(x, y))
+/// CPU seconds (user + system) this process has used, from /proc (Linux).
+fn cpu_seconds() -> f64 {
+    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
+    let fields: Vec<&str> = stat
+        .rsplit(')')
+        .next()
+        .unwrap_or("")
+        .split_whitespace()
         .collect();
-    let at = |x: i64, y: i64| cols[(y.rem_euclid(h) * w + x.rem_euclid(w)) as usize];
-    for y in 0..h {
-        for x in 0..w {
-            let c = at(x, y);
-            let n = [at(x - 1, y), at(x + 1, y), at(x, y - 1), at(x, y + 1)];
-            let lap = |f: &dyn Fn(&strata_level::Column) -> u8| {
-                (n.iter().map(|c| i32::from(f(c))).sum::<i32>() - 4 * i32::from(f(&c))).abs() as f64
-            };
-            let l = lap(&|c| c.low);
-            low += l;
-            comp += (l + lap(&|c| c.mid) + lap(&|c| c.high)) / 3.0;
-        }
-    }
-    let n = (w * h) as f64;
-    (low / n, comp / n)
+    let ticks = |i: usize| {
+        fields
+            .get(i)
+            .and_then(|v| v.parse::<f64>().ok())
+            .unwrap_or(0.0)
+    };
+    (ticks(11) + ticks(12)) / 100.0
 }
 
 #[test]
@@ -33,17 +27,22 @@ fn lap_figures(level: &strata_level::Level) -> (f64, f64) {
 fn look() {
     let size = std::env::var("LOOK_SIZE").unwrap_or("512x2048".into());
     let (w, h) = strata_level::generate::parse_size(&size).unwrap();
-    let t = std::time::Instant::now();
+    let (t, cpu) = (std::time::Instant::now(), cpu_seconds());
     let world = generate(&GenerateParams {
         seed: 1997,
         width: w,
         height: h,
     })
     .unwrap();
-    println!("generated {w}x{h} in {:.2} s", t.elapsed().as_secs_f64());
+    println!(
+        "generated {w}x{h} in {:.2} s wall, {:.2} s CPU",
+        t.elapsed().as_secs_f64(),
+        cpu_seconds() - cpu
+    );
     let level = &world.level;
-    let dual = level.dual_texel_count() as f64 / (w as f64 * h as f64);
-    let (low, comp) = lap_figures(level);
+    let stats = strata_level::stats::LevelStats::compute(level);
+    let dual = stats.dual_percent / 100.0;
+    let (low, comp) = (stats.roughness_floor, stats.roughness_surface);
     let mut types = [0u64; 8];
     for &m in level.metas() {
         types[usize::from((m >> 3) & 7)] += 1;

@@ -77,20 +77,37 @@ impl ValueNoise {
 /// A smooth field sampled every `2^step_log2` texels and interpolated
 /// bilinearly: for low-frequency inputs (warps, masks, regions) it is
 /// indistinguishable from evaluating them per texel, at a fraction of the cost.
+/// `N` fields share one grid so one lookup interpolates them all.
 #[derive(Clone, Debug)]
-pub struct Coarse {
-    values: Vec<f32>,
+pub struct Coarse<const N: usize = 1> {
+    values: Vec<[f32; N]>,
     cols: usize,
     rows: usize,
     step_log2: u32,
 }
 
-impl Coarse {
+impl Coarse<1> {
     pub fn new(
         width: u32,
         height: u32,
         step_log2: u32,
         f: impl Fn(f32, f32) -> f32 + Sync,
+    ) -> Self {
+        Self::many(width, height, step_log2, move |x, y| [f(x, y)])
+    }
+
+    #[inline]
+    pub fn at(&self, x: f32, y: f32) -> f32 {
+        self.all(x, y)[0]
+    }
+}
+
+impl<const N: usize> Coarse<N> {
+    pub fn many(
+        width: u32,
+        height: u32,
+        step_log2: u32,
+        f: impl Fn(f32, f32) -> [f32; N] + Sync,
     ) -> Self {
         use rayon::prelude::*;
         let step_log2 = step_log2
@@ -101,7 +118,7 @@ impl Coarse {
             (height >> step_log2) as usize,
         );
         let step = (1u32 << step_log2) as f32;
-        let mut values = vec![0f32; cols * rows];
+        let mut values = vec![[0f32; N]; cols * rows];
         values
             .par_chunks_mut(cols)
             .enumerate()
@@ -119,7 +136,7 @@ impl Coarse {
     }
 
     #[inline]
-    pub fn at(&self, x: f32, y: f32) -> f32 {
+    pub fn all(&self, x: f32, y: f32) -> [f32; N] {
         let inv = 1.0 / (1u32 << self.step_log2) as f32;
         let (fx, fy) = (x * inv, y * inv);
         let (x0, y0) = (fast_floor(fx), fast_floor(fy));
@@ -128,10 +145,19 @@ impl Coarse {
         let (mx, my) = (self.cols - 1, self.rows - 1);
         let (i0, j0) = (x0 as usize & mx, y0 as usize & my);
         let (i1, j1) = ((i0 + 1) & mx, (j0 + 1) & my);
-        let v = |i: usize, j: usize| self.values[j * self.cols + i];
-        let top = v(i0, j0) + (v(i1, j0) - v(i0, j0)) * tx;
-        let bottom = v(i0, j1) + (v(i1, j1) - v(i0, j1)) * tx;
-        top + (bottom - top) * ty
+        let (a, b) = (
+            self.values[j0 * self.cols + i0],
+            self.values[j0 * self.cols + i1],
+        );
+        let (c, d) = (
+            self.values[j1 * self.cols + i0],
+            self.values[j1 * self.cols + i1],
+        );
+        std::array::from_fn(|k| {
+            let top = a[k] + (b[k] - a[k]) * tx;
+            let bottom = c[k] + (d[k] - c[k]) * tx;
+            top + (bottom - top) * ty
+        })
     }
 }
 

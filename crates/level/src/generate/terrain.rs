@@ -44,13 +44,10 @@ pub struct Terrain {
     /// The base noise's two broad octaves, precomputed, and its two fine ones.
     base_broad: Coarse,
     base_fine: Fbm,
-    warp_x: Coarse,
-    warp_y: Coarse,
+    /// Smooth fields sampled together: warp x, warp y, ramp mask, overhang mask, regions.
+    fields: Coarse<5>,
     jag_x: ValueNoise,
     jag_y: ValueNoise,
-    regions: Coarse,
-    ramp_mask: Coarse,
-    over_mask: Coarse,
     fine: ValueNoise,
     river_wobble: ValueNoise,
     river_width: ValueNoise,
@@ -95,9 +92,9 @@ impl Terrain {
         let h = |k: u32| unit(hash32(s ^ k));
         // The river meanders a whole number of times along the map so it wraps.
         let waves = (height / 4096).max(1) as f32;
-        let coarse = |f: ValueNoise| Coarse::new(width, height, 3, move |x, y| f.at(x, y));
         let regions = Fbm::new(s ^ 0x7e77, 9, 2, width, height);
-        let district_log2 = 8
+        let smooth = [vn(1, 6), vn(2, 6), vn(5, 7), vn(6, 6)];
+        let district_log2 = 7
             .min(width.trailing_zeros())
             .min(height.trailing_zeros() - 1);
         let mut t = Terrain {
@@ -109,13 +106,12 @@ impl Terrain {
                 Coarse::new(width, height, 3, move |x, y| broad.at(x, y))
             },
             base_fine: Fbm::octaves(s ^ 0xba5e, 8, 2..4, 4, width, height),
-            warp_x: coarse(vn(1, 6)),
-            warp_y: coarse(vn(2, 6)),
+            fields: Coarse::many(width, height, 3, move |x, y| {
+                let [a, b, c, d] = smooth.map(|n| n.at(x, y));
+                [a, b, c, d, regions.at(x, y)]
+            }),
             jag_x: vn(3, 3),
             jag_y: vn(4, 3),
-            regions: Coarse::new(width, height, 3, move |x, y| regions.at(x, y)),
-            ramp_mask: coarse(vn(5, 7)),
-            over_mask: coarse(vn(6, 6)),
             fine: vn(7, 2),
             river_wobble: vn(8, 6),
             river_width: vn(9, 7),
@@ -141,10 +137,10 @@ impl Terrain {
             .map(|(dx, dy)| {
                 let hash = hash2(self.seed ^ 0xd15c, dx, dy);
                 let kind = match hash % 100 {
-                    0..=44 => District::Natural,
-                    45..=58 => District::Pits,
-                    59..=76 => District::Furrows,
-                    77..=91 => District::Hall,
+                    0..=41 => District::Natural,
+                    42..=55 => District::Pits,
+                    56..=72 => District::Furrows,
+                    73..=91 => District::Hall,
                     _ => District::Hangars,
                 };
                 // A pattern covers a random part of its district, not all of it.
@@ -184,14 +180,23 @@ impl Terrain {
     /// Terrain type of the region around (x, y): 1..=7 in broad patches.
     #[inline]
     pub fn region_type(&self, x: f32, y: f32) -> u8 {
-        let v = self.regions.at(x, y);
-        (((v - 0.25) * 2.0 * 7.0).floor().clamp(0.0, 6.0) as u8) + 1
+        Self::type_of(self.fields.all(x, y)[4])
+    }
+
+    #[inline]
+    fn type_of(region: f32) -> u8 {
+        (((region - 0.25) * 14.0).clamp(0.0, 6.0) as u8) + 1
     }
 
     #[inline]
     fn base_noise(&self, x: f32, y: f32) -> f32 {
-        let wx = x + (self.warp_x.at(x, y) - 0.5) * 64.0 + (self.jag_x.at(x, y) - 0.5) * 7.0;
-        let wy = y + (self.warp_y.at(x, y) - 0.5) * 64.0 + (self.jag_y.at(x, y) - 0.5) * 7.0;
+        self.base_noise_with(x, y, &self.fields.all(x, y))
+    }
+
+    #[inline]
+    fn base_noise_with(&self, x: f32, y: f32, f: &[f32; 5]) -> f32 {
+        let wx = x + (f[0] - 0.5) * 64.0 + (self.jag_x.at(x, y) - 0.5) * 7.0;
+        let wy = y + (f[1] - 0.5) * 64.0 + (self.jag_y.at(x, y) - 0.5) * 7.0;
         self.base_broad.at(wx, wy) + self.base_fine.at(wx, wy)
     }
 
@@ -223,17 +228,20 @@ impl Terrain {
             + w * 0.05 * (t * self.river_waves[1] + self.river_phase[1]).sin()
             + (self.river_wobble.at(0.0, y) - 0.5) * 40.0;
         let rw = 9.0 + 12.0 * self.river_width.at(0.0, y);
-        let vw = rw + 14.0 + 22.0 * self.river_width.at(64.0, y);
+        // Narrow maps get a narrower valley, so the river does not take them over.
+        let scale = (w / 2048.0).clamp(0.4, 1.0);
+        let vw = rw + (14.0 + 22.0 * self.river_width.at(64.0, y)) * scale;
         (x, rw, vw)
     }
 
     /// The plateau layer alone: floor, band, type, and an overhanging slab
     /// where a higher plateau reaches out over this texel.
     fn plateau(&self, xf: f32, yf: f32) -> (Texel, usize) {
-        let n = self.base_noise(xf, yf);
+        let f = self.fields.all(xf, yf);
+        let n = self.base_noise_with(xf, yf, &f);
         let band = Self::band(n);
-        let ramp = self.ramp_mask.at(xf, yf) > 0.74;
-        let ty = self.region_type(xf, yf);
+        let ramp = f[2] > 0.74;
+        let ty = Self::type_of(f[4]);
         let mut floor = if ramp {
             fast_round(Self::ramp_height(n))
         } else {
@@ -243,7 +251,7 @@ impl Terrain {
         let mut t = Texel::single(floor, if floor < SEA { WATER } else { ty });
         // Overhangs: the higher band "reaches" this texel if nudging the noise
         // by `reach` crosses an edge; the nudge varies so edges overhang in stretches.
-        let reach = (self.over_mask.at(xf, yf) - 0.45).max(0.0) * 0.12;
+        let reach = (f[3] - 0.45).max(0.0) * 0.12;
         if !ramp && reach > 0.0 && band < EDGES.len() {
             let up = Self::band(n + reach);
             if up > band {
@@ -264,7 +272,11 @@ impl Terrain {
         let mut t = self.texel_whole(x, row);
         // Water is exactly the ground below sea level.
         if (t.ty == WATER) != (t.floor < SEA) {
-            t.ty = if t.floor < SEA { WATER } else { self.region_type(x as f32, row.y as f32) };
+            t.ty = if t.floor < SEA {
+                WATER
+            } else {
+                self.region_type(x as f32, row.y as f32)
+            };
         }
         match t.slab {
             Some(s) => self.weather(t, s, x >> 1, row.y),
@@ -314,7 +326,7 @@ impl Terrain {
                     },
                 );
                 // The plateau above overhangs the valley wall in stretches.
-                let reach = (self.over_mask.at(xf + 91.0, yf + 45.0) - 0.45).max(0.0) * 40.0;
+                let reach = (self.fields.all(xf + 91.0, yf + 45.0)[3] - 0.45).max(0.0) * 40.0;
                 if dx > vw - reach && wall >= valley + 20 {
                     t.slab = Some(Slab {
                         ceiling: wall - 8,
