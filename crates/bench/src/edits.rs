@@ -118,13 +118,18 @@ pub fn edit_row(
                     done += 1;
                 }
                 let (class_mismatch, depth_p95) = disagreement(&distance(&r, cam)?, &target);
+                let consistent =
+                    class_mismatch <= EDIT_MAX_CLASS_MISMATCH && depth_p95 <= EDIT_MAX_DEPTH_P95;
                 checks.push(EditCheck {
                     frames,
                     class_mismatch,
                     depth_p95,
-                    consistent: class_mismatch <= EDIT_MAX_CLASS_MISMATCH
-                        && depth_p95 <= EDIT_MAX_DEPTH_P95,
+                    consistent,
                 });
+                // The answer is the first consistent count; later frames cannot change it.
+                if consistent {
+                    break;
+                }
             }
         }
     }

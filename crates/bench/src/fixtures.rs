@@ -49,6 +49,7 @@ pub fn row(view: &str, pitch: f32, method: &str, see: f64, coh: f64, gpu: &[f64]
         prep_warmup_ms: 30.0,
         gpu_bytes: 3 * 1024 * 1024,
         cpu_bytes: 0,
+        passes: Vec::new(),
         image: format!("cells/{view}-{method}.png"),
     }
 }

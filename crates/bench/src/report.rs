@@ -402,7 +402,8 @@ fn edit_tables(md: &mut String, runs: &[RunResults]) {
         "Crater edit seen from the edit camera. CPU/GPU₀: median frame of a renderer built fresh from the \
          edited level; CPU/GPU₁: median of 5 independent first post-edit frames (CPU is submit-and-wait: \
          upload + any rebuild + GPU work + round trip). match: post-edit frames until the edited renderer \
-         agrees with the fresh build (≤ 0.01 % hit/miss, p95 depth ≤ 0.1).\n\n",
+         agrees with the fresh build (≤ 0.01 % hit/miss, p95 depth ≤ 0.1); the last column is the \
+         disagreement at that check (at 16 when never consistent).\n\n",
     );
     for run in runs {
         let _ = writeln!(md, "{}:\n", cell_text(&run.adapter.name));
@@ -411,7 +412,7 @@ fn edit_tables(md: &mut String, runs: &[RunResults]) {
             continue;
         }
         md.push_str(
-            "| method | CPU₀ | CPU₁ | ΔC | GPU₀ | GPU₁ | ΔG | match | at 16: hit/miss % / p95 |\n\
+            "| method | CPU₀ | CPU₁ | ΔC | GPU₀ | GPU₁ | ΔG | match | last check: hit/miss % / p95 |\n\
              |---|---:|---:|---:|---:|---:|---:|---|---|\n",
         );
         for e in &run.edit_rows {

@@ -122,6 +122,9 @@ pub struct Row {
     /// Persistent method-specific bytes (shared resources excluded).
     pub gpu_bytes: u64,
     pub cpu_bytes: u64,
+    /// Mean GPU ms of each timed pass (label order of the first frame); empty without timestamps.
+    #[serde(default)]
+    pub passes: Vec<PassTime>,
     /// The cell picture, relative to the output directory.
     pub image: String,
 }
@@ -139,6 +142,12 @@ impl Row {
             None => &self.cpu_ms.samples,
         }
     }
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PassTime {
+    pub label: String,
+    pub mean_ms: f64,
 }
 
 /// The disagreement between an edited renderer and a fresh build of the

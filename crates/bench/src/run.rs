@@ -345,9 +345,19 @@ impl Plan {
         )?;
         let mut gpu = Vec::new();
         let mut cpu = Vec::new();
+        let mut passes: Vec<PassTime> = Vec::new();
         for _ in 0..self.opts.frames {
             let t = renderer.render_frame(camera)?;
             cpu.push(t.cpu_ms);
+            for (label, ms) in &t.passes {
+                match passes.iter_mut().find(|p| p.label == *label) {
+                    Some(p) => p.mean_ms += ms / f64::from(self.opts.frames),
+                    None => passes.push(PassTime {
+                        label: label.clone(),
+                        mean_ms: ms / f64::from(self.opts.frames),
+                    }),
+                }
+            }
             if let Some(g) = t.gpu_ms {
                 gpu.push(g);
             }
@@ -393,6 +403,7 @@ impl Plan {
             prep_warmup_ms: warm.total_ms,
             gpu_bytes: retained.gpu,
             cpu_bytes: retained.cpu,
+            passes,
             image,
         })
     }
