@@ -9,9 +9,14 @@
 //! row-major. Depth is linearised with the reference's camera; `--camera
 //! FILE.json` (a Camera, or any JSON object with a `camera` field, like the
 //! render's metadata) checks that the image was rendered with that camera.
+//! `--render DIR` is shorthand for `--depth DIR/depth.f32 --camera
+//! DIR/render.json`, i.e. a view directory written by `strata render`.
+//!
+//! `strata metrics --reference ref/river --render render-out/river --json`
 
 use anyhow::{Context, bail};
 use serde::Serialize;
+use std::io::Write;
 use std::path::PathBuf;
 use strata_camera::Camera;
 use strata_reference::metrics::try_compare;
@@ -23,13 +28,11 @@ pub struct Args {
     /// A view directory written by `strata reference` (`OUT/<view name>`).
     #[arg(long, value_name = "DIR")]
     pub reference: PathBuf,
+    /// A view directory written by `strata render` (`depth.f32` + `render.json`).
+    #[arg(long, value_name = "DIR", conflicts_with_all = ["depth", "distance", "camera"])]
+    pub render: Option<PathBuf>,
     /// Raw depth buffer (f32 LE, 0 near .. 1 far; >= 1 = nothing drawn).
-    #[arg(
-        long,
-        value_name = "FILE.f32",
-        conflicts_with = "distance",
-        required_unless_present = "distance"
-    )]
+    #[arg(long, value_name = "FILE.f32", conflicts_with = "distance")]
     pub depth: Option<PathBuf>,
     /// Distances along the pixel rays (f32 LE; inf/NaN = nothing drawn).
     #[arg(long, value_name = "FILE.f32")]
@@ -65,7 +68,13 @@ fn read_camera(path: &PathBuf) -> anyhow::Result<Camera> {
     })
 }
 
-pub fn run(args: Args) -> anyhow::Result<()> {
+pub fn run(mut args: Args) -> anyhow::Result<()> {
+    // Written, not println!ed: a closed pipe (`| head`) is an error, not a panic.
+    let mut out = std::io::stdout().lock();
+    if let Some(dir) = args.render.take() {
+        args.depth = Some(dir.join("depth.f32"));
+        args.camera = Some(dir.join("render.json"));
+    }
     let (header, reference) = read_view(&args.reference)
         .with_context(|| format!("reading reference view {}", args.reference.display()))?;
     let camera = header.camera;
@@ -88,7 +97,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             p,
             read_f32(p, n).context("--distance (must match the reference's size)")?,
         ),
-        (None, None) => bail!("give --depth FILE.f32 or --distance FILE.f32"),
+        (None, None) => bail!("give --render DIR, --depth FILE.f32 or --distance FILE.f32"),
     };
     let metrics = try_compare(&reference, &distance)?;
     let report = Report {
@@ -98,19 +107,20 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         metrics,
     };
     if args.json {
-        println!("{}", serde_json::to_string(&report)?);
+        writeln!(out, "{}", serde_json::to_string(&report)?)?;
     } else {
-        println!(
+        writeln!(
+            out,
             "reference   {} ({}x{})",
             report.reference, reference.width, reference.height
-        );
-        println!("rendered    {} (read as {input})", report.rendered);
-        println!("see-through {:.3} %", metrics.see_through);
-        println!("covers-sky  {:.3} %", metrics.covers_sky);
-        println!("depth p50   {:.4}", metrics.depth_p50);
-        println!("depth p95   {:.4}", metrics.depth_p95);
-        println!("coherence   {:.3} %", metrics.coherence);
-        println!("both solid  {:.3} %", metrics.both_solid);
+        )?;
+        writeln!(out, "rendered    {} (read as {input})", report.rendered)?;
+        writeln!(out, "see-through {:.3} %", metrics.see_through)?;
+        writeln!(out, "covers-sky  {:.3} %", metrics.covers_sky)?;
+        writeln!(out, "depth p50   {:.4}", metrics.depth_p50)?;
+        writeln!(out, "depth p95   {:.4}", metrics.depth_p95)?;
+        writeln!(out, "coherence   {:.3} %", metrics.coherence)?;
+        writeln!(out, "both solid  {:.3} %", metrics.both_solid)?;
     }
     Ok(())
 }

@@ -6,6 +6,7 @@
 use crate::world_arg::WorldArgs;
 use anyhow::{Context, bail};
 use serde::Serialize;
+use std::io::Write;
 use std::path::PathBuf;
 use std::time::Instant;
 use strata_camera::Camera;
@@ -91,6 +92,8 @@ pub fn parse_image_size(text: &str) -> Result<(u32, u32), String> {
 }
 
 pub fn run(args: Args) -> anyhow::Result<()> {
+    // Written, not println!ed: a closed pipe (`| head`) is an error, not a panic.
+    let mut out = std::io::stdout().lock();
     let world = args.world.load()?;
     let views: Vec<ViewSpec> = match (&args.view, &args.views) {
         (Some(spec), _) => {
@@ -128,10 +131,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             .unwrap_or_else(strata_reference::default_cache_dir),
     );
     if !args.json {
-        println!(
+        writeln!(
+            out,
             "{:<14} {:>7} {:>9} {:>9} {:>9} {:>8}  cache",
             "view", "sky %", "min", "median", "max", "seconds"
-        );
+        )?;
     }
     for (view, camera) in views.iter().zip(&cameras) {
         let start = Instant::now();
@@ -178,10 +182,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                 height: h,
                 out: dir.display().to_string(),
             };
-            println!("{}", serde_json::to_string(&line)?);
+            writeln!(out, "{}", serde_json::to_string(&line)?)?;
         } else {
             let f = |v: Option<f32>| v.map_or("-".to_string(), |v| format!("{v:.2}"));
-            println!(
+            writeln!(
+                out,
                 "{:<14} {:>7.2} {:>9} {:>9} {:>9} {:>8.3}  {}",
                 view.name,
                 header.sky_fraction,
@@ -190,7 +195,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                 f(header.distance_max),
                 seconds,
                 if from_cache { "hit" } else { "computed" }
-            );
+            )?;
         }
     }
     Ok(())
