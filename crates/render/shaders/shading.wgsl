@@ -13,11 +13,12 @@ const SURFACE_FLOOR: u32 = 0u;
 const SURFACE_SLAB_TOP: u32 = 1u;
 const SURFACE_CEILING: u32 = 2u;
 
-// The palette colour of terrain type `t` at altitude `z`: the type's
-// begin..end range, picked by altitude (low = begin, 255 = end).
-fn terrain_color(t: u32, z: f32) -> vec3<f32> {
+// The palette colour of terrain type `t` lit by `light` in [0, 1]: like the
+// original game, each type's begin..end range is a dark-to-light ramp and the
+// light picks the entry (so shading stays within the world's own colours).
+fn terrain_color(t: u32, light: f32) -> vec3<f32> {
     let r = shading.ranges[t & 7u];
-    let idx = round(mix(f32(r.x), f32(r.y), clamp(z / MAX_ALTITUDE, 0.0, 1.0)));
+    let idx = round(mix(f32(r.x), f32(r.y), clamp(light, 0.0, 1.0)));
     return shading.palette[u32(clamp(idx, 0.0, 255.0))].rgb;
 }
 
@@ -59,25 +60,31 @@ fn surface_normal(x: i32, y: i32, kind: u32, here: f32) -> vec3<f32> {
     return normalize(vec3<f32>(-gx, -gy, 1.0));
 }
 
-// One shadow-map test: 1 lit, 0 shadowed.
+// One shadow-map test: 1 lit, 0 shadowed. `t` already includes the bias.
 fn shadow_tap(ij: vec2<i32>, t: f32) -> f32 {
     let side = i32(globals.shadow_u.w);
     if (any(ij < vec2<i32>(0)) || any(ij >= vec2<i32>(side))) {
         return 1.0;
     }
     let blocker = textureLoad(shadow_map, ij, 0).r;
-    return select(0.0, 1.0, t <= blocker + globals.shadow_v.w);
+    return select(0.0, 1.0, t <= blocker);
 }
 
-// 4-tap PCF with bilinear weights over the shadow map.
-fn shadow_factor(p: vec3<f32>) -> f32 {
+// 4-tap PCF with bilinear weights over the shadow map. Against acne on the
+// stair-stepped height field the point is pushed off the surface along its
+// normal by 1.5 shadow texels, and the bias grows with the light's grazing
+// angle (a shadow texel spans more depth on surfaces the light skims).
+fn shadow_factor(p_surface: vec3<f32>, n: vec3<f32>) -> f32 {
     if (globals.light_dir.w == 0.0) {
         return 1.0;
     }
-    let rel = p - globals.shadow_origin.xyz;
     let texel = globals.shadow_origin.w;
+    let p = p_surface + n * (1.5 * texel);
+    let rel = p - globals.shadow_origin.xyz;
     let uv = vec2<f32>(dot(rel, globals.shadow_u.xyz), dot(rel, globals.shadow_v.xyz)) / texel - 0.5;
-    let t = dot(rel, globals.light_dir.xyz);
+    let ndl = max(dot(n, -globals.light_dir.xyz), 0.05);
+    let slope = min(sqrt(1.0 - ndl * ndl) / ndl, 4.0);
+    let t = dot(rel, globals.light_dir.xyz) - globals.shadow_v.w - slope * texel;
     let base = floor(uv);
     let f = uv - base;
     let ij = vec2<i32>(base);
@@ -104,9 +111,9 @@ fn shade_with_normal(p: vec3<f32>, c: Column, kind: u32, n: vec3<f32>) -> vec3<f
         light = CAVE_AMBIENT;
     } else {
         let diffuse = max(dot(n, -globals.light_dir.xyz), 0.0);
-        light = AMBIENT + (1.0 - AMBIENT) * diffuse * shadow_factor(p);
+        light = AMBIENT + (1.0 - AMBIENT) * diffuse * shadow_factor(p, n);
     }
-    let color = terrain_color(t, p.z) * light;
+    let color = terrain_color(t, light);
     return mix(color, globals.sky.rgb, fog_factor(p));
 }
 

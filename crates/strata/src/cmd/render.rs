@@ -70,21 +70,6 @@ fn parse_size(text: &str) -> Result<(u32, u32), String> {
     Ok((w, h))
 }
 
-// TODO(world_arg): switch to `WorldArgs::load` once it lands.
-fn load_world(args: &WorldArgs) -> anyhow::Result<strata_level::World> {
-    let rule = if args.vange_rs_mid {
-        strata_level::MidRule::VangeRs
-    } else {
-        strata_level::MidRule::Original
-    };
-    match &args.level {
-        Some(dir) => strata_level::io::load_world(dir, rule)
-            .with_context(|| format!("loading the world in {}", dir.display())),
-        // The built-in generated world (Fostral's size, fixed seed).
-        None => Ok(strata_level::generate::generate(&Default::default())?),
-    }
-}
-
 fn select_views(args: &Args, world: &strata_level::World) -> anyhow::Result<Vec<ViewSpec>> {
     let views = match (&args.view, &args.views, &args.view_name) {
         (Some(spec), _, _) => {
@@ -123,7 +108,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     if args.frames == 0 {
         bail!("--frames must be at least 1");
     }
-    let world = load_world(&args.world)?;
+    let world = args.world.load()?;
     let views = select_views(&args, &world)?;
     let (w, h) = args.size;
     let cameras = views
