@@ -1,5 +1,5 @@
 //! Time the fit and a crater refit on a synthetic level:
-//! `cargo run --release -p strata-mesh --example fit_synthetic -- [W H [TOL]]`.
+//! `cargo run --release -p strata-mesh --example fit_synthetic -- [W H [TOL] | WORLD_DIR - [TOL]]`.
 
 use std::time::Instant;
 
@@ -11,11 +11,22 @@ use strata_mesh::{LevelMesh, timed_fit};
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    let w = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(2048u32);
-    let h = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(16384u32);
     let tol = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(4.0f64);
     let t = Instant::now();
-    let mut level = synthetic_level(w, h, 1);
+    // A world directory, or the synthetic level's size.
+    let mut level = match args.get(1).map(std::path::Path::new) {
+        Some(dir) if dir.is_dir() => {
+            strata_level::io::load_world(dir, strata_level::MidRule::Original)
+                .expect("world")
+                .level
+        }
+        _ => {
+            let w = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(2048u32);
+            let h = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(16384u32);
+            synthetic_level(w, h, 1)
+        }
+    };
+    let (w, h) = (level.width(), level.height());
     println!(
         "generated {w}x{h} in {:.2} s, dual texels {:.1}%",
         t.elapsed().as_secs_f64(),

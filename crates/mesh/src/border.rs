@@ -11,7 +11,7 @@ use crate::samples::Sample;
 /// comparison both the border and the interior fit use.
 #[inline]
 pub fn exceeds(num: i64, den: i64, tol: f64) -> bool {
-    num as f64 > tol * den as f64
+    num as f64 / den as f64 > tol
 }
 
 /// Indices (strictly between 0 and `edge.len() - 1`, ascending) of the

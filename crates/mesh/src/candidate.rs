@@ -6,12 +6,13 @@ use std::cmp::Ordering;
 use crate::predicates::Pt;
 use crate::samples::ChunkSamples;
 
-/// The worst sample of a triangle. Its error is `num / den` height units
-/// (`den` is twice the triangle's area), compared exactly across triangles.
+/// The worst sample of a triangle, as a heap entry.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Candidate {
-    pub num: i64,
-    pub den: i64,
+    /// Bits of the error `num / den` as a positive `f64`: they order like the
+    /// value, and distinct errors (denominators < 2^16) stay distinct, so
+    /// one integer comparison orders candidates exactly.
+    pub key: u64,
     /// Sample index in the chunk grid.
     pub sample: u32,
     pub tri: u32,
@@ -19,12 +20,19 @@ pub struct Candidate {
     pub stamp: u32,
 }
 
+impl Candidate {
+    /// The error in height units.
+    pub fn error(&self) -> f64 {
+        f64::from_bits(self.key)
+    }
+}
+
 impl Ord for Candidate {
     /// Larger error first; ties go to the lower sample index, then the lower
     /// triangle, so the insertion order is a pure function of the input.
     fn cmp(&self, other: &Self) -> Ordering {
-        (self.num * other.den)
-            .cmp(&(other.num * self.den))
+        self.key
+            .cmp(&other.key)
             .then_with(|| other.sample.cmp(&self.sample))
             .then_with(|| other.tri.cmp(&self.tri))
             .then_with(|| other.stamp.cmp(&self.stamp))
@@ -93,6 +101,10 @@ fn scan_generic(pts: [Pt; 3], zs: [[u8; 3]; 3], chunk: &ChunkSamples) -> (i64, i
     if x0 > x1 || y0 > y1 {
         return (0, i64::from(den), 0);
     }
+    if (x1 - x0 + 1) * (y1 - y0 + 1) <= SMALL {
+        let (best, at) = scan_small(pts, zs, den, [x0, y0, x1, y1], chunk);
+        return (i64::from(best), i64::from(den), at);
+    }
     // Where the vertices and every sample are single, mid = high = low and
     // the three fields have identical errors: scan one.
     let single =
@@ -106,6 +118,39 @@ fn scan_generic(pts: [Pt; 3], zs: [[u8; 3]; 3], chunk: &ChunkSamples) -> (i64, i
 }
 
 const NUDGE: f64 = 1.0 / 4096.0;
+
+/// Bounding boxes up to this many samples are scanned directly (most
+/// triangles of a fine fit): no span arithmetic, no per-row setup.
+const SMALL: i32 = 24;
+
+#[inline(always)]
+fn scan_small(
+    pts: [Pt; 3],
+    zs: [[u8; 3]; 3],
+    den: i32,
+    bbox: [i32; 4],
+    chunk: &ChunkSamples,
+) -> (i32, u32) {
+    let [a, b, c] = pts;
+    let [x0, y0, x1, y1] = bbox;
+    let stride = chunk.stride();
+    let mut best = (0i32, 0u32);
+    for y in y0..=y1 {
+        for x in x0..=x1 {
+            let w = barycentric(a, b, c, [x, y]);
+            if (w[0] | w[1] | w[2]) < 0 {
+                continue;
+            }
+            let i = y as usize * stride + x as usize;
+            let e = errors(w, den, zs, chunk.samples[i].z);
+            let e = e[0].max(e[1]).max(e[2]);
+            if e > best.0 {
+                best = (e, i as u32);
+            }
+        }
+    }
+    best
+}
 
 #[inline(always)]
 fn scan_rows<const F: usize>(

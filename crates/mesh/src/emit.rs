@@ -111,7 +111,7 @@ pub struct Emitter {
     positions: u32,
     /// Each LOD's triangles as keys (three indices, smallest first).
     lists: [Vec<u64>; LODS],
-    sorted: [Vec<u64>; LODS],
+    blocks: [Vec<u64>; 8],
     stats: [LodStats; LODS],
 }
 
@@ -198,34 +198,38 @@ impl Emitter {
 
     /// Lay the three LODs out by membership blocks and move them into `mesh`.
     pub fn finish(&mut self, mesh: &mut ChunkMesh, tr: &Triangulation) {
-        for l in 0..LODS {
-            self.sorted[l].clear();
-            self.sorted[l].extend_from_slice(&self.lists[l]);
-            self.sorted[l].sort_unstable();
+        for l in &mut self.lists {
+            l.sort_unstable();
         }
-        let member = |sorted: &[Vec<u64>; LODS], k: u64| {
-            (0..LODS).fold(0u8, |m, l| {
-                m | (u8::from(sorted[l].binary_search(&k).is_ok()) << l)
-            })
-        };
-        // Blocks by membership mask, in layout order; each triangle is placed
-        // once, from the first LOD list it appears in (emission order).
+        // Blocks by LOD membership mask, from a three-way merge of the sorted
+        // lists; inside a block triangles are in key order (by their lowest
+        // vertex index, which keeps neighbours close for the vertex cache).
         const ORDER: [u8; 6] = [0b100, 0b110, 0b111, 0b011, 0b001, 0b010];
-        let mut blocks: [Vec<u64>; 8] = Default::default();
-        for l in 0..LODS {
-            for &k in &self.lists[l] {
-                let m = member(&self.sorted, k);
-                // Placed by the lowest LOD holding it. A triangle in LODs 0
-                // and 2 but not 1 (possible, rare) is stored twice.
-                if m.trailing_zeros() as usize != l {
-                    continue;
+        let blocks = &mut self.blocks;
+        for b in blocks.iter_mut() {
+            b.clear();
+        }
+        let lists = &self.lists;
+        let mut at = [0usize; LODS];
+        loop {
+            let head = |l: usize| lists[l].get(at[l]).copied().unwrap_or(u64::MAX);
+            let k = head(0).min(head(1)).min(head(2));
+            if k == u64::MAX {
+                break;
+            }
+            let mut m = 0u8;
+            for (l, a) in at.iter_mut().enumerate() {
+                if lists[l].get(*a) == Some(&k) {
+                    m |= 1 << l;
+                    *a += 1;
                 }
-                if m == 0b101 {
-                    blocks[0b001].push(k);
-                    blocks[0b100].push(k);
-                } else {
-                    blocks[m as usize].push(k);
-                }
+            }
+            if m == 0b101 {
+                // In LODs 0 and 2 but not 1 (rare): stored twice.
+                blocks[0b001].push(k);
+                blocks[0b100].push(k);
+            } else {
+                blocks[m as usize].push(k);
             }
         }
         let mut indices = Vec::with_capacity(blocks.iter().map(|b| b.len() * 3).sum());

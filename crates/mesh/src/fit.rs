@@ -124,8 +124,7 @@ impl ChunkFitter {
                 self.heap.pop();
             }
             let top = self.heap.peek().copied();
-            while next_lod > 0 && top.is_none_or(|c| !exceeds(c.num, c.den, lod_tols[next_lod - 1]))
-            {
+            while next_lod > 0 && top.is_none_or(|c| c.error() <= lod_tols[next_lod - 1]) {
                 next_lod -= 1;
                 self.emitter
                     .emit_lod(next_lod, &self.tr, &self.vsample, &self.samples);
@@ -172,8 +171,7 @@ impl ChunkFitter {
         let (num, den, sample) = scan(pts, zs, &self.samples);
         if num > 0 && exceeds(num, den, tol) {
             self.heap.push(Candidate {
-                num,
-                den,
+                key: (num as f64 / den as f64).to_bits(),
                 sample,
                 tri: t,
                 stamp: self.stamps[t as usize],

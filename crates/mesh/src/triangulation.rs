@@ -91,10 +91,14 @@ impl Triangulation {
     /// Find a triangle containing `p` by scanning every triangle (used only
     /// while placing the few border vertices of an empty chunk).
     pub fn locate_scan(&self, p: Pt) -> Option<(u32, Location)> {
-        (0..self.tris.len() as u32).find_map(|t| match self.locate_in(t, p) {
-            Location::Outside => None,
-            loc => Some((t, loc)),
-        })
+        // Newest first: consecutive border points along an edge usually
+        // fall in a triangle the previous one just created.
+        (0..self.tris.len() as u32)
+            .rev()
+            .find_map(|t| match self.locate_in(t, p) {
+                Location::Outside => None,
+                loc => Some((t, loc)),
+            })
     }
 
     /// Insert `p`, known to lie in triangle `t` (inside or on an edge), and
