@@ -123,7 +123,7 @@ impl Landmark {
                 let b = LEVELS[2];
                 let apron =
                     Texel::single(b + (fine >> 1) + (u % 16 == 0 || v % 16 == 0) as i32, ROAD);
-                let (u0, u1, v0, v1) = (c / 4, 3 * c / 4, 3 * c / 10, 17 * c / 20);
+                let (u0, u1, v0, v1) = (c / 4, 3 * c / 4, 9 * c / 20, 19 * c / 20);
                 if u < u0 || u >= u1 || v < v0 || v >= v1 {
                     return apron;
                 }
@@ -137,7 +137,7 @@ impl Landmark {
             }
             Kind::Ramp => {
                 let (lo, hi) = (100, 144);
-                let (r0, r1) = (3 * c / 20, 11 * c / 20);
+                let (r0, r1) = (3 * c / 10, 13 * c / 20);
                 let on_road = (u - c / 2).abs() < c / 10;
                 if on_road && v >= r0 && v < r1 {
                     let h = lo + (hi - lo) * (v - r0) / (r1 - r0);
@@ -435,12 +435,12 @@ impl Layout {
         let lift = |eye: f32, l: &Landmark| eye * (0.5 + 0.5 * l.scale());
         vec![
             view("river", river_eye, yaw_to(river_eye, deck), 30.0, 0.0),
-            view("hangar", hangar.at(0.5, 0.3 - 0.2), 0.0, 22.0, 0.0),
+            view("hangar", hangar.at(0.5, 0.1), 0.0, 22.0, 0.0),
             view("ramp", ramp.at(0.5, 0.04), 0.0, 14.0, 0.0),
             view("portal", portal.at(0.5, 0.04), 0.0, 34.0 + 26.0 * s, -30.0),
             aimed(
                 "entrance",
-                hangar.at(0.5, 0.34),
+                hangar.at(0.5, 0.47),
                 340.0,
                 lift(46.0, hangar),
                 -30.0,
