@@ -44,6 +44,12 @@ fn ray_methods_match_the_reference() {
         for ((view, camera), reference) in views.iter().zip(&cameras).zip(&references) {
             r.render_frame(camera).unwrap();
             let depth = r.read_depth().unwrap();
+            if let Ok(dir) = std::env::var("STRATA_TEST_OUT") {
+                // Pictures for a human: STRATA_TEST_OUT=/tmp/x cargo test ...
+                let path = std::path::Path::new(&dir).join(format!("{method}-{}.png", view.name));
+                std::fs::create_dir_all(&dir).unwrap();
+                strata_render::report::write_png(&path, W, H, &r.read_color().unwrap()).unwrap();
+            }
             let distance = metrics::distance_from_depth(camera, &depth);
             let m = metrics::compare(reference, &distance);
             eprintln!(

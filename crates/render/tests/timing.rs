@@ -14,13 +14,26 @@ fn every_pass_is_timed() {
     for (method, shadows, want) in [
         ("ray", true, vec!["shadow", "ray"]),
         ("ray", false, vec!["ray"]),
-        ("ray-compute", true, vec!["shadow", "ray-compute march", "ray-compute depth copy"]),
+        (
+            "ray-compute",
+            true,
+            vec!["shadow", "ray-compute march", "ray-compute depth copy"],
+        ),
     ] {
         let settings = MethodSettings {
             shadows,
             ..Default::default()
         };
-        let mut r = Renderer::new(&gpu, &level, &TerrainColors::test_ramps(), method, &settings, 160, 100).unwrap();
+        let mut r = Renderer::new(
+            &gpu,
+            &level,
+            &TerrainColors::test_ramps(),
+            method,
+            &settings,
+            160,
+            100,
+        )
+        .unwrap();
         let m = r.measure(&camera, 1, 3).unwrap();
         for t in &m.timings {
             eprintln!("{method} shadows={shadows}: {t:?}");
