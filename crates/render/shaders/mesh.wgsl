@@ -1,0 +1,72 @@
+// `mesh` (§3.6): the fitted TIN (crates/mesh). There is no vertex buffer:
+// an index names a grid sample of its chunk and which altitude to take,
+// `index = kind * positions + y * stride + x` (see strata_mesh::emit), and the
+// vertex shader reads that column from the terrain texture. The instance
+// index selects the draw's chunk origin in the unwrapped plane (a chunk near
+// the map edge is drawn again at its wrapped copies).
+#include "frame.wgsl"
+#include "surface.wgsl"
+#include "shading.wgsl"
+
+struct MeshParams {
+    // x stride (chunk side + 1), y positions per kind ((side_x + 1) * (side_y + 1))
+    grid: vec4<u32>,
+}
+
+@group(1) @binding(0) var<uniform> mesh: MeshParams;
+// Per draw: xy the chunk's sample (0, 0) in unwrapped texels.
+@group(1) @binding(1) var<storage, read> draws: array<vec4<i32>>;
+
+const KIND_FLOOR: u32 = 0u;
+const KIND_TOP: u32 = 1u;
+
+struct VertexOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) world: vec3<f32>,
+    @location(1) @interpolate(flat) kind: u32,
+}
+
+@vertex
+fn vs_mesh(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) -> VertexOut {
+    let kind = v / mesh.grid.y;
+    let pos = v % mesh.grid.y;
+    let origin = draws[i].xy;
+    let gx = origin.x + i32(pos % mesh.grid.x);
+    let gy = origin.y + i32(pos / mesh.grid.x);
+    let c = decode_column(gx, gy);
+    var z = c.low;
+    if (kind == KIND_TOP) {
+        z = c.high;
+    } else if (kind != KIND_FLOOR) {
+        z = c.mid;
+    }
+    // Samples stand at texel centres, so a ramp between two samples crosses
+    // the texel boundary where the height field steps.
+    let p = vec3<f32>(f32(gx) + 0.5, f32(gy) + 0.5, z);
+    var out: VertexOut;
+    out.clip = globals.view_proj * vec4<f32>(p, 1.0);
+    out.world = p;
+    out.kind = kind;
+    return out;
+}
+
+@fragment
+fn fs_mesh(in: VertexOut) -> @location(0) vec4<f32> {
+    let p = in.world;
+    // The triangle's flat geometric normal: world position is linear over
+    // the triangle, so its screen derivatives span the triangle's plane.
+    var n = normalize(cross(dpdx(p), dpdy(p)));
+    let to_eye = globals.eye.xyz - p;
+    if (dot(n, to_eye) < 0.0) {
+        // Whichever side is seen is the outside of the solid.
+        n = -n;
+    }
+    let c = decode_column(i32(floor(p.x)), i32(floor(p.y)));
+    var kind = SURFACE_FLOOR;
+    if (in.kind != KIND_FLOOR) {
+        // Slab triangles: tops and walls take the slab top's light, faces
+        // looking down are the cave ceiling.
+        kind = select(SURFACE_SLAB_TOP, SURFACE_CEILING, n.z < -0.5);
+    }
+    return vec4<f32>(shade_with_normal(p, c, kind, n), 1.0);
+}

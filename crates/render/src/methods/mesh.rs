@@ -1,0 +1,393 @@
+//! `mesh` (§3.6): the greedy TIN of `strata-mesh`, rasterised.
+//!
+//! Setup fits the whole level (parallel, the method's preparation cost) and
+//! uploads every chunk's three LODs into one index pool ([`mesh_pool`]); the
+//! fit itself is not kept. There is no vertex buffer: each u16 index names a
+//! grid sample of its chunk and an altitude kind, and `mesh.wgsl` reads the
+//! column from the shared terrain texture.
+//!
+//! Per frame: the chunk grid around the eye is walked in the unwrapped plane
+//! (the map is a torus; a chunk near the edge is also seen at its wrapped
+//! copies), each copy is frustum-culled by its box, takes LOD 0 within
+//! [`LOD_DISTANCE`]`[0]`, LOD 1 within `[1]`, LOD 2 beyond (distance from the
+//! eye to the box), and the copies are drawn front to back, one
+//! `draw_indexed` per LOD range with the copy's origin at its
+//! `first_instance`. Borders are crack-free across LODs by construction.
+//!
+//! Edits refit the dirty chunks from scratch (equal to a fresh fit of the
+//! edited level) and rewrite only their slots.
+//!
+//! [`mesh_pool`]: super::mesh_pool
+
+use super::mesh_pool::{Fitted, IndexPool, Slot};
+use super::painted::{begin_pass, forward_pipeline};
+use super::{Frame, Method, MethodSettings, RetainedBytes};
+use crate::frame::{Shared, uniform_layout_entry};
+use glam::{Vec3, Vec4};
+use strata_camera::Camera;
+use strata_level::model::decode_column;
+use strata_level::{DirtyRect, Level};
+use strata_mesh::{
+    ChunkFitter, ChunkLayout, ChunkMesh, LevelMesh, dirty_chunks, tolerance_for_quality,
+};
+
+/// LOD 0 within the first distance, LOD 1 within the second, LOD 2 beyond
+/// (world units from the eye to the chunk's box). At q = 0.5 LOD 2's 16
+/// units of error seen edge-on at 300 moved horizon silhouettes by ~27 px
+/// (1.1 % covers-sky on the hand-built level's `high` view at 150/300; 0.6 %
+/// at these distances).
+pub const LOD_DISTANCE: [f32; 2] = [250.0, 450.0];
+
+/// Per-draw record: the chunk copy's sample (0, 0) in unwrapped texels.
+const DRAW_BYTES: u64 = 16;
+
+/// One visible chunk copy.
+#[derive(Clone, Copy, Debug)]
+struct Draw {
+    chunk: u32,
+    lod: u8,
+    distance: f32,
+    origin: [i32; 2],
+}
+
+pub struct Mesh {
+    pipeline: wgpu::RenderPipeline,
+    group_layout: wgpu::BindGroupLayout,
+    group: wgpu::BindGroup,
+    params: wgpu::Buffer,
+    draws_buffer: wgpu::Buffer,
+    /// Draw records `draws_buffer` holds.
+    draws_capacity: u32,
+    pool: IndexPool,
+    slots: Vec<Slot>,
+    layout: ChunkLayout,
+    tolerance: f64,
+    /// This frame's visible copies, front to back (written by `prepare`).
+    draws: Vec<Draw>,
+}
+
+/// Altitude range of the vertices a chunk's indices name.
+fn z_range(level: &Level, layout: &ChunkLayout, chunk: usize, mesh: &ChunkMesh) -> (u8, u8) {
+    let (cx, cy) = layout.coords(chunk);
+    let stride = layout.size_x + 1;
+    let positions = stride * (layout.size_y + 1);
+    let (wmask, hmask) = (level.width() - 1, level.height() - 1);
+    let (mut lo, mut hi) = (u8::MAX, u8::MIN);
+    for &i in &mesh.indices {
+        let (x, y, kind) = strata_mesh::decode(i, stride, positions);
+        let (heights, metas) = level.row((cy * layout.size_y + y) & hmask);
+        let c = decode_column(
+            heights,
+            metas,
+            ((cx * layout.size_x + x) & wmask) as usize,
+            level.mid_rule,
+        );
+        let z = [c.low, c.high, c.mid][usize::from(kind.min(2))];
+        lo = lo.min(z);
+        hi = hi.max(z);
+    }
+    if lo > hi { (0, 0) } else { (lo, hi) }
+}
+
+fn draws_binding(
+    shared: &Shared,
+    layout: &wgpu::BindGroupLayout,
+    params: &wgpu::Buffer,
+    capacity: u32,
+) -> (wgpu::Buffer, wgpu::BindGroup) {
+    let buffer = shared.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("mesh draws"),
+        size: u64::from(capacity.max(1)) * DRAW_BYTES,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let group = shared.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("mesh"),
+        layout,
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: params.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: buffer.as_entire_binding(),
+            },
+        ],
+    });
+    (buffer, group)
+}
+
+/// The chunks of `level`, fitted at `tolerance`, each with its altitude range.
+fn fit_all(level: &Level, tolerance: f64) -> (ChunkLayout, Vec<Fitted>) {
+    let mesh = LevelMesh::fit(level, tolerance);
+    let layout = mesh.layout;
+    let chunks = mesh
+        .chunks
+        .into_iter()
+        .enumerate()
+        .map(|(i, m)| {
+            let z = z_range(level, &layout, i, &m);
+            (m, z)
+        })
+        .collect();
+    (layout, chunks)
+}
+
+pub fn create(
+    shared: &Shared,
+    level: &Level,
+    settings: &MethodSettings,
+) -> anyhow::Result<Box<dyn Method>> {
+    let q = settings.mesh_quality;
+    let Some(tolerance) = tolerance_for_quality(f64::from(q)) else {
+        anyhow::bail!("mesh quality {q} is outside [0, 1] (max error 2^(4(1-q)))");
+    };
+    let (layout, chunks) = fit_all(level, tolerance);
+    let headroom = pool_headroom(&chunks);
+    let (pool, slots) = IndexPool::build(&shared.device, &shared.queue, &chunks, headroom)?;
+    drop(chunks);
+    let device = &shared.device;
+    let group_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("mesh"),
+        entries: &[
+            uniform_layout_entry(0),
+            wgpu::BindGroupLayoutEntry {
+                binding: 1,
+                visibility: wgpu::ShaderStages::VERTEX,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Storage { read_only: true },
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            },
+        ],
+    });
+    let stride = layout.size_x + 1;
+    let grid = [stride, stride * (layout.size_y + 1), 0, 0];
+    let params = shared.uniform_buffer("mesh params", bytemuck::cast_slice(&grid));
+    let draws_capacity = 256;
+    let (draws_buffer, group) = draws_binding(shared, &group_layout, &params, draws_capacity);
+    let pipeline = forward_pipeline(
+        shared,
+        "mesh",
+        "mesh.wgsl",
+        &group_layout,
+        ("vs_mesh", "fs_mesh"),
+    )?;
+    Ok(Box::new(Mesh {
+        pipeline,
+        group_layout,
+        group,
+        params,
+        draws_buffer,
+        draws_capacity,
+        pool,
+        slots,
+        layout,
+        tolerance,
+        draws: Vec::new(),
+    }))
+}
+
+/// Spare tail for refits that grow: 1/16 of the level's indices, at least
+/// room for a dense chunk (past it the pool grows by a GPU copy).
+fn pool_headroom(chunks: &[Fitted]) -> u32 {
+    let total: usize = chunks.iter().map(|(m, _)| m.indices.len()).sum();
+    (total / 16).max(1 << 15) as u32
+}
+
+/// Fit `ids` of `level` at `tol`, split over the available cores.
+fn refit_chunks(level: &Level, layout: &ChunkLayout, tol: f64, ids: &[usize]) -> Vec<Fitted> {
+    let fit = |ids: &[usize]| -> Vec<Fitted> {
+        let mut fitter = ChunkFitter::default();
+        ids.iter()
+            .map(|&i| {
+                let (cx, cy) = layout.coords(i);
+                let m = fitter.fit(level, layout, cx, cy, tol);
+                let z = z_range(level, layout, i, &m);
+                (m, z)
+            })
+            .collect()
+    };
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    if threads < 2 || ids.len() < 2 {
+        return fit(ids);
+    }
+    let per = ids.len().div_ceil(threads);
+    std::thread::scope(|s| {
+        let handles: Vec<_> = ids
+            .chunks(per)
+            .map(|part| s.spawn(move || fit(part)))
+            .collect();
+        handles
+            .into_iter()
+            .flat_map(|h| h.join().expect("chunk fit thread panicked"))
+            .collect()
+    })
+}
+
+/// Whether the box `[lo, hi]` lies entirely outside one clip plane of `m`.
+fn outside_frustum(m: &glam::Mat4, lo: Vec3, hi: Vec3) -> bool {
+    let corners = (0..8).map(|k| {
+        let p = Vec3::new(
+            if k & 1 == 0 { lo.x } else { hi.x },
+            if k & 2 == 0 { lo.y } else { hi.y },
+            if k & 4 == 0 { lo.z } else { hi.z },
+        );
+        *m * Vec4::new(p.x, p.y, p.z, 1.0)
+    });
+    // Planes: -w <= x <= w, -w <= y <= w, 0 <= z <= w.
+    let mut mask = [true; 6];
+    for c in corners {
+        let inside = [
+            c.x >= -c.w,
+            c.x <= c.w,
+            c.y >= -c.w,
+            c.y <= c.w,
+            c.z >= 0.0,
+            c.z <= c.w,
+        ];
+        for (o, i) in mask.iter_mut().zip(inside) {
+            *o &= !i;
+        }
+    }
+    mask.iter().any(|&o| o)
+}
+
+impl Mesh {
+    /// Visible chunk copies for `camera`, front to back.
+    fn cull(&mut self, camera: &Camera) {
+        self.draws.clear();
+        let m = camera.view_proj();
+        let e = camera.position;
+        // Farthest visible point: the far plane at the image corner.
+        let (hw, hh) = (camera.width as f32 * 0.5, camera.height as f32 * 0.5);
+        let reach =
+            camera.far * (1.0 + (hw * hw + hh * hh) / (camera.focal_px * camera.focal_px)).sqrt();
+        let (sx, sy) = (self.layout.size_x as i64, self.layout.size_y as i64);
+        let (nx, ny) = (
+            i64::from(self.layout.chunks_x),
+            i64::from(self.layout.chunks_y),
+        );
+        let range = |c: f32, size: i64| {
+            let lo = ((c - reach - 1.0) as i64).div_euclid(size);
+            let hi = ((c + reach) as i64).div_euclid(size);
+            lo..=hi
+        };
+        for gy in range(e.y, sy) {
+            for gx in range(e.x, sx) {
+                let chunk = self
+                    .layout
+                    .index(gx.rem_euclid(nx) as u32, gy.rem_euclid(ny) as u32);
+                let slot = &self.slots[chunk];
+                let origin = [(gx * sx) as i32, (gy * sy) as i32];
+                // Samples stand at texel centres: (0.5 .. size + 0.5).
+                let lo = Vec3::new(
+                    origin[0] as f32 + 0.5,
+                    origin[1] as f32 + 0.5,
+                    f32::from(slot.z.0),
+                );
+                let hi = lo + Vec3::new(sx as f32, sy as f32, f32::from(slot.z.1 - slot.z.0));
+                if outside_frustum(&m, lo, hi) {
+                    continue;
+                }
+                let distance = (e.clamp(lo, hi) - e).length();
+                let lod = LOD_DISTANCE.iter().filter(|&&d| distance >= d).count() as u8;
+                self.draws.push(Draw {
+                    chunk: chunk as u32,
+                    lod,
+                    distance,
+                    origin,
+                });
+            }
+        }
+        self.draws.sort_by(|a, b| a.distance.total_cmp(&b.distance));
+    }
+}
+
+impl Method for Mesh {
+    fn name(&self) -> &'static str {
+        "mesh"
+    }
+
+    fn apply_edit(
+        &mut self,
+        shared: &Shared,
+        level: &Level,
+        rects: &[DirtyRect],
+    ) -> anyhow::Result<()> {
+        let layout = ChunkLayout::of(level);
+        if layout != self.layout {
+            // Another map size: nothing local survives.
+            let (layout, chunks) = fit_all(level, self.tolerance);
+            let headroom = pool_headroom(&chunks);
+            let (pool, slots) = IndexPool::build(&shared.device, &shared.queue, &chunks, headroom)?;
+            (self.layout, self.pool, self.slots) = (layout, pool, slots);
+            let stride = layout.size_x + 1;
+            let grid = [stride, stride * (layout.size_y + 1), 0, 0];
+            shared
+                .queue
+                .write_buffer(&self.params, 0, bytemuck::cast_slice(&grid));
+            return Ok(());
+        }
+        let ids = dirty_chunks(&layout, level.width(), level.height(), rects);
+        let fresh = refit_chunks(level, &layout, self.tolerance, &ids);
+        for (&i, (mesh, z)) in ids.iter().zip(&fresh) {
+            self.pool
+                .replace(&shared.device, &shared.queue, &mut self.slots[i], mesh, *z);
+        }
+        Ok(())
+    }
+
+    fn prepare(&mut self, shared: &Shared, camera: &Camera) -> anyhow::Result<()> {
+        self.cull(camera);
+        let n = self.draws.len() as u32;
+        if n > self.draws_capacity {
+            let capacity = n.next_power_of_two();
+            let (buffer, group) = draws_binding(shared, &self.group_layout, &self.params, capacity);
+            (self.draws_buffer, self.group, self.draws_capacity) = (buffer, group, capacity);
+        }
+        if n > 0 {
+            let records: Vec<[i32; 4]> = self
+                .draws
+                .iter()
+                .map(|d| [d.origin[0], d.origin[1], 0, 0])
+                .collect();
+            shared
+                .queue
+                .write_buffer(&self.draws_buffer, 0, bytemuck::cast_slice(&records));
+        }
+        Ok(())
+    }
+
+    fn record(&self, shared: &Shared, frame: &Frame<'_>, encoder: &mut wgpu::CommandEncoder) {
+        let mut pass = begin_pass(shared, frame, encoder, "mesh");
+        if self.draws.is_empty() {
+            return;
+        }
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &shared.frame_group, &[]);
+        pass.set_bind_group(1, &self.group, &[]);
+        pass.set_index_buffer(self.pool.buffer.slice(..), wgpu::IndexFormat::Uint16);
+        for (k, d) in self.draws.iter().enumerate() {
+            let slot = &self.slots[d.chunk as usize];
+            let k = k as u32;
+            for &(s, e) in &slot.lods[usize::from(d.lod)] {
+                if e > s {
+                    pass.draw_indexed(slot.start + s..slot.start + e, 0, k..k + 1);
+                }
+            }
+        }
+    }
+
+    fn retained_bytes(&self) -> RetainedBytes {
+        RetainedBytes {
+            gpu: self.pool.gpu_bytes() + self.draws_buffer.size() + self.params.size(),
+            cpu: self.pool.cpu_bytes()
+                + (self.slots.capacity() * std::mem::size_of::<Slot>()
+                    + self.draws.capacity() * std::mem::size_of::<Draw>()) as u64,
+        }
+    }
+}
