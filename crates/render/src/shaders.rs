@@ -50,6 +50,12 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("forward.wgsl", include_str!("../shaders/forward.wgsl")),
     ("painted.wgsl", include_str!("../shaders/painted.wgsl")),
     ("sliced.wgsl", include_str!("../shaders/sliced.wgsl")),
+    ("mesh.wgsl", include_str!("../shaders/mesh.wgsl")),
+    ("scattered.wgsl", include_str!("../shaders/scattered.wgsl")),
+    (
+        "scattered_resolve.wgsl",
+        include_str!("../shaders/scattered_resolve.wgsl"),
+    ),
 ];
 
 /// Shaders with entry points (the rest are modules); the naga test validates these.
@@ -64,6 +70,9 @@ pub const ENTRY_SHADERS: &[&str] = &[
     "voxel_build.wgsl",
     "painted.wgsl",
     "sliced.wgsl",
+    "mesh.wgsl",
+    "scattered.wgsl",
+    "scattered_resolve.wgsl",
 ];
 
 #[derive(Debug, thiserror::Error, PartialEq, Eq)]

@@ -38,6 +38,20 @@ pub const PARAMS_BYTES: u64 = std::mem::size_of::<FootprintParams>() as u64;
 /// The xy bound of the part of the frustum (near to `far`) with altitude in
 /// `0..=Z_MAX`, or `None` when the frustum misses that range.
 pub fn footprint_bounds(camera: &Camera, far: f32) -> Option<([f32; 2], [f32; 2])> {
+    let points = frustum_slab_points(camera, far);
+    let first = points.first()?;
+    let (mut lo, mut hi) = ([first.x, first.y], [first.x, first.y]);
+    for p in &points {
+        lo = [lo[0].min(p.x), lo[1].min(p.y)];
+        hi = [hi[0].max(p.x), hi[1].max(p.y)];
+    }
+    Some((lo, hi))
+}
+
+/// Points whose convex hull is the part of the frustum (near to `far`) with
+/// altitude in `0..=Z_MAX` (empty when the frustum misses that range). Shared
+/// by the footprint bounds here and `scattered`'s camera-aligned grid.
+pub fn frustum_slab_points(camera: &Camera, far: f32) -> Vec<Vec3> {
     let (w, h) = (camera.width as f32, camera.height as f32);
     let image = [(0.0, 0.0), (w, 0.0), (w, h), (0.0, h)];
     // Corners at view depth `d`: the image direction's forward part is the focal length.
@@ -69,13 +83,7 @@ pub fn footprint_bounds(camera: &Camera, far: f32) -> Option<([f32; 2], [f32; 2]
             }
         }
     }
-    let first = points.first()?;
-    let (mut lo, mut hi) = ([first.x, first.y], [first.x, first.y]);
-    for p in &points {
-        lo = [lo[0].min(p.x), lo[1].min(p.y)];
-        hi = [hi[0].max(p.x), hi[1].max(p.y)];
-    }
-    Some((lo, hi))
+    points
 }
 
 /// Samples in the bound of the frustum cut at `far`: the bound's corners.

@@ -31,9 +31,12 @@
 //! - `retained_bytes` counts only what the method allocates beyond [`Shared`].
 
 pub mod forward;
+pub mod mesh;
+mod mesh_pool;
 pub mod painted;
 pub mod ray;
 pub mod ray_compute;
+pub mod scattered;
 pub mod sliced;
 pub mod voxel;
 pub mod voxel_build;
@@ -133,6 +136,8 @@ pub const METHODS: &[(&str, Constructor)] = &[
     ("voxel-compute", voxel::create_compute),
     ("painted", painted::create),
     ("sliced", sliced::create),
+    ("mesh", mesh::create),
+    ("scattered", scattered::create),
 ];
 
 /// The names [`create`] accepts.

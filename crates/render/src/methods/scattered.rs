@@ -1,0 +1,513 @@
+//! `scattered` (§3.5): point samples of the terrain scattered into a screen
+//! buffer by a compute pass, the nearest kept by a 32-bit `atomicMin` of
+//! `(24-bit depth << 8) | info` (info: surface kind << 3 | terrain type); a
+//! full-screen pass then rebuilds each pixel's point from its depth and shades
+//! it (`shaders/scattered.wgsl`, `shaders/scattered_resolve.wgsl`).
+//!
+//! # The grid and `scatter_density` (X, Y, Z)
+//! The footprint is the part of the frustum (near to far) with altitude in
+//! 0..=256, seen from above in camera-aligned coordinates: `a` along the
+//! horizontal heading `flat`, `c` along `right`, both from the eye. Its
+//! outline is a convex polygon; the grid has
+//! - `rows = ceil(Y * (a_max - a_min))`: Y rows per texel of distance on
+//!   average, placed uniformly in `asinh(a / 32)` so they are dense within
+//!   about 32 texels of the eye and logarithmic (like perspective) beyond;
+//! - `cols = ceil(X * widest)`: every row spreads the same columns over its
+//!   own width, so X per texel across at the polygon's widest row (the far
+//!   end at the horizon) and denser nearer, about uniform on screen;
+//! - Z samples per unit of altitude: each sample walks `[0, low]` and, for a
+//!   dual column, `[mid, high]` from the top down, 1/Z apart, over the part of
+//!   each interval that projects into the view (clipped analytically).
+//!
+//! A grid over [`MAX_GRID`] samples is scaled down (both axes alike) with a
+//! warning; Z is capped at [`MAX_Z`]. Results depend only on the grid and the
+//! terrain texture, never on earlier frames, so an edit shows in the next frame.
+
+use super::forward::{Z_MAX, frustum_slab_points};
+use super::{Frame, Method, MethodSettings, RetainedBytes};
+use crate::frame::{COLOR_FORMAT, DEPTH_FORMAT, Shared, sky_clear, uniform_layout_entry};
+use bytemuck::{Pod, Zeroable};
+use strata_camera::Camera;
+use strata_level::Level;
+
+/// Most grid samples per frame (16 M: a 1280x800 horizon view at the default
+/// density needs about 14 M).
+pub const MAX_GRID: u64 = 1 << 24;
+/// Most vertical samples per unit of altitude.
+pub const MAX_Z: f32 = 64.0;
+/// The warp's scale: rows are uniform in `asinh(a / WARP_SCALE)`.
+pub const WARP_SCALE: f32 = 32.0;
+/// Most footprint polygon vertices the uniform holds (a frustum cut by a slab
+/// has at most 12).
+const MAX_HULL: usize = 16;
+/// Invocations per scatter workgroup (`WORKGROUP` in scattered.wgsl).
+const WORKGROUP: u32 = 64;
+
+/// Twin of `ScatterParams` in scattered.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct ScatterParams {
+    /// `flat` xy, `right` xy.
+    pub axes: [f32; 4],
+    /// Eye xy, warp scale, Z.
+    pub origin: [f32; 4],
+    /// asinh(a / h) of the nearest and farthest row bound; unused; unused.
+    pub warp: [f32; 4],
+    /// Rows, columns, polygon vertices, vertical samples per interval at most.
+    pub grid: [u32; 4],
+    /// The footprint polygon (a, c), two vertices per entry.
+    pub hull: [[f32; 4]; MAX_HULL / 2],
+}
+
+impl ScatterParams {
+    pub fn samples(&self) -> u64 {
+        u64::from(self.grid[0]) * u64::from(self.grid[1])
+    }
+
+    fn vertex(&self, i: usize) -> [f32; 2] {
+        let v = self.hull[i / 2];
+        if i % 2 == 0 {
+            [v[0], v[1]]
+        } else {
+            [v[2], v[3]]
+        }
+    }
+
+    /// The across range of the footprint polygon at distance `a`, `None`
+    /// outside it (the CPU twin of `row_range`).
+    pub fn row_range(&self, a: f32) -> Option<(f32, f32)> {
+        let n = self.grid[2] as usize;
+        let mut r: Option<(f32, f32)> = None;
+        for i in 0..n {
+            let (p, q) = (self.vertex(i), self.vertex((i + 1) % n));
+            if a < p[0].min(q[0]) || a > p[0].max(q[0]) {
+                continue;
+            }
+            let c = if q[0] != p[0] {
+                p[1] + (q[1] - p[1]) * (a - p[0]) / (q[0] - p[0])
+            } else {
+                p[1]
+            };
+            r = Some(r.map_or((c, c), |(lo, hi)| (lo.min(c), hi.max(c))));
+        }
+        r
+    }
+}
+
+/// Convex hull, counter-clockwise, without collinear points (monotone chain).
+fn convex_hull(mut pts: Vec<[f32; 2]>) -> Vec<[f32; 2]> {
+    pts.sort_by(|p, q| p[0].total_cmp(&q[0]).then(p[1].total_cmp(&q[1])));
+    pts.dedup();
+    if pts.len() < 3 {
+        return pts;
+    }
+    let turn = |o: [f32; 2], a: [f32; 2], b: [f32; 2]| {
+        (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+    };
+    let mut hull: Vec<[f32; 2]> = Vec::with_capacity(2 * pts.len());
+    for pass in [false, true] {
+        let start = hull.len();
+        let iter: Box<dyn Iterator<Item = &[f32; 2]>> = if pass {
+            Box::new(pts.iter().rev())
+        } else {
+            Box::new(pts.iter())
+        };
+        for &p in iter {
+            while hull.len() >= start + 2
+                && turn(hull[hull.len() - 2], hull[hull.len() - 1], p) <= 0.0
+            {
+                hull.pop();
+            }
+            hull.push(p);
+        }
+        hull.pop();
+    }
+    hull
+}
+
+/// The grid for `camera` at `density` (X, Y, Z; Z already within
+/// [`MAX_Z`]), at most `max_samples` samples; the second value is a warning
+/// when the grid had to be scaled down.
+pub fn scatter_grid(
+    camera: &Camera,
+    density: [f32; 3],
+    max_samples: u64,
+) -> (ScatterParams, Option<String>) {
+    let b = camera.basis();
+    let e = camera.position;
+    let mut params = ScatterParams {
+        axes: [b.flat.x, b.flat.y, b.right.x, b.right.y],
+        origin: [e.x, e.y, WARP_SCALE, density[2]],
+        ..Default::default()
+    };
+    let pts = frustum_slab_points(camera, camera.far)
+        .into_iter()
+        .map(|p| {
+            let r = p - e;
+            [r.dot(b.flat), r.dot(b.right)]
+        })
+        .collect();
+    let mut hull = convex_hull(pts);
+    if hull.len() < 3 {
+        return (params, None);
+    }
+    if hull.len() > MAX_HULL {
+        // Cannot happen for a frustum (12 at most); the bounding box is safe.
+        let (mut lo, mut hi) = (hull[0], hull[0]);
+        for p in &hull {
+            lo = [lo[0].min(p[0]), lo[1].min(p[1])];
+            hi = [hi[0].max(p[0]), hi[1].max(p[1])];
+        }
+        hull = vec![lo, [hi[0], lo[1]], hi, [lo[0], hi[1]]];
+    }
+    for (i, p) in hull.iter().enumerate() {
+        let slot = &mut params.hull[i / 2];
+        slot[2 * (i % 2)..2 * (i % 2) + 2].copy_from_slice(p);
+    }
+    params.grid[2] = hull.len() as u32;
+    let a0 = hull.iter().map(|p| p[0]).fold(f32::INFINITY, f32::min);
+    let a1 = hull.iter().map(|p| p[0]).fold(f32::NEG_INFINITY, f32::max);
+    // A convex polygon's width is concave in a: widest at a vertex.
+    let widest = hull
+        .iter()
+        .filter_map(|p| params.row_range(p[0]))
+        .map(|(lo, hi)| hi - lo)
+        .fold(0.0f32, f32::max);
+    let mut rows = (f64::from(density[1]) * f64::from(a1 - a0)).ceil().max(1.0);
+    let mut cols = (f64::from(density[0]) * f64::from(widest)).ceil().max(1.0);
+    let mut warning = None;
+    if rows * cols > max_samples as f64 {
+        let k = (max_samples as f64 / (rows * cols)).sqrt();
+        let (r, c) = ((rows * k).floor().max(1.0), (cols * k).floor().max(1.0));
+        warning = Some(format!(
+            "scattered: the grid of {rows:.0} x {cols:.0} samples exceeds {max_samples}; \
+             using {r:.0} x {c:.0} (density scaled by {k:.3})"
+        ));
+        (rows, cols) = (r, c.min((max_samples as f64 / r).floor()));
+    }
+    params.grid[0] = rows as u32;
+    params.grid[1] = cols as u32;
+    params.grid[3] = (Z_MAX * density[2]).ceil() as u32 + 1;
+    params.warp = [
+        (a0 / WARP_SCALE).asinh(),
+        (a1 / WARP_SCALE).asinh(),
+        0.0,
+        0.0,
+    ];
+    (params, warning)
+}
+
+/// The density, checked: each positive and finite, Z capped at [`MAX_Z`].
+pub fn checked_density(density: [f32; 3]) -> anyhow::Result<[f32; 3]> {
+    if density.iter().any(|d| !d.is_finite() || *d <= 0.0) {
+        anyhow::bail!("scatter density must be positive and finite in X, Y and Z, got {density:?}");
+    }
+    let mut d = density;
+    if d[2] > MAX_Z {
+        eprintln!(
+            "warning: scattered: {} vertical samples per unit is over {MAX_Z}; using {MAX_Z}",
+            d[2]
+        );
+        d[2] = MAX_Z;
+    }
+    Ok(d)
+}
+
+pub struct Scattered {
+    density: [f32; 3],
+    params: wgpu::Buffer,
+    screen_bytes: u64,
+    clear: wgpu::ComputePipeline,
+    scatter: wgpu::ComputePipeline,
+    scatter_group: wgpu::BindGroup,
+    resolve: wgpu::RenderPipeline,
+    resolve_group: wgpu::BindGroup,
+    /// Most samples one frame may have: [`MAX_GRID`] and the dispatch limits.
+    max_samples: u64,
+    max_groups: u32,
+    /// Workgroups of this frame's scatter (x, y); (0, 0) when nothing is in view.
+    groups: (u32, u32),
+    warned: bool,
+}
+
+fn storage_entry(
+    binding: u32,
+    read_only: bool,
+    visibility: wgpu::ShaderStages,
+) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+pub fn create(
+    shared: &Shared,
+    _level: &Level,
+    settings: &MethodSettings,
+) -> anyhow::Result<Box<dyn Method>> {
+    let density = checked_density(settings.scatter_density)?;
+    let device = &shared.device;
+    let limits = device.limits();
+    let screen_bytes = u64::from(shared.width) * u64::from(shared.height) * 4;
+    let max_binding = u64::from(limits.max_storage_buffer_binding_size);
+    if screen_bytes > max_binding {
+        anyhow::bail!(
+            "scattered: a {}x{} screen buffer needs {screen_bytes} bytes, over this adapter's \
+             storage binding limit of {max_binding}",
+            shared.width,
+            shared.height
+        );
+    }
+    let params = shared.uniform_buffer("scattered", bytemuck::bytes_of(&ScatterParams::default()));
+    let screen = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("scattered screen"),
+        size: screen_bytes,
+        usage: wgpu::BufferUsages::STORAGE,
+        mapped_at_creation: false,
+    });
+    let scatter_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("scattered"),
+        entries: &[
+            uniform_layout_entry(0),
+            storage_entry(1, false, wgpu::ShaderStages::COMPUTE),
+        ],
+    });
+    let scatter_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("scattered"),
+        layout: &scatter_layout,
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: params.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: screen.as_entire_binding(),
+            },
+        ],
+    });
+    let module = shared.shader("scattered.wgsl")?;
+    let layout = shared.pipeline_layout("scattered", &[&scatter_layout]);
+    let compute = |entry: &str| {
+        device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(entry),
+            layout: Some(&layout),
+            module: &module,
+            entry_point: Some(entry),
+            compilation_options: Default::default(),
+            cache: None,
+        })
+    };
+    let (clear, scatter) = (compute("cs_clear"), compute("cs_scatter"));
+
+    let resolve_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("scattered resolve"),
+        entries: &[storage_entry(0, true, wgpu::ShaderStages::FRAGMENT)],
+    });
+    let resolve_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("scattered resolve"),
+        layout: &resolve_layout,
+        entries: &[wgpu::BindGroupEntry {
+            binding: 0,
+            resource: screen.as_entire_binding(),
+        }],
+    });
+    let resolve_module = shared.shader("scattered_resolve.wgsl")?;
+    let resolve = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("scattered resolve"),
+        layout: Some(&shared.pipeline_layout("scattered resolve", &[&resolve_layout])),
+        vertex: wgpu::VertexState {
+            module: &resolve_module,
+            entry_point: Some("vs_fullscreen"),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        primitive: wgpu::PrimitiveState::default(),
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: DEPTH_FORMAT,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Always),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module: &resolve_module,
+            entry_point: Some("fs_resolve"),
+            compilation_options: Default::default(),
+            targets: &[Some(COLOR_FORMAT.into())],
+        }),
+        multiview_mask: None,
+        cache: None,
+    });
+    let max_groups = limits.max_compute_workgroups_per_dimension;
+    let dispatchable = u64::from(max_groups) * u64::from(max_groups) * u64::from(WORKGROUP);
+    Ok(Box::new(Scattered {
+        density,
+        params,
+        screen_bytes,
+        clear,
+        scatter,
+        scatter_group,
+        resolve,
+        resolve_group,
+        max_samples: MAX_GRID.min(dispatchable),
+        max_groups,
+        groups: (0, 0),
+        warned: false,
+    }))
+}
+
+impl Method for Scattered {
+    fn name(&self) -> &'static str {
+        "scattered"
+    }
+
+    fn prepare(&mut self, shared: &Shared, camera: &Camera) -> anyhow::Result<()> {
+        let (params, warning) = scatter_grid(camera, self.density, self.max_samples);
+        if let Some(w) = warning
+            && !self.warned
+        {
+            eprintln!("warning: {w}");
+            self.warned = true;
+        }
+        let groups = params.samples().div_ceil(u64::from(WORKGROUP));
+        // groups <= max_groups^2 by `max_samples`, so y fits too.
+        let x = groups.min(u64::from(self.max_groups));
+        self.groups = if groups == 0 {
+            (0, 0)
+        } else {
+            (x as u32, groups.div_ceil(x) as u32)
+        };
+        shared
+            .queue
+            .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
+        Ok(())
+    }
+
+    fn record(&self, shared: &Shared, frame: &Frame<'_>, encoder: &mut wgpu::CommandEncoder) {
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("scattered clear"),
+                timestamp_writes: frame.timer.compute("scattered clear"),
+            });
+            pass.set_pipeline(&self.clear);
+            pass.set_bind_group(0, &shared.frame_group, &[]);
+            pass.set_bind_group(1, &self.scatter_group, &[]);
+            pass.dispatch_workgroups(shared.width.div_ceil(8), shared.height.div_ceil(8), 1);
+        }
+        if self.groups.0 > 0 {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("scattered scatter"),
+                timestamp_writes: frame.timer.compute("scattered scatter"),
+            });
+            pass.set_pipeline(&self.scatter);
+            pass.set_bind_group(0, &shared.frame_group, &[]);
+            pass.set_bind_group(1, &self.scatter_group, &[]);
+            pass.dispatch_workgroups(self.groups.0, self.groups.1, 1);
+        }
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("scattered resolve"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &shared.color_view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(sky_clear()),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &shared.depth_view,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: frame.timer.render("scattered resolve"),
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&self.resolve);
+        pass.set_bind_group(0, &shared.frame_group, &[]);
+        pass.set_bind_group(1, &self.resolve_group, &[]);
+        pass.draw(0..3, 0..1);
+    }
+
+    fn retained_bytes(&self) -> RetainedBytes {
+        // The screen buffer (4 bytes per pixel) and the grid uniform.
+        RetainedBytes {
+            gpu: self.screen_bytes + std::mem::size_of::<ScatterParams>() as u64,
+            cpu: 0,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+
+    #[test]
+    fn hull_drops_inner_and_collinear_points() {
+        let pts = vec![
+            [0.0, 0.0],
+            [2.0, 0.0],
+            [1.0, 0.0],
+            [2.0, 2.0],
+            [0.0, 2.0],
+            [1.0, 1.0],
+        ];
+        let h = convex_hull(pts);
+        assert_eq!(h.len(), 4, "{h:?}");
+    }
+
+    #[test]
+    fn grid_covers_the_view_at_every_pitch() {
+        for (pitch, yaw) in [(0.0, 0.0), (-30.0, 45.0), (-60.0, 200.0), (-90.0, 10.0)] {
+            let cam = Camera::new(Vec3::new(300.0, 500.0, 120.0), yaw, pitch, 160, 100).unwrap();
+            let (p, w) = scatter_grid(&cam, [4.0, 4.0, 4.0], MAX_GRID);
+            assert!(w.is_none() && p.samples() > 0 && p.samples() <= MAX_GRID);
+            let b = cam.basis();
+            // Points of pixel rays inside the altitude range are inside the polygon.
+            for (i, j) in [(0, 0), (159, 0), (80, 50), (0, 99), (159, 99)] {
+                let d = cam.pixel_ray(i, j);
+                for s in 1..=60 {
+                    let q = cam.position + d * (cam.far_distance(i, j) * s as f32 / 60.0);
+                    if !(0.0..=Z_MAX).contains(&q.z) {
+                        continue;
+                    }
+                    let r = q - cam.position;
+                    let (a, c) = (r.dot(b.flat), r.dot(b.right));
+                    let (lo, hi) = p.row_range(a).expect("row inside the footprint");
+                    assert!(
+                        c >= lo - 1e-2 && c <= hi + 1e-2,
+                        "{pitch}: {c} not in {lo}..{hi}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_huge_grid_is_clamped_and_bad_density_refused() {
+        let mut cam = Camera::new(Vec3::new(0.0, 0.0, 100.0), 45.0, 0.0, 160, 100).unwrap();
+        cam.far = 100_000.0;
+        let (p, w) = scatter_grid(&cam, [4.0, 4.0, 4.0], MAX_GRID);
+        assert!(w.is_some() && p.samples() <= MAX_GRID && p.samples() > MAX_GRID / 2);
+        for d in [[0.0, 4.0, 4.0], [4.0, -1.0, 4.0], [4.0, 4.0, f32::NAN]] {
+            assert!(checked_density(d).is_err());
+        }
+        assert_eq!(checked_density([1.0, 1.0, 1e9]).unwrap()[2], MAX_Z);
+        let above = Camera::new(Vec3::new(0.0, 0.0, 5000.0), 0.0, 30.0, 160, 100).unwrap();
+        assert_eq!(scatter_grid(&above, [4.0; 3], MAX_GRID).0.samples(), 0);
+    }
+}
