@@ -371,7 +371,10 @@ mod tests {
     fn single_texels_and_sea_level() {
         let level = hand_built(MidRule::Original);
         let c = level.column(2, 0);
-        assert_eq!((c.low, c.mid, c.high, c.dual, c.lower_type), (7, 7, 7, false, 3));
+        assert_eq!(
+            (c.low, c.mid, c.high, c.dual, c.lower_type),
+            (7, 7, 7, false, 3)
+        );
         let sea = level.column(3, 0);
         assert_eq!(sea.low, 0);
         assert!(sea.is_solid(0.0), "height 0 is solid at z = 0");

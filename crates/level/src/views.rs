@@ -116,8 +116,8 @@ pub fn parse_views(text: &str) -> Result<Vec<ViewSpec>, ViewError> {
         let pitch: f32 = fields[2]
             .parse()
             .map_err(|_| malformed(format!("pitch `{}` is not a number", fields[2])))?;
-        let view = ViewSpec::parse(fields[0], fields[1], pitch)
-            .map_err(|e| malformed(e.to_string()))?;
+        let view =
+            ViewSpec::parse(fields[0], fields[1], pitch).map_err(|e| malformed(e.to_string()))?;
         views.push(view);
     }
     Ok(views)
@@ -125,7 +125,8 @@ pub fn parse_views(text: &str) -> Result<Vec<ViewSpec>, ViewError> {
 
 /// Write views in the format [`parse_views`] reads.
 pub fn format_views(views: &[ViewSpec]) -> String {
-    let mut out = String::from("# NAME X,Y:YAW:EYE[:under] PITCH (degrees; eye above the top surface)\n");
+    let mut out =
+        String::from("# NAME X,Y:YAW:EYE[:under] PITCH (degrees; eye above the top surface)\n");
     for v in views {
         out.push_str(&v.to_string());
         out.push('\n');
@@ -180,20 +181,38 @@ impl EditSite {
             let fields: Vec<&str> = line.split_whitespace().collect();
             match fields.as_slice() {
                 ["crater", pos, radius, depth] => {
-                    let (x, y) = pos.split_once(',').ok_or_else(|| malformed("crater position must be X,Y"))?;
-                    let parse_i = |t: &str| t.parse::<i64>().map_err(|_| malformed("crater position must be integers"));
-                    let radius: u32 = radius.parse().map_err(|_| malformed("crater radius must be a positive integer"))?;
-                    let depth: f32 = depth.parse().map_err(|_| malformed("crater depth must be a number"))?;
+                    let (x, y) = pos
+                        .split_once(',')
+                        .ok_or_else(|| malformed("crater position must be X,Y"))?;
+                    let parse_i = |t: &str| {
+                        t.parse::<i64>()
+                            .map_err(|_| malformed("crater position must be integers"))
+                    };
+                    let radius: u32 = radius
+                        .parse()
+                        .map_err(|_| malformed("crater radius must be a positive integer"))?;
+                    let depth: f32 = depth
+                        .parse()
+                        .map_err(|_| malformed("crater depth must be a number"))?;
                     if radius == 0 || !depth.is_finite() {
                         return Err(malformed("crater radius must be > 0 and depth finite"));
                     }
                     crater = Some((parse_i(x)?, parse_i(y)?, radius, depth));
                 }
                 ["camera", spec, pitch] => {
-                    let pitch: f32 = pitch.parse().map_err(|_| malformed("camera pitch must be a number"))?;
-                    camera = Some(ViewSpec::parse("edit", spec, pitch).map_err(|e| malformed(&e.to_string()))?);
+                    let pitch: f32 = pitch
+                        .parse()
+                        .map_err(|_| malformed("camera pitch must be a number"))?;
+                    camera = Some(
+                        ViewSpec::parse("edit", spec, pitch)
+                            .map_err(|e| malformed(&e.to_string()))?,
+                    );
                 }
-                _ => return Err(malformed("expected `crater X,Y RADIUS DEPTH` or `camera SPEC PITCH`")),
+                _ => {
+                    return Err(malformed(
+                        "expected `crater X,Y RADIUS DEPTH` or `camera SPEC PITCH`",
+                    ));
+                }
             }
         }
         match (crater, camera) {
@@ -237,16 +256,29 @@ mod tests {
         let views = parse_views(text).unwrap();
         assert_eq!(views.len(), 2);
         assert_eq!(views[0].name, "river");
-        assert_eq!((views[0].x, views[0].y, views[0].yaw, views[0].eye), (837.0, 3984.0, 299.0, 78.0));
+        assert_eq!(
+            (views[0].x, views[0].y, views[0].yaw, views[0].eye),
+            (837.0, 3984.0, 299.0, 78.0)
+        );
         assert!(views[1].under && views[1].pitch == -30.0);
         assert_eq!(parse_views(&format_views(&views)).unwrap(), views);
     }
 
     #[test]
     fn malformed_views_name_the_line() {
-        for bad in ["a 1,2:3 0", "a 1;2:3:4 0", "a 1,2:3:4 x", "a 1,2:3:4:over 0", "a 1,2:3:4 -91", "a 1,2:3:4"] {
+        for bad in [
+            "a 1,2:3 0",
+            "a 1;2:3:4 0",
+            "a 1,2:3:4 x",
+            "a 1,2:3:4:over 0",
+            "a 1,2:3:4 -91",
+            "a 1,2:3:4",
+        ] {
             let err = parse_views(&format!("ok 1,2:3:4 0\n{bad}\n")).unwrap_err();
-            assert!(matches!(err, ViewError::Malformed { line: 2, .. }), "{bad}: {err}");
+            assert!(
+                matches!(err, ViewError::Malformed { line: 2, .. }),
+                "{bad}: {err}"
+            );
         }
     }
 
