@@ -8,6 +8,18 @@
 //! max-height pyramid) and intersects the ray's segment inside each column
 //! with the column's solid intervals analytically. Nothing is skipped, so a
 //! finer step cannot change a class; `tests/convergence.rs` proves it.
+//! There is no march step to tune and no bisection: each column's entry
+//! point is solved exactly (the paper's "march + >= 12 bisections" converges
+//! to the same point).
+//!
+//! For many views of one level, build one [`Tracer`] (it owns the pyramid)
+//! and hash the level once: [`ReferenceCache::get_or_compute_traced`].
+//! [`ReferenceCache::get_or_compute`] re-hashes the level (64 MiB for a
+//! Fostral-sized map) and rebuilds the pyramid on every miss.
+//!
+//! Command line: `strata reference --out DIR [--view SPEC --pitch DEG |
+//! --views FILE] [--size WxH] [--json] [--no-cache]`, then `strata metrics
+//! --reference DIR/<view> --render RENDER_DIR [--json]`.
 
 pub mod cache;
 pub mod metrics;
