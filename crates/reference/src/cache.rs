@@ -3,11 +3,13 @@
 //! camera field and the image size. File: a 20-byte header then the three
 //! planes (distance f32 LE, class u8, terrain u8): 6 bytes per pixel.
 
+use crate::pyramid::Pyramid;
 use crate::raycast::Tracer;
 use crate::{HitClass, REFERENCE_VERSION, Reference, ReferenceSettings};
 use sha2::{Digest, Sha256};
 use std::io;
 use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
 use strata_camera::Camera;
 use strata_level::Level;
 
@@ -41,12 +43,18 @@ pub enum CacheError {
 
 pub struct ReferenceCache {
     dir: PathBuf,
+    /// The pyramid of the last level computed, by content hash, so that
+    /// `get_or_compute` over many views of one level builds it once.
+    last_pyramid: Mutex<Option<(String, Arc<Pyramid>)>>,
 }
 
 impl ReferenceCache {
     /// A cache in `dir` (created on first store).
     pub fn new(dir: impl Into<PathBuf>) -> Self {
-        ReferenceCache { dir: dir.into() }
+        ReferenceCache {
+            dir: dir.into(),
+            last_pyramid: Mutex::new(None),
+        }
     }
 
     pub fn dir(&self) -> &Path {
@@ -109,7 +117,17 @@ impl ReferenceCache {
         if let Some(r) = self.get(&hash, camera) {
             return Ok(r);
         }
-        let r = Tracer::new(level).render(camera, &ReferenceSettings::default());
+        let mut last = self.last_pyramid.lock().unwrap_or_else(|e| e.into_inner());
+        let tracer = match &*last {
+            Some((h, p)) if *h == hash => Tracer::with_pyramid(level, p.clone()),
+            _ => {
+                let t = Tracer::new(level);
+                *last = Some((hash.clone(), t.pyramid().clone()));
+                t
+            }
+        };
+        drop(last);
+        let r = tracer.render(camera, &ReferenceSettings::default());
         self.put(&hash, camera, &r)?;
         Ok(r)
     }
@@ -214,6 +232,10 @@ mod tests {
         );
         let other_level = Level::flat(64, 64, 11, 3).unwrap();
         assert!(cache.get(&other_level.content_hash(), &cam).is_none());
+        // The remembered pyramid belongs to the first level: not reused here.
+        let other = cache.get_or_compute(&other_level, &cam).unwrap();
+        assert_eq!(other, crate::render_reference(&other_level, &cam));
+        assert_ne!(other, a);
         // A damaged file is a miss, then repaired.
         let path = cache.path(&ReferenceCache::key(&hash, &cam));
         std::fs::write(&path, b"STRATARF garbage").unwrap();

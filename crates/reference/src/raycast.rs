@@ -10,6 +10,7 @@ use crate::{HitClass, Reference, ReferenceSettings};
 use glam::DVec3;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
+use std::sync::Arc;
 use strata_camera::Camera;
 use strata_level::{Column, Level};
 
@@ -26,15 +27,24 @@ pub struct RayHit {
 /// level and reuse it for every view.
 pub struct Tracer<'a> {
     level: &'a Level,
-    pyramid: Pyramid,
+    pyramid: Arc<Pyramid>,
 }
 
 impl<'a> Tracer<'a> {
     pub fn new(level: &'a Level) -> Self {
         Tracer {
             level,
-            pyramid: Pyramid::new(level),
+            pyramid: Arc::new(Pyramid::new(level)),
         }
+    }
+
+    /// A tracer for `level` reusing a pyramid built for identical content.
+    pub(crate) fn with_pyramid(level: &'a Level, pyramid: Arc<Pyramid>) -> Self {
+        Tracer { level, pyramid }
+    }
+
+    pub(crate) fn pyramid(&self) -> &Arc<Pyramid> {
+        &self.pyramid
     }
 
     pub fn level(&self) -> &'a Level {
