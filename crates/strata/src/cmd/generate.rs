@@ -30,6 +30,14 @@ pub struct Args {
     preview_area: Option<String>,
 }
 
+/// `println!` into a String.
+macro_rules! outln {
+    ($out:expr, $($arg:tt)*) => {{
+        use std::fmt::Write as _;
+        let _ = writeln!($out, $($arg)*);
+    }};
+}
+
 pub fn run(args: Args) -> anyhow::Result<()> {
     let (width, height) = parse_size(&args.size)?;
     let params = GenerateParams {
@@ -55,12 +63,16 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .with_context(|| format!("writing {}", args.out.display()))?;
     let write_s = t1.elapsed().as_secs_f64();
     let stats = LevelStats::compute(&world.level);
-    println!(
+    // Collected and written once: a closed pipe (`| head`) is not an error worth a panic.
+    let mut out = String::new();
+    outln!(
+        out,
         "wrote {} ({width}x{height}, seed {}): generated in {generate_s:.2} s, written in {write_s:.2} s",
         args.out.display(),
         args.seed
     );
-    println!(
+    outln!(
+        out,
         "dual {:.2} %  roughness floor {:.2}  surface {:.2} ({:.2}x)  heights {}..{}",
         stats.dual_percent,
         stats.roughness_floor,
@@ -69,16 +81,17 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         stats.height_min,
         stats.height_max
     );
-    println!("landmarks:");
+    outln!(out, "landmarks:");
     for (name, what, x, y) in landmark_list(&params)? {
-        println!("  {name:<8} {x:>5},{y:<5}  {what}");
+        outln!(out, "  {name:<8} {x:>5},{y:<5}  {what}");
     }
-    println!("views (views.txt):");
+    outln!(out, "views (views.txt):");
     for v in &world.views {
-        println!("  {v}");
+        outln!(out, "  {v}");
     }
     if let Some(edit) = &world.edit {
-        println!(
+        outln!(
+            out,
             "edit site (edit.txt): crater {},{} radius {} depth {}, camera {} {}",
             edit.centre_x,
             edit.centre_y,
@@ -91,7 +104,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     if let Some(png) = &args.preview {
         let area = area.unwrap_or_else(|| default_area(&world));
         write_preview(&world, area, png)?;
-        println!(
+        outln!(
+            out,
             "preview of {},{} {}x{}: {}",
             area.x,
             area.y,
@@ -100,6 +114,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             png.display()
         );
     }
+    let _ = std::io::Write::write_all(&mut std::io::stdout(), out.as_bytes());
     Ok(())
 }
 
