@@ -90,7 +90,9 @@ fn scan_avx2(pts: [Pt; 3], zs: [[u8; 3]; 3], chunk: &ChunkSamples) -> (i64, i64,
 fn scan_generic(pts: [Pt; 3], zs: [[u8; 3]; 3], chunk: &ChunkSamples) -> (i64, i64, u32) {
     let [a, b, c] = pts;
     let den = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
-    if den <= 0 {
+    // Pick's theorem: a lattice triangle of area 1/2 holds no sample but its
+    // vertices, and those interpolate exactly. Common in a fine fit.
+    if den <= 1 {
         return (0, 1, 0);
     }
     let (sx, sy) = (chunk.size_x as i32, chunk.size_y as i32);

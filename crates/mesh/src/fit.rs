@@ -24,13 +24,15 @@ pub const LODS: usize = 3;
 pub enum Cause {
     /// `low` had the largest error (ties go to `low`).
     Floor = 0,
-    /// `mid` or `high` had the largest error and the sample and its eight
-    /// neighbours in the chunk are all dual: the slab's own relief.
+    /// `mid` or `high` had the largest error, the triangle's three vertices
+    /// are dual and so are the sample and its eight neighbours in the chunk:
+    /// the slab's own relief.
     SlabInterior = 1,
-    /// `mid` or `high` had the largest error and the sample is not inside a
-    /// dual region: it is single, or dual next to a single sample. These are
-    /// the insertions a single↔dual transition forces (a single sample has
-    /// `mid = high = low`, so both step by the slab thickness across it).
+    /// `mid` or `high` had the largest error otherwise: the sample is single
+    /// or on the edge of a dual region, or the triangle straddles a
+    /// single↔dual transition (some vertices single). These are the
+    /// insertions the transition forces: a single sample has
+    /// `mid = high = low`, so both step by the slab thickness across it.
     Boundary = 2,
     /// A vertex of the 1D fit of a chunk edge.
     Border = 3,
@@ -189,9 +191,13 @@ impl ChunkFitter {
         let den = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
         let s = self.samples.at(p[0], p[1]);
         let e = errors(barycentric(a, b, c, p), den, zs, s.z);
+        let all_dual = tri
+            .v
+            .iter()
+            .all(|&v| self.samples.samples[self.vsample[v as usize] as usize].dual());
         if e[0] >= e[1] && e[0] >= e[2] {
             Cause::Floor
-        } else if s.flags & DUAL_INTERIOR != 0 {
+        } else if all_dual && s.flags & DUAL_INTERIOR != 0 {
             Cause::SlabInterior
         } else {
             Cause::Boundary
