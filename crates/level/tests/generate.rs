@@ -208,4 +208,30 @@ fn twelve_views_and_an_edit_site() {
         .filter(|(dx, dy)| level.column(edit.centre_x + dx, edit.centre_y + dy).dual)
         .count();
     assert!(slabs > 500, "only {slabs} slab texels inside the crater");
+    // ... and the edit camera sees the crater centre: nothing solid on the way.
+    let cam = &edit.camera;
+    let eye = f32::from(level.column_at(cam.x, cam.y).top()) + cam.eye;
+    let centre = (edit.centre_x as f32 + 0.5, edit.centre_y as f32 + 0.5);
+    let ground = f32::from(level.column_at(centre.0, centre.1).top()) + 4.0;
+    for i in 1..1000 {
+        let t = i as f32 / 1000.0;
+        let (x, y) = (
+            cam.x + (centre.0 - cam.x) * t,
+            cam.y + (centre.1 - cam.y) * t,
+        );
+        let z = eye + (ground - eye) * t;
+        assert!(
+            !level.is_solid(x, y, z),
+            "edit camera's view of the crater blocked at ({x}, {y}, {z})"
+        );
+    }
+    // Within the picture: the crater is less than the half field of view
+    // (400 px of an 800-px-high image at 512 px focal) above the view axis.
+    let down = ((eye - ground) / (cam.y - centre.1).abs())
+        .atan()
+        .to_degrees();
+    assert!(
+        (cam.pitch + down).abs() < (400f32 / 512.0).atan().to_degrees(),
+        "crater {down} deg down"
+    );
 }
