@@ -58,6 +58,32 @@ impl ValueNoise {
         unit(hash32(a ^ b ^ self.seed))
     }
 
+    /// Two independent noises from one set of corner hashes (high and low
+    /// 16 bits), for the price of one.
+    #[inline]
+    pub fn at2(&self, x: f32, y: f32) -> (f32, f32) {
+        let fx = x * self.inv_cell;
+        let fy = y * self.inv_cell;
+        let (ix, iy) = (fast_floor(fx), fast_floor(fy));
+        let (tx, ty) = (smooth(fx - ix as f32), smooth(fy - iy as f32));
+        let h = |dx: i32, dy: i32| {
+            let a = ((ix + dx) as u32 & self.mask_x).wrapping_mul(0x8da6_b343);
+            let b = ((iy + dy) as u32 & self.mask_y).wrapping_mul(0xd816_3841);
+            hash32(a ^ b ^ self.seed)
+        };
+        let (a, b, c, d) = (h(0, 0), h(1, 0), h(0, 1), h(1, 1));
+        let lerp = |a: f32, b: f32, c: f32, d: f32| {
+            let top = a + (b - a) * tx;
+            top + (c + (d - c) * tx - top) * ty
+        };
+        let hi = |v: u32| (v >> 16) as f32 * (1.0 / 65536.0);
+        let lo = |v: u32| (v & 0xffff) as f32 * (1.0 / 65536.0);
+        (
+            lerp(hi(a), hi(b), hi(c), hi(d)),
+            lerp(lo(a), lo(b), lo(c), lo(d)),
+        )
+    }
+
     #[inline]
     pub fn at(&self, x: f32, y: f32) -> f32 {
         let fx = x * self.inv_cell;

@@ -46,8 +46,8 @@ pub struct Terrain {
     base_fine: Fbm,
     /// Smooth fields sampled together: warp x, warp y, ramp mask, overhang mask, regions.
     fields: Coarse<5>,
-    jag_x: ValueNoise,
-    jag_y: ValueNoise,
+    /// Texel-scale wobble of the cliff edges (x and y from one noise).
+    jag: ValueNoise,
     fine: ValueNoise,
     river_wobble: ValueNoise,
     river_width: ValueNoise,
@@ -110,8 +110,7 @@ impl Terrain {
                 let [a, b, c, d] = smooth.map(|n| n.at(x, y));
                 [a, b, c, d, regions.at(x, y)]
             }),
-            jag_x: vn(3, 3),
-            jag_y: vn(4, 3),
+            jag: vn(3, 3),
             fine: vn(7, 2),
             river_wobble: vn(8, 6),
             river_width: vn(9, 7),
@@ -173,7 +172,8 @@ impl Terrain {
     #[inline]
     pub fn fine(&self, x: f32, y: f32) -> i32 {
         let v = self.fine.at(x, y);
-        let speck = (hash2(self.seed ^ 0xf1e, x as u32, y as u32) & 15 == 0) as i32;
+        let mixed = (x as u32).wrapping_mul(0x9e37_79b1) ^ (y as u32).wrapping_mul(0x85eb_ca77);
+        let speck = (hash32(mixed ^ self.seed) & 15 == 0) as i32;
         fast_round((v - 0.5) * 5.0) + speck
     }
 
@@ -195,8 +195,9 @@ impl Terrain {
 
     #[inline]
     fn base_noise_with(&self, x: f32, y: f32, f: &[f32; 5]) -> f32 {
-        let wx = x + (f[0] - 0.5) * 64.0 + (self.jag_x.at(x, y) - 0.5) * 7.0;
-        let wy = y + (f[1] - 0.5) * 64.0 + (self.jag_y.at(x, y) - 0.5) * 7.0;
+        let (jx, jy) = self.jag.at2(x, y);
+        let wx = x + (f[0] - 0.5) * 64.0 + (jx - 0.5) * 7.0;
+        let wy = y + (f[1] - 0.5) * 64.0 + (jy - 0.5) * 7.0;
         self.base_broad.at(wx, wy) + self.base_fine.at(wx, wy)
     }
 
