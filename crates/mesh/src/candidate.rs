@@ -1,47 +1,45 @@
 //! Per-triangle candidates: the worst sample of a triangle, found by scanning
 //! its rows with incremental integer barycentrics, and their priority order.
 
-use std::cmp::Ordering;
-
 use crate::predicates::Pt;
 use crate::samples::ChunkSamples;
 
-/// The worst sample of a triangle, as a heap entry.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// The worst sample of a triangle, as a 16-byte heap entry ordered by one
+/// tuple comparison: larger error first, then the lower sample index, then
+/// the lower triangle, so the insertion order is a pure function of the input.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub struct Candidate {
     /// Bits of the error `num / den` as a positive `f64`: they order like the
-    /// value, and distinct errors (denominators < 2^16) stay distinct, so
-    /// one integer comparison orders candidates exactly.
-    pub key: u64,
-    /// Sample index in the chunk grid.
-    pub sample: u32,
-    pub tri: u32,
-    /// The triangle's stamp when scanned; stale entries are skipped.
-    pub stamp: u32,
+    /// value, and distinct errors (denominators < 2^16) stay distinct.
+    key: u64,
+    /// `(!sample) << 48 | (!tri) << 32 | stamp` (16-bit sample and triangle
+    /// indices: a 128-chunk has 16 641 samples and at most 32 768 triangles).
+    aux: u64,
 }
 
 impl Candidate {
+    pub fn new(num: i64, den: i64, sample: u32, tri: u32, stamp: u32) -> Self {
+        let aux = (u64::from(!(sample as u16)) << 48)
+            | (u64::from(!(tri as u16)) << 32)
+            | u64::from(stamp);
+        Candidate {
+            key: (num as f64 / den as f64).to_bits(),
+            aux,
+        }
+    }
     /// The error in height units.
     pub fn error(&self) -> f64 {
         f64::from_bits(self.key)
     }
-}
-
-impl Ord for Candidate {
-    /// Larger error first; ties go to the lower sample index, then the lower
-    /// triangle, so the insertion order is a pure function of the input.
-    fn cmp(&self, other: &Self) -> Ordering {
-        self.key
-            .cmp(&other.key)
-            .then_with(|| other.sample.cmp(&self.sample))
-            .then_with(|| other.tri.cmp(&self.tri))
-            .then_with(|| other.stamp.cmp(&self.stamp))
+    pub fn sample(&self) -> u32 {
+        u32::from(!((self.aux >> 48) as u16))
     }
-}
-
-impl PartialOrd for Candidate {
-    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
-        Some(self.cmp(other))
+    pub fn tri(&self) -> u32 {
+        u32::from(!((self.aux >> 32) as u16))
+    }
+    /// The triangle's stamp when scanned; stale entries are skipped.
+    pub fn stamp(&self) -> u32 {
+        self.aux as u32
     }
 }
 

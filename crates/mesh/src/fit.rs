@@ -120,7 +120,7 @@ impl ChunkFitter {
         let mut epoch = 0u32;
         loop {
             while let Some(top) = self.heap.peek() {
-                if self.stamps[top.tri as usize] == top.stamp {
+                if self.stamps[top.tri() as usize] == top.stamp() {
                     break;
                 }
                 self.heap.pop();
@@ -137,13 +137,13 @@ impl ChunkFitter {
             }
             self.heap.pop();
             let stride = stride as u32;
-            let p = [(c.sample % stride) as i32, (c.sample / stride) as i32];
-            causes[self.cause(c.tri, p) as usize] += 1;
-            if self.tr.insert(c.tri, p).is_none() {
+            let p = [(c.sample() % stride) as i32, (c.sample() / stride) as i32];
+            causes[self.cause(c.tri(), p) as usize] += 1;
+            if self.tr.insert(c.tri(), p).is_none() {
                 // Cannot happen for a candidate of a live triangle; drop it.
                 continue;
             }
-            self.vsample.push(c.sample);
+            self.vsample.push(c.sample());
             epoch += 1;
             while self.stamps.len() < self.tr.tris.len() {
                 self.stamps.push(0);
@@ -172,12 +172,8 @@ impl ChunkFitter {
             .map(|v| self.samples.samples[self.vsample[v as usize] as usize].z);
         let (num, den, sample) = scan(pts, zs, &self.samples);
         if num > 0 && exceeds(num, den, tol) {
-            self.heap.push(Candidate {
-                key: (num as f64 / den as f64).to_bits(),
-                sample,
-                tri: t,
-                stamp: self.stamps[t as usize],
-            });
+            self.heap
+                .push(Candidate::new(num, den, sample, t, self.stamps[t as usize]));
         }
     }
 
