@@ -496,7 +496,10 @@ impl Layout {
     }
 
     /// The crater and its camera: like the paper's, looking north at the
-    /// crater from 158 units south (less on small maps), eye 40, pitch -30.
+    /// crater from 158 units south (less on small maps) at pitch -30, but
+    /// with the eye 90 up instead of 40: that puts the crater on the view
+    /// axis, so it is in the picture at every image size (at eye 40 its
+    /// centre is 16 degrees above the axis, outside a 200-pixel-tall image).
     pub fn edit_site(&self) -> EditSite {
         let d = self.get(Kind::Depot);
         let (cx, cy) = d.crater_local();
@@ -512,7 +515,7 @@ impl Layout {
                 x: cx as f32,
                 y: (cy + back) as f32,
                 yaw: 180.0,
-                eye: 40.0,
+                eye: 90.0,
                 under: false,
                 pitch: -30.0,
             },

@@ -22,7 +22,7 @@ pub use assets::{BEGIN_COLORS, END_COLORS, palette, world_config};
 pub use terrain::SEA;
 
 /// Bumped whenever the output for a given seed and size changes (cache key).
-pub const GENERATOR_VERSION: u32 = 3;
+pub const GENERATOR_VERSION: u32 = 4;
 /// Smallest side the generator accepts (the landmarks need the room).
 pub const MIN_SIDE: u32 = 256;
 /// Largest side (the `world.ini` reader refuses map powers above 15).
