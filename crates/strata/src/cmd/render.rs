@@ -38,18 +38,123 @@ pub struct Args {
     /// Untimed warm-up frames after the first.
     #[arg(long, default_value_t = 3)]
     pub warmup: u32,
-    /// Forward samples per ray (`ray`, `ray-compute`).
-    #[arg(long, default_value_t = 128)]
-    pub ray_steps: u32,
-    /// Turn the shared shadow map off.
-    #[arg(long)]
-    pub no_shadows: bool,
+    #[command(flatten)]
+    pub method_args: MethodArgs,
     /// Output directory (one sub-directory per view when there are several).
     #[arg(long, default_value = "render-out")]
     pub out: PathBuf,
     /// Print one JSON line per view instead of a table.
     #[arg(long)]
     pub json: bool,
+}
+
+/// Every method's setting as flags; `strata compare` (or anything else that
+/// builds a renderer) can `#[command(flatten)]` this. Defaults come from
+/// [`MethodSettings::default`], so the help text and the library agree.
+/// Values are checked here for their form (positive, in range); each method
+/// still checks its own field when it is built.
+#[derive(clap::Args, Clone, Debug)]
+pub struct MethodArgs {
+    /// `ray`, `ray-compute`: forward samples per ray.
+    #[arg(long, value_name = "N", value_parser = parse_positive,
+          default_value_t = MethodSettings::default().ray_steps)]
+    pub ray_steps: u32,
+    /// `voxel`, `voxel-compute`: occupancy voxel size in texels, X,Y,Z.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_voxel_size,
+          default_value_t = Triple(MethodSettings::default().voxel_size))]
+    pub voxel_size: Triple<u32>,
+    /// `voxel`, `voxel-compute`: traversal step budget.
+    #[arg(long, value_name = "N", value_parser = parse_positive,
+          default_value_t = MethodSettings::default().voxel_steps)]
+    pub voxel_steps: u32,
+    /// `sliced`: horizontal slices.
+    #[arg(long, value_name = "N", value_parser = parse_positive,
+          default_value_t = MethodSettings::default().slices)]
+    pub slices: u32,
+    /// `scattered`: footprint samples per unit, X,Y,Z (or one D for all three).
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_density,
+          default_value_t = Triple(MethodSettings::default().scatter_density))]
+    pub scatter_density: Triple<f32>,
+    /// `mesh`: fit quality q in [0, 1]; max error 2^(4(1-q)) height units.
+    #[arg(long, value_name = "Q", value_parser = parse_quality,
+          default_value_t = MethodSettings::default().mesh_quality)]
+    pub mesh_quality: f32,
+    /// Turn the shared shadow map off.
+    #[arg(long)]
+    pub no_shadows: bool,
+}
+
+impl MethodArgs {
+    pub fn settings(&self) -> MethodSettings {
+        MethodSettings {
+            ray_steps: self.ray_steps,
+            voxel_size: self.voxel_size.0,
+            voxel_steps: self.voxel_steps,
+            slices: self.slices,
+            scatter_density: self.scatter_density.0,
+            mesh_quality: self.mesh_quality,
+            shadows: !self.no_shadows,
+        }
+    }
+}
+
+/// Three values written `X,Y,Z` (clap shows defaults through `Display`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Triple<T>(pub [T; 3]);
+
+impl<T: std::fmt::Display> std::fmt::Display for Triple<T> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let [x, y, z] = &self.0;
+        write!(f, "{x},{y},{z}")
+    }
+}
+
+fn parse_positive(text: &str) -> Result<u32, String> {
+    match text.trim().parse::<u32>() {
+        Ok(v) if v > 0 => Ok(v),
+        Ok(_) => Err("must be at least 1 (got 0)".into()),
+        Err(_) => Err(format!("`{text}` is not a positive whole number")),
+    }
+}
+
+fn parse_positive_f32(text: &str) -> Result<f32, String> {
+    match text.trim().parse::<f32>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err(format!("`{text}` is not a positive number")),
+    }
+}
+
+fn parse_voxel_size(text: &str) -> Result<Triple<u32>, String> {
+    let parts: Vec<&str> = text.split(',').collect();
+    let [x, y, z] = parts[..] else {
+        return Err(format!(
+            "`{text}` is not X,Y,Z (three voxel sizes in texels, e.g. 4,8,2)"
+        ));
+    };
+    let size = |t| parse_positive(t).map_err(|e| format!("voxel size {e}"));
+    Ok(Triple([size(x)?, size(y)?, size(z)?]))
+}
+
+fn parse_density(text: &str) -> Result<Triple<f32>, String> {
+    let v = text
+        .split(',')
+        .map(|t| parse_positive_f32(t).map_err(|e| format!("density {e}")))
+        .collect::<Result<Vec<_>, _>>()?;
+    match v[..] {
+        [d] => Ok(Triple([d; 3])),
+        [x, y, z] => Ok(Triple([x, y, z])),
+        _ => Err(format!(
+            "`{text}` is not X,Y,Z or D (samples per unit, e.g. 4,4,4)"
+        )),
+    }
+}
+
+fn parse_quality(text: &str) -> Result<f32, String> {
+    match text.trim().parse::<f32>() {
+        Ok(q) if (0.0..=1.0).contains(&q) => Ok(q),
+        Ok(q) => Err(format!("mesh quality {q} is outside [0, 1]")),
+        Err(_) => Err(format!("`{text}` is not a number in [0, 1]")),
+    }
 }
 
 fn parse_size(text: &str) -> Result<(u32, u32), String> {
@@ -117,11 +222,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             Camera::from_view(&world.level, v, w, h).with_context(|| format!("view `{}`", v.name))
         })
         .collect::<anyhow::Result<Vec<_>>>()?;
-    let settings = MethodSettings {
-        ray_steps: args.ray_steps,
-        shadows: !args.no_shadows,
-        ..Default::default()
-    };
+    let settings = args.method_args.settings();
     let gpu = Gpu::headless()?;
     let mut renderer = Renderer::new(
         &gpu,
@@ -183,4 +284,73 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(clap::Parser)]
+    struct Cli {
+        #[command(flatten)]
+        m: MethodArgs,
+    }
+
+    fn parse(args: &[&str]) -> Result<MethodSettings, String> {
+        let argv = std::iter::once("t").chain(args.iter().copied());
+        Cli::try_parse_from(argv)
+            .map(|c| c.m.settings())
+            .map_err(|e| e.to_string())
+    }
+
+    #[test]
+    fn no_flags_give_the_library_defaults() {
+        assert_eq!(parse(&[]).unwrap(), MethodSettings::default());
+    }
+
+    #[test]
+    fn every_setting_has_a_flag() {
+        let s = parse(&[
+            "--ray-steps=64",
+            "--voxel-size=2,4,1",
+            "--voxel-steps=50",
+            "--slices=256",
+            "--scatter-density=2,3,4.5",
+            "--mesh-quality=0.75",
+            "--no-shadows",
+        ])
+        .unwrap();
+        let want = MethodSettings {
+            ray_steps: 64,
+            voxel_size: [2, 4, 1],
+            voxel_steps: 50,
+            slices: 256,
+            scatter_density: [2.0, 3.0, 4.5],
+            mesh_quality: 0.75,
+            shadows: false,
+        };
+        assert_eq!(s, want);
+        assert_eq!(
+            parse(&["--scatter-density=3"]).unwrap().scatter_density,
+            [3.0; 3]
+        );
+    }
+
+    #[test]
+    fn bad_values_are_clear_errors() {
+        for (args, needle) in [
+            (&["--slices=0"][..], "at least 1"),
+            (&["--ray-steps=many"], "not a positive whole number"),
+            (&["--voxel-size=4,8"], "X,Y,Z"),
+            (&["--voxel-size=4,0,2"], "voxel size"),
+            (&["--scatter-density=1,2"], "X,Y,Z or D"),
+            (&["--scatter-density=1,-2,3"], "not a positive number"),
+            (&["--mesh-quality=1.5"], "outside [0, 1]"),
+            (&["--mesh-quality=high"], "not a number"),
+        ] {
+            let e = parse(args).unwrap_err();
+            assert!(e.contains(needle), "{args:?}: {e}");
+        }
+    }
 }
