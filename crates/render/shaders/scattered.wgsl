@@ -101,7 +101,10 @@ fn scatter(clip: vec4<f32>, info: u32) {
 }
 
 // Walk one solid interval [bottom, top] of column `c` at `xy` from the top
-// down, 1 / Z apart, over the part that projects into the view.
+// down, 1 / Z apart, over the part that projects into the view. Every point
+// is scattered, hidden ones included: culling points behind the neighbours'
+// faces was tried and left rows of holes in near walls (1/Z apart on screen)
+// and broke cave views, which the stacked hidden points had been filling.
 fn walk(xy: vec2<f32>, c: Column, bottom: f32, top: f32) {
     let vp = globals.view_proj;
     let base = vp[0] * xy.x + vp[1] * xy.y + vp[3];

@@ -34,6 +34,12 @@ fn per_pitch(
             // The second frame is the timed one (the first compiles lazily).
             let t = r.render_frame(&camera).unwrap();
             let depth = r.read_depth().unwrap();
+            if let Ok(dir) = std::env::var("STRATA_TEST_OUT") {
+                // Pictures for a human: STRATA_TEST_OUT=/tmp/x cargo test ...
+                let path = std::path::Path::new(&dir).join(format!("scattered-{}.png", view.name));
+                std::fs::create_dir_all(&dir).unwrap();
+                strata_render::report::write_png(&path, w, h, &r.read_color().unwrap()).unwrap();
+            }
             let reference = render_reference(level, &camera);
             let m = metrics::compare(&reference, &metrics::distance_from_depth(&camera, &depth));
             eprintln!(
@@ -93,7 +99,13 @@ fn scattered_matches_the_reference() {
         &common::synthetic_views(),
         (160, 100),
     ) {
-        assert!(worst.covers_sky <= 100.0, "{pitch}: {worst:?} {mean:?}");
+        // Measured: see-through 2.3 % at horizon-b (pitch 0), 0 % looking
+        // down; covers-sky 0.9 % at `high`; p50 <= 1.9 (the cave views:
+        // points of the slab stand in for its underside).
+        let limit = if pitch == 0.0 { 4.0 } else { 0.5 };
+        assert!(worst.see_through <= limit, "{pitch}: {worst:?} {mean:?}");
+        assert!(worst.covers_sky <= 1.5, "{pitch}: {worst:?}");
+        assert!(worst.depth_p50 <= 2.5, "{pitch}: {worst:?}");
     }
 }
 
@@ -102,7 +114,134 @@ fn scattered_matches_the_reference_on_a_generated_world() {
     let Some(gpu) = common::gpu() else { return };
     let w = world();
     let colors = TerrainColors::from_world(&w);
-    for (pitch, mean, worst) in per_pitch(&gpu, &w.level, &colors, &w.views, (320, 200)) {
-        assert!(worst.covers_sky <= 100.0, "{pitch}: {worst:?} {mean:?}");
+    let pitches = per_pitch(&gpu, &w.level, &colors, &w.views, (160, 100));
+    assert_eq!(pitches.len(), 4, "three views per pitch expected");
+    for (pitch, mean, worst) in pitches {
+        // Measured at 160x100: see-through and covers-sky 0 % in all twelve
+        // views (the dense default grid; the paper's 40 % at the horizon is
+        // not reproduced); p50 <= 1.07 (river-down), p95 <= 1.0 looking down.
+        assert!(worst.see_through <= 1.0, "{pitch}: {worst:?} {mean:?}");
+        assert!(worst.covers_sky <= 0.5, "{pitch}: {worst:?}");
+        assert!(worst.depth_p50 <= 1.6, "{pitch}: {worst:?}");
+        if pitch <= -60.0 {
+            assert!(
+                mean.see_through <= 0.2 && worst.depth_p95 <= 2.0,
+                "{pitch}: {worst:?}"
+            );
+        }
     }
+}
+
+/// The world's crater, dug after the first frame: the next frame's distances
+/// against a renderer built fresh from the edited level (class mismatch %,
+/// p95, pixels the crater changed). The same protocol as the painted/sliced
+/// test in forward_sliced_painted.rs.
+fn crater_against_fresh(gpu: &Gpu, method: &str) -> (f64, f32, usize) {
+    // The fixture's camera stands 158 back and 40 up at pitch -30: the crater
+    // is about 14 degrees down, in frame only in a tall image.
+    let (w_px, h_px) = (160, 400);
+    let w = world();
+    let colors = TerrainColors::from_world(&w);
+    let settings = MethodSettings::default();
+    let site = w.edit.clone().expect("generated worlds carry an edit site");
+    let mut level = w.level.clone();
+    let camera = Camera::from_view(&level, &site.camera, w_px, h_px).unwrap();
+    let mut r = Renderer::new(gpu, &level, &colors, method, &settings, w_px, h_px).unwrap();
+    r.render_frame(&camera).unwrap();
+    let before = r.read_depth().unwrap();
+    let rects = strata_level::edit::crater(&mut level, &site);
+    r.apply_edit(&level, &rects).unwrap();
+    r.render_frame(&camera).unwrap();
+    let after = metrics::distance_from_depth(&camera, &r.read_depth().unwrap());
+    let mut fresh = Renderer::new(gpu, &level, &colors, method, &settings, w_px, h_px).unwrap();
+    fresh.render_frame(&camera).unwrap();
+    let want = metrics::distance_from_depth(&camera, &fresh.read_depth().unwrap());
+    let changed = metrics::distance_from_depth(&camera, &before)
+        .iter()
+        .zip(&after)
+        .filter(|(a, b)| a.is_finite() != b.is_finite() || (*a - *b).abs() > 1e-3)
+        .count();
+    let mismatch = after
+        .iter()
+        .zip(&want)
+        .filter(|(a, b)| a.is_finite() != b.is_finite())
+        .count();
+    let mut d: Vec<f32> = after
+        .iter()
+        .zip(&want)
+        .filter(|(a, b)| a.is_finite() && b.is_finite())
+        .map(|(a, b)| (a - b).abs())
+        .collect();
+    d.sort_by(f32::total_cmp);
+    let p95 = d.get(d.len() * 95 / 100).copied().unwrap_or(0.0);
+    let pct = 100.0 * mismatch as f64 / after.len() as f64;
+    eprintln!(
+        "{method}: crater changed {changed} pixels; vs fresh: class mismatch {pct:.4} %, p95 {p95:.4}"
+    );
+    (pct, p95, changed)
+}
+
+#[test]
+fn scattered_shows_a_crater_in_the_next_frame() {
+    let Some(gpu) = common::gpu() else { return };
+    let (pct, p95, changed) = crater_against_fresh(&gpu, "scattered");
+    assert!(
+        changed > 100,
+        "the crater left (almost) no trace: {changed}"
+    );
+    // The grid depends only on the camera, so this holds exactly.
+    assert!(pct == 0.0 && p95 == 0.0, "mismatch {pct} %, p95 {p95}");
+}
+
+#[test]
+fn memory_and_bad_settings() {
+    let Some(gpu) = common::gpu() else { return };
+    let level = Level::flat(64, 64, 10, 1).unwrap();
+    let colors = TerrainColors::test_ramps();
+    for density in [[0.0, 4.0, 4.0], [4.0, -1.0, 4.0], [4.0, 4.0, f32::NAN]] {
+        let settings = MethodSettings {
+            scatter_density: density,
+            ..Default::default()
+        };
+        let err = Renderer::new(&gpu, &level, &colors, "scattered", &settings, 8, 8)
+            .err()
+            .expect("should fail");
+        assert!(format!("{err:#}").contains("scatter density"), "{err:#}");
+    }
+    let (w, h) = (64, 40);
+    let mut r = Renderer::new(
+        &gpu,
+        &level,
+        &colors,
+        "scattered",
+        &MethodSettings::default(),
+        w,
+        h,
+    )
+    .unwrap();
+    // The screen buffer (4 bytes per pixel) plus the 192-byte grid uniform.
+    let bytes = r.retained_bytes();
+    assert_eq!(bytes.gpu, u64::from(w * h) * 4 + 192, "{bytes:?}");
+    assert_eq!(bytes.cpu, 0);
+    // Looking level over flat ground: ground below the horizon, sky above.
+    let camera = Camera::new(glam::Vec3::new(5.0, 5.0, 30.0), 45.0, 0.0, w, h).unwrap();
+    r.render_frame(&camera).unwrap();
+    let depth = r.read_depth().unwrap();
+    let (w, h) = (w as usize, h as usize);
+    assert!(depth[..w].iter().all(|&d| d == 1.0), "sky at the top");
+    assert!(
+        depth[(h - 1) * w..].iter().all(|&d| d < 1.0),
+        "ground at the bottom"
+    );
+    // Above the terrain looking up: nothing in view, all sky.
+    let up = Camera::new(
+        glam::Vec3::new(5.0, 5.0, 300.0),
+        0.0,
+        30.0,
+        w as u32,
+        h as u32,
+    )
+    .unwrap();
+    r.render_frame(&up).unwrap();
+    assert!(r.read_depth().unwrap().iter().all(|&d| d == 1.0));
 }

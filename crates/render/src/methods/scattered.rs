@@ -66,7 +66,7 @@ impl ScatterParams {
 
     fn vertex(&self, i: usize) -> [f32; 2] {
         let v = self.hull[i / 2];
-        if i % 2 == 0 {
+        if i.is_multiple_of(2) {
             [v[0], v[1]]
         } else {
             [v[2], v[3]]
@@ -256,7 +256,7 @@ pub fn create(
     let device = &shared.device;
     let limits = device.limits();
     let screen_bytes = u64::from(shared.width) * u64::from(shared.height) * 4;
-    let max_binding = u64::from(limits.max_storage_buffer_binding_size);
+    let max_binding = limits.max_storage_buffer_binding_size;
     if screen_bytes > max_binding {
         anyhow::bail!(
             "scattered: a {}x{} screen buffer needs {screen_bytes} bytes, over this adapter's \
