@@ -134,20 +134,56 @@ fn scan_small(
     let [a, b, c] = pts;
     let [x0, y0, x1, y1] = bbox;
     let stride = chunk.stride();
+    // Edge functions and interpolant numerators, stepped per sample.
+    let mut dx = [0i32; 3];
+    let mut dy = [0i32; 3];
+    for i in 0..3 {
+        let (u, v) = (pts[(i + 1) % 3], pts[(i + 2) % 3]);
+        dx[i] = u[1] - v[1];
+        dy[i] = v[0] - u[0];
+    }
+    let z = |f: usize| {
+        [
+            i32::from(zs[0][f]),
+            i32::from(zs[1][f]),
+            i32::from(zs[2][f]),
+        ]
+    };
+    let (z0, z1, z2) = (z(0), z(1), z(2));
+    let dot = |w: [i32; 3], z: [i32; 3]| w[0] * z[0] + w[1] * z[1] + w[2] * z[2];
+    let (dn0, dn1, dn2) = (dot(dx, z0), dot(dx, z1), dot(dx, z2));
+    let (en0, en1, en2) = (dot(dy, z0), dot(dy, z1), dot(dy, z2));
+    let mut w_row = barycentric(a, b, c, [x0, y0]);
+    let mut n_row = [dot(w_row, z0), dot(w_row, z1), dot(w_row, z2)];
     let mut best = (0i32, 0u32);
     for y in y0..=y1 {
+        let (mut w, mut n) = (w_row, n_row);
+        let row = y as usize * stride;
         for x in x0..=x1 {
-            let w = barycentric(a, b, c, [x, y]);
-            if (w[0] | w[1] | w[2]) < 0 {
-                continue;
+            if (w[0] | w[1] | w[2]) >= 0 {
+                let i = row + x as usize;
+                let s = chunk.samples[i].z;
+                let e = (n[0] - i32::from(s[0]) * den)
+                    .abs()
+                    .max((n[1] - i32::from(s[1]) * den).abs())
+                    .max((n[2] - i32::from(s[2]) * den).abs());
+                if e > best.0 {
+                    best = (e, i as u32);
+                }
             }
-            let i = y as usize * stride + x as usize;
-            let e = errors(w, den, zs, chunk.samples[i].z);
-            let e = e[0].max(e[1]).max(e[2]);
-            if e > best.0 {
-                best = (e, i as u32);
+            for k in 0..3 {
+                w[k] += dx[k];
             }
+            n[0] += dn0;
+            n[1] += dn1;
+            n[2] += dn2;
         }
+        for k in 0..3 {
+            w_row[k] += dy[k];
+        }
+        n_row[0] += en0;
+        n_row[1] += en1;
+        n_row[2] += en2;
     }
     best
 }

@@ -147,13 +147,11 @@ impl Emitter {
         vsample: &[u32],
         samples: &ChunkSamples,
     ) {
-        let (stride, positions) = (self.stride, self.positions);
+        let positions = self.positions;
         let sample = |v: u32| &samples.samples[vsample[v as usize] as usize];
         let slab = |t: u32| tr.tris[t as usize].v.iter().all(|&v| sample(v).dual());
-        let idx = |v: u32, kind: u16| {
-            let p = tr.pt(v);
-            encode(p[0] as u32, p[1] as u32, stride, positions, kind)
-        };
+        // A vertex's sample index is its grid position `y * stride + x`.
+        let idx = |v: u32, kind: u16| (u32::from(kind) * positions + vsample[v as usize]) as u16;
         let out = &mut self.lists[lod];
         let mut st = LodStats::default();
         for t in 0..tr.tris.len() as u32 {
