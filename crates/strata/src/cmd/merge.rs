@@ -20,7 +20,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     if flags.is_empty() {
         println!("accuracy agrees across all {} run(s)", args.runs.len());
     } else {
-        println!("{} accuracy field(s) disagree across adapters:", flags.len());
+        println!(
+            "{} accuracy field(s) disagree across adapters:",
+            flags.len()
+        );
         for d in &flags {
             let fmt = |v: Option<f64>| v.map_or("missing".to_string(), |v| format!("{v:.3}"));
             println!(
