@@ -6,7 +6,11 @@ mod world_arg;
 use clap::{Parser, Subcommand};
 
 #[derive(Parser)]
-#[command(name = "strata", version, about = "Render and measure editable multi-layer height fields (Vangers terrain)")]
+#[command(
+    name = "strata",
+    version,
+    about = "Render and measure editable multi-layer height fields (Vangers terrain)"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
