@@ -112,6 +112,7 @@ pub struct Emitter {
     /// Each LOD's triangles as keys (three indices, smallest first).
     lists: [Vec<u64>; LODS],
     blocks: [Vec<u64>; 8],
+    scratch: Vec<u64>,
     stats: [LodStats; LODS],
 }
 
@@ -197,7 +198,7 @@ impl Emitter {
     /// Lay the three LODs out by membership blocks and move them into `mesh`.
     pub fn finish(&mut self, mesh: &mut ChunkMesh, tr: &Triangulation) {
         for l in &mut self.lists {
-            l.sort_unstable();
+            radix_sort(l, &mut self.scratch);
         }
         // Blocks by LOD membership mask, from a three-way merge of the sorted
         // lists; inside a block triangles are in key order (by their lowest
@@ -247,5 +248,54 @@ impl Emitter {
         mesh.indices = indices;
         mesh.stats.lods = self.stats;
         mesh.stats.planar_vertices = tr.pts.len() as u32;
+    }
+}
+
+/// Sort 48-bit keys (three u16 indices) by LSD radix, 8 bits a pass,
+/// skipping passes whose digit is the same for every key. Faster than a
+/// comparison sort for the few thousand keys of a chunk LOD.
+fn radix_sort(keys: &mut Vec<u64>, scratch: &mut Vec<u64>) {
+    scratch.clear();
+    scratch.resize(keys.len(), 0);
+    for pass in 0..6 {
+        let shift = pass * 8;
+        let mut count = [0usize; 256];
+        for &k in keys.iter() {
+            count[((k >> shift) & 0xff) as usize] += 1;
+        }
+        if count.iter().any(|&c| c == keys.len()) {
+            continue;
+        }
+        let mut sum = 0;
+        for c in count.iter_mut() {
+            let n = *c;
+            *c = sum;
+            sum += n;
+        }
+        for &k in keys.iter() {
+            let d = ((k >> shift) & 0xff) as usize;
+            scratch[count[d]] = k;
+            count[d] += 1;
+        }
+        std::mem::swap(keys, scratch);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn radix_sort_sorts() {
+        let mut keys: Vec<u64> = (0..5000u64)
+            .map(|i| (i * 2_654_435_761) & 0xffff_ffff_ffff)
+            .collect();
+        let mut expected = keys.clone();
+        expected.sort_unstable();
+        radix_sort(&mut keys, &mut Vec::new());
+        assert_eq!(keys, expected);
+        let mut same = vec![7u64; 10];
+        radix_sort(&mut same, &mut Vec::new());
+        assert_eq!(same, vec![7u64; 10]);
     }
 }
