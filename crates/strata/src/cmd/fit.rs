@@ -67,7 +67,10 @@ struct Report {
     fit_seconds: f64,
     /// CPU time of all threads during the fit (the machine may be shared).
     fit_cpu_seconds: Option<f64>,
+    /// Finest triangles per wall second, divided by the threads.
     triangles_per_second_per_core: f64,
+    /// Finest triangles per CPU second (robust on a shared machine).
+    triangles_per_cpu_second: Option<f64>,
     gpu_bytes: u64,
     cpu_bytes: u64,
     gpu_bytes_per_triangle: f64,
@@ -175,6 +178,7 @@ fn report(
         fit_seconds: seconds,
         fit_cpu_seconds: cpu,
         triangles_per_second_per_core: tris as f64 / seconds.max(1e-9) / threads.max(1) as f64,
+        triangles_per_cpu_second: cpu.map(|c| tris as f64 / c.max(1e-9)),
         gpu_bytes: s.gpu_bytes,
         cpu_bytes: s.cpu_bytes,
         gpu_bytes_per_triangle: per_tri(s.gpu_bytes),
@@ -204,11 +208,12 @@ fn print_text(r: &Report) {
         "insertions: floor {} ({:.1}%), slab interior {} ({:.1}%), single/double boundary {} ({:.1}%), chunk border {} ({:.1}%)",
         c.floor, s[0], c.slab_interior, s[1], c.single_double_boundary, s[2], c.chunk_border, s[3]
     );
-    let cpu = r
-        .fit_cpu_seconds
-        .map_or(String::from("n/a"), |c| format!("{c:.2} s"));
+    let cpu = match (r.fit_cpu_seconds, r.triangles_per_cpu_second) {
+        (Some(c), Some(t)) => format!("CPU {c:.2} s, {t:.0} triangles per CPU second"),
+        _ => String::from("CPU n/a"),
+    };
     println!(
-        "fit: {:.2} s wall on {} threads (CPU {cpu}), {:.0} triangles/s per core",
+        "fit: {:.2} s wall on {} threads ({:.0} triangles/s per core; {cpu})",
         r.fit_seconds, r.threads, r.triangles_per_second_per_core
     );
     println!(
