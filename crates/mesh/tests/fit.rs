@@ -241,3 +241,39 @@ fn flat_level_fits_to_two_triangles_per_chunk() {
     }
     assert_eq!(mesh.stats().causes, [0; 4]);
 }
+
+#[test]
+fn small_and_odd_shaped_levels_fit_without_panics() {
+    use strata_mesh::samples::ChunkLayout;
+    for (w, h) in [(2, 1), (2, 2), (4, 4), (64, 256), (256, 32)] {
+        let l = synthetic_level(w, h, 9);
+        let layout = ChunkLayout::of(&l);
+        let mesh = LevelMesh::fit(&l, 2.0);
+        assert_eq!(mesh.chunks.len(), layout.count());
+        // Floor triangles tile each chunk at every LOD.
+        let stride = layout.size_x + 1;
+        let positions = stride * (layout.size_y + 1);
+        for c in &mesh.chunks {
+            for lod in 0..LODS {
+                let area: i64 = c
+                    .lod_triangles(lod)
+                    .map(|t| t.map(|i| strata_mesh::decode(i, stride, positions)))
+                    .filter(|v| v.iter().all(|v| v.2 == 0))
+                    .map(|v| {
+                        let [a, b, c] = v.map(|v| [v.0 as i32, v.1 as i32]);
+                        orient2d(a, b, c)
+                    })
+                    .sum();
+                assert_eq!(
+                    area,
+                    i64::from(layout.size_x * layout.size_y * 2),
+                    "{w}x{h} lod {lod}"
+                );
+            }
+        }
+    }
+    // Nonsense tolerances are clamped, not trusted.
+    let l = synthetic_level(128, 128, 2);
+    assert_eq!(LevelMesh::fit(&l, f64::NAN), LevelMesh::fit(&l, 1.0));
+    assert_eq!(LevelMesh::fit(&l, -3.0), LevelMesh::fit(&l, 1.0));
+}
