@@ -5,7 +5,9 @@
 #include "frame.wgsl"
 #include "surface.wgsl"
 
-const AMBIENT: f32 = 0.3;
+// Ambient of lit (open-sky) ground: high enough that walls facing away from
+// the sun and shadowed ground stay readable, as in the game's screenshots.
+const AMBIENT: f32 = 0.45;
 const CAVE_AMBIENT: f32 = 0.25;
 const FOG_RANGE: f32 = 50.0;
 
@@ -16,9 +18,14 @@ const SURFACE_CEILING: u32 = 2u;
 // The palette colour of terrain type `t` lit by `light` in [0, 1]: like the
 // original game, each type's begin..end range is a dark-to-light ramp and the
 // light picks the entry (so shading stays within the world's own colours).
+// The bottom of each ramp is near-black, so light 0 maps to RAMP_FLOOR of the
+// way up: every surface keeps its hue and lit ground uses the bright part.
+const RAMP_FLOOR: f32 = 0.3;
+
 fn terrain_color(t: u32, light: f32) -> vec3<f32> {
     let r = shading.ranges[t & 7u];
-    let idx = round(mix(f32(r.x), f32(r.y), clamp(light, 0.0, 1.0)));
+    let k = RAMP_FLOOR + (1.0 - RAMP_FLOOR) * clamp(light, 0.0, 1.0);
+    let idx = round(mix(f32(r.x), f32(r.y), k));
     return shading.palette[u32(clamp(idx, 0.0, 255.0))].rgb;
 }
 
