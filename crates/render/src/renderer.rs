@@ -56,7 +56,7 @@ impl Renderer {
         }
         let shared = Shared::new(&gpu.device, &gpu.queue, level, colors, width, height)?;
         let method = methods::create(method, &shared, level, settings)?;
-        let shadow = ShadowPass::new(&shared, level)?;
+        let shadow = ShadowPass::new(&shared)?;
         let timer = PassTimer::new(&gpu.device, gpu.report.timestamps);
         let stamps = gpu.report.timestamps.then(|| {
             let size = u64::from(2 * MAX_TIMED_PASSES) * 8;
@@ -234,7 +234,6 @@ impl Renderer {
         self.shared
             .terrain
             .upload(&self.shared.queue, level, rects)?;
-        self.shadow.apply_edit(&self.shared, level, rects);
         self.method.apply_edit(&self.shared, level, rects)?;
         Ok(())
     }
@@ -257,7 +256,7 @@ impl Renderer {
 
     /// Bytes of the shared resources (terrain, uniforms, shadow map, targets).
     pub fn shared_gpu_bytes(&self) -> u64 {
-        self.shared.gpu_bytes() + self.shadow.gpu_bytes()
+        self.shared.gpu_bytes()
     }
 
     /// Copy a 4-byte-per-texel target to the CPU, unpadding rows.
