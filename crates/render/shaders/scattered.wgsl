@@ -9,9 +9,11 @@
 struct ScatterParams {
     // xy: the horizontal view heading `flat`, zw: `right` (both unit, z = 0)
     axes: vec4<f32>,
-    // xy: the eye; z: warp scale h (texels); w: Z, vertical samples per unit
+    // xy: the eye; z: warp scale and clearance h (texels); w: vertical
+    // samples per pixel of projected height
     origin: vec4<f32>,
-    // x, y: asinh(a / h) of the footprint's nearest and farthest distance a
+    // x, y: asinh(a / h) of the footprint's nearest and farthest distance a;
+    // z: columns a row needs per unit of width / sqrt(a^2 + h^2)
     warp: vec4<f32>,
     // rows (along), columns (across), hull vertices, vertical samples per
     // interval at most
@@ -100,26 +102,34 @@ fn scatter(clip: vec4<f32>, info: u32) {
     atomicMin(&screen_buf[ij.y * size.x + ij.x], packed);
 }
 
-// Walk one solid interval [bottom, top] of column `c` at `xy` from the top
-// down, 1 / Z apart, over the part that projects into the view. Every point
-// is scattered, hidden ones included: culling points behind the neighbours'
-// faces was tried and left rows of holes in near walls (1/Z apart on screen)
-// and broke cave views, which the stacked hidden points had been filling.
-fn walk(xy: vec2<f32>, c: Column, bottom: f32, top: f32) {
-    let vp = globals.view_proj;
-    let base = vp[0] * xy.x + vp[1] * xy.y + vp[3];
-    let dz = vp[2];
-    let r = clip_altitudes(base, dz, bottom, top);
-    if (r.x > r.y) {
+// Pixels of screen per unit of altitude at clip point p of a vertical line
+// (clip = base + z * dz).
+fn pixel_rate(p: vec4<f32>, dz: vec4<f32>) -> f32 {
+    let d = (dz.xy * p.w - p.xy * dz.w) / (p.w * p.w);
+    return length(d * globals.screen.xy * 0.5);
+}
+
+// Walk the solid interval [lo, hi] of column `c` (already clipped to the part
+// that projects into the view) from the top down, each step 1 / Z pixels of
+// projected height at the point. Every point is scattered, hidden ones
+// included: culling points behind the neighbours' faces was tried and left
+// rows of holes in near walls and broke cave views, which the stacked hidden
+// points had been filling.
+fn walk(base: vec4<f32>, dz: vec4<f32>, c: Column, lo: f32, hi: f32) {
+    if (lo > hi) {
         return;
     }
-    let per_unit = params.origin.w;
-    let n = min(u32(floor((r.y - r.x) * per_unit)) + 1u, params.grid.w);
-    for (var k = 0u; k < n; k++) {
-        let z = r.y - f32(k) / per_unit;
+    let per_px = params.origin.w;
+    var z = hi;
+    for (var k = 0u; k < params.grid.w; k++) {
+        let p = base + dz * z;
         let kind = surface_kind(c, z, z - globals.eye.z);
         let t = select(c.upper_type, c.lower_type, kind == SURFACE_FLOOR);
-        scatter(base + dz * z, t | (kind << 3u));
+        scatter(p, t | (kind << 3u));
+        z -= 1.0 / (per_px * max(pixel_rate(p, dz), 1e-4));
+        if (z < lo) {
+            break;
+        }
     }
 }
 
@@ -140,17 +150,36 @@ fn cs_scatter(
     let col = linear % cols;
     // Rows are uniform in asinh(a / h): dense within ~h of the eye,
     // logarithmic (like perspective) beyond.
+    let h = params.origin.z;
     let s = mix(params.warp.x, params.warp.y, (f32(row) + 0.5) / f32(rows));
-    let a = params.origin.z * sinh(s);
+    let a = h * sinh(s);
     let range = row_range(a);
     if (range.x > range.y) {
         return;
     }
+    // A row that needs fewer columns keeps every 2^k-th.
+    let need = params.warp.z * (range.y - range.x) / sqrt(a * a + h * h);
+    let ratio = f32(cols) / max(need, 1e-6);
+    if (ratio >= 2.0) {
+        let k = 1u << min(u32(floor(log2(ratio))), 30u);
+        if ((col & (k - 1u)) != 0u) {
+            return;
+        }
+    }
     let across = mix(range.x, range.y, (f32(col) + 0.5) / f32(cols));
     let xy = params.origin.xy + params.axes.xy * a + params.axes.zw * across;
+    let vp = globals.view_proj;
+    let base = vp[0] * xy.x + vp[1] * xy.y + vp[3];
+    let dz = vp[2];
+    // The altitudes of the whole column that project into the view: none,
+    // and the texture is never read.
+    let r = clip_altitudes(base, dz, 0.0, 256.0);
+    if (r.x > r.y) {
+        return;
+    }
     let c = decode_column(i32(floor(xy.x)), i32(floor(xy.y)));
-    walk(xy, c, 0.0, c.low);
+    walk(base, dz, c, r.x, min(c.low, r.y));
     if (c.dual) {
-        walk(xy, c, c.mid, c.high);
+        walk(base, dz, c, max(c.mid, r.x), min(c.high, r.y));
     }
 }

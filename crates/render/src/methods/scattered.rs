@@ -5,38 +5,54 @@
 //! it (`shaders/scattered.wgsl`, `shaders/scattered_resolve.wgsl`).
 //!
 //! # The grid and `scatter_density` (X, Y, Z)
+//! Every density is in screen terms: a density `D` asks for `D * PER_PIXEL`
+//! samples per pixel ([`PER_PIXEL`] = 1/4, so the paper's default (4, 4, 4)
+//! is about one sample per pixel along each axis; a point splats one pixel, so
+//! less leaves holes and more buys little).
+//!
 //! The footprint is the part of the frustum (near to far) with altitude in
 //! 0..=256, seen from above in camera-aligned coordinates: `a` along the
 //! horizontal heading `flat`, `c` along `right`, both from the eye. Its
-//! outline is a convex polygon; the grid has
-//! - `rows = ceil(Y * (a_max - a_min))`: Y rows per texel of distance on
-//!   average, placed uniformly in `asinh(a / 32)` so they are dense within
-//!   about 32 texels of the eye and logarithmic (like perspective) beyond;
-//! - `cols = ceil(X * widest)`: every row spreads the same columns over its
-//!   own width, so X per texel across at the polygon's widest row (the far
-//!   end at the horizon) and denser nearer, about uniform on screen;
-//! - Z samples per unit of altitude: each sample walks `[0, low]` and, for a
-//!   dual column, `[mid, high]` from the top down, 1/Z apart, over the part of
-//!   each interval that projects into the view (clipped analytically).
+//! outline is a convex polygon. A column at `(a, c)` is at least
+//! `dist(a) = sqrt(a² + h²)` from the eye, where `h` is the eye's clearance
+//! above the highest column top in the footprint's bounding box (from a
+//! per-tile maximum of the level, at least the near distance), so one pixel
+//! there is at most `dist(a) / focal` wide (times `1 / cos` of the image's
+//! widest half angle, for the corners). The grid has
+//! - rows uniform in `asinh(a / h)`, `Y * PER_PIXEL` per pixel of that size:
+//!   row spacing `dist(a) / (focal * Y/4)` (logarithmic far away, like
+//!   perspective; fine only where the terrain comes close to the eye);
+//! - `cols` columns per row spread over the row's own width, enough for
+//!   `X * PER_PIXEL` per pixel in the row that needs the most; a row that
+//!   needs fewer keeps only every `2^k`-th of them (the rest return at once);
+//! - vertical samples walked from the top of `[0, low]` and, for a dual column,
+//!   `[mid, high]` down, over the part of each interval that projects into the
+//!   view (clipped analytically), each step `1 / (Z * PER_PIXEL)` pixels of
+//!   projected height at that point (the exact screen-space rate of the
+//!   column's vertical line there), so a far column takes a few points and a
+//!   column seen end-on (looking down) one.
 //!
-//! A grid over [`MAX_GRID`] samples is scaled down (both axes alike) with a
-//! warning; Z is capped at [`MAX_Z`]. Results depend only on the grid and the
-//! terrain texture, never on earlier frames, so an edit shows in the next frame.
+//! A sample whose whole column (0..=256) is off screen returns before reading
+//! the texture. A grid over [`MAX_GRID`] samples is scaled down (both axes
+//! alike) with a warning; each density is capped at [`MAX_DENSITY`]. Results
+//! depend only on the grid and the terrain, never on earlier frames, so an
+//! edit shows in the next frame (the tile maximum is rebuilt on edits).
 
-use super::forward::{Z_MAX, frustum_slab_points};
+use super::forward::{footprint_bounds, frustum_slab_points};
 use super::{Frame, Method, MethodSettings, RetainedBytes};
 use crate::frame::{COLOR_FORMAT, DEPTH_FORMAT, Shared, sky_clear, uniform_layout_entry};
 use bytemuck::{Pod, Zeroable};
 use strata_camera::Camera;
 use strata_level::Level;
 
-/// Most grid samples per frame (16 M: a 1280x800 horizon view at the default
-/// density needs about 14 M).
+/// Most grid samples per frame (16 M).
 pub const MAX_GRID: u64 = 1 << 24;
-/// Most vertical samples per unit of altitude.
-pub const MAX_Z: f32 = 64.0;
-/// The warp's scale: rows are uniform in `asinh(a / WARP_SCALE)`.
-pub const WARP_SCALE: f32 = 32.0;
+/// Most of each density (X, Y, Z).
+pub const MAX_DENSITY: f32 = 64.0;
+/// Samples per pixel that a density of 1 asks for: (4, 4, 4) is one per pixel.
+pub const PER_PIXEL: f32 = 0.25;
+/// Side of the tiles of the level's column-top maximum, texels.
+const TILE: u32 = 16;
 /// Most footprint polygon vertices the uniform holds (a frustum cut by a slab
 /// has at most 12).
 const MAX_HULL: usize = 16;
@@ -49,9 +65,10 @@ const WORKGROUP: u32 = 64;
 pub struct ScatterParams {
     /// `flat` xy, `right` xy.
     pub axes: [f32; 4],
-    /// Eye xy, warp scale, Z.
+    /// Eye xy, the warp scale and clearance `h`, vertical samples per pixel.
     pub origin: [f32; 4],
-    /// asinh(a / h) of the nearest and farthest row bound; unused; unused.
+    /// asinh(a / h) of the nearest and farthest row bound; columns a row needs
+    /// per unit of `width / dist`; unused.
     pub warp: [f32; 4],
     /// Rows, columns, polygon vertices, vertical samples per interval at most.
     pub grid: [u32; 4],
@@ -125,19 +142,112 @@ fn convex_hull(mut pts: Vec<[f32; 2]>) -> Vec<[f32; 2]> {
     hull
 }
 
-/// The grid for `camera` at `density` (X, Y, Z; Z already within
-/// [`MAX_Z`]), at most `max_samples` samples; the second value is a warning
-/// when the grid had to be scaled down.
+/// The highest column top of each `TILE`² tile of a level, to bound how close
+/// the terrain of a footprint can come to the eye.
+#[derive(Clone, Debug)]
+pub struct TopMax {
+    size: [u32; 2],
+    tiles: [u32; 2],
+    tile: [u32; 2],
+    top: Vec<u8>,
+}
+
+impl TopMax {
+    pub fn new(level: &Level) -> Self {
+        let size = [level.width(), level.height()];
+        let tile = [TILE.min(size[0]), TILE.min(size[1])];
+        let tiles = [size[0].div_ceil(tile[0]), size[1].div_ceil(tile[1])];
+        let mut m = TopMax {
+            size,
+            tiles,
+            tile,
+            top: vec![0u8; (tiles[0] * tiles[1]) as usize],
+        };
+        for ty in 0..tiles[1] {
+            for tx in 0..tiles[0] {
+                m.refresh(level, tx, ty);
+            }
+        }
+        m
+    }
+
+    /// Recompute tile (tx, ty) from the level.
+    fn refresh(&mut self, level: &Level, tx: u32, ty: u32) {
+        let mut t = 0u8;
+        for y in ty * self.tile[1]..((ty + 1) * self.tile[1]).min(self.size[1]) {
+            for x in tx * self.tile[0]..((tx + 1) * self.tile[0]).min(self.size[0]) {
+                t = t.max(level.column(i64::from(x), i64::from(y)).top());
+            }
+        }
+        self.top[(ty * self.tiles[0] + tx) as usize] = t;
+    }
+
+    /// Recompute the tiles `rect` touches (a pair's partner included).
+    pub fn update(&mut self, level: &Level, rect: &strata_level::DirtyRect) {
+        if rect.width == 0 || rect.height == 0 {
+            return;
+        }
+        let x0 = rect.x.saturating_sub(1).min(self.size[0] - 1) / self.tile[0];
+        let x1 = (rect.x + rect.width).min(self.size[0] - 1) / self.tile[0];
+        let y0 = rect.y.min(self.size[1] - 1) / self.tile[1];
+        let y1 = (rect.y + rect.height - 1).min(self.size[1] - 1) / self.tile[1];
+        for ty in y0..=y1 {
+            for tx in x0..=x1 {
+                self.refresh(level, tx, ty);
+            }
+        }
+    }
+
+    /// The highest column top with texel (x, y) in `lo..=hi` (wrapping).
+    pub fn max_in(&self, lo: [f32; 2], hi: [f32; 2]) -> f32 {
+        let range = |k: usize| {
+            let t = i64::from(self.tile[k]);
+            let (a, b) = (
+                (lo[k].floor() as i64).div_euclid(t),
+                (hi[k].floor() as i64).div_euclid(t),
+            );
+            let n = i64::from(self.tiles[k]);
+            let w = i64::from(self.size[k]);
+            if b - a + 1 >= n {
+                (0..n).collect::<Vec<_>>()
+            } else {
+                (a..=b).map(|i| (i * t).rem_euclid(w) / t).collect()
+            }
+        };
+        let (xs, ys) = (range(0), range(1));
+        let mut m = 0u8;
+        for &ty in &ys {
+            for &tx in &xs {
+                m = m.max(self.top[(ty * i64::from(self.tiles[0]) + tx) as usize]);
+            }
+        }
+        f32::from(m)
+    }
+}
+
+/// The grid for `camera` at `density` (X, Y, Z, each already within
+/// [`MAX_DENSITY`]) when no column top in the footprint is above `max_top`, at
+/// most `max_samples` samples; the second value is a warning when the grid
+/// had to be scaled down.
 pub fn scatter_grid(
     camera: &Camera,
     density: [f32; 3],
+    max_top: f32,
     max_samples: u64,
 ) -> (ScatterParams, Option<String>) {
     let b = camera.basis();
     let e = camera.position;
+    let [xp, yp, zp] = density.map(|d| d * PER_PIXEL);
+    // Clearance: a column top lies at least this far below the eye.
+    let h = (e.z - max_top).max(camera.near);
+    let (w, ht) = (camera.width as f32, camera.height as f32);
+    let f = camera.focal_px;
+    // Pixels per unit of length per unit of distance, at the image's corners
+    // (the smallest pixels in angle are the ones that need the samples).
+    let per_px = f * f / (f * f + 0.25 * (w * w + ht * ht)).sqrt();
     let mut params = ScatterParams {
         axes: [b.flat.x, b.flat.y, b.right.x, b.right.y],
-        origin: [e.x, e.y, WARP_SCALE, density[2]],
+        origin: [e.x, e.y, h, zp],
         ..Default::default()
     };
     let pts = frustum_slab_points(camera, camera.far)
@@ -167,14 +277,24 @@ pub fn scatter_grid(
     params.grid[2] = hull.len() as u32;
     let a0 = hull.iter().map(|p| p[0]).fold(f32::INFINITY, f32::min);
     let a1 = hull.iter().map(|p| p[0]).fold(f32::NEG_INFINITY, f32::max);
-    // A convex polygon's width is concave in a: widest at a vertex.
+    let (s0, s1) = ((a0 / h).asinh(), (a1 / h).asinh());
+    let col_scale = xp * per_px;
+    // Columns the neediest row wants: width / dist at the hull's vertices and
+    // at 64 rows between (uniform in the warp, like the rows).
+    let need = |a: f32| {
+        params.row_range(a).map_or(0.0, |(lo, hi)| {
+            col_scale * (hi - lo) / (a * a + h * h).sqrt()
+        })
+    };
     let widest = hull
         .iter()
-        .filter_map(|p| params.row_range(p[0]))
-        .map(|(lo, hi)| hi - lo)
+        .map(|p| need(p[0]))
+        .chain((0..=64).map(|i| need(h * (s0 + (s1 - s0) * i as f32 / 64.0).sinh())))
         .fold(0.0f32, f32::max);
-    let mut rows = (f64::from(density[1]) * f64::from(a1 - a0)).ceil().max(1.0);
-    let mut cols = (f64::from(density[0]) * f64::from(widest)).ceil().max(1.0);
+    let mut rows = (f64::from(yp * per_px) * f64::from(s1 - s0))
+        .ceil()
+        .max(1.0);
+    let mut cols = f64::from(widest).ceil().max(1.0);
     let mut warning = None;
     if rows * cols > max_samples as f64 {
         let k = (max_samples as f64 / (rows * cols)).sqrt();
@@ -187,34 +307,34 @@ pub fn scatter_grid(
     }
     params.grid[0] = rows as u32;
     params.grid[1] = cols as u32;
-    params.grid[3] = (Z_MAX * density[2]).ceil() as u32 + 1;
-    params.warp = [
-        (a0 / WARP_SCALE).asinh(),
-        (a1 / WARP_SCALE).asinh(),
-        0.0,
-        0.0,
-    ];
+    // A clipped interval projects inside the image: at most about w + h
+    // pixels long.
+    params.grid[3] = (zp * (w + ht)).ceil() as u32 + 2;
+    params.warp = [s0, s1, col_scale, 0.0];
     (params, warning)
 }
 
-/// The density, checked: each positive and finite, Z capped at [`MAX_Z`].
+/// The density, checked: each positive and finite, each capped at
+/// [`MAX_DENSITY`].
 pub fn checked_density(density: [f32; 3]) -> anyhow::Result<[f32; 3]> {
     if density.iter().any(|d| !d.is_finite() || *d <= 0.0) {
         anyhow::bail!("scatter density must be positive and finite in X, Y and Z, got {density:?}");
     }
     let mut d = density;
-    if d[2] > MAX_Z {
-        eprintln!(
-            "warning: scattered: {} vertical samples per unit is over {MAX_Z}; using {MAX_Z}",
-            d[2]
-        );
-        d[2] = MAX_Z;
+    for v in &mut d {
+        if *v > MAX_DENSITY {
+            eprintln!(
+                "warning: scattered: a density of {v} is over {MAX_DENSITY}; using {MAX_DENSITY}"
+            );
+            *v = MAX_DENSITY;
+        }
     }
     Ok(d)
 }
 
 pub struct Scattered {
     density: [f32; 3],
+    tops: TopMax,
     params: wgpu::Buffer,
     screen_bytes: u64,
     clear: wgpu::ComputePipeline,
@@ -249,7 +369,7 @@ fn storage_entry(
 
 pub fn create(
     shared: &Shared,
-    _level: &Level,
+    level: &Level,
     settings: &MethodSettings,
 ) -> anyhow::Result<Box<dyn Method>> {
     let density = checked_density(settings.scatter_density)?;
@@ -351,6 +471,7 @@ pub fn create(
     let dispatchable = u64::from(max_groups) * u64::from(max_groups) * u64::from(WORKGROUP);
     Ok(Box::new(Scattered {
         density,
+        tops: TopMax::new(level),
         params,
         screen_bytes,
         clear,
@@ -370,8 +491,27 @@ impl Method for Scattered {
         "scattered"
     }
 
+    fn apply_edit(
+        &mut self,
+        _shared: &Shared,
+        level: &Level,
+        rects: &[strata_level::DirtyRect],
+    ) -> anyhow::Result<()> {
+        if level.width() != self.tops.size[0] || level.height() != self.tops.size[1] {
+            self.tops = TopMax::new(level);
+        }
+        for r in rects {
+            self.tops.update(level, r);
+        }
+        Ok(())
+    }
+
     fn prepare(&mut self, shared: &Shared, camera: &Camera) -> anyhow::Result<()> {
-        let (params, warning) = scatter_grid(camera, self.density, self.max_samples);
+        let max_top = match footprint_bounds(camera, camera.far) {
+            Some((lo, hi)) => self.tops.max_in(lo, hi),
+            None => 0.0,
+        };
+        let (params, warning) = scatter_grid(camera, self.density, max_top, self.max_samples);
         if let Some(w) = warning
             && !self.warned
         {
