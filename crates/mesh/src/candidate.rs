@@ -121,7 +121,7 @@ const NUDGE: f64 = 1.0 / 4096.0;
 
 /// Bounding boxes up to this many samples are scanned directly (most
 /// triangles of a fine fit): no span arithmetic, no per-row setup.
-const SMALL: i32 = 24;
+const SMALL: i32 = 48;
 
 #[inline(always)]
 fn scan_small(

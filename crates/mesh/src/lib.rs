@@ -4,9 +4,31 @@
 //! shared borders, compact emission for the GPU, and an exact local refit.
 //! No GPU dependency.
 //!
+//! # Using it (the drawing side)
+//! - [`LevelMesh::fit`]`(level, tolerance_for_quality(q))` gives one
+//!   [`ChunkMesh`] per chunk (row-major, [`ChunkLayout`]); chunk `(cx, cy)`
+//!   covers samples `[cx*128, cx*128+128]` in x and y, its last row and
+//!   column wrapping into the next chunk (the map is a torus).
+//! - A chunk is only a `u16` index list ([`ChunkMesh::indices`]); there is
+//!   no vertex buffer. An index is `kind * 129² + y * 129 + x`
+//!   ([`encode`]/[`decode`]; kind 0 floor `low`, 1 slab top `high`, 2 cave
+//!   ceiling `mid`). The vertex shader decodes the terrain column at chunk
+//!   origin + (x, y) from the terrain the GPU already holds (wrapping),
+//!   exactly as `Level::column` does, and takes the altitude and terrain
+//!   type of that kind (floor: lower type; top/ceiling: upper type).
+//! - LOD `k` (max error `τ·2^k`, 0 the finest) is the triangle list in up
+//!   to two index ranges [`ChunkMesh::lods`]`[k]` (LODs share triangles).
+//!   Any LOD may sit next to any LOD: borders are identical, no skirts.
+//! - Triangles are counter-clockwise seen from outside the solid in the
+//!   (x, y, z-up) grid frame (see [`emit`] for walls and chunk borders).
+//!   Normals are flat, from the triangle.
+//! - After an edit: [`LevelMesh::refit`]`(level, dirty)` refits the touched
+//!   chunks from scratch and returns the indices of those that changed;
+//!   their index lists change length, so replace those ranges.
+//!
 //! Module map: [`predicates`] (exact integer geometry), [`triangulation`]
 //! (arena + flips), [`candidate`] (worst-sample scan), [`border`] (1D edge
-//! fit), [`fit`] (one chunk, all LODs), [`emit`] (vertex/index data),
+//! fit), [`fit`] (one chunk, all LODs), [`emit`] (index data),
 //! [`level_mesh`] (whole level, refit, statistics), [`synthetic`] (fixture).
 
 pub mod border;
