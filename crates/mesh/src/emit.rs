@@ -73,6 +73,11 @@ impl LodStats {
 pub struct ChunkStats {
     /// Vertices of the finest planar triangulation (4 corners + insertions).
     pub planar_vertices: u32,
+    /// Length of the index list (kept when the list itself is released).
+    pub indices: u32,
+    /// FNV-1a of the index list and LOD ranges: how a refit tells whether a
+    /// chunk changed once its CPU copy is gone.
+    pub hash: u64,
     pub lods: [LodStats; LODS],
     /// Insertions by [`crate::fit::Cause`].
     pub causes: [u32; crate::fit::CAUSES],
@@ -245,6 +250,8 @@ impl Emitter {
             [(range[0b110].0, range[0b011].1), range[0b010]],
             [(range[0b100].0, range[0b111].1), (0, 0)],
         ];
+        mesh.stats.indices = indices.len() as u32;
+        mesh.stats.hash = content_hash(&indices, &mesh.lods);
         mesh.indices = indices;
         mesh.stats.lods = self.stats;
         mesh.stats.planar_vertices = tr.pts.len() as u32;
@@ -298,4 +305,20 @@ mod tests {
         radix_sort(&mut same, &mut Vec::new());
         assert_eq!(same, vec![7u64; 10]);
     }
+}
+
+/// FNV-1a over the indices and the LOD ranges.
+pub fn content_hash(indices: &[u16], lods: &[[(u32, u32); 2]; LODS]) -> u64 {
+    let mut h = 0xcbf2_9ce4_8422_2325u64;
+    let mut eat = |v: u64| {
+        h ^= v;
+        h = h.wrapping_mul(0x0000_0100_0000_01b3);
+    };
+    for &i in indices {
+        eat(u64::from(i));
+    }
+    for r in lods.iter().flatten() {
+        eat(u64::from(r.0) << 32 | u64::from(r.1));
+    }
+    h
 }

@@ -72,12 +72,25 @@ impl LevelMesh {
             .collect();
         let mut changed = Vec::new();
         for (i, mesh) in fresh {
-            if self.chunks[i] != mesh {
+            // Compared by content hash, so this works after
+            // [`release_indices`](Self::release_indices) too.
+            let old = &self.chunks[i].stats;
+            if (old.hash, old.indices) != (mesh.stats.hash, mesh.stats.indices) {
                 self.chunks[i] = mesh;
                 changed.push(i);
             }
         }
         changed
+    }
+
+    /// Drop the CPU copies of the index lists (after uploading them); the
+    /// statistics and content hashes stay, and a later refit fills in the
+    /// chunks it changes. The fit itself needs nothing else: it refits from
+    /// the level.
+    pub fn release_indices(&mut self) {
+        for c in &mut self.chunks {
+            c.indices = Vec::new();
+        }
     }
 
     /// Level-wide totals.
@@ -89,7 +102,7 @@ impl LevelMesh {
         };
         for c in &self.chunks {
             s.planar_vertices += u64::from(c.stats.planar_vertices);
-            s.gpu_indices += c.indices.len() as u64;
+            s.gpu_indices += u64::from(c.stats.indices);
             for k in 0..LODS {
                 let l = &c.stats.lods[k];
                 s.lods[k].planar += u64::from(l.planar);
@@ -109,7 +122,9 @@ impl LevelMesh {
 }
 
 /// What the renderer keeps on the CPU per chunk once the buffers are
-/// uploaded: where its data lives and its LOD ranges. The fit itself is not retained — a refit
+/// uploaded: where its data lives and its LOD ranges. (`cpu_bytes` counts
+/// this table; a [`LevelMesh`] after [`LevelMesh::release_indices`] keeps
+/// about the same: per-chunk statistics and hashes.) The fit itself is not retained — a refit
 /// recomputes the dirty chunks from the level.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct ChunkRange {

@@ -190,6 +190,14 @@ fn refit_after_edit_equals_fresh_fit() {
             .filter(|&i| fresh.chunks[i] != before.chunks[i])
             .collect();
         assert_eq!(changed, differ);
+        // The same answer once the CPU copies are released after upload.
+        let mut released = before.clone();
+        released.release_indices();
+        assert_eq!(released.refit(&l, &dirty), differ);
+        assert_eq!(released.stats(), fresh.stats());
+        for &i in &differ {
+            assert_eq!(released.chunks[i], fresh.chunks[i]);
+        }
     }
 }
 
