@@ -288,6 +288,22 @@ fn radix_sort(keys: &mut Vec<u64>, scratch: &mut Vec<u64>) {
     }
 }
 
+/// FNV-1a over the indices and the LOD ranges.
+pub fn content_hash(indices: &[u16], lods: &[[(u32, u32); 2]; LODS]) -> u64 {
+    let mut h = 0xcbf2_9ce4_8422_2325u64;
+    let mut eat = |v: u64| {
+        h ^= v;
+        h = h.wrapping_mul(0x0000_0100_0000_01b3);
+    };
+    for &i in indices {
+        eat(u64::from(i));
+    }
+    for r in lods.iter().flatten() {
+        eat(u64::from(r.0) << 32 | u64::from(r.1));
+    }
+    h
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -305,20 +321,4 @@ mod tests {
         radix_sort(&mut same, &mut Vec::new());
         assert_eq!(same, vec![7u64; 10]);
     }
-}
-
-/// FNV-1a over the indices and the LOD ranges.
-pub fn content_hash(indices: &[u16], lods: &[[(u32, u32); 2]; LODS]) -> u64 {
-    let mut h = 0xcbf2_9ce4_8422_2325u64;
-    let mut eat = |v: u64| {
-        h ^= v;
-        h = h.wrapping_mul(0x0000_0100_0000_01b3);
-    };
-    for &i in indices {
-        eat(u64::from(i));
-    }
-    for r in lods.iter().flatten() {
-        eat(u64::from(r.0) << 32 | u64::from(r.1));
-    }
-    h
 }
