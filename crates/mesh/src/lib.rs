@@ -24,7 +24,9 @@
 //!   Normals are flat, from the triangle.
 //! - After an edit: [`LevelMesh::refit`]`(level, dirty)` refits the touched
 //!   chunks from scratch and returns the indices of those that changed;
-//!   their index lists change length, so replace those ranges.
+//!   their index lists change length, so replace those ranges. Call
+//!   [`LevelMesh::release_indices`] after each upload: nothing else needs
+//!   the CPU copies (the refit works from the level and per-chunk hashes).
 //!
 //! Module map: [`predicates`] (exact integer geometry), [`triangulation`]
 //! (arena + flips), [`candidate`] (worst-sample scan), [`border`] (1D edge
