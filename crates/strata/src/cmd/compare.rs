@@ -17,6 +17,7 @@ pub struct Args {
     #[arg(long, value_name = "DIR", default_value = "out/compare")]
     pub out: PathBuf,
     /// The CPU-machine smoke: 320x200, 4 timed frames (explicit --size/--frames win).
+    /// The default on a CPU rasteriser such as lavapipe.
     #[arg(long)]
     pub quick: bool,
     /// Comma-separated methods, each `name` or `name:setting`
@@ -63,12 +64,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             })
             .collect(),
     };
-    let (width, height) = match (&args.size, args.quick) {
-        (Some(s), _) => parse_size(s)?,
-        (None, true) => (320, 200),
-        (None, false) => (1280, 800),
-    };
-    let frames = args.frames.unwrap_or(if args.quick { 4 } else { 40 });
+    // Parse an explicit size now, so a bad one fails before any GPU work.
+    let explicit_size = args.size.as_deref().map(parse_size).transpose()?;
     let file_views = match &args.views {
         Some(path) => {
             let text = std::fs::read_to_string(path)
@@ -89,23 +86,6 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     } else {
         EditMode::Auto
     };
-    let options = Options {
-        out: args.out.clone(),
-        methods,
-        views,
-        width,
-        height,
-        frames,
-        min_warmup: args.warmup.unwrap_or(if args.quick { 1 } else { 3 }),
-        shadows: !args.no_shadows,
-        edits,
-        cache_dir: args
-            .cache
-            .clone()
-            .unwrap_or_else(strata_reference::default_cache_dir),
-    };
-    let plan = Plan::new(world, options)?;
-
     let gpu = strata_render::Gpu::headless()?;
     eprintln!(
         "adapter: {} ({}, {}); timestamps {}",
@@ -118,6 +98,36 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             "off: CPU submit-and-wait"
         }
     );
+    // The publication configuration takes hours on a CPU rasteriser
+    // (lavapipe/llvmpipe), so there the default is the quick smoke; an
+    // explicit --size or --frames still wins.
+    let quick = args.quick
+        || (gpu.report.device_type == "Cpu" && args.size.is_none() && args.frames.is_none());
+    if quick && !args.quick {
+        eprintln!(
+            "note: {} is a CPU rasteriser: running the --quick smoke (320x200, 4 frames); \
+             pass --size/--frames for the full configuration",
+            gpu.report.name
+        );
+    }
+    let (width, height) = explicit_size.unwrap_or(if quick { (320, 200) } else { (1280, 800) });
+    let frames = args.frames.unwrap_or(if quick { 4 } else { 40 });
+    let options = Options {
+        out: args.out.clone(),
+        methods,
+        views,
+        width,
+        height,
+        frames,
+        min_warmup: args.warmup.unwrap_or(if quick { 1 } else { 3 }),
+        shadows: !args.no_shadows,
+        edits,
+        cache_dir: args
+            .cache
+            .clone()
+            .unwrap_or_else(strata_reference::default_cache_dir),
+    };
+    let plan = Plan::new(world, options)?;
     let (json, report) = plan.run(&gpu)?;
     println!("wrote {}", json.display());
     println!("wrote {}", report.display());
