@@ -19,8 +19,8 @@
 //!
 //! [`mesh_pool`]: super::mesh_pool
 
+use super::common::{begin_pass, forward_pipeline};
 use super::mesh_pool::{Fitted, IndexPool, Slot};
-use super::painted::{begin_pass, forward_pipeline};
 use super::{Frame, Method, MethodSettings, RetainedBytes};
 use crate::frame::{Shared, uniform_layout_entry};
 use glam::{Vec3, Vec4};

@@ -30,6 +30,7 @@
 //!   methods that only read the texture need not override it.
 //! - `retained_bytes` counts only what the method allocates beyond [`Shared`].
 
+mod common;
 pub mod forward;
 pub mod mesh;
 mod mesh_pool;

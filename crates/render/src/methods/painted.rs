@@ -4,9 +4,10 @@
 //! index (the sample, front to back: `forward.wgsl`) and the vertex index
 //! (bar, face, corner), and emits only the faces that face the eye.
 
+use super::common::{begin_pass, forward_pipeline, uniform_binding};
 use super::forward::{self, FootprintParams};
 use super::{Frame, Method, MethodSettings, RetainedBytes};
-use crate::frame::{COLOR_FORMAT, DEPTH_FORMAT, Shared, sky_clear, uniform_layout_entry};
+use crate::frame::Shared;
 use strata_camera::Camera;
 use strata_level::Level;
 
@@ -21,104 +22,14 @@ pub struct Painted {
     samples: u32,
 }
 
-/// A depth-tested, write-enabled state with the shared `Less` test.
-pub(crate) fn depth_state() -> wgpu::DepthStencilState {
-    wgpu::DepthStencilState {
-        format: DEPTH_FORMAT,
-        depth_write_enabled: Some(true),
-        depth_compare: Some(wgpu::CompareFunction::Less),
-        stencil: Default::default(),
-        bias: Default::default(),
-    }
-}
-
 /// The footprint uniform, its bind group layout and group.
 pub(crate) fn footprint_binding(
     shared: &Shared,
     label: &str,
 ) -> (wgpu::Buffer, wgpu::BindGroupLayout, wgpu::BindGroup) {
     let params = shared.uniform_buffer(label, bytemuck::bytes_of(&FootprintParams::default()));
-    let device = &shared.device;
-    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some(label),
-        entries: &[uniform_layout_entry(0)],
-    });
-    let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some(label),
-        layout: &layout,
-        entries: &[wgpu::BindGroupEntry {
-            binding: 0,
-            resource: params.as_entire_binding(),
-        }],
-    });
+    let (layout, group) = uniform_binding(shared, label, &params);
     (params, layout, group)
-}
-
-/// A pipeline of one vertex and one fragment entry of `shader`, no vertex
-/// buffers, no culling (the vertex shader picks the faces itself).
-pub(crate) fn forward_pipeline(
-    shared: &Shared,
-    label: &str,
-    shader: &str,
-    layout: &wgpu::BindGroupLayout,
-    entries: (&str, &str),
-) -> anyhow::Result<wgpu::RenderPipeline> {
-    let module = shared.shader(shader)?;
-    Ok(shared
-        .device
-        .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some(label),
-            layout: Some(&shared.pipeline_layout(label, &[layout])),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some(entries.0),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: wgpu::PrimitiveState::default(),
-            depth_stencil: Some(depth_state()),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some(entries.1),
-                compilation_options: Default::default(),
-                targets: &[Some(COLOR_FORMAT.into())],
-            }),
-            multiview_mask: None,
-            cache: None,
-        }))
-}
-
-/// Begin the method's one pass, clearing colour to sky and depth to far.
-pub(crate) fn begin_pass<'e>(
-    shared: &Shared,
-    frame: &Frame<'_>,
-    encoder: &'e mut wgpu::CommandEncoder,
-    label: &str,
-) -> wgpu::RenderPass<'e> {
-    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-        label: Some(label),
-        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-            view: &shared.color_view,
-            depth_slice: None,
-            resolve_target: None,
-            ops: wgpu::Operations {
-                load: wgpu::LoadOp::Clear(sky_clear()),
-                store: wgpu::StoreOp::Store,
-            },
-        })],
-        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-            view: &shared.depth_view,
-            depth_ops: Some(wgpu::Operations {
-                load: wgpu::LoadOp::Clear(1.0),
-                store: wgpu::StoreOp::Store,
-            }),
-            stencil_ops: None,
-        }),
-        timestamp_writes: frame.timer.render(label),
-        occlusion_query_set: None,
-        multiview_mask: None,
-    })
 }
 
 pub fn create(

@@ -1,8 +1,9 @@
 //! `ray`: the paper's height-field march (§3.1) as one full-screen fragment
 //! pass over the shared WGSL core (`ray_core.wgsl::ray_pixel`).
 
+use super::common::{draw_fullscreen, fullscreen_pipeline, uniform_binding};
 use super::{Frame, Method, MethodSettings, RetainedBytes};
-use crate::frame::{COLOR_FORMAT, DEPTH_FORMAT, Shared, sky_clear, uniform_layout_entry};
+use crate::frame::Shared;
 use strata_level::Level;
 
 pub struct Ray {
@@ -30,47 +31,14 @@ pub fn create(
     settings: &MethodSettings,
 ) -> anyhow::Result<Box<dyn Method>> {
     let params = ray_params(shared, settings)?;
-    let device = &shared.device;
-    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("ray"),
-        entries: &[uniform_layout_entry(0)],
-    });
-    let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("ray"),
-        layout: &layout,
-        entries: &[wgpu::BindGroupEntry {
-            binding: 0,
-            resource: params.as_entire_binding(),
-        }],
-    });
-    let module = shared.shader("ray.wgsl")?;
-    let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some("ray"),
-        layout: Some(&shared.pipeline_layout("ray", &[&layout])),
-        vertex: wgpu::VertexState {
-            module: &module,
-            entry_point: Some("vs_fullscreen"),
-            compilation_options: Default::default(),
-            buffers: &[],
-        },
-        primitive: wgpu::PrimitiveState::default(),
-        depth_stencil: Some(wgpu::DepthStencilState {
-            format: DEPTH_FORMAT,
-            depth_write_enabled: Some(true),
-            depth_compare: Some(wgpu::CompareFunction::Always),
-            stencil: Default::default(),
-            bias: Default::default(),
-        }),
-        multisample: Default::default(),
-        fragment: Some(wgpu::FragmentState {
-            module: &module,
-            entry_point: Some("fs_ray"),
-            compilation_options: Default::default(),
-            targets: &[Some(COLOR_FORMAT.into())],
-        }),
-        multiview_mask: None,
-        cache: None,
-    });
+    let (layout, group) = uniform_binding(shared, "ray", &params);
+    let pipeline = fullscreen_pipeline(
+        shared,
+        "ray",
+        "ray.wgsl",
+        &shared.pipeline_layout("ray", &[&layout]),
+        "fs_ray",
+    )?;
     Ok(Box::new(Ray { pipeline, group }))
 }
 
@@ -80,33 +48,7 @@ impl Method for Ray {
     }
 
     fn record(&self, shared: &Shared, frame: &Frame<'_>, encoder: &mut wgpu::CommandEncoder) {
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("ray"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &shared.color_view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(sky_clear()),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &shared.depth_view,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
-                    store: wgpu::StoreOp::Store,
-                }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: frame.timer.render("ray"),
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &shared.frame_group, &[]);
-        pass.set_bind_group(1, &self.group, &[]);
-        pass.draw(0..3, 0..1);
+        draw_fullscreen(shared, frame, encoder, "ray", &self.pipeline, &self.group);
     }
 
     fn retained_bytes(&self) -> RetainedBytes {

@@ -5,19 +5,16 @@
 //! texture can be neither a storage texture nor a copy destination from a
 //! colour one). Both passes are timed; the copy is part of the method's cost.
 
+use super::common::{DepthCopy, compute_pipeline, dispatch_per_pixel};
 use super::ray::ray_params;
 use super::{Frame, Method, MethodSettings, RetainedBytes};
-use crate::frame::{
-    DEPTH_FORMAT, Shared, storage_texture_entry, texture_entry, uniform_layout_entry,
-};
+use crate::frame::{Shared, uniform_layout_entry};
 use strata_level::Level;
 
 pub struct RayCompute {
     march: wgpu::ComputePipeline,
     march_group: wgpu::BindGroup,
-    blit: wgpu::RenderPipeline,
-    blit_group: wgpu::BindGroup,
-    depth_bytes: u64,
+    depth: DepthCopy,
 }
 
 pub fn create(
@@ -26,32 +23,16 @@ pub fn create(
     settings: &MethodSettings,
 ) -> anyhow::Result<Box<dyn Method>> {
     let params = ray_params(shared, settings)?;
-    let device = &shared.device;
-    let depth = device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("ray-compute depth"),
-        size: wgpu::Extent3d {
-            width: shared.width,
-            height: shared.height,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: wgpu::TextureFormat::R32Float,
-        usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING,
-        view_formats: &[],
-    });
-    let depth_view = depth.create_view(&Default::default());
-
-    let march_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("ray-compute"),
-        entries: &[
-            uniform_layout_entry(0),
-            storage_texture_entry(1, crate::frame::COLOR_FORMAT),
-            storage_texture_entry(2, wgpu::TextureFormat::R32Float),
-        ],
-    });
-    let march_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+    let depth = DepthCopy::new(shared, "ray-compute", "depth blit")?;
+    let [color_entry, depth_entry] = DepthCopy::layout_entries(1);
+    let march_layout = shared
+        .device
+        .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("ray-compute"),
+            entries: &[uniform_layout_entry(0), color_entry, depth_entry],
+        });
+    let [color_binding, depth_binding] = depth.bindings(shared, 1);
+    let march_group = shared.device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("ray-compute"),
         layout: &march_layout,
         entries: &[
@@ -59,82 +40,21 @@ pub fn create(
                 binding: 0,
                 resource: params.as_entire_binding(),
             },
-            wgpu::BindGroupEntry {
-                binding: 1,
-                resource: wgpu::BindingResource::TextureView(&shared.color_view),
-            },
-            wgpu::BindGroupEntry {
-                binding: 2,
-                resource: wgpu::BindingResource::TextureView(&depth_view),
-            },
+            color_binding,
+            depth_binding,
         ],
     });
-    let module = shared.shader("ray_compute.wgsl")?;
-    let march = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-        label: Some("ray-compute"),
-        layout: Some(&shared.pipeline_layout("ray-compute", &[&march_layout])),
-        module: &module,
-        entry_point: Some("cs_ray"),
-        compilation_options: Default::default(),
-        cache: None,
-    });
-
-    let blit_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("depth blit"),
-        entries: &[texture_entry(
-            0,
-            wgpu::TextureSampleType::Float { filterable: false },
-            wgpu::TextureViewDimension::D2,
-        )],
-    });
-    let blit_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("depth blit"),
-        layout: &blit_layout,
-        entries: &[wgpu::BindGroupEntry {
-            binding: 0,
-            resource: wgpu::BindingResource::TextureView(&depth_view),
-        }],
-    });
-    let blit_module = shared.shader("depth_blit.wgsl")?;
-    let blit = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some("depth blit"),
-        layout: Some(
-            &device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some("depth blit"),
-                bind_group_layouts: &[Some(&blit_layout)],
-                immediate_size: 0,
-            }),
-        ),
-        vertex: wgpu::VertexState {
-            module: &blit_module,
-            entry_point: Some("vs_fullscreen"),
-            compilation_options: Default::default(),
-            buffers: &[],
-        },
-        primitive: wgpu::PrimitiveState::default(),
-        depth_stencil: Some(wgpu::DepthStencilState {
-            format: DEPTH_FORMAT,
-            depth_write_enabled: Some(true),
-            depth_compare: Some(wgpu::CompareFunction::Always),
-            stencil: Default::default(),
-            bias: Default::default(),
-        }),
-        multisample: Default::default(),
-        fragment: Some(wgpu::FragmentState {
-            module: &blit_module,
-            entry_point: Some("fs_depth_blit"),
-            compilation_options: Default::default(),
-            targets: &[],
-        }),
-        multiview_mask: None,
-        cache: None,
-    });
+    let march = compute_pipeline(
+        shared,
+        "ray-compute",
+        "ray_compute.wgsl",
+        &shared.pipeline_layout("ray-compute", &[&march_layout]),
+        "cs_ray",
+    )?;
     Ok(Box::new(RayCompute {
         march,
         march_group,
-        blit,
-        blit_group,
-        depth_bytes: u64::from(shared.width) * u64::from(shared.height) * 4,
+        depth,
     }))
 }
 
@@ -144,40 +64,22 @@ impl Method for RayCompute {
     }
 
     fn record(&self, shared: &Shared, frame: &Frame<'_>, encoder: &mut wgpu::CommandEncoder) {
-        {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("ray-compute march"),
-                timestamp_writes: frame.timer.compute("ray-compute march"),
-            });
-            pass.set_pipeline(&self.march);
-            pass.set_bind_group(0, &shared.frame_group, &[]);
-            pass.set_bind_group(1, &self.march_group, &[]);
-            pass.dispatch_workgroups(shared.width.div_ceil(8), shared.height.div_ceil(8), 1);
-        }
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("ray-compute depth copy"),
-            color_attachments: &[],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &shared.depth_view,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
-                    store: wgpu::StoreOp::Store,
-                }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: frame.timer.render("ray-compute depth copy"),
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        pass.set_pipeline(&self.blit);
-        pass.set_bind_group(0, &self.blit_group, &[]);
-        pass.draw(0..3, 0..1);
+        dispatch_per_pixel(
+            shared,
+            frame,
+            encoder,
+            "ray-compute march",
+            &self.march,
+            &self.march_group,
+        );
+        self.depth
+            .record(shared, frame, encoder, "ray-compute depth copy");
     }
 
     fn retained_bytes(&self) -> RetainedBytes {
         // The R32Float depth image plus the 16-byte uniform.
         RetainedBytes {
-            gpu: self.depth_bytes + 16,
+            gpu: self.depth.bytes() + 16,
             cpu: 0,
         }
     }

@@ -3,8 +3,9 @@
 //! point where the decoded column is solid (floor column or slab) and
 //! discards it elsewhere. Depth-tested like any geometry.
 
+use super::common::{begin_pass, forward_pipeline};
 use super::forward::{self, Z_MAX};
-use super::painted::{begin_pass, footprint_binding, forward_pipeline};
+use super::painted::footprint_binding;
 use super::{Frame, Method, MethodSettings, RetainedBytes};
 use crate::frame::Shared;
 use strata_camera::Camera;

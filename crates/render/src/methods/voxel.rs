@@ -7,11 +7,12 @@
 //!
 //! [`voxel_build`]: super::voxel_build
 
+use super::common::{
+    DepthCopy, compute_pipeline, dispatch_per_pixel, draw_fullscreen, fullscreen_pipeline,
+};
 use super::voxel_build::{DEFAULT_BUDGET_TEXELS, GpuPyramid};
 use super::{Frame, Method, MethodSettings, RetainedBytes};
-use crate::frame::{
-    COLOR_FORMAT, DEPTH_FORMAT, Shared, sky_clear, storage_texture_entry, texture_entry,
-};
+use crate::frame::Shared;
 use strata_camera::Camera;
 use strata_level::{DirtyRect, Level};
 use strata_occupancy::VoxelSize;
@@ -33,9 +34,7 @@ struct VoxelParams {
 /// The compute variant's extra parts: its depth image and the copy into the shared depth.
 struct ComputeParts {
     march: wgpu::ComputePipeline,
-    blit: wgpu::RenderPipeline,
-    blit_group: wgpu::BindGroup,
-    depth_bytes: u64,
+    depth: DepthCopy,
 }
 
 pub struct Voxel {
@@ -151,26 +150,11 @@ pub fn build(
             count: None,
         },
     ];
-    let depth = compute.then(|| {
-        let t = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("voxel-compute depth"),
-            size: wgpu::Extent3d {
-                width: shared.width,
-                height: shared.height,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::R32Float,
-            usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING,
-            view_formats: &[],
-        });
-        t.create_view(&Default::default())
-    });
+    let depth = compute
+        .then(|| DepthCopy::new(shared, "voxel-compute", "voxel depth blit"))
+        .transpose()?;
     if compute {
-        entries.push(storage_texture_entry(2, COLOR_FORMAT));
-        entries.push(storage_texture_entry(3, wgpu::TextureFormat::R32Float));
+        entries.extend(DepthCopy::layout_entries(2));
     }
     let group_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("voxel"),
@@ -187,14 +171,7 @@ pub fn build(
         },
     ];
     if let Some(depth) = &depth {
-        bindings.push(wgpu::BindGroupEntry {
-            binding: 2,
-            resource: wgpu::BindingResource::TextureView(&shared.color_view),
-        });
-        bindings.push(wgpu::BindGroupEntry {
-            binding: 3,
-            resource: wgpu::BindingResource::TextureView(depth),
-        });
+        bindings.extend(depth.bindings(shared, 2));
     }
     let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("voxel"),
@@ -205,48 +182,19 @@ pub fn build(
 
     let (fragment, compute_parts, name) = match depth {
         None => {
-            let module = shared.shader("voxel.wgsl")?;
-            let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some("voxel"),
-                layout: Some(&pipeline_layout),
-                vertex: wgpu::VertexState {
-                    module: &module,
-                    entry_point: Some("vs_fullscreen"),
-                    compilation_options: Default::default(),
-                    buffers: &[],
-                },
-                primitive: wgpu::PrimitiveState::default(),
-                depth_stencil: Some(depth_always()),
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &module,
-                    entry_point: Some("fs_voxel"),
-                    compilation_options: Default::default(),
-                    targets: &[Some(COLOR_FORMAT.into())],
-                }),
-                multiview_mask: None,
-                cache: None,
-            });
+            let pipeline =
+                fullscreen_pipeline(shared, "voxel", "voxel.wgsl", &pipeline_layout, "fs_voxel")?;
             (Some(pipeline), None, "voxel")
         }
-        Some(depth_view) => {
-            let module = shared.shader("voxel_compute.wgsl")?;
-            let march = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some("voxel-compute"),
-                layout: Some(&pipeline_layout),
-                module: &module,
-                entry_point: Some("cs_voxel"),
-                compilation_options: Default::default(),
-                cache: None,
-            });
-            let (blit, blit_group) = depth_blit(shared, &depth_view)?;
-            let parts = ComputeParts {
-                march,
-                blit,
-                blit_group,
-                depth_bytes: u64::from(shared.width) * u64::from(shared.height) * 4,
-            };
-            (None, Some(parts), "voxel-compute")
+        Some(depth) => {
+            let march = compute_pipeline(
+                shared,
+                "voxel-compute",
+                "voxel_compute.wgsl",
+                &pipeline_layout,
+                "cs_voxel",
+            )?;
+            (None, Some(ComputeParts { march, depth }), "voxel-compute")
         }
     };
     Ok(Voxel {
@@ -256,69 +204,6 @@ pub fn build(
         fragment,
         compute: compute_parts,
     })
-}
-
-fn depth_always() -> wgpu::DepthStencilState {
-    wgpu::DepthStencilState {
-        format: DEPTH_FORMAT,
-        depth_write_enabled: Some(true),
-        depth_compare: Some(wgpu::CompareFunction::Always),
-        stencil: Default::default(),
-        bias: Default::default(),
-    }
-}
-
-/// The core's `fs_depth_blit` over this method's R32Float depth image.
-fn depth_blit(
-    shared: &Shared,
-    depth: &wgpu::TextureView,
-) -> anyhow::Result<(wgpu::RenderPipeline, wgpu::BindGroup)> {
-    let device = &shared.device;
-    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("voxel depth blit"),
-        entries: &[texture_entry(
-            0,
-            wgpu::TextureSampleType::Float { filterable: false },
-            wgpu::TextureViewDimension::D2,
-        )],
-    });
-    let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("voxel depth blit"),
-        layout: &layout,
-        entries: &[wgpu::BindGroupEntry {
-            binding: 0,
-            resource: wgpu::BindingResource::TextureView(depth),
-        }],
-    });
-    let module = shared.shader("depth_blit.wgsl")?;
-    let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some("voxel depth blit"),
-        layout: Some(
-            &device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some("voxel depth blit"),
-                bind_group_layouts: &[Some(&layout)],
-                immediate_size: 0,
-            }),
-        ),
-        vertex: wgpu::VertexState {
-            module: &module,
-            entry_point: Some("vs_fullscreen"),
-            compilation_options: Default::default(),
-            buffers: &[],
-        },
-        primitive: wgpu::PrimitiveState::default(),
-        depth_stencil: Some(depth_always()),
-        multisample: Default::default(),
-        fragment: Some(wgpu::FragmentState {
-            module: &module,
-            entry_point: Some("fs_depth_blit"),
-            compilation_options: Default::default(),
-            targets: &[],
-        }),
-        multiview_mask: None,
-        cache: None,
-    });
-    Ok((pipeline, group))
 }
 
 impl Method for Voxel {
@@ -346,71 +231,30 @@ impl Method for Voxel {
                 .record(encoder, frame.timer.compute("voxel occupancy update"));
         }
         if let Some(pipeline) = &self.fragment {
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("voxel"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &shared.color_view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(sky_clear()),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                depth_stencil_attachment: Some(depth_attachment(shared)),
-                timestamp_writes: frame.timer.render("voxel"),
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            pass.set_pipeline(pipeline);
-            pass.set_bind_group(0, &shared.frame_group, &[]);
-            pass.set_bind_group(1, &self.group, &[]);
-            pass.draw(0..3, 0..1);
+            draw_fullscreen(shared, frame, encoder, "voxel", pipeline, &self.group);
             return;
         }
         let Some(c) = &self.compute else { return };
-        {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("voxel-compute march"),
-                timestamp_writes: frame.timer.compute("voxel-compute march"),
-            });
-            pass.set_pipeline(&c.march);
-            pass.set_bind_group(0, &shared.frame_group, &[]);
-            pass.set_bind_group(1, &self.group, &[]);
-            pass.dispatch_workgroups(shared.width.div_ceil(8), shared.height.div_ceil(8), 1);
-        }
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("voxel-compute depth copy"),
-            color_attachments: &[],
-            depth_stencil_attachment: Some(depth_attachment(shared)),
-            timestamp_writes: frame.timer.render("voxel-compute depth copy"),
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        pass.set_pipeline(&c.blit);
-        pass.set_bind_group(0, &c.blit_group, &[]);
-        pass.draw(0..3, 0..1);
+        dispatch_per_pixel(
+            shared,
+            frame,
+            encoder,
+            "voxel-compute march",
+            &c.march,
+            &self.group,
+        );
+        c.depth
+            .record(shared, frame, encoder, "voxel-compute depth copy");
     }
 
     fn retained_bytes(&self) -> RetainedBytes {
         let params = std::mem::size_of::<VoxelParams>() as u64;
-        let depth = self.compute.as_ref().map_or(0, |c| c.depth_bytes);
+        let depth = self.compute.as_ref().map_or(0, |c| c.depth.bytes());
         RetainedBytes {
             gpu: self.pyramid.gpu_bytes() + params + depth,
             // The layout table and the edit queue: a few hundred bytes.
             cpu: 0,
         }
-    }
-}
-
-fn depth_attachment(shared: &Shared) -> wgpu::RenderPassDepthStencilAttachment<'_> {
-    wgpu::RenderPassDepthStencilAttachment {
-        view: &shared.depth_view,
-        depth_ops: Some(wgpu::Operations {
-            load: wgpu::LoadOp::Clear(1.0),
-            store: wgpu::StoreOp::Store,
-        }),
-        stencil_ops: None,
     }
 }
 

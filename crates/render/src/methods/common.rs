@@ -1,0 +1,341 @@
+//! Pipeline and pass plumbing that several methods share, so that the
+//! method files hold only what makes each method different.
+
+use super::Frame;
+use crate::frame::{
+    COLOR_FORMAT, DEPTH_FORMAT, Shared, sky_clear, storage_texture_entry, texture_entry,
+    uniform_layout_entry,
+};
+
+/// Depth written with `compare`: `Less` for geometry, `Always` for passes
+/// that compute every pixel's depth themselves (marches, the depth copy).
+fn depth_write(compare: wgpu::CompareFunction) -> wgpu::DepthStencilState {
+    wgpu::DepthStencilState {
+        format: DEPTH_FORMAT,
+        depth_write_enabled: Some(true),
+        depth_compare: Some(compare),
+        stencil: Default::default(),
+        bias: Default::default(),
+    }
+}
+
+/// A render pipeline of one vertex and one fragment entry of `module`, no
+/// vertex buffers (the vertex shaders derive their corners from indices) and
+/// no culling (the forward shaders pick the faces themselves).
+fn render_pipeline(
+    shared: &Shared,
+    label: &str,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+    entries: (&str, &str),
+    depth_compare: wgpu::CompareFunction,
+    targets: &[Option<wgpu::ColorTargetState>],
+) -> wgpu::RenderPipeline {
+    shared
+        .device
+        .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some(label),
+            layout: Some(layout),
+            vertex: wgpu::VertexState {
+                module,
+                entry_point: Some(entries.0),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: wgpu::PrimitiveState::default(),
+            depth_stencil: Some(depth_write(depth_compare)),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module,
+                entry_point: Some(entries.1),
+                compilation_options: Default::default(),
+                targets,
+            }),
+            multiview_mask: None,
+            cache: None,
+        })
+}
+
+/// A depth-tested (`Less`) geometry pipeline over the frame group and
+/// `layout`, drawing into the shared colour and depth targets.
+pub(crate) fn forward_pipeline(
+    shared: &Shared,
+    label: &str,
+    shader: &str,
+    layout: &wgpu::BindGroupLayout,
+    entries: (&str, &str),
+) -> anyhow::Result<wgpu::RenderPipeline> {
+    let module = shared.shader(shader)?;
+    Ok(render_pipeline(
+        shared,
+        label,
+        &shared.pipeline_layout(label, &[layout]),
+        &module,
+        entries,
+        wgpu::CompareFunction::Less,
+        &[Some(COLOR_FORMAT.into())],
+    ))
+}
+
+/// A full-screen march: one triangle (`vs_fullscreen`) whose fragment entry
+/// writes every pixel's colour and depth (`Always`: the march decides).
+pub(crate) fn fullscreen_pipeline(
+    shared: &Shared,
+    label: &str,
+    shader: &str,
+    layout: &wgpu::PipelineLayout,
+    fragment_entry: &str,
+) -> anyhow::Result<wgpu::RenderPipeline> {
+    let module = shared.shader(shader)?;
+    Ok(render_pipeline(
+        shared,
+        label,
+        layout,
+        &module,
+        ("vs_fullscreen", fragment_entry),
+        wgpu::CompareFunction::Always,
+        &[Some(COLOR_FORMAT.into())],
+    ))
+}
+
+/// A compute pipeline of one entry of `shader`.
+pub(crate) fn compute_pipeline(
+    shared: &Shared,
+    label: &str,
+    shader: &str,
+    layout: &wgpu::PipelineLayout,
+    entry: &str,
+) -> anyhow::Result<wgpu::ComputePipeline> {
+    let module = shared.shader(shader)?;
+    Ok(shared
+        .device
+        .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(label),
+            layout: Some(layout),
+            module: &module,
+            entry_point: Some(entry),
+            compilation_options: Default::default(),
+            cache: None,
+        }))
+}
+
+/// A bind group of one uniform buffer at binding 0, with its layout.
+pub(crate) fn uniform_binding(
+    shared: &Shared,
+    label: &str,
+    buffer: &wgpu::Buffer,
+) -> (wgpu::BindGroupLayout, wgpu::BindGroup) {
+    let device = &shared.device;
+    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some(label),
+        entries: &[uniform_layout_entry(0)],
+    });
+    let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout: &layout,
+        entries: &[wgpu::BindGroupEntry {
+            binding: 0,
+            resource: buffer.as_entire_binding(),
+        }],
+    });
+    (layout, group)
+}
+
+/// The shared depth target, cleared to far (the contract: the first pass
+/// that touches it clears it).
+fn depth_attachment(shared: &Shared) -> wgpu::RenderPassDepthStencilAttachment<'_> {
+    wgpu::RenderPassDepthStencilAttachment {
+        view: &shared.depth_view,
+        depth_ops: Some(wgpu::Operations {
+            load: wgpu::LoadOp::Clear(1.0),
+            store: wgpu::StoreOp::Store,
+        }),
+        stencil_ops: None,
+    }
+}
+
+/// Begin a timed pass over the shared targets, clearing colour to sky and
+/// depth to far.
+pub(crate) fn begin_pass<'e>(
+    shared: &Shared,
+    frame: &Frame<'_>,
+    encoder: &'e mut wgpu::CommandEncoder,
+    label: &str,
+) -> wgpu::RenderPass<'e> {
+    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view: &shared.color_view,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations {
+                load: wgpu::LoadOp::Clear(sky_clear()),
+                store: wgpu::StoreOp::Store,
+            },
+        })],
+        depth_stencil_attachment: Some(depth_attachment(shared)),
+        timestamp_writes: frame.timer.render(label),
+        occlusion_query_set: None,
+        multiview_mask: None,
+    })
+}
+
+/// Record a full-screen march: one pass, frame group 0, `group` at 1.
+pub(crate) fn draw_fullscreen(
+    shared: &Shared,
+    frame: &Frame<'_>,
+    encoder: &mut wgpu::CommandEncoder,
+    label: &str,
+    pipeline: &wgpu::RenderPipeline,
+    group: &wgpu::BindGroup,
+) {
+    let mut pass = begin_pass(shared, frame, encoder, label);
+    pass.set_pipeline(pipeline);
+    pass.set_bind_group(0, &shared.frame_group, &[]);
+    pass.set_bind_group(1, group, &[]);
+    pass.draw(0..3, 0..1);
+}
+
+/// Record a compute march, one invocation per pixel in 8×8 workgroups
+/// (the compute shaders' `@workgroup_size`): frame group 0, `group` at 1.
+pub(crate) fn dispatch_per_pixel(
+    shared: &Shared,
+    frame: &Frame<'_>,
+    encoder: &mut wgpu::CommandEncoder,
+    label: &str,
+    pipeline: &wgpu::ComputePipeline,
+    group: &wgpu::BindGroup,
+) {
+    let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+        label: Some(label),
+        timestamp_writes: frame.timer.compute(label),
+    });
+    pass.set_pipeline(pipeline);
+    pass.set_bind_group(0, &shared.frame_group, &[]);
+    pass.set_bind_group(1, group, &[]);
+    pass.dispatch_workgroups(shared.width.div_ceil(8), shared.height.div_ceil(8), 1);
+}
+
+/// The compute variants' depth path: a compute shader cannot write a depth
+/// texture, so the march writes an R32Float storage image and a full-screen
+/// pass (`depth_blit.wgsl`) copies it into the shared depth target.
+pub(crate) struct DepthCopy {
+    view: wgpu::TextureView,
+    bytes: u64,
+    blit: wgpu::RenderPipeline,
+    blit_group: wgpu::BindGroup,
+}
+
+impl DepthCopy {
+    /// The storage image (labelled `"{method} depth"`) and its copy pass
+    /// (labelled `blit_label`).
+    pub(crate) fn new(shared: &Shared, method: &str, blit_label: &str) -> anyhow::Result<Self> {
+        let device = &shared.device;
+        let depth = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(&format!("{method} depth")),
+            size: wgpu::Extent3d {
+                width: shared.width,
+                height: shared.height,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::R32Float,
+            usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        });
+        let view = depth.create_view(&Default::default());
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some(blit_label),
+            entries: &[texture_entry(
+                0,
+                wgpu::TextureSampleType::Float { filterable: false },
+                wgpu::TextureViewDimension::D2,
+            )],
+        });
+        let blit_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some(blit_label),
+            layout: &layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::TextureView(&view),
+            }],
+        });
+        let module = shared.shader("depth_blit.wgsl")?;
+        // No frame group: the copy reads only the storage image.
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(blit_label),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let blit = render_pipeline(
+            shared,
+            blit_label,
+            &pipeline_layout,
+            &module,
+            ("vs_fullscreen", "fs_depth_blit"),
+            wgpu::CompareFunction::Always,
+            &[],
+        );
+        Ok(Self {
+            view,
+            bytes: u64::from(shared.width) * u64::from(shared.height) * 4,
+            blit,
+            blit_group,
+        })
+    }
+
+    /// Layout entries for the march's outputs: the shared colour target at
+    /// `first`, this depth image at `first + 1` (both storage textures).
+    pub(crate) fn layout_entries(first: u32) -> [wgpu::BindGroupLayoutEntry; 2] {
+        [
+            storage_texture_entry(first, COLOR_FORMAT),
+            storage_texture_entry(first + 1, wgpu::TextureFormat::R32Float),
+        ]
+    }
+
+    /// The bindings matching [`DepthCopy::layout_entries`].
+    pub(crate) fn bindings<'a>(
+        &'a self,
+        shared: &'a Shared,
+        first: u32,
+    ) -> [wgpu::BindGroupEntry<'a>; 2] {
+        [
+            wgpu::BindGroupEntry {
+                binding: first,
+                resource: wgpu::BindingResource::TextureView(&shared.color_view),
+            },
+            wgpu::BindGroupEntry {
+                binding: first + 1,
+                resource: wgpu::BindingResource::TextureView(&self.view),
+            },
+        ]
+    }
+
+    /// Bytes of the storage image (4 per pixel).
+    pub(crate) fn bytes(&self) -> u64 {
+        self.bytes
+    }
+
+    /// Record the timed copy pass (it clears depth first, per the contract).
+    pub(crate) fn record(
+        &self,
+        shared: &Shared,
+        frame: &Frame<'_>,
+        encoder: &mut wgpu::CommandEncoder,
+        label: &str,
+    ) {
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some(label),
+            color_attachments: &[],
+            depth_stencil_attachment: Some(depth_attachment(shared)),
+            timestamp_writes: frame.timer.render(label),
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&self.blit);
+        pass.set_bind_group(0, &self.blit_group, &[]);
+        pass.draw(0..3, 0..1);
+    }
+}
