@@ -5,7 +5,6 @@
 mod common;
 
 use strata_camera::Camera;
-use strata_level::generate::{GenerateParams, generate};
 use strata_level::{Level, ViewSpec};
 use strata_reference::metrics::{self, Metrics};
 use strata_reference::render_reference;
@@ -33,32 +32,15 @@ fn worst_over(
         let reference = render_reference(level, &camera);
         let m = metrics::compare(&reference, &metrics::distance_from_depth(&camera, &depth));
         eprintln!(
-            "{method:8} {:12} pitch {:4}: see-through {:.3} % covers-sky {:.3} % coherence {:.3} % p50 {:.3} p95 {:.3} gpu {:?} ms",
+            "{method:8} {:12} pitch {:4}: {} gpu {:?} ms",
             view.name,
             view.pitch,
-            m.see_through,
-            m.covers_sky,
-            m.coherence,
-            m.depth_p50,
-            m.depth_p95,
+            common::metrics_line(&m),
             t.gpu_ms.map(|g| (g * 10.0).round() / 10.0),
         );
-        worst.see_through = worst.see_through.max(m.see_through);
-        worst.covers_sky = worst.covers_sky.max(m.covers_sky);
-        worst.coherence = worst.coherence.max(m.coherence);
-        worst.depth_p50 = worst.depth_p50.max(m.depth_p50);
-        worst.depth_p95 = worst.depth_p95.max(m.depth_p95);
+        common::fold_worst(&mut worst, &m);
     }
     worst
-}
-
-fn world() -> strata_level::World {
-    generate(&GenerateParams {
-        seed: 6,
-        width: 512,
-        height: 1024,
-    })
-    .expect("generated world")
 }
 
 #[test]
@@ -83,7 +65,7 @@ fn painted_matches_the_reference() {
 #[test]
 fn painted_matches_the_reference_on_a_generated_world() {
     let Some(gpu) = common::gpu() else { return };
-    let w = world();
+    let w = common::generated_world();
     let m = worst_over(
         &gpu,
         &w.level,
@@ -97,62 +79,20 @@ fn painted_matches_the_reference_on_a_generated_world() {
     assert!(m.depth_p95 <= 0.1, "{m:?}");
 }
 
-/// The world's crater, dug after the first frame: the next frame's distances
-/// against a renderer built fresh from the edited level (class mismatch %, p95).
-fn crater_against_fresh(gpu: &Gpu, method: &str) -> (f64, f32, usize) {
-    // The fixture's camera stands 158 back and 40 up at pitch -30: the crater
-    // is about 14 degrees down, in frame only in a tall image.
-    let (w_px, h_px) = (160, 400);
-    let w = world();
-    let colors = TerrainColors::from_world(&w);
-    let settings = MethodSettings::default();
-    let site = w.edit.clone().expect("generated worlds carry an edit site");
-    let mut level = w.level.clone();
-    let camera = Camera::from_view(&level, &site.camera, w_px, h_px).unwrap();
-    let mut r = Renderer::new(gpu, &level, &colors, method, &settings, w_px, h_px).unwrap();
-    r.render_frame(&camera).unwrap();
-    let before = r.read_depth().unwrap();
-    let rects = strata_level::edit::crater(&mut level, &site);
-    r.apply_edit(&level, &rects).unwrap();
-    r.render_frame(&camera).unwrap();
-    let after = metrics::distance_from_depth(&camera, &r.read_depth().unwrap());
-    let mut fresh = Renderer::new(gpu, &level, &colors, method, &settings, w_px, h_px).unwrap();
-    fresh.render_frame(&camera).unwrap();
-    let want = metrics::distance_from_depth(&camera, &fresh.read_depth().unwrap());
-    let changed = metrics::distance_from_depth(&camera, &before)
-        .iter()
-        .zip(&after)
-        .filter(|(a, b)| a.is_finite() != b.is_finite() || (*a - *b).abs() > 1e-3)
-        .count();
-    let mismatch = after
-        .iter()
-        .zip(&want)
-        .filter(|(a, b)| a.is_finite() != b.is_finite())
-        .count();
-    let mut d: Vec<f32> = after
-        .iter()
-        .zip(&want)
-        .filter(|(a, b)| a.is_finite() && b.is_finite())
-        .map(|(a, b)| (a - b).abs())
-        .collect();
-    d.sort_by(f32::total_cmp);
-    let p95 = d.get(d.len() * 95 / 100).copied().unwrap_or(0.0);
-    let pct = 100.0 * mismatch as f64 / after.len() as f64;
-    eprintln!(
-        "{method}: crater changed {changed} pixels; vs fresh: class mismatch {pct:.4} %, p95 {p95:.4}"
-    );
-    (pct, p95, changed)
-}
-
-#[test]
-fn painted_shows_a_crater_in_the_next_frame() {
+/// The crater's first frame equals a fresh renderer's, and shows.
+fn assert_crater_like_fresh(method: &str) {
     let Some(gpu) = common::gpu() else { return };
-    let (pct, p95, changed) = crater_against_fresh(&gpu, "painted");
+    let (pct, p95, changed) = common::crater_against_fresh(&gpu, method);
     assert!(
         changed > 100,
         "the crater left (almost) no trace: {changed}"
     );
     assert!(pct <= 0.01 && p95 <= 0.1, "mismatch {pct} %, p95 {p95}");
+}
+
+#[test]
+fn painted_shows_a_crater_in_the_next_frame() {
+    assert_crater_like_fresh("painted");
 }
 
 #[test]
@@ -179,7 +119,7 @@ fn sliced_matches_the_reference() {
 #[test]
 fn sliced_matches_the_reference_on_a_generated_world() {
     let Some(gpu) = common::gpu() else { return };
-    let w = world();
+    let w = common::generated_world();
     let m = worst_over(
         &gpu,
         &w.level,
@@ -197,13 +137,7 @@ fn sliced_matches_the_reference_on_a_generated_world() {
 
 #[test]
 fn sliced_shows_a_crater_in_the_next_frame() {
-    let Some(gpu) = common::gpu() else { return };
-    let (pct, p95, changed) = crater_against_fresh(&gpu, "sliced");
-    assert!(
-        changed > 100,
-        "the crater left (almost) no trace: {changed}"
-    );
-    assert!(pct <= 0.01 && p95 <= 0.1, "mismatch {pct} %, p95 {p95}");
+    assert_crater_like_fresh("sliced");
 }
 
 #[test]

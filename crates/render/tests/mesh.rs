@@ -6,7 +6,7 @@
 mod common;
 
 use strata_camera::Camera;
-use strata_level::generate::{GenerateParams, generate};
+use strata_level::generate::generate;
 use strata_level::{Level, ViewSpec};
 use strata_reference::metrics::{self, Metrics};
 use strata_reference::render_reference;
@@ -38,11 +38,7 @@ fn worst_over(
         let camera = Camera::from_view(level, view, w, h).unwrap();
         let t = r.render_frame(&camera).unwrap();
         let depth = r.read_depth().unwrap();
-        if let Ok(dir) = std::env::var("STRATA_TEST_OUT") {
-            let path = std::path::Path::new(&dir).join(format!("mesh-{}.png", view.name));
-            std::fs::create_dir_all(&dir).unwrap();
-            strata_render::report::write_png(&path, w, h, &r.read_color().unwrap()).unwrap();
-        }
+        common::save_png(&r, &format!("mesh-{}", view.name), (w, h));
         let reference = render_reference(level, &camera);
         let dist = metrics::distance_from_depth(&camera, &depth);
         let m = metrics::compare(&reference, &dist);
@@ -63,32 +59,15 @@ fn worst_over(
             }
         }
         eprintln!(
-            "mesh {:12} pitch {:4}: see-through {:.3} % covers-sky {:.3} % coherence {:.3} % p50 {:.3} p95 {:.3} gpu {:?} ms",
+            "mesh {:12} pitch {:4}: {} gpu {:?} ms",
             view.name,
             view.pitch,
-            m.see_through,
-            m.covers_sky,
-            m.coherence,
-            m.depth_p50,
-            m.depth_p95,
+            common::metrics_line(&m),
             t.gpu_ms.map(|g| (g * 10.0).round() / 10.0),
         );
-        worst.see_through = worst.see_through.max(m.see_through);
-        worst.covers_sky = worst.covers_sky.max(m.covers_sky);
-        worst.coherence = worst.coherence.max(m.coherence);
-        worst.depth_p50 = worst.depth_p50.max(m.depth_p50);
-        worst.depth_p95 = worst.depth_p95.max(m.depth_p95);
+        common::fold_worst(&mut worst, &m);
     }
     worst
-}
-
-fn world() -> strata_level::World {
-    generate(&GenerateParams {
-        seed: 6,
-        width: 512,
-        height: 1024,
-    })
-    .expect("generated world")
 }
 
 #[test]
@@ -114,7 +93,7 @@ fn mesh_matches_the_reference() {
 #[test]
 fn mesh_matches_the_reference_on_a_generated_world() {
     let Some(gpu) = common::gpu() else { return };
-    let w = world();
+    let w = common::generated_world();
     let m = worst_over(
         &gpu,
         &w.level,
@@ -160,7 +139,7 @@ fn a_crater_equals_a_fresh_fit_in_the_next_frame() {
     // The fixture's camera: the crater is ~14 degrees down, in frame only in
     // a tall image.
     let (w_px, h_px) = (160, 400);
-    let w = world();
+    let w = common::generated_world();
     let colors = TerrainColors::from_world(&w);
     let site = w.edit.clone().expect("generated worlds carry an edit site");
     let mut level = w.level.clone();

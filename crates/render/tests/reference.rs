@@ -31,10 +31,7 @@ fn ray_methods_match_the_reference() {
             &TerrainColors::test_ramps(),
             method,
             &MethodSettings {
-                ray_steps: std::env::var("RAY_STEPS")
-                    .ok()
-                    .and_then(|s| s.parse().ok())
-                    .unwrap_or(128),
+                ray_steps: common::ray_steps(),
                 ..Default::default()
             },
             W,
@@ -44,23 +41,14 @@ fn ray_methods_match_the_reference() {
         for ((view, camera), reference) in views.iter().zip(&cameras).zip(&references) {
             r.render_frame(camera).unwrap();
             let depth = r.read_depth().unwrap();
-            if let Ok(dir) = std::env::var("STRATA_TEST_OUT") {
-                // Pictures for a human: STRATA_TEST_OUT=/tmp/x cargo test ...
-                let path = std::path::Path::new(&dir).join(format!("{method}-{}.png", view.name));
-                std::fs::create_dir_all(&dir).unwrap();
-                strata_render::report::write_png(&path, W, H, &r.read_color().unwrap()).unwrap();
-            }
+            common::save_png(&r, &format!("{method}-{}", view.name), (W, H));
             let distance = metrics::distance_from_depth(camera, &depth);
             let m = metrics::compare(reference, &distance);
             eprintln!(
-                "{method:12} {:10} pitch {:4}: see-through {:.3} % covers-sky {:.3} % coherence {:.3} % p50 {:.3} p95 {:.3} sky {:.1} %",
+                "{method:12} {:10} pitch {:4}: {} sky {:.1} %",
                 view.name,
                 view.pitch,
-                m.see_through,
-                m.covers_sky,
-                m.coherence,
-                m.depth_p50,
-                m.depth_p95,
+                common::metrics_line(&m),
                 reference.sky_fraction()
             );
             // A high eye looking level skims distant terrace edges between

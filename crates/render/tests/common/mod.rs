@@ -1,8 +1,10 @@
-//! Shared by the GPU tests: the adapter (or a loud skip) and a hand-built level.
+//! Shared by the GPU tests: the adapter (or a loud skip), a hand-built level,
+//! the small generated world, and the metric and crater comparisons.
 #![allow(dead_code)]
 
 use strata_level::model::{META_DOUBLE_LEVEL, META_TERRAIN_SHIFT};
 use strata_level::{Level, MidRule, ViewSpec};
+use strata_reference::metrics::Metrics;
 use strata_render::Gpu;
 
 /// The GPU, or `None` after printing a loud skip notice.
@@ -87,4 +89,106 @@ pub fn synthetic_views() -> Vec<ViewSpec> {
     .into_iter()
     .map(|(n, s, p)| ViewSpec::parse(n, s, p).unwrap())
     .collect()
+}
+
+/// The small generated world the method tests share (seed 6, 512x1024).
+pub fn generated_world() -> strata_level::World {
+    strata_level::generate::generate(&strata_level::generate::GenerateParams {
+        seed: 6,
+        width: 512,
+        height: 1024,
+    })
+    .expect("generated world")
+}
+
+/// `RAY_STEPS` from the environment (to try other budgets by hand), else
+/// the paper's 128.
+pub fn ray_steps() -> u32 {
+    std::env::var("RAY_STEPS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(128)
+}
+
+/// Pictures for a human: with `STRATA_TEST_OUT=/tmp/x cargo test ...`, the
+/// renderer's colour image goes to `/tmp/x/{name}.png`.
+pub fn save_png(r: &strata_render::Renderer, name: &str, (w, h): (u32, u32)) {
+    if let Ok(dir) = std::env::var("STRATA_TEST_OUT") {
+        let path = std::path::Path::new(&dir).join(format!("{name}.png"));
+        std::fs::create_dir_all(&dir).unwrap();
+        strata_render::report::write_png(&path, w, h, &r.read_color().unwrap()).unwrap();
+    }
+}
+
+/// One view's metrics for the test log.
+pub fn metrics_line(m: &Metrics) -> String {
+    format!(
+        "see-through {:.3} % covers-sky {:.3} % coherence {:.3} % p50 {:.3} p95 {:.3}",
+        m.see_through, m.covers_sky, m.coherence, m.depth_p50, m.depth_p95
+    )
+}
+
+/// Raise `worst` to at least `m`, field by field.
+pub fn fold_worst(worst: &mut Metrics, m: &Metrics) {
+    worst.see_through = worst.see_through.max(m.see_through);
+    worst.covers_sky = worst.covers_sky.max(m.covers_sky);
+    worst.coherence = worst.coherence.max(m.coherence);
+    worst.depth_p50 = worst.depth_p50.max(m.depth_p50);
+    worst.depth_p95 = worst.depth_p95.max(m.depth_p95);
+}
+
+/// Two frames' distances compared: the % of pixels where one hits and the
+/// other sees sky, and the p95 of |a - b| where both hit.
+pub fn distance_mismatch(a: &[f32], b: &[f32]) -> (f64, f32) {
+    let mismatch = a
+        .iter()
+        .zip(b)
+        .filter(|(x, y)| x.is_finite() != y.is_finite())
+        .count();
+    let mut d: Vec<f32> = a
+        .iter()
+        .zip(b)
+        .filter(|(x, y)| x.is_finite() && y.is_finite())
+        .map(|(x, y)| (x - y).abs())
+        .collect();
+    d.sort_by(f32::total_cmp);
+    let p95 = d.get(d.len() * 95 / 100).copied().unwrap_or(0.0);
+    (100.0 * mismatch as f64 / a.len() as f64, p95)
+}
+
+/// The generated world's crater, dug after the first frame: the next frame's
+/// distances against a renderer built fresh from the edited level (class
+/// mismatch %, p95, and how many pixels the crater changed).
+pub fn crater_against_fresh(gpu: &Gpu, method: &str) -> (f64, f32, usize) {
+    use strata_reference::metrics;
+    use strata_render::{MethodSettings, Renderer, TerrainColors};
+    // The fixture's camera stands 158 back and 40 up at pitch -30: the crater
+    // is about 14 degrees down, in frame only in a tall image.
+    let (w_px, h_px) = (160, 400);
+    let w = generated_world();
+    let colors = TerrainColors::from_world(&w);
+    let settings = MethodSettings::default();
+    let site = w.edit.clone().expect("generated worlds carry an edit site");
+    let mut level = w.level.clone();
+    let camera = strata_camera::Camera::from_view(&level, &site.camera, w_px, h_px).unwrap();
+    let mut r = Renderer::new(gpu, &level, &colors, method, &settings, w_px, h_px).unwrap();
+    r.render_frame(&camera).unwrap();
+    let before = r.read_depth().unwrap();
+    let rects = strata_level::edit::crater(&mut level, &site);
+    r.apply_edit(&level, &rects).unwrap();
+    r.render_frame(&camera).unwrap();
+    let after = metrics::distance_from_depth(&camera, &r.read_depth().unwrap());
+    let mut fresh = Renderer::new(gpu, &level, &colors, method, &settings, w_px, h_px).unwrap();
+    fresh.render_frame(&camera).unwrap();
+    let want = metrics::distance_from_depth(&camera, &fresh.read_depth().unwrap());
+    let changed = metrics::distance_from_depth(&camera, &before)
+        .iter()
+        .zip(&after)
+        .filter(|(a, b)| a.is_finite() != b.is_finite() || (*a - *b).abs() > 1e-3)
+        .count();
+    let (pct, p95) = distance_mismatch(&after, &want);
+    eprintln!(
+        "{method}: crater changed {changed} pixels; vs fresh: class mismatch {pct:.4} %, p95 {p95:.4}"
+    );
+    (pct, p95, changed)
 }
