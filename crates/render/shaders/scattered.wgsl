@@ -13,7 +13,7 @@ struct ScatterParams {
     // samples per pixel of projected height
     origin: vec4<f32>,
     // x, y: asinh(a / h) of the footprint's nearest and farthest distance a;
-    // z: columns a row needs per unit of width / sqrt(a^2 + h^2)
+    // z: columns a row needs per unit of its warped width
     warp: vec4<f32>,
     // rows (along), columns (across), hull vertices, vertical samples per
     // interval at most
@@ -126,10 +126,11 @@ fn walk(base: vec4<f32>, dz: vec4<f32>, c: Column, lo: f32, hi: f32) {
         let kind = surface_kind(c, z, z - globals.eye.z);
         let t = select(c.upper_type, c.lower_type, kind == SURFACE_FLOOR);
         scatter(p, t | (kind << 3u));
-        z -= 1.0 / (per_px * max(pixel_rate(p, dz), 1e-4));
-        if (z < lo) {
+        if (z <= lo) {
             break;
         }
+        // The last point lands on lo exactly.
+        z = max(z - 1.0 / (per_px * max(pixel_rate(p, dz), 1e-4)), lo);
     }
 }
 
@@ -157,16 +158,21 @@ fn cs_scatter(
     if (range.x > range.y) {
         return;
     }
-    // A row that needs fewer columns keeps every 2^k-th.
-    let need = params.warp.z * (range.y - range.x) / sqrt(a * a + h * h);
+    // Columns are uniform in asinh(c / d), d the row's least distance (a
+    // column at c is at least sqrt(c^2 + d^2) away); a row that needs fewer
+    // than `cols` keeps every 2^k-th.
+    let d = sqrt(a * a + h * h);
+    let u = vec2<f32>(asinh(range.x / d), asinh(range.y / d));
+    let need = params.warp.z * (u.y - u.x);
     let ratio = f32(cols) / max(need, 1e-6);
+    var k = 1u;
     if (ratio >= 2.0) {
-        let k = 1u << min(u32(floor(log2(ratio))), 30u);
+        k = 1u << min(u32(floor(log2(ratio))), 30u);
         if ((col & (k - 1u)) != 0u) {
             return;
         }
     }
-    let across = mix(range.x, range.y, (f32(col) + 0.5) / f32(cols));
+    let across = d * sinh(mix(u.x, u.y, (f32(col) + 0.5) / f32(cols)));
     let xy = params.origin.xy + params.axes.xy * a + params.axes.zw * across;
     let vp = globals.view_proj;
     let base = vp[0] * xy.x + vp[1] * xy.y + vp[3];
@@ -178,7 +184,25 @@ fn cs_scatter(
         return;
     }
     let c = decode_column(i32(floor(xy.x)), i32(floor(xy.y)));
-    walk(base, dz, c, r.x, min(c.low, r.y));
+    // The floor below every neighbour sample's floor (the next sample, or
+    // texel, along and across both ways) is hidden behind them, but for a
+    // strip that fills the screen gap between this column and the nearer
+    // one: the ray over the neighbour's top reaches this column
+    // (eye height over it) * spacing / distance lower.
+    let da = max(1.0, d * (params.warp.y - params.warp.x) / f32(rows));
+    let dc = max(1.0, sqrt(across * across + d * d) * (u.y - u.x) * f32(k) / f32(cols));
+    let fa = params.axes.xy * da;
+    let fc = params.axes.zw * dc;
+    var cover = c.low;
+    for (var n = 0u; n < 4u; n++) {
+        let off = select(select(-fc, fc, n == 2u), select(-fa, fa, n == 0u), n < 2u);
+        let q = floor(xy + off);
+        cover = min(cover, decode_column(i32(q.x), i32(q.y)).low);
+    }
+    let reach = length(vec2<f32>(a, across));
+    let bottom = cover - max(globals.eye.z - cover, 0.0) * 2.0 * max(da, dc) / max(reach, 1.0) - 0.5;
+    let top = min(c.low, r.y);
+    walk(base, dz, c, min(max(bottom, r.x), top), top);
     if (c.dual) {
         walk(base, dz, c, max(c.mid, r.x), min(c.high, r.y));
     }

@@ -5,38 +5,45 @@
 //! it (`shaders/scattered.wgsl`, `shaders/scattered_resolve.wgsl`).
 //!
 //! # The grid and `scatter_density` (X, Y, Z)
-//! Every density is in screen terms: a density `D` asks for `D * PER_PIXEL`
-//! samples per pixel ([`PER_PIXEL`] = 1/4, so the paper's default (4, 4, 4)
-//! is about one sample per pixel along each axis; a point splats one pixel, so
-//! less leaves holes and more buys little).
+//! Every density is in screen terms: X, Y and Z ask for `X * PER_PIXEL[0]`
+//! samples per pixel across, `Y * PER_PIXEL[1]` along the (warped) distance
+//! axis and `Z * PER_PIXEL[2]` per pixel of a column's projected height. The
+//! paper's default (4, 4, 4) is 1.25, 1 and 1 ([`PER_PIXEL`]): a point splats
+//! one pixel, so fewer leave holes (2 per 4 pixels: 50 % see-through at the
+//! horizon) and more buy little. Work per frame grows with the image, not
+//! with the world's texels.
 //!
 //! The footprint is the part of the frustum (near to far) with altitude in
 //! 0..=256, seen from above in camera-aligned coordinates: `a` along the
 //! horizontal heading `flat`, `c` along `right`, both from the eye. Its
 //! outline is a convex polygon. A column at `(a, c)` is at least
-//! `dist(a) = sqrt(a² + h²)` from the eye, where `h` is the eye's clearance
-//! above the highest column top in the footprint's bounding box (from a
-//! per-tile maximum of the level, at least the near distance), so one pixel
-//! there is at most `dist(a) / focal` wide (times `1 / cos` of the image's
-//! widest half angle, for the corners). The grid has
-//! - rows uniform in `asinh(a / h)`, `Y * PER_PIXEL` per pixel of that size:
-//!   row spacing `dist(a) / (focal * Y/4)` (logarithmic far away, like
-//!   perspective; fine only where the terrain comes close to the eye);
-//! - `cols` columns per row spread over the row's own width, enough for
-//!   `X * PER_PIXEL` per pixel in the row that needs the most; a row that
-//!   needs fewer keeps only every `2^k`-th of them (the rest return at once);
-//! - vertical samples walked from the top of `[0, low]` and, for a dual column,
-//!   `[mid, high]` down, over the part of each interval that projects into the
-//!   view (clipped analytically), each step `1 / (Z * PER_PIXEL)` pixels of
-//!   projected height at that point (the exact screen-space rate of the
-//!   column's vertical line there), so a far column takes a few points and a
-//!   column seen end-on (looking down) one.
+//! `sqrt(a² + c² + h²)` from the eye, `h` the eye's clearance above the
+//! highest column top in the footprint's bounding box (from a per-tile maximum
+//! of the level, [`TopMax`]; at least the near distance), so one pixel there
+//! is at most that distance / focal wide, taken at the image corners (whose
+//! pixels are the smallest in angle). So the grid is
+//! - rows uniform in `asinh(a / h)`, spacing `sqrt(a² + h²) / (focal * Y')`:
+//!   logarithmic (like perspective) far away, fine only where the terrain can
+//!   come close to the eye;
+//! - columns uniform in `asinh(c / d)` within a row, `d = sqrt(a² + h²)`,
+//!   spacing `sqrt(c² + d²) / (focal * X')`; `cols` is what the neediest row
+//!   wants, and a row that wants fewer keeps every `2^k`-th (the rest return
+//!   at once);
+//! - a walk down each solid interval from its top, `[0, low]` and for a dual
+//!   column `[mid, high]`, over the part that projects into the view (clipped
+//!   analytically), each step `1 / Z'` pixels of the interval's projected
+//!   height at that point, so a far column takes a few points and a column
+//!   seen end-on one. The floor walk stops where it is hidden behind the four
+//!   neighbouring samples' floors (at the grid spacing, at least a texel),
+//!   less a margin that fills the screen gap between rows at grazing views;
+//!   without it most points of a horizon view were buried inside the terrain.
 //!
 //! A sample whose whole column (0..=256) is off screen returns before reading
 //! the texture. A grid over [`MAX_GRID`] samples is scaled down (both axes
 //! alike) with a warning; each density is capped at [`MAX_DENSITY`]. Results
-//! depend only on the grid and the terrain, never on earlier frames, so an
-//! edit shows in the next frame (the tile maximum is rebuilt on edits).
+//! depend only on the camera and the terrain, never on earlier frames, so an
+//! edit shows in the next frame (edits refresh the tile maximum).
+//! [`count_points`] is a CPU twin of the scatter that counts its work.
 
 use super::forward::{footprint_bounds, frustum_slab_points};
 use super::{Frame, Method, MethodSettings, RetainedBytes};
@@ -49,8 +56,10 @@ use strata_level::Level;
 pub const MAX_GRID: u64 = 1 << 24;
 /// Most of each density (X, Y, Z).
 pub const MAX_DENSITY: f32 = 64.0;
-/// Samples per pixel that a density of 1 asks for: (4, 4, 4) is one per pixel.
-pub const PER_PIXEL: f32 = 0.25;
+/// Samples per pixel that a density of 1 asks for, across, along and
+/// vertically: (4, 4, 4) is 1.25 across (one exactly left holes in about 1 %
+/// of a horizon view), 1 along and 1 vertically.
+pub const PER_PIXEL: [f32; 3] = [0.3125, 0.25, 0.25];
 /// Side of the tiles of the level's column-top maximum, texels.
 const TILE: u32 = 16;
 /// Most footprint polygon vertices the uniform holds (a frustum cut by a slab
@@ -68,7 +77,7 @@ pub struct ScatterParams {
     /// Eye xy, the warp scale and clearance `h`, vertical samples per pixel.
     pub origin: [f32; 4],
     /// asinh(a / h) of the nearest and farthest row bound; columns a row needs
-    /// per unit of `width / dist`; unused.
+    /// per unit of its warped width (`across_warp`); unused.
     pub warp: [f32; 4],
     /// Rows, columns, polygon vertices, vertical samples per interval at most.
     pub grid: [u32; 4],
@@ -237,7 +246,7 @@ pub fn scatter_grid(
 ) -> (ScatterParams, Option<String>) {
     let b = camera.basis();
     let e = camera.position;
-    let [xp, yp, zp] = density.map(|d| d * PER_PIXEL);
+    let [xp, yp, zp] = [0, 1, 2].map(|i| density[i] * PER_PIXEL[i]);
     // Clearance: a column top lies at least this far below the eye.
     let h = (e.z - max_top).max(camera.near);
     let (w, ht) = (camera.width as f32, camera.height as f32);
@@ -279,12 +288,12 @@ pub fn scatter_grid(
     let a1 = hull.iter().map(|p| p[0]).fold(f32::NEG_INFINITY, f32::max);
     let (s0, s1) = ((a0 / h).asinh(), (a1 / h).asinh());
     let col_scale = xp * per_px;
-    // Columns the neediest row wants: width / dist at the hull's vertices and
-    // at 64 rows between (uniform in the warp, like the rows).
+    // Columns the neediest row wants: the hull's vertices and 64 rows
+    // between (uniform in the warp, like the rows).
     let need = |a: f32| {
-        params.row_range(a).map_or(0.0, |(lo, hi)| {
-            col_scale * (hi - lo) / (a * a + h * h).sqrt()
-        })
+        params
+            .row_range(a)
+            .map_or(0.0, |(lo, hi)| col_scale * across_warp(lo, hi, a, h))
     };
     let widest = hull
         .iter()
@@ -312,6 +321,124 @@ pub fn scatter_grid(
     params.grid[3] = (zp * (w + ht)).ceil() as u32 + 2;
     params.warp = [s0, s1, col_scale, 0.0];
     (params, warning)
+}
+
+/// The warped width of a row at distance `a` spanning `lo..=hi` across:
+/// columns are uniform in `asinh(c / d)`, `d = sqrt(a² + h²)` the row's least
+/// distance, as a column at `c` is at least `sqrt(c² + d²)` from the eye.
+fn across_warp(lo: f32, hi: f32, a: f32, h: f32) -> f32 {
+    let d = (a * a + h * h).sqrt();
+    (hi / d).asinh() - (lo / d).asinh()
+}
+
+/// The altitudes of `lo..=hi` whose points `base + z * dz` (clip space) lie
+/// inside the view (the CPU twin of `clip_altitudes`).
+fn clip_altitudes(base: glam::Vec4, dz: glam::Vec4, lo: f32, hi: f32) -> Option<(f32, f32)> {
+    let alpha = [
+        base.w + base.x,
+        base.w - base.x,
+        base.w + base.y,
+        base.w - base.y,
+        base.z,
+        base.w - base.z,
+    ];
+    let beta = [
+        dz.w + dz.x,
+        dz.w - dz.x,
+        dz.w + dz.y,
+        dz.w - dz.y,
+        dz.z,
+        dz.w - dz.z,
+    ];
+    let (mut lo, mut hi) = (lo, hi);
+    for (a, b) in alpha.into_iter().zip(beta) {
+        if b.abs() < 1e-12 {
+            if a < 0.0 {
+                return None;
+            }
+        } else if b > 0.0 {
+            lo = lo.max(-a / b);
+        } else {
+            hi = hi.min(-a / b);
+        }
+    }
+    (lo <= hi).then_some((lo, hi))
+}
+
+/// What one frame's scatter does, counted on the CPU (a twin of
+/// `cs_scatter`): (samples that walk a column, points scattered).
+pub fn count_points(level: &Level, camera: &Camera, density: [f32; 3]) -> (u64, u64) {
+    let tops = TopMax::new(level);
+    let max_top = footprint_bounds(camera, camera.far).map_or(0.0, |(lo, hi)| tops.max_in(lo, hi));
+    let (p, _) = scatter_grid(camera, density, max_top, MAX_GRID);
+    let vp = camera.view_proj();
+    let (rows, cols) = (p.grid[0], p.grid[1]);
+    let h = p.origin[2];
+    let (w, ht) = (camera.width as f32, camera.height as f32);
+    let (mut samples, mut points) = (0u64, 0u64);
+    for row in 0..rows {
+        let s = p.warp[0] + (p.warp[1] - p.warp[0]) * (row as f32 + 0.5) / rows as f32;
+        let a = h * s.sinh();
+        let Some((lo, hi)) = p.row_range(a) else {
+            continue;
+        };
+        let d = (a * a + h * h).sqrt();
+        let u = ((lo / d).asinh(), (hi / d).asinh());
+        let ratio = cols as f32 / (p.warp[2] * (u.1 - u.0)).max(1e-6);
+        let k = if ratio >= 2.0 {
+            1u32 << (ratio.log2().floor() as u32).min(30)
+        } else {
+            1
+        };
+        let da = (d * (p.warp[1] - p.warp[0]) / rows as f32).max(1.0);
+        for col in (0..cols).step_by(k as usize) {
+            let across = d * (u.0 + (u.1 - u.0) * (col as f32 + 0.5) / cols as f32).sinh();
+            let x = p.origin[0] + p.axes[0] * a + p.axes[2] * across;
+            let y = p.origin[1] + p.axes[1] * a + p.axes[3] * across;
+            let base = vp.col(0) * x + vp.col(1) * y + vp.col(3);
+            let dz = vp.col(2);
+            let Some((r0, r1)) = clip_altitudes(base, dz, 0.0, 256.0) else {
+                continue;
+            };
+            samples += 1;
+            let c = level.column_at(x, y);
+            let dc =
+                ((across * across + d * d).sqrt() * (u.1 - u.0) * k as f32 / cols as f32).max(1.0);
+            let mut cover = f32::from(c.low);
+            for (fa, fc) in [(da, 0.0), (-da, 0.0), (0.0, dc), (0.0, -dc)] {
+                let (nx, ny) = (
+                    x + p.axes[0] * fa + p.axes[2] * fc,
+                    y + p.axes[1] * fa + p.axes[3] * fc,
+                );
+                cover = cover.min(f32::from(level.column_at(nx, ny).low));
+            }
+            let reach = (a * a + across * across).sqrt().max(1.0);
+            let bottom = cover - (camera.position.z - cover).max(0.0) * da.max(dc) / reach;
+            let top = r1.min(f32::from(c.low));
+            let mut intervals = vec![(bottom.max(r0).min(top), top)];
+            if c.dual {
+                intervals.push((r0.max(f32::from(c.mid)), r1.min(f32::from(c.high))));
+            }
+            for (z0, z1) in intervals {
+                if z0 > z1 {
+                    continue;
+                }
+                let mut z = z1;
+                for _ in 0..p.grid[3] {
+                    points += 1;
+                    if z <= z0 {
+                        break;
+                    }
+                    let q = base + dz * z;
+                    let dd = (dz.truncate().truncate() * q.w - q.truncate().truncate() * dz.w)
+                        / (q.w * q.w);
+                    let rate = (dd * glam::Vec2::new(w, ht) * 0.5).length();
+                    z = (z - 1.0 / (p.origin[3] * rate.max(1e-4))).max(z0);
+                }
+            }
+        }
+    }
+    (samples, points)
 }
 
 /// The density, checked: each positive and finite, each capped at
