@@ -193,17 +193,36 @@ fn cs_scatter(
     let dc = max(1.0, sqrt(across * across + d * d) * (u.y - u.x) * f32(k) / f32(cols));
     let fa = params.axes.xy * da;
     let fc = params.axes.zw * dc;
+    // The slab's sides are hidden, likewise, where every neighbour is solid:
+    // `hid`, the intersection of each neighbour's slab (or, for a single-level
+    // neighbour, everything up to its floor's top).
     var cover = c.low;
+    var hid = vec2<f32>(-1e9, 1e9);
     for (var n = 0u; n < 4u; n++) {
         let off = select(select(-fc, fc, n == 2u), select(-fa, fa, n == 0u), n < 2u);
         let q = floor(xy + off);
-        cover = min(cover, decode_column(i32(q.x), i32(q.y)).low);
+        let nc = decode_column(i32(q.x), i32(q.y));
+        cover = min(cover, nc.low);
+        let hn = select(vec2<f32>(-1e9, nc.low), vec2<f32>(nc.mid, nc.high), nc.dual);
+        hid = vec2<f32>(max(hid.x, hn.x), min(hid.y, hn.y));
     }
-    let reach = length(vec2<f32>(a, across));
-    let bottom = cover - max(globals.eye.z - cover, 0.0) * 2.0 * max(da, dc) / max(reach, 1.0) - 0.5;
+    let gap = 2.0 * max(da, dc) / max(length(vec2<f32>(a, across)), 1.0);
+    let eye = globals.eye.z;
+    let bottom = cover - max(eye - cover, 0.0) * gap - 0.5;
     let top = min(c.low, r.y);
     walk(base, dz, c, min(max(bottom, r.x), top), top);
     if (c.dual) {
-        walk(base, dz, c, max(c.mid, r.x), min(c.high, r.y));
+        let lo = max(c.mid, r.x);
+        let hi = min(c.high, r.y);
+        // Walk down from the top to the hidden core and from the core to the
+        // underside, each with the gap margin (seen from above, from below).
+        let core_top = hid.y - max(eye - hid.y, 0.0) * gap - 0.5;
+        let core_bottom = hid.x + max(hid.x - eye, 0.0) * gap + 0.5;
+        if (core_bottom < core_top) {
+            walk(base, dz, c, min(max(core_top, lo), hi), hi);
+            walk(base, dz, c, lo, max(min(core_bottom, hi), lo));
+        } else {
+            walk(base, dz, c, lo, hi);
+        }
     }
 }

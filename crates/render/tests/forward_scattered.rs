@@ -99,10 +99,11 @@ fn scattered_matches_the_reference() {
         &common::synthetic_views(),
         (160, 100),
     ) {
-        // Measured: see-through 2.3 % at horizon-b (pitch 0), 0 % looking
-        // down; covers-sky 0.9 % at `high`; p50 <= 1.9 (the cave views:
-        // points of the slab stand in for its underside).
-        let limit = if pitch == 0.0 { 4.0 } else { 0.5 };
+        // Measured (screen-space density, floor walk culled behind the
+        // neighbours): see-through 0.14 % at `high` (pitch 0), 0 % elsewhere;
+        // covers-sky 0.83 % at `high`; p50 <= 0.28. With one sample per pixel
+        // across instead of 1.25 the horizon views had 0.8-1.3 %.
+        let limit = if pitch == 0.0 { 1.0 } else { 0.5 };
         assert!(worst.see_through <= limit, "{pitch}: {worst:?} {mean:?}");
         assert!(worst.covers_sky <= 1.5, "{pitch}: {worst:?}");
         assert!(worst.depth_p50 <= 2.5, "{pitch}: {worst:?}");
@@ -118,9 +119,17 @@ fn scattered_matches_the_reference_on_a_generated_world() {
     assert_eq!(pitches.len(), 4, "three views per pitch expected");
     for (pitch, mean, worst) in pitches {
         // Measured at 160x100: see-through and covers-sky 0 % in all twelve
-        // views (the dense default grid; the paper's 40 % at the horizon is
-        // not reproduced); p50 <= 1.07 (river-down), p95 <= 1.0 looking down.
-        assert!(worst.see_through <= 1.0, "{pitch}: {worst:?} {mean:?}");
+        // views (the paper's 40 % at the horizon is not reproduced); p50 <=
+        // 0.11, p95 <= 0.85 (river), <= 0.4 looking down. Horizon: mean 1 %,
+        // worst 2 % allowed; 0.5 % in any view elsewhere.
+        if pitch == 0.0 {
+            assert!(
+                mean.see_through <= 1.0 && worst.see_through <= 2.0,
+                "{pitch}: {worst:?} {mean:?}"
+            );
+        } else {
+            assert!(worst.see_through <= 0.5, "{pitch}: {worst:?} {mean:?}");
+        }
         assert!(worst.covers_sky <= 0.5, "{pitch}: {worst:?}");
         assert!(worst.depth_p50 <= 1.6, "{pitch}: {worst:?}");
         if pitch <= -60.0 {
@@ -244,4 +253,35 @@ fn memory_and_bad_settings() {
     .unwrap();
     r.render_frame(&up).unwrap();
     assert!(r.read_depth().unwrap().iter().all(|&d| d == 1.0));
+}
+
+/// Work per frame, counted by the CPU twin of the scatter
+/// (`scattered::count_points`) at 160x100 over the world's twelve views.
+/// Measured at 320x200: 1.4 M (lake, -90) to 10.4 M (river-down, -30)
+/// points, 56 M over the twelve views; the grid per texel with 4 points per
+/// unit of altitude it replaced scattered 38 M (canyon; now 7.0 M) to 578 M
+/// (ramp; now 5.4 M), 2.7 G in all.
+#[test]
+fn points_per_frame_stay_within_budget() {
+    let w = world();
+    let (px, py) = (160u32, 100u32);
+    let mut total = 0;
+    for view in &w.views {
+        let camera = Camera::from_view(&w.level, view, px, py).unwrap();
+        let (_, points) =
+            strata_render::methods::scattered::count_points(&w.level, &camera, [4.0; 3]);
+        eprintln!(
+            "points {px}x{py} {:12} pitch {:4}: {points}",
+            view.name, view.pitch
+        );
+        total += points;
+        // At most ~400 points per pixel in any view (hangar is ~330 at 320x200).
+        assert!(
+            points <= 400 * u64::from(px * py),
+            "{}: {points}",
+            view.name
+        );
+    }
+    // Measured: 17.9 M over the twelve views.
+    assert!(total <= 25_000_000, "{total}");
 }

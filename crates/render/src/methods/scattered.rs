@@ -45,10 +45,11 @@
 //! edit shows in the next frame (edits refresh the tile maximum).
 //! [`count_points`] is a CPU twin of the scatter that counts its work.
 
-use super::forward::{footprint_bounds, frustum_slab_points};
+use super::forward::{Z_MAX, footprint_bounds};
 use super::{Frame, Method, MethodSettings, RetainedBytes};
 use crate::frame::{COLOR_FORMAT, DEPTH_FORMAT, Shared, sky_clear, uniform_layout_entry};
 use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
 use strata_camera::Camera;
 use strata_level::Level;
 
@@ -234,6 +235,38 @@ impl TopMax {
     }
 }
 
+/// Points whose convex hull is the part of the frustum (near to far) with
+/// altitude in `0..=top` (as `forward::frustum_slab_points`, which cuts at
+/// `Z_MAX`): no terrain in view lies outside it when no column top in view is
+/// above `top`.
+pub fn slab_points(camera: &Camera, top: f32) -> Vec<Vec3> {
+    let (w, h) = (camera.width as f32, camera.height as f32);
+    let image = [(0.0, 0.0), (w, 0.0), (w, h), (0.0, h)];
+    let corners = |d: f32| {
+        image.map(|(px, py)| {
+            camera.position + camera.image_direction(px, py) * (d / camera.focal_px)
+        })
+    };
+    let (near, far) = (corners(camera.near), corners(camera.far));
+    let mut points: Vec<Vec3> = near
+        .iter()
+        .chain(&far)
+        .copied()
+        .filter(|p| (0.0..=top).contains(&p.z))
+        .collect();
+    for i in 0..4 {
+        let j = (i + 1) % 4;
+        for (a, b) in [(near[i], near[j]), (far[i], far[j]), (near[i], far[i])] {
+            for z in [0.0, top] {
+                if (a.z - z) * (b.z - z) < 0.0 {
+                    points.push(a.lerp(b, (z - a.z) / (b.z - a.z)));
+                }
+            }
+        }
+    }
+    points
+}
+
 /// The grid for `camera` at `density` (X, Y, Z, each already within
 /// [`MAX_DENSITY`]) when no column top in the footprint is above `max_top`, at
 /// most `max_samples` samples; the second value is a warning when the grid
@@ -259,7 +292,7 @@ pub fn scatter_grid(
         origin: [e.x, e.y, h, zp],
         ..Default::default()
     };
-    let pts = frustum_slab_points(camera, camera.far)
+    let pts = slab_points(camera, (max_top + 1.0).min(Z_MAX))
         .into_iter()
         .map(|p| {
             let r = p - e;
@@ -405,19 +438,34 @@ pub fn count_points(level: &Level, camera: &Camera, density: [f32; 3]) -> (u64, 
             let dc =
                 ((across * across + d * d).sqrt() * (u.1 - u.0) * k as f32 / cols as f32).max(1.0);
             let mut cover = f32::from(c.low);
+            let mut hid = (-1e9f32, 1e9f32);
             for (fa, fc) in [(da, 0.0), (-da, 0.0), (0.0, dc), (0.0, -dc)] {
-                let (nx, ny) = (
-                    x + p.axes[0] * fa + p.axes[2] * fc,
-                    y + p.axes[1] * fa + p.axes[3] * fc,
-                );
-                cover = cover.min(f32::from(level.column_at(nx, ny).low));
+                let nx = x + p.axes[0] * fa + p.axes[2] * fc;
+                let ny = y + p.axes[1] * fa + p.axes[3] * fc;
+                let n = level.column_at(nx, ny);
+                cover = cover.min(f32::from(n.low));
+                let hn = if n.dual {
+                    (f32::from(n.mid), f32::from(n.high))
+                } else {
+                    (-1e9, f32::from(n.low))
+                };
+                hid = (hid.0.max(hn.0), hid.1.min(hn.1));
             }
-            let reach = (a * a + across * across).sqrt().max(1.0);
-            let bottom = cover - (camera.position.z - cover).max(0.0) * da.max(dc) / reach;
+            let gap = 2.0 * da.max(dc) / (a * a + across * across).sqrt().max(1.0);
+            let eye = camera.position.z;
+            let bottom = cover - (eye - cover).max(0.0) * gap - 0.5;
             let top = r1.min(f32::from(c.low));
             let mut intervals = vec![(bottom.max(r0).min(top), top)];
             if c.dual {
-                intervals.push((r0.max(f32::from(c.mid)), r1.min(f32::from(c.high))));
+                let (lo, hi) = (r0.max(f32::from(c.mid)), r1.min(f32::from(c.high)));
+                let core_top = hid.1 - (eye - hid.1).max(0.0) * gap - 0.5;
+                let core_bottom = hid.0 + (hid.0 - eye).max(0.0) * gap + 0.5;
+                if core_bottom < core_top {
+                    intervals.push((core_top.max(lo).min(hi), hi));
+                    intervals.push((lo, core_bottom.min(hi).max(lo)));
+                } else {
+                    intervals.push((lo, hi));
+                }
             }
             for (z0, z1) in intervals {
                 if z0 > z1 {
@@ -721,7 +769,50 @@ impl Method for Scattered {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use glam::Vec3;
+
+    #[test]
+    fn slab_points_match_the_forward_footprint_at_z_max() {
+        use super::super::forward::frustum_slab_points;
+        for pitch in [0.0, -45.0, -90.0] {
+            let cam = Camera::new(Vec3::new(30.0, 50.0, 120.0), 20.0, pitch, 160, 100).unwrap();
+            assert_eq!(slab_points(&cam, Z_MAX), frustum_slab_points(&cam, cam.far));
+        }
+    }
+
+    #[test]
+    fn a_low_terrain_shrinks_the_footprint_and_widens_the_rows() {
+        // Looking steeply down from 150: terrain no higher than 50 is at least
+        // 100 away, so rows near the eye are not needed.
+        let cam = Camera::new(Vec3::new(0.0, 0.0, 150.0), 0.0, -60.0, 320, 200).unwrap();
+        let (all, _) = scatter_grid(&cam, [4.0; 3], Z_MAX, MAX_GRID);
+        let (low, _) = scatter_grid(&cam, [4.0; 3], 50.0, MAX_GRID);
+        assert!(low.origin[2] == 100.0 && all.origin[2] == 1.0, "{low:?}");
+        assert!(
+            low.samples() * 2 < all.samples(),
+            "{} vs {}",
+            low.samples(),
+            all.samples()
+        );
+    }
+
+    #[test]
+    fn the_tile_maximum_follows_edits() {
+        let mut level = Level::flat(64, 64, 10, 1).unwrap();
+        let mut tops = TopMax::new(&level);
+        assert_eq!(tops.max_in([-100.0, -100.0], [100.0, 100.0]), 10.0);
+        level.planes_mut().0[0] = 200;
+        let rect = strata_level::DirtyRect {
+            x: 0,
+            y: 0,
+            width: 1,
+            height: 1,
+        };
+        tops.update(&level, &rect);
+        assert_eq!(tops.max_in([0.0, 0.0], [3.0, 3.0]), 200.0);
+        // Wrapping: texel (0, 0) is also (64, 64).
+        assert_eq!(tops.max_in([60.0, 60.0], [65.0, 65.0]), 200.0);
+        assert_eq!(tops.max_in([20.0, 20.0], [40.0, 40.0]), 10.0);
+    }
 
     #[test]
     fn hull_drops_inner_and_collinear_points() {
@@ -741,7 +832,7 @@ mod tests {
     fn grid_covers_the_view_at_every_pitch() {
         for (pitch, yaw) in [(0.0, 0.0), (-30.0, 45.0), (-60.0, 200.0), (-90.0, 10.0)] {
             let cam = Camera::new(Vec3::new(300.0, 500.0, 120.0), yaw, pitch, 160, 100).unwrap();
-            let (p, w) = scatter_grid(&cam, [4.0, 4.0, 4.0], MAX_GRID);
+            let (p, w) = scatter_grid(&cam, [4.0, 4.0, 4.0], Z_MAX, MAX_GRID);
             assert!(w.is_none() && p.samples() > 0 && p.samples() <= MAX_GRID);
             let b = cam.basis();
             // Points of pixel rays inside the altitude range are inside the polygon.
@@ -766,15 +857,19 @@ mod tests {
 
     #[test]
     fn a_huge_grid_is_clamped_and_bad_density_refused() {
-        let mut cam = Camera::new(Vec3::new(0.0, 0.0, 100.0), 45.0, 0.0, 160, 100).unwrap();
+        let mut cam = Camera::new(Vec3::new(0.0, 0.0, 100.0), 45.0, 0.0, 1280, 800).unwrap();
         cam.far = 100_000.0;
-        let (p, w) = scatter_grid(&cam, [4.0, 4.0, 4.0], MAX_GRID);
+        let (p, w) = scatter_grid(&cam, [64.0, 64.0, 4.0], Z_MAX, MAX_GRID);
         assert!(w.is_some() && p.samples() <= MAX_GRID && p.samples() > MAX_GRID / 2);
         for d in [[0.0, 4.0, 4.0], [4.0, -1.0, 4.0], [4.0, 4.0, f32::NAN]] {
             assert!(checked_density(d).is_err());
         }
-        assert_eq!(checked_density([1.0, 1.0, 1e9]).unwrap()[2], MAX_Z);
+        assert_eq!(checked_density([1.0, 1.0, 1e9]).unwrap()[2], MAX_DENSITY);
+        assert_eq!(checked_density([1e9, 1.0, 1.0]).unwrap()[0], MAX_DENSITY);
         let above = Camera::new(Vec3::new(0.0, 0.0, 5000.0), 0.0, 30.0, 160, 100).unwrap();
-        assert_eq!(scatter_grid(&above, [4.0; 3], MAX_GRID).0.samples(), 0);
+        assert_eq!(
+            scatter_grid(&above, [4.0; 3], Z_MAX, MAX_GRID).0.samples(),
+            0
+        );
     }
 }
