@@ -34,6 +34,40 @@ fn clip_to_altitudes(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32) -> vec2<f32> 
     return vec2<f32>(max(t0, min(ta, tb)), min(t1, max(ta, tb)));
 }
 
+// `n` uniform samples over (ta, tb] (ta is known empty) until one is solid,
+// then `bisections` halvings between the last empty and the first solid
+// sample: the refinement `march` and the voxel leaves share.
+fn sample_and_bisect(o: vec3<f32>, d: vec3<f32>, ta: f32, tb: f32, n: u32, bisections: u32) -> MarchHit {
+    var result: MarchHit;
+    result.hit = false;
+    result.t = tb;
+    let dt = (tb - ta) / f32(n);
+    var a = ta;
+    var b = tb;
+    for (var i = 1u; i <= n; i = i + 1u) {
+        let t = ta + dt * f32(i);
+        if (is_solid(o + d * t)) {
+            b = t;
+            result.hit = true;
+            break;
+        }
+        a = t;
+    }
+    if (!result.hit) {
+        return result;
+    }
+    for (var i = 0u; i < bisections; i = i + 1u) {
+        let c = 0.5 * (a + b);
+        if (is_solid(o + d * c)) {
+            b = c;
+        } else {
+            a = c;
+        }
+    }
+    result.t = b;
+    return result;
+}
+
 // The paper's RAYMARCH: `steps` uniform samples over [t0, t1] until one is
 // solid, then four bisections between the last empty and first solid sample.
 fn march(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, steps: u32) -> MarchHit {
@@ -48,31 +82,7 @@ fn march(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, steps: u32) -> MarchHit {
         result.t = t0;
         return result;
     }
-    let dt = (t1 - t0) / f32(steps);
-    var a = t0;
-    var b = t1;
-    for (var i = 1u; i <= steps; i = i + 1u) {
-        let t = t0 + dt * f32(i);
-        if (is_solid(o + d * t)) {
-            b = t;
-            result.hit = true;
-            break;
-        }
-        a = t;
-    }
-    if (!result.hit) {
-        return result;
-    }
-    for (var i = 0u; i < BISECTIONS; i = i + 1u) {
-        let c = 0.5 * (a + b);
-        if (is_solid(o + d * c)) {
-            b = c;
-        } else {
-            a = c;
-        }
-    }
-    result.t = b;
-    return result;
+    return sample_and_bisect(o, d, t0, t1, steps, BISECTIONS);
 }
 
 // Depth-buffer value of a point at view depth `view_z`: the twin of

@@ -9,14 +9,16 @@ struct PixelSample {
     depth: f32,
 }
 
-// March the camera ray of image point (px, py) and shade it.
-fn ray_pixel(px: f32, py: f32, steps: u32) -> PixelSample {
-    let o = globals.eye.xyz;
-    let d = camera_ray(px, py);
+// The camera ray o + t d clipped to the near and far planes (view depth is
+// t * focal) and to the altitude slab.
+fn camera_segment(o: vec3<f32>, d: vec3<f32>) -> vec2<f32> {
     let focal = globals.eye.w;
-    // View depth is t * focal: the segment runs from the near to the far plane.
-    let seg = clip_to_altitudes(o, d, globals.forward.w / focal, globals.right.w / focal);
-    let h = march(o, d, seg.x, seg.y, steps);
+    return clip_to_altitudes(o, d, globals.forward.w / focal, globals.right.w / focal);
+}
+
+// A camera ray's march result as a pixel: sky at a miss, else the shaded
+// hit and its depth (shared by `ray_pixel` and `voxel_pixel`).
+fn shade_hit(o: vec3<f32>, d: vec3<f32>, h: MarchHit) -> PixelSample {
     var out: PixelSample;
     if (!h.hit) {
         out.color = vec4<f32>(globals.sky.rgb, 1.0);
@@ -25,6 +27,14 @@ fn ray_pixel(px: f32, py: f32, steps: u32) -> PixelSample {
     }
     let p = o + d * h.t;
     out.color = vec4<f32>(shade(p, d), 1.0);
-    out.depth = view_z_to_depth(h.t * focal);
+    out.depth = view_z_to_depth(h.t * globals.eye.w);
     return out;
+}
+
+// March the camera ray of image point (px, py) and shade it.
+fn ray_pixel(px: f32, py: f32, steps: u32) -> PixelSample {
+    let o = globals.eye.xyz;
+    let d = camera_ray(px, py);
+    let seg = camera_segment(o, d);
+    return shade_hit(o, d, march(o, d, seg.x, seg.y, steps));
 }

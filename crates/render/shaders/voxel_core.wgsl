@@ -24,31 +24,7 @@ fn voxel_leaf(o: vec3<f32>, d: vec3<f32>, ta: f32, tb: f32) -> MarchHit {
     }
     let len = (tb - ta) * length(d);
     let n = clamp(u32(ceil(len / VOXEL_SAMPLE_SPACING)), 1u, vparams.config.z);
-    let dt = (tb - ta) / f32(n);
-    var a = ta;
-    var b = tb;
-    for (var i = 1u; i <= n; i = i + 1u) {
-        let t = ta + dt * f32(i);
-        if (is_solid(o + d * t)) {
-            b = t;
-            r.hit = true;
-            break;
-        }
-        a = t;
-    }
-    if (!r.hit) {
-        return r;
-    }
-    for (var i = 0u; i < VOXEL_BISECTIONS; i = i + 1u) {
-        let c = 0.5 * (a + b);
-        if (is_solid(o + d * c)) {
-            b = c;
-        } else {
-            a = c;
-        }
-    }
-    r.t = b;
-    return r;
+    return sample_and_bisect(o, d, ta, tb, n, VOXEL_BISECTIONS);
 }
 
 // The first solid point of o + t d in [t0, t1] (already clipped to the
@@ -125,17 +101,7 @@ fn voxel_march(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, steps: u32) -> Marc
 fn voxel_pixel(px: f32, py: f32) -> PixelSample {
     let o = globals.eye.xyz;
     let d = camera_ray(px, py);
-    let focal = globals.eye.w;
-    let seg = clip_to_altitudes(o, d, globals.forward.w / focal, globals.right.w / focal);
+    let seg = camera_segment(o, d);
     let h = voxel_march(o, d, seg.x, seg.y, vparams.config.x);
-    var out: PixelSample;
-    if (!h.hit) {
-        out.color = vec4<f32>(globals.sky.rgb, 1.0);
-        out.depth = 1.0;
-        return out;
-    }
-    let p = o + d * h.t;
-    out.color = vec4<f32>(shade(p, d), 1.0);
-    out.depth = view_z_to_depth(h.t * focal);
-    return out;
+    return shade_hit(o, d, h);
 }
