@@ -6,8 +6,7 @@ mod common;
 
 use strata_camera::Camera;
 use strata_level::{Level, ViewSpec};
-use strata_reference::metrics::{self, Metrics};
-use strata_reference::render_reference;
+use strata_reference::metrics::Metrics;
 use strata_render::{Gpu, MethodSettings, Renderer, TerrainColors};
 
 const W: u32 = 160;
@@ -24,23 +23,7 @@ fn worst_over(
 ) -> Metrics {
     let mut r =
         Renderer::new(gpu, level, colors, method, &MethodSettings::default(), w, h).unwrap();
-    let mut worst = Metrics::default();
-    for view in views {
-        let camera = Camera::from_view(level, view, w, h).unwrap();
-        let t = r.render_frame(&camera).unwrap();
-        let depth = r.read_depth().unwrap();
-        let reference = render_reference(level, &camera);
-        let m = metrics::compare(&reference, &metrics::distance_from_depth(&camera, &depth));
-        eprintln!(
-            "{method:8} {:12} pitch {:4}: {} gpu {:?} ms",
-            view.name,
-            view.pitch,
-            common::metrics_line(&m),
-            t.gpu_ms.map(|g| (g * 10.0).round() / 10.0),
-        );
-        common::fold_worst(&mut worst, &m);
-    }
-    worst
+    common::worst_over_views(&mut r, level, views, (w, h), method, |_, _, _, _| {})
 }
 
 #[test]

@@ -8,8 +8,7 @@ mod common;
 use strata_camera::Camera;
 use strata_level::generate::generate;
 use strata_level::{Level, ViewSpec};
-use strata_reference::metrics::{self, Metrics};
-use strata_reference::render_reference;
+use strata_reference::metrics::Metrics;
 use strata_render::{Gpu, MethodSettings, Renderer, TerrainColors};
 
 fn settings() -> MethodSettings {
@@ -33,41 +32,32 @@ fn worst_over(
         "mesh setup (fit + upload + pipelines): {:.1} ms",
         r.setup_ms()
     );
-    let mut worst = Metrics::default();
-    for view in views {
-        let camera = Camera::from_view(level, view, w, h).unwrap();
-        let t = r.render_frame(&camera).unwrap();
-        let depth = r.read_depth().unwrap();
-        common::save_png(&r, &format!("mesh-{}", view.name), (w, h));
-        let reference = render_reference(level, &camera);
-        let dist = metrics::distance_from_depth(&camera, &depth);
-        let m = metrics::compare(&reference, &dist);
-        if std::env::var("MESH_DEBUG").as_deref() == Ok(view.name.as_str()) {
-            for j in 0..h as usize {
-                let row: String = (0..w as usize)
-                    .map(|i| {
-                        let k = j * w as usize + i;
-                        match (reference.distance[k].is_finite(), dist[k].is_finite()) {
-                            (true, true) => '#',
-                            (true, false) => 'R',
-                            (false, true) => 'M',
-                            _ => '.',
-                        }
-                    })
-                    .collect();
-                eprintln!("{row}");
+    common::worst_over_views(
+        &mut r,
+        level,
+        views,
+        (w, h),
+        "mesh",
+        |r, view, reference, distance| {
+            common::save_png(r, &format!("mesh-{}", view.name), (w, h));
+            if std::env::var("MESH_DEBUG").as_deref() == Ok(view.name.as_str()) {
+                for j in 0..h as usize {
+                    let row: String = (0..w as usize)
+                        .map(|i| {
+                            let k = j * w as usize + i;
+                            match (reference.distance[k].is_finite(), distance[k].is_finite()) {
+                                (true, true) => '#',
+                                (true, false) => 'R',
+                                (false, true) => 'M',
+                                _ => '.',
+                            }
+                        })
+                        .collect();
+                    eprintln!("{row}");
+                }
             }
-        }
-        eprintln!(
-            "mesh {:12} pitch {:4}: {} gpu {:?} ms",
-            view.name,
-            view.pitch,
-            common::metrics_line(&m),
-            t.gpu_ms.map(|g| (g * 10.0).round() / 10.0),
-        );
-        common::fold_worst(&mut worst, &m);
-    }
-    worst
+        },
+    )
 }
 
 #[test]

@@ -128,6 +128,40 @@ pub fn metrics_line(m: &Metrics) -> String {
     )
 }
 
+/// Render each of `views` with `r` at `(w, h)`, compare it with the CPU
+/// reference, log the view's metrics and GPU time under `label`, and return
+/// the worst of each metric. `each` sees every view's renderer, reference and
+/// distances (for pictures and debug maps).
+pub fn worst_over_views(
+    r: &mut strata_render::Renderer,
+    level: &Level,
+    views: &[ViewSpec],
+    (w, h): (u32, u32),
+    label: &str,
+    mut each: impl FnMut(&strata_render::Renderer, &ViewSpec, &strata_reference::Reference, &[f32]),
+) -> Metrics {
+    use strata_reference::metrics;
+    let mut worst = Metrics::default();
+    for view in views {
+        let camera = strata_camera::Camera::from_view(level, view, w, h).unwrap();
+        let t = r.render_frame(&camera).unwrap();
+        let depth = r.read_depth().unwrap();
+        let reference = strata_reference::render_reference(level, &camera);
+        let distance = metrics::distance_from_depth(&camera, &depth);
+        each(r, view, &reference, &distance);
+        let m = metrics::compare(&reference, &distance);
+        eprintln!(
+            "{label:8} {:12} pitch {:4}: {} gpu {:?} ms",
+            view.name,
+            view.pitch,
+            metrics_line(&m),
+            t.gpu_ms.map(|g| (g * 10.0).round() / 10.0),
+        );
+        fold_worst(&mut worst, &m);
+    }
+    worst
+}
+
 /// Raise `worst` to at least `m`, field by field.
 pub fn fold_worst(worst: &mut Metrics, m: &Metrics) {
     worst.see_through = worst.see_through.max(m.see_through);
