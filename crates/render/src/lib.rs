@@ -15,6 +15,10 @@
 //! # Ok(()) }
 //! ```
 
+// Lets the in-crate tests share `tests/common` (which names this crate).
+#[cfg(test)]
+extern crate self as strata_render;
+
 pub mod frame;
 pub mod gpu;
 pub mod methods;

@@ -5,26 +5,21 @@
 
 use super::super::voxel_build::GpuPyramid;
 use crate::frame::{Shared, TerrainColors};
-use crate::{Gpu, MethodSettings, Renderer};
+use crate::{MethodSettings, Renderer};
 use strata_camera::Camera;
 use strata_level::generate::{GenerateParams, generate};
 use strata_level::{DirtyRect, Level, World};
 use strata_occupancy::{Pyramid, VoxelSize};
-use strata_reference::metrics::{Metrics, compare, distance_from_depth};
-use strata_reference::render_reference;
+use strata_reference::metrics::distance_from_depth;
+
+// The integration tests' helpers (adapter skip, metric loops, distance
+// comparisons); `strata_render::` paths there resolve through the
+// `extern crate self` alias in lib.rs.
+#[path = "../../tests/common/mod.rs"]
+mod common;
 
 const W: u32 = 160;
 const H: u32 = 100;
-
-fn gpu() -> Option<Gpu> {
-    match Gpu::headless() {
-        Ok(g) => Some(g),
-        Err(e) => {
-            eprintln!("\n\n*** SKIPPED: no GPU adapter ({e}) ***\n");
-            None
-        }
-    }
-}
 
 fn world(width: u32, height: u32) -> World {
     generate(&GenerateParams {
@@ -59,7 +54,7 @@ fn drain(p: &mut GpuPyramid, shared: &Shared) -> u32 {
 
 #[test]
 fn gpu_pyramid_equals_cpu_twin_before_and_after_an_edit() {
-    let Some(gpu) = gpu() else { return };
+    let Some(gpu) = common::gpu() else { return };
     let w = world(256, 512);
     // Budgets: a few tile rows per submission, and less than one tile row
     // (one (4,8,2) tile column is 2048 texels), which splits rows into columns.
@@ -123,39 +118,16 @@ fn diff(a: &[u32], b: &[u32]) -> String {
     )
 }
 
-/// Render one view with a method and score it against the CPU reference.
-fn score(r: &mut Renderer, level: &Level, camera: &Camera) -> Metrics {
-    r.render_frame(camera).unwrap();
-    let depth = r.read_depth().unwrap();
-    let reference = render_reference(level, camera);
-    compare(&reference, &distance_from_depth(camera, &depth))
-}
-
 #[test]
 fn voxel_matches_the_reference_over_pitches() {
-    let Some(gpu) = gpu() else { return };
-    let w = world(512, 1024);
+    let Some(gpu) = common::gpu() else { return };
+    let w = common::generated_world();
     let colors = TerrainColors::from_world(&w);
     let settings = MethodSettings::default();
     for method in ["voxel", "voxel-compute"] {
         let mut r = Renderer::new(&gpu, &w.level, &colors, method, &settings, W, H).unwrap();
-        let mut worst = Metrics::default();
-        for view in &w.views {
-            let camera = Camera::from_view(&w.level, view, W, H).unwrap();
-            let m = score(&mut r, &w.level, &camera);
-            eprintln!(
-                "{method} {:>12} pitch {:>4}: see-through {:.3}% covers-sky {:.3}% coherence {:.3}% p50 {:.3} p95 {:.3}",
-                view.name,
-                view.pitch,
-                m.see_through,
-                m.covers_sky,
-                m.coherence,
-                m.depth_p50,
-                m.depth_p95
-            );
-            worst.see_through = worst.see_through.max(m.see_through);
-            worst.coherence = worst.coherence.max(m.coherence);
-        }
+        let worst =
+            common::worst_over_views(&mut r, &w.level, &w.views, (W, H), method, |_, _, _, _| {});
         assert!(
             worst.see_through <= 0.5,
             "{method}: see-through {:.3}%",
@@ -177,8 +149,8 @@ const EH: u32 = 400;
 
 #[test]
 fn first_frame_after_the_crater_matches_a_fresh_build() {
-    let Some(gpu) = gpu() else { return };
-    let w = world(512, 1024);
+    let Some(gpu) = common::gpu() else { return };
+    let w = common::generated_world();
     let colors = TerrainColors::from_world(&w);
     let settings = MethodSettings::default();
     let site = w.edit.clone().unwrap();
@@ -194,20 +166,7 @@ fn first_frame_after_the_crater_matches_a_fresh_build() {
     let clean = fresh.read_depth().unwrap();
     let a = distance_from_depth(&camera, &edited);
     let b = distance_from_depth(&camera, &clean);
-    let class_mismatch = a
-        .iter()
-        .zip(&b)
-        .filter(|(x, y)| x.is_finite() != y.is_finite())
-        .count();
-    let mut d: Vec<f32> = a
-        .iter()
-        .zip(&b)
-        .filter(|(x, y)| x.is_finite() && y.is_finite())
-        .map(|(x, y)| (x - y).abs())
-        .collect();
-    d.sort_by(f32::total_cmp);
-    let p95 = d.get(d.len() * 95 / 100).copied().unwrap_or(0.0);
-    let pct = 100.0 * class_mismatch as f64 / a.len() as f64;
+    let (pct, p95) = common::distance_mismatch(&a, &b);
     eprintln!("crater first frame vs fresh build: class mismatch {pct:.4}%, p95 {p95:.4}");
     assert!(pct <= 0.01, "class mismatch {pct}%");
     assert!(p95 <= 0.1, "p95 {p95}");
@@ -229,7 +188,7 @@ fn first_frame_after_the_crater_matches_a_fresh_build() {
 
 #[test]
 fn bad_settings_are_clear_errors() {
-    let Some(gpu) = gpu() else { return };
+    let Some(gpu) = common::gpu() else { return };
     let level = Level::flat(256, 256, 40, 1).unwrap();
     let colors = TerrainColors::test_ramps();
     let zero = MethodSettings {
@@ -256,7 +215,7 @@ fn bad_settings_are_clear_errors() {
 #[test]
 #[ignore]
 fn fostral_sized_build_and_frame_times() {
-    let Some(gpu) = gpu() else { return };
+    let Some(gpu) = common::gpu() else { return };
     let (iw, ih) = std::env::var("STRATA_VOXEL_BENCH")
         .ok()
         .and_then(|s| {
@@ -331,15 +290,14 @@ fn fostral_sized_build_and_frame_times() {
 /// before reaching distant terrain, and the default budget does not.
 #[test]
 fn step_budget_is_honoured() {
-    let Some(gpu) = gpu() else { return };
-    let w = world(512, 1024);
+    let Some(gpu) = common::gpu() else { return };
+    let w = common::generated_world();
     let colors = TerrainColors::from_world(&w);
     let view = w
         .views
         .iter()
         .find(|v| v.pitch == 0.0)
         .expect("a horizon view");
-    let camera = Camera::from_view(&w.level, view, W, H).unwrap();
     let mut see_through = Vec::new();
     for steps in [4, 100] {
         let settings = MethodSettings {
@@ -348,7 +306,15 @@ fn step_budget_is_honoured() {
         };
         let mut r =
             Renderer::new(&gpu, &w.level, &colors, "voxel-compute", &settings, W, H).unwrap();
-        let m = score(&mut r, &w.level, &camera);
+        // The "worst" over one view is that view's metrics.
+        let m = common::worst_over_views(
+            &mut r,
+            &w.level,
+            std::slice::from_ref(view),
+            (W, H),
+            "voxel-compute",
+            |_, _, _, _| {},
+        );
         eprintln!(
             "{} steps {steps}: see-through {:.3}%",
             view.name, m.see_through
