@@ -61,6 +61,9 @@ pub const MAX_DENSITY: f32 = 64.0;
 /// vertically: (4, 4, 4) is 1.25 across (one exactly left holes in about 1 %
 /// of a horizon view), 1 along and 1 vertically.
 pub const PER_PIXEL: [f32; 3] = [0.3125, 0.25, 0.25];
+/// Radius (texels, a square) around the eye whose highest column top sets
+/// the clearance `h`.
+pub const NEAR_RADIUS: f32 = 96.0;
 /// Side of the tiles of the level's column-top maximum, texels.
 const TILE: u32 = 16;
 /// Most footprint polygon vertices the uniform holds (a frustum cut by a slab
@@ -208,6 +211,19 @@ impl TopMax {
         }
     }
 
+    /// The highest column top in `camera`'s footprint and within
+    /// [`NEAR_RADIUS`] of its eye.
+    pub fn bounds(&self, camera: &Camera) -> (f32, f32) {
+        let Some((lo, hi)) = footprint_bounds(camera, camera.far) else {
+            return (0.0, 0.0);
+        };
+        let (e, r) = (camera.position, NEAR_RADIUS);
+        (
+            self.max_in(lo, hi),
+            self.max_in([e.x - r, e.y - r], [e.x + r, e.y + r]),
+        )
+    }
+
     /// The highest column top with texel (x, y) in `lo..=hi` (wrapping).
     pub fn max_in(&self, lo: [f32; 2], hi: [f32; 2]) -> f32 {
         let range = |k: usize| {
@@ -268,25 +284,35 @@ pub fn slab_points(camera: &Camera, top: f32) -> Vec<Vec3> {
 }
 
 /// The grid for `camera` at `density` (X, Y, Z, each already within
-/// [`MAX_DENSITY`]) when no column top in the footprint is above `max_top`, at
+/// [`MAX_DENSITY`]) when no column top in the footprint is above `max_top`
+/// and none within [`NEAR_RADIUS`] of the eye above `near_top`, at
 /// most `max_samples` samples; the second value is a warning when the grid
 /// had to be scaled down.
 pub fn scatter_grid(
     camera: &Camera,
     density: [f32; 3],
     max_top: f32,
+    near_top: f32,
     max_samples: u64,
 ) -> (ScatterParams, Option<String>) {
     let b = camera.basis();
     let e = camera.position;
     let [xp, yp, zp] = [0, 1, 2].map(|i| density[i] * PER_PIXEL[i]);
     // Clearance: a column top lies at least this far below the eye.
-    let h = (e.z - max_top).max(camera.near);
+    // Clearance over the columns within NEAR_RADIUS; a column beyond is at
+    // least NEAR_RADIUS >= 3 h away across the ground, so sqrt(r² + h²)
+    // overstates its distance by at most sqrt(1 + 1/9): `per_px` makes up
+    // for that.
+    // The clearance above the whole footprint needs no cap: the larger wins.
+    let h = (e.z - near_top.min(max_top))
+        .min(NEAR_RADIUS / 3.0)
+        .max(e.z - max_top)
+        .max(camera.near);
     let (w, ht) = (camera.width as f32, camera.height as f32);
     let f = camera.focal_px;
     // Pixels per unit of length per unit of distance, at the image's corners
     // (the smallest pixels in angle are the ones that need the samples).
-    let per_px = f * f / (f * f + 0.25 * (w * w + ht * ht)).sqrt();
+    let per_px = f * f / (f * f + 0.25 * (w * w + ht * ht)).sqrt() * (10.0f32 / 9.0).sqrt();
     let mut params = ScatterParams {
         axes: [b.flat.x, b.flat.y, b.right.x, b.right.y],
         origin: [e.x, e.y, h, zp],
@@ -402,8 +428,8 @@ fn clip_altitudes(base: glam::Vec4, dz: glam::Vec4, lo: f32, hi: f32) -> Option<
 /// `cs_scatter`): (samples that walk a column, points scattered).
 pub fn count_points(level: &Level, camera: &Camera, density: [f32; 3]) -> (u64, u64) {
     let tops = TopMax::new(level);
-    let max_top = footprint_bounds(camera, camera.far).map_or(0.0, |(lo, hi)| tops.max_in(lo, hi));
-    let (p, _) = scatter_grid(camera, density, max_top, MAX_GRID);
+    let (max_top, near_top) = tops.bounds(camera);
+    let (p, _) = scatter_grid(camera, density, max_top, near_top, MAX_GRID);
     let vp = camera.view_proj();
     let (rows, cols) = (p.grid[0], p.grid[1]);
     let h = p.origin[2];
@@ -682,11 +708,9 @@ impl Method for Scattered {
     }
 
     fn prepare(&mut self, shared: &Shared, camera: &Camera) -> anyhow::Result<()> {
-        let max_top = match footprint_bounds(camera, camera.far) {
-            Some((lo, hi)) => self.tops.max_in(lo, hi),
-            None => 0.0,
-        };
-        let (params, warning) = scatter_grid(camera, self.density, max_top, self.max_samples);
+        let (max_top, near_top) = self.tops.bounds(camera);
+        let (params, warning) =
+            scatter_grid(camera, self.density, max_top, near_top, self.max_samples);
         if let Some(w) = warning
             && !self.warned
         {
@@ -784,9 +808,14 @@ mod tests {
         // Looking steeply down from 150: terrain no higher than 50 is at least
         // 100 away, so rows near the eye are not needed.
         let cam = Camera::new(Vec3::new(0.0, 0.0, 150.0), 0.0, -60.0, 320, 200).unwrap();
-        let (all, _) = scatter_grid(&cam, [4.0; 3], Z_MAX, MAX_GRID);
-        let (low, _) = scatter_grid(&cam, [4.0; 3], 50.0, MAX_GRID);
+        let (all, _) = scatter_grid(&cam, [4.0; 3], Z_MAX, Z_MAX, MAX_GRID);
+        let (low, _) = scatter_grid(&cam, [4.0; 3], 50.0, 50.0, MAX_GRID);
         assert!(low.origin[2] == 100.0 && all.origin[2] == 1.0, "{low:?}");
+        // Terrain up to 140 only within NEAR_RADIUS: the capped local clearance.
+        let (near, _) = scatter_grid(&cam, [4.0; 3], Z_MAX, 140.0, MAX_GRID);
+        assert_eq!(near.origin[2], 10.0);
+        let (near, _) = scatter_grid(&cam, [4.0; 3], Z_MAX, 50.0, MAX_GRID);
+        assert_eq!(near.origin[2], 32.0);
         assert!(
             low.samples() * 2 < all.samples(),
             "{} vs {}",
@@ -832,7 +861,7 @@ mod tests {
     fn grid_covers_the_view_at_every_pitch() {
         for (pitch, yaw) in [(0.0, 0.0), (-30.0, 45.0), (-60.0, 200.0), (-90.0, 10.0)] {
             let cam = Camera::new(Vec3::new(300.0, 500.0, 120.0), yaw, pitch, 160, 100).unwrap();
-            let (p, w) = scatter_grid(&cam, [4.0, 4.0, 4.0], Z_MAX, MAX_GRID);
+            let (p, w) = scatter_grid(&cam, [4.0, 4.0, 4.0], Z_MAX, Z_MAX, MAX_GRID);
             assert!(w.is_none() && p.samples() > 0 && p.samples() <= MAX_GRID);
             let b = cam.basis();
             // Points of pixel rays inside the altitude range are inside the polygon.
@@ -859,7 +888,7 @@ mod tests {
     fn a_huge_grid_is_clamped_and_bad_density_refused() {
         let mut cam = Camera::new(Vec3::new(0.0, 0.0, 100.0), 45.0, 0.0, 1280, 800).unwrap();
         cam.far = 100_000.0;
-        let (p, w) = scatter_grid(&cam, [64.0, 64.0, 4.0], Z_MAX, MAX_GRID);
+        let (p, w) = scatter_grid(&cam, [64.0, 64.0, 4.0], Z_MAX, Z_MAX, MAX_GRID);
         assert!(w.is_some() && p.samples() <= MAX_GRID && p.samples() > MAX_GRID / 2);
         for d in [[0.0, 4.0, 4.0], [4.0, -1.0, 4.0], [4.0, 4.0, f32::NAN]] {
             assert!(checked_density(d).is_err());
@@ -868,7 +897,9 @@ mod tests {
         assert_eq!(checked_density([1e9, 1.0, 1.0]).unwrap()[0], MAX_DENSITY);
         let above = Camera::new(Vec3::new(0.0, 0.0, 5000.0), 0.0, 30.0, 160, 100).unwrap();
         assert_eq!(
-            scatter_grid(&above, [4.0; 3], Z_MAX, MAX_GRID).0.samples(),
+            scatter_grid(&above, [4.0; 3], Z_MAX, Z_MAX, MAX_GRID)
+                .0
+                .samples(),
             0
         );
     }
