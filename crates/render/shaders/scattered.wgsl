@@ -184,13 +184,14 @@ fn cs_scatter(
         return;
     }
     let c = decode_column(i32(floor(xy.x)), i32(floor(xy.y)));
-    // The floor below every neighbour sample's floor (the next sample, or
-    // texel, along and across both ways) is hidden behind them, but for a
-    // strip that fills the screen gap between this column and the nearer
-    // one: the ray over the neighbour's top reaches this column
-    // (eye height over it) * spacing / distance lower.
-    let da = max(1.0, d * (params.warp.y - params.warp.x) / f32(rows));
-    let dc = max(1.0, sqrt(across * across + d * d) * (u.y - u.x) * f32(k) / f32(cols));
+    // The floor below every neighbour sample's floor (the next sample along
+    // and across, both ways; within one texel, the same column) is hidden
+    // behind them, so only samples next to a texel's edge walk its sides: the walk
+    // stops half a unit below it. (Also walking the strip a ray over the
+    // nearer neighbour could reach, as a margin for grazing views, changed no
+    // coverage and cost a third more points at -60 degrees.)
+    let da = d * (params.warp.y - params.warp.x) / f32(rows);
+    let dc = sqrt(across * across + d * d) * (u.y - u.x) * f32(k) / f32(cols);
     let fa = params.axes.xy * da;
     let fc = params.axes.zw * dc;
     // The slab's sides are hidden, likewise, where every neighbour is solid:
@@ -206,18 +207,16 @@ fn cs_scatter(
         let hn = select(vec2<f32>(-1e9, nc.low), vec2<f32>(nc.mid, nc.high), nc.dual);
         hid = vec2<f32>(max(hid.x, hn.x), min(hid.y, hn.y));
     }
-    let gap = 2.0 * max(da, dc) / max(length(vec2<f32>(a, across)), 1.0);
-    let eye = globals.eye.z;
-    let bottom = cover - max(eye - cover, 0.0) * gap - 0.5;
+    let bottom = cover - 0.5;
     let top = min(c.low, r.y);
     walk(base, dz, c, min(max(bottom, r.x), top), top);
     if (c.dual) {
         let lo = max(c.mid, r.x);
         let hi = min(c.high, r.y);
         // Walk down from the top to the hidden core and from the core to the
-        // underside, each with the gap margin (seen from above, from below).
-        let core_top = hid.y - max(eye - hid.y, 0.0) * gap - 0.5;
-        let core_bottom = hid.x + max(hid.x - eye, 0.0) * gap + 0.5;
+        // underside.
+        let core_top = hid.y - 0.5;
+        let core_bottom = hid.x + 0.5;
         if (core_bottom < core_top) {
             walk(base, dz, c, min(max(core_top, lo), hi), hi);
             walk(base, dz, c, lo, max(min(core_bottom, hi), lo));

@@ -8,7 +8,7 @@
 //! Every density is in screen terms: X, Y and Z ask for `X * PER_PIXEL[0]`
 //! samples per pixel across, `Y * PER_PIXEL[1]` along the (warped) distance
 //! axis and `Z * PER_PIXEL[2]` per pixel of a column's projected height. The
-//! paper's default (4, 4, 4) is 1.25, 1 and 1 ([`PER_PIXEL`]): a point splats
+//! paper's default (4, 4, 4) is 1.25, 1 and 1.25 ([`PER_PIXEL`]): a point splats
 //! one pixel, so fewer leave holes (2 per 4 pixels: 50 % see-through at the
 //! horizon) and more buy little. Work per frame grows with the image, not
 //! with the world's texels.
@@ -33,10 +33,12 @@
 //!   column `[mid, high]`, over the part that projects into the view (clipped
 //!   analytically), each step `1 / Z'` pixels of the interval's projected
 //!   height at that point, so a far column takes a few points and a column
-//!   seen end-on one. The floor walk stops where it is hidden behind the four
-//!   neighbouring samples' floors (at the grid spacing, at least a texel),
-//!   less a margin that fills the screen gap between rows at grazing views;
-//!   without it most points of a horizon view were buried inside the terrain.
+//!   seen end-on one. The floor walk stops half a unit below the four
+//!   neighbouring samples' floors (at the grid spacing: only the samples next
+//!   to a texel's edge walk its sides),
+//!   where boxes would hide it, and the slab's walk skips the part every
+//!   neighbour's slab (or floor) hides; without this most points of a horizon
+//!   view were buried inside the terrain.
 //!
 //! A sample whose whole column (0..=256) is off screen returns before reading
 //! the texture. A grid over [`MAX_GRID`] samples is scaled down (both axes
@@ -59,8 +61,9 @@ pub const MAX_GRID: u64 = 1 << 24;
 pub const MAX_DENSITY: f32 = 64.0;
 /// Samples per pixel that a density of 1 asks for, across, along and
 /// vertically: (4, 4, 4) is 1.25 across (one exactly left holes in about 1 %
-/// of a horizon view), 1 along and 1 vertically.
-pub const PER_PIXEL: [f32; 3] = [0.3125, 0.25, 0.25];
+/// of a horizon view), 1 along and 1.25 vertically (one left rows of holes in
+/// near walls, which only the samples next to a texel's edge walk).
+pub const PER_PIXEL: [f32; 3] = [0.3125, 0.25, 0.3125];
 /// Radius (texels, a square) around the eye whose highest column top sets
 /// the clearance `h`.
 pub const NEAR_RADIUS: f32 = 96.0;
@@ -449,7 +452,7 @@ pub fn count_points(level: &Level, camera: &Camera, density: [f32; 3]) -> (u64, 
         } else {
             1
         };
-        let da = (d * (p.warp[1] - p.warp[0]) / rows as f32).max(1.0);
+        let da = (d * (p.warp[1] - p.warp[0]) / rows as f32);
         for col in (0..cols).step_by(k as usize) {
             let across = d * (u.0 + (u.1 - u.0) * (col as f32 + 0.5) / cols as f32).sinh();
             let x = p.origin[0] + p.axes[0] * a + p.axes[2] * across;
@@ -461,8 +464,7 @@ pub fn count_points(level: &Level, camera: &Camera, density: [f32; 3]) -> (u64, 
             };
             samples += 1;
             let c = level.column_at(x, y);
-            let dc =
-                ((across * across + d * d).sqrt() * (u.1 - u.0) * k as f32 / cols as f32).max(1.0);
+            let dc = (across * across + d * d).sqrt() * (u.1 - u.0) * k as f32 / cols as f32;
             let mut cover = f32::from(c.low);
             let mut hid = (-1e9f32, 1e9f32);
             for (fa, fc) in [(da, 0.0), (-da, 0.0), (0.0, dc), (0.0, -dc)] {
@@ -477,15 +479,12 @@ pub fn count_points(level: &Level, camera: &Camera, density: [f32; 3]) -> (u64, 
                 };
                 hid = (hid.0.max(hn.0), hid.1.min(hn.1));
             }
-            let gap = 2.0 * da.max(dc) / (a * a + across * across).sqrt().max(1.0);
-            let eye = camera.position.z;
-            let bottom = cover - (eye - cover).max(0.0) * gap - 0.5;
+            let bottom = cover - 0.5;
             let top = r1.min(f32::from(c.low));
             let mut intervals = vec![(bottom.max(r0).min(top), top)];
             if c.dual {
                 let (lo, hi) = (r0.max(f32::from(c.mid)), r1.min(f32::from(c.high)));
-                let core_top = hid.1 - (eye - hid.1).max(0.0) * gap - 0.5;
-                let core_bottom = hid.0 + (hid.0 - eye).max(0.0) * gap + 0.5;
+                let (core_top, core_bottom) = (hid.1 - 0.5, hid.0 + 0.5);
                 if core_bottom < core_top {
                     intervals.push((core_top.max(lo).min(hi), hi));
                     intervals.push((lo, core_bottom.min(hi).max(lo)));
