@@ -452,7 +452,7 @@ pub fn count_points(level: &Level, camera: &Camera, density: [f32; 3]) -> (u64, 
         } else {
             1
         };
-        let da = (d * (p.warp[1] - p.warp[0]) / rows as f32);
+        let da = d * (p.warp[1] - p.warp[0]) / rows as f32;
         for col in (0..cols).step_by(k as usize) {
             let across = d * (u.0 + (u.1 - u.0) * (col as f32 + 0.5) / cols as f32).sinh();
             let x = p.origin[0] + p.axes[0] * a + p.axes[2] * across;
