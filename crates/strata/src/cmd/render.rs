@@ -71,7 +71,7 @@ pub struct MethodArgs {
     #[arg(long, value_name = "N", value_parser = parse_positive,
           default_value_t = MethodSettings::default().slices)]
     pub slices: u32,
-    /// `scattered`: footprint samples per unit, X,Y,Z (or one D for all three).
+    /// `scattered`: grid density X,Y,Z in screen terms (4 → 1.25 samples per pixel across, 1 per pixel along, 1.25 per pixel of projected height), or one D for all three.
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_density,
           default_value_t = Triple(MethodSettings::default().scatter_density))]
     pub scatter_density: Triple<f32>,
