@@ -246,7 +246,13 @@ mod tests {
 
     #[test]
     fn projection_inverts_pixel_rays() {
-        for (yaw, pitch) in [(0.0, 0.0), (299.0, -30.0), (158.0, -60.0), (10.0, -90.0), (45.0, 20.0)] {
+        for (yaw, pitch) in [
+            (0.0, 0.0),
+            (299.0, -30.0),
+            (158.0, -60.0),
+            (10.0, -90.0),
+            (45.0, 20.0),
+        ] {
             let c = cam(yaw, pitch, 320, 200);
             for (i, j) in [(0, 0), (319, 199), (160, 100), (17, 150)] {
                 let dist = 123.0;
@@ -265,7 +271,11 @@ mod tests {
         let c = cam(0.0, 0.0, 16, 16);
         assert!((c.view_z_to_depth(c.near)).abs() < 1e-6);
         assert!((c.view_z_to_depth(c.far) - 1.0).abs() < 1e-6);
-        assert!((c.depth_to_view_z(0.5) - c.depth_to_view_z(c.view_z_to_depth(c.depth_to_view_z(0.5)))).abs() < 1e-3);
+        assert!(
+            (c.depth_to_view_z(0.5) - c.depth_to_view_z(c.view_z_to_depth(c.depth_to_view_z(0.5))))
+                .abs()
+                < 1e-3
+        );
     }
 
     #[test]
@@ -277,8 +287,14 @@ mod tests {
         let b = large.project(p).unwrap();
         // 512 px focal: a point 30 units right and 20 up at distance 256 is
         // 60 px right and 40 px up of the centre at every image size.
-        assert!((a.x - 200.0 - 60.0).abs() < 1e-3 && (a.y - 130.0 + 40.0).abs() < 1e-3, "{a}");
-        assert!((b.x - 640.0 - 60.0).abs() < 1e-3 && (b.y - 400.0 + 40.0).abs() < 1e-3, "{b}");
+        assert!(
+            (a.x - 200.0 - 60.0).abs() < 1e-3 && (a.y - 130.0 + 40.0).abs() < 1e-3,
+            "{a}"
+        );
+        assert!(
+            (b.x - 640.0 - 60.0).abs() < 1e-3 && (b.y - 400.0 + 40.0).abs() < 1e-3,
+            "{b}"
+        );
     }
 
     #[test]
@@ -288,7 +304,13 @@ mod tests {
         let c = Camera::from_view(&level, &view, 32, 16).unwrap();
         assert_eq!(c.position, Vec3::new(54.0, 6.0, 35.0));
         let inside = ViewSpec::parse("v", "1,1:0:-5", 0.0).unwrap();
-        assert!(matches!(Camera::from_view(&level, &inside, 32, 16), Err(CameraError::EyeInSolid { .. })));
-        assert!(matches!(Camera::from_view(&level, &view, 0, 16), Err(CameraError::Size(0, 16))));
+        assert!(matches!(
+            Camera::from_view(&level, &inside, 32, 16),
+            Err(CameraError::EyeInSolid { .. })
+        ));
+        assert!(matches!(
+            Camera::from_view(&level, &view, 0, 16),
+            Err(CameraError::Size(0, 16))
+        ));
     }
 }

@@ -83,7 +83,11 @@ fn load(args: &Args) -> anyhow::Result<(String, Level)> {
             .split_once('x')
             .and_then(|(w, h)| Some((w.parse::<u32>().ok()?, h.parse::<u32>().ok()?)))
             .context("--synthetic wants WxH, e.g. 2048x16384")?;
-        if !w.is_power_of_two() || !h.is_power_of_two() || w < 2 || w > 1 << 15 || h > 1 << 15 {
+        if !w.is_power_of_two()
+            || !h.is_power_of_two()
+            || !(2..=1 << 15).contains(&w)
+            || h > 1 << 15
+        {
             bail!("--synthetic {w}x{h}: sides must be powers of two, 2..=32768");
         }
         return Ok((format!("synthetic-{w}x{h}"), synthetic_level(w, h, 1)));
