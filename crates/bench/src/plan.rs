@@ -140,8 +140,15 @@ pub fn file_part(label: &str) -> String {
     s.trim_matches('-').to_string()
 }
 
-/// `git describe --always --dirty` of the working directory, or "unknown".
+/// `$STRATA_SOURCE_REVISION` when set (a binary copied to a machine without
+/// the checkout), else `git describe --always --dirty` of the working
+/// directory, or "unknown".
 pub fn source_revision() -> String {
+    if let Ok(rev) = std::env::var("STRATA_SOURCE_REVISION")
+        && !rev.trim().is_empty()
+    {
+        return rev.trim().to_string();
+    }
     let run = |args: &[&str]| {
         std::process::Command::new("git")
             .args(args)
