@@ -38,6 +38,7 @@ pub mod painted;
 pub mod ray;
 pub mod ray_compute;
 pub mod scattered;
+mod scattered_grid;
 pub mod sliced;
 pub mod voxel;
 pub mod voxel_build;
