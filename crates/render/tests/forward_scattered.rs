@@ -6,7 +6,6 @@
 mod common;
 
 use strata_camera::Camera;
-use strata_level::generate::{GenerateParams, generate};
 use strata_level::{Level, ViewSpec};
 use strata_reference::metrics::{self, Metrics};
 use strata_reference::render_reference;
@@ -34,23 +33,14 @@ fn per_pitch(
             // The second frame is the timed one (the first compiles lazily).
             let t = r.render_frame(&camera).unwrap();
             let depth = r.read_depth().unwrap();
-            if let Ok(dir) = std::env::var("STRATA_TEST_OUT") {
-                // Pictures for a human: STRATA_TEST_OUT=/tmp/x cargo test ...
-                let path = std::path::Path::new(&dir).join(format!("scattered-{}.png", view.name));
-                std::fs::create_dir_all(&dir).unwrap();
-                strata_render::report::write_png(&path, w, h, &r.read_color().unwrap()).unwrap();
-            }
+            common::save_png(&r, &format!("scattered-{}", view.name), (w, h));
             let reference = render_reference(level, &camera);
             let m = metrics::compare(&reference, &metrics::distance_from_depth(&camera, &depth));
             eprintln!(
-                "scattered {:12} pitch {:4}: see-through {:6.3} % covers-sky {:.3} % coherence {:.3} % p50 {:.3} p95 {:.3} | gpu {:?} ms cpu {:.1} ms",
+                "scattered {:12} pitch {:4}: {} | gpu {:?} ms cpu {:.1} ms",
                 view.name,
                 view.pitch,
-                m.see_through,
-                m.covers_sky,
-                m.coherence,
-                m.depth_p50,
-                m.depth_p95,
+                common::metrics_line(&m),
                 t.gpu_ms.map(|g| (g * 10.0).round() / 10.0),
                 t.cpu_ms,
             );
@@ -58,11 +48,7 @@ fn per_pitch(
             mean.see_through += m.see_through;
             mean.covers_sky += m.covers_sky;
             mean.coherence += m.coherence;
-            worst.see_through = worst.see_through.max(m.see_through);
-            worst.covers_sky = worst.covers_sky.max(m.covers_sky);
-            worst.coherence = worst.coherence.max(m.coherence);
-            worst.depth_p50 = worst.depth_p50.max(m.depth_p50);
-            worst.depth_p95 = worst.depth_p95.max(m.depth_p95);
+            common::fold_worst(&mut worst, &m);
         }
         if n > 0.0 {
             mean.see_through /= n;
@@ -76,15 +62,6 @@ fn per_pitch(
         }
     }
     out
-}
-
-fn world() -> strata_level::World {
-    generate(&GenerateParams {
-        seed: 6,
-        width: 512,
-        height: 1024,
-    })
-    .expect("generated world")
 }
 
 #[test]
@@ -116,7 +93,7 @@ fn scattered_matches_the_reference() {
 #[test]
 fn scattered_matches_the_reference_on_a_generated_world() {
     let Some(gpu) = common::gpu() else { return };
-    let w = world();
+    let w = common::generated_world();
     let colors = TerrainColors::from_world(&w);
     let pitches = per_pitch(&gpu, &w.level, &colors, &w.views, (160, 100));
     assert_eq!(pitches.len(), 4, "three views per pitch expected");
@@ -145,59 +122,10 @@ fn scattered_matches_the_reference_on_a_generated_world() {
     }
 }
 
-/// The world's crater, dug after the first frame: the next frame's distances
-/// against a renderer built fresh from the edited level (class mismatch %,
-/// p95, pixels the crater changed). The same protocol as the painted/sliced
-/// test in forward_sliced_painted.rs.
-fn crater_against_fresh(gpu: &Gpu, method: &str) -> (f64, f32, usize) {
-    // The fixture's camera stands 158 back and 40 up at pitch -30: the crater
-    // is about 14 degrees down, in frame only in a tall image.
-    let (w_px, h_px) = (160, 400);
-    let w = world();
-    let colors = TerrainColors::from_world(&w);
-    let settings = MethodSettings::default();
-    let site = w.edit.clone().expect("generated worlds carry an edit site");
-    let mut level = w.level.clone();
-    let camera = Camera::from_view(&level, &site.camera, w_px, h_px).unwrap();
-    let mut r = Renderer::new(gpu, &level, &colors, method, &settings, w_px, h_px).unwrap();
-    r.render_frame(&camera).unwrap();
-    let before = r.read_depth().unwrap();
-    let rects = strata_level::edit::crater(&mut level, &site);
-    r.apply_edit(&level, &rects).unwrap();
-    r.render_frame(&camera).unwrap();
-    let after = metrics::distance_from_depth(&camera, &r.read_depth().unwrap());
-    let mut fresh = Renderer::new(gpu, &level, &colors, method, &settings, w_px, h_px).unwrap();
-    fresh.render_frame(&camera).unwrap();
-    let want = metrics::distance_from_depth(&camera, &fresh.read_depth().unwrap());
-    let changed = metrics::distance_from_depth(&camera, &before)
-        .iter()
-        .zip(&after)
-        .filter(|(a, b)| a.is_finite() != b.is_finite() || (*a - *b).abs() > 1e-3)
-        .count();
-    let mismatch = after
-        .iter()
-        .zip(&want)
-        .filter(|(a, b)| a.is_finite() != b.is_finite())
-        .count();
-    let mut d: Vec<f32> = after
-        .iter()
-        .zip(&want)
-        .filter(|(a, b)| a.is_finite() && b.is_finite())
-        .map(|(a, b)| (a - b).abs())
-        .collect();
-    d.sort_by(f32::total_cmp);
-    let p95 = d.get(d.len() * 95 / 100).copied().unwrap_or(0.0);
-    let pct = 100.0 * mismatch as f64 / after.len() as f64;
-    eprintln!(
-        "{method}: crater changed {changed} pixels; vs fresh: class mismatch {pct:.4} %, p95 {p95:.4}"
-    );
-    (pct, p95, changed)
-}
-
 #[test]
 fn scattered_shows_a_crater_in_the_next_frame() {
     let Some(gpu) = common::gpu() else { return };
-    let (pct, p95, changed) = crater_against_fresh(&gpu, "scattered");
+    let (pct, p95, changed) = common::crater_against_fresh(&gpu, "scattered");
     assert!(
         changed > 100,
         "the crater left (almost) no trace: {changed}"
@@ -267,7 +195,7 @@ fn memory_and_bad_settings() {
 /// now 3.7 M), 2.7 G in all.
 #[test]
 fn points_per_frame_stay_within_budget() {
-    let w = world();
+    let w = common::generated_world();
     let (px, py) = (160u32, 100u32);
     let mut total = 0;
     for view in &w.views {
