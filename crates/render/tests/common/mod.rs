@@ -18,10 +18,22 @@ pub fn gpu() -> Option<Gpu> {
             Some(gpu)
         }
         Err(e) => {
-            eprintln!("SKIPPED: no GPU adapter ({e:#})");
+            skip_loudly(&format!("no GPU adapter ({e:#})"));
             None
         }
     }
+}
+
+/// Report a skipped GPU test where the harness cannot swallow it: libtest
+/// captures `eprintln!` of passing tests, so this writes to the process's
+/// stderr directly. With `STRATA_REQUIRE_GPU=1` (CI, which installs lavapipe)
+/// a missing adapter fails the test instead.
+pub fn skip_loudly(why: &str) {
+    use std::io::Write;
+    if std::env::var_os("STRATA_REQUIRE_GPU").is_some_and(|v| v == "1") {
+        panic!("STRATA_REQUIRE_GPU=1 but {why}");
+    }
+    let _ = writeln!(std::io::stderr(), "\n*** SKIPPED GPU test: {why} ***\n");
 }
 
 /// 256x256: terraces with cliffs, a water basin, a bridge slab and a cave.
