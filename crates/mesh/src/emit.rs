@@ -258,31 +258,39 @@ impl Emitter {
     }
 }
 
-/// Sort 48-bit keys (three u16 indices) by LSD radix, 8 bits a pass,
-/// skipping passes whose digit is the same for every key. Faster than a
-/// comparison sort for the few thousand keys of a chunk LOD.
+/// Sort 48-bit keys (three u16 indices) by LSD radix, 12 bits a pass (four
+/// passes, histograms counted in one read), skipping passes whose digit is
+/// the same for every key. Faster than a comparison sort for the few
+/// thousand keys of a chunk LOD.
 fn radix_sort(keys: &mut Vec<u64>, scratch: &mut Vec<u64>) {
+    const BITS: u32 = 12;
+    const BUCKETS: usize = 1 << BITS;
+    const PASSES: usize = 4;
+    const MASK: u64 = BUCKETS as u64 - 1;
     scratch.clear();
     scratch.resize(keys.len(), 0);
-    for pass in 0..6 {
-        let shift = pass * 8;
-        let mut count = [0usize; 256];
-        for &k in keys.iter() {
-            count[((k >> shift) & 0xff) as usize] += 1;
+    let mut count = vec![[0u32; BUCKETS]; PASSES];
+    for &k in keys.iter() {
+        for (pass, c) in count.iter_mut().enumerate() {
+            c[((k >> (pass as u32 * BITS)) & MASK) as usize] += 1;
         }
-        if count.contains(&keys.len()) {
+    }
+    let n = keys.len() as u32;
+    for (pass, c) in count.iter_mut().enumerate() {
+        if c.contains(&n) {
             continue;
         }
+        let shift = pass as u32 * BITS;
         let mut sum = 0;
-        for c in count.iter_mut() {
-            let n = *c;
-            *c = sum;
-            sum += n;
+        for v in c.iter_mut() {
+            let x = *v;
+            *v = sum;
+            sum += x;
         }
         for &k in keys.iter() {
-            let d = ((k >> shift) & 0xff) as usize;
-            scratch[count[d]] = k;
-            count[d] += 1;
+            let d = ((k >> shift) & MASK) as usize;
+            scratch[c[d] as usize] = k;
+            c[d] += 1;
         }
         std::mem::swap(keys, scratch);
     }
