@@ -15,7 +15,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 use strata_camera::Camera;
 use strata_level::{EditSite, ViewSpec, World};
-use strata_reference::{Reference, ReferenceCache};
+use strata_reference::{Reference, ReferenceCache, Tracer};
 use strata_render::{Gpu, MethodSettings, Renderer, TerrainColors};
 
 /// Texels the incremental voxel build processes per frame
@@ -247,12 +247,24 @@ impl Plan {
             )
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
         );
+        // Hash the level once (64 MiB for a Fostral-sized map) and build the
+        // tracer's pyramid only if some view misses the cache.
+        let level = &self.world.level;
+        let hash = level.content_hash();
+        let mut tracer: Option<Tracer> = None;
         let mut out = Vec::new();
         for (v, (view, camera)) in self.opts.views.iter().zip(&self.cameras).enumerate() {
             bar.set_message(view.name.clone());
-            let r = cache
-                .get_or_compute(&self.world.level, camera)
-                .with_context(|| format!("reference of view `{}`", view.name))?;
+            let r = match cache.get(&hash, camera) {
+                Some(r) => r,
+                None => {
+                    let tracer = tracer.get_or_insert_with(|| Tracer::new(level));
+                    cache
+                        .get_or_compute_traced(tracer, &hash, camera)
+                        .with_context(|| format!("reference of view `{}`", view.name))?
+                        .0
+                }
+            };
             session.save_picture(
                 v,
                 0,
