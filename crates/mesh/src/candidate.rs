@@ -123,6 +123,20 @@ const NUDGE: f64 = 1.0 / 4096.0;
 /// triangles of a fine fit): no span arithmetic, no per-row setup.
 const SMALL: i32 = 48;
 
+/// How each edge function of the triangle changes per sample step in x and
+/// in y (`w_i(x, y) = w_i(x0, y0) + dx[i] (x - x0) + dy[i] (y - y0)`).
+#[inline(always)]
+fn edge_steps(pts: [Pt; 3]) -> ([i32; 3], [i32; 3]) {
+    let mut dx = [0i32; 3];
+    let mut dy = [0i32; 3];
+    for i in 0..3 {
+        let (u, v) = (pts[(i + 1) % 3], pts[(i + 2) % 3]);
+        dx[i] = u[1] - v[1];
+        dy[i] = v[0] - u[0];
+    }
+    (dx, dy)
+}
+
 #[inline(always)]
 fn scan_small(
     pts: [Pt; 3],
@@ -135,13 +149,7 @@ fn scan_small(
     let [x0, y0, x1, y1] = bbox;
     let stride = chunk.stride();
     // Edge functions and interpolant numerators, stepped per sample.
-    let mut dx = [0i32; 3];
-    let mut dy = [0i32; 3];
-    for i in 0..3 {
-        let (u, v) = (pts[(i + 1) % 3], pts[(i + 2) % 3]);
-        dx[i] = u[1] - v[1];
-        dy[i] = v[0] - u[0];
-    }
+    let (dx, dy) = edge_steps(pts);
     let z = |f: usize| {
         [
             i32::from(zs[0][f]),
@@ -200,13 +208,7 @@ fn scan_rows<const F: usize>(
     let [x0, y0, x1, y1] = bbox;
     let stride = chunk.stride();
     // w_i(x, y) = w_i(x0, y0) + dx[i] (x - x0) + dy[i] (y - y0).
-    let mut dx = [0i32; 3];
-    let mut dy = [0i32; 3];
-    for i in 0..3 {
-        let (u, v) = (pts[(i + 1) % 3], pts[(i + 2) % 3]);
-        dx[i] = u[1] - v[1];
-        dy[i] = v[0] - u[0];
-    }
+    let (dx, dy) = edge_steps(pts);
     let mut w_row = barycentric(a, b, c, [x0, y0]);
     let inv = dx.map(|d| {
         if d == 0 {
