@@ -138,6 +138,103 @@ fn dual_writes(rule: MidRule, c: Column) -> [Write; 2] {
     }
 }
 
+/// `rect` widened to whole pairs and clipped to one map's extent: the
+/// unwrapped even start x, the width and the height; `None` when empty.
+fn pair_extent(level: &Level, rect: EditRect) -> Option<(i64, u32, u32)> {
+    // Even start, even end. (i128: coordinates may be anywhere in i64.)
+    let x0 = rect.x.div_euclid(2) * 2;
+    let x_end = (i128::from(rect.x) + i128::from(rect.width) + 1).div_euclid(2) * 2;
+    let width = u32::try_from(x_end - i128::from(x0))
+        .unwrap_or(u32::MAX)
+        .min(level.width());
+    let height = rect.height.min(level.height());
+    (rect.width > 0 && height > 0).then_some((x0, width, height))
+}
+
+/// The in-map rectangles `rect` covers once widened to whole pairs (split at
+/// the map edges): what an edit over `rect` may touch.
+pub fn covered_rects(level: &Level, rect: EditRect) -> Vec<DirtyRect> {
+    let Some((x0, width, height)) = pair_extent(level, rect) else {
+        return Vec::new();
+    };
+    let mut out = Vec::new();
+    for (x, w) in spans(x0, width, level.width()) {
+        for (y, h) in spans(rect.y, height, level.height()) {
+            out.push(DirtyRect {
+                x,
+                y,
+                width: w,
+                height: h,
+            });
+        }
+    }
+    out
+}
+
+/// The raw bytes (heights and metas, every bit) of the texels an edit over
+/// a rectangle may touch, taken before the edit so it can be undone exactly.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Snapshot {
+    rects: Vec<DirtyRect>,
+    heights: Vec<u8>,
+    metas: Vec<u8>,
+}
+
+impl Snapshot {
+    /// Copy what an edit over `rect` may change.
+    pub fn take(level: &Level, rect: EditRect) -> Self {
+        let rects = covered_rects(level, rect);
+        let (mut heights, mut metas) = (Vec::new(), Vec::new());
+        for r in &rects {
+            for y in r.y..r.y + r.height {
+                let (hr, mr) = level.row(y);
+                let span = r.x as usize..(r.x + r.width) as usize;
+                heights.extend_from_slice(&hr[span.clone()]);
+                metas.extend_from_slice(&mr[span]);
+            }
+        }
+        Snapshot {
+            rects,
+            heights,
+            metas,
+        }
+    }
+
+    /// The level must be the one the snapshot was taken of (same size).
+    /// Writes the bytes back and returns the rectangles rewritten.
+    pub fn restore(&self, level: &mut Level) -> Vec<DirtyRect> {
+        let w = level.width() as usize;
+        let (hs, ms) = level.planes_mut();
+        let mut at = 0;
+        for r in &self.rects {
+            let n = r.width as usize;
+            for y in r.y..r.y + r.height {
+                let row = y as usize * w + r.x as usize;
+                hs[row..row + n].copy_from_slice(&self.heights[at..at + n]);
+                ms[row..row + n].copy_from_slice(&self.metas[at..at + n]);
+                at += n;
+            }
+        }
+        self.rects.clone()
+    }
+
+    /// Bytes held.
+    pub fn bytes(&self) -> usize {
+        self.heights.len() + self.metas.len()
+    }
+}
+
+/// The unwrapped rectangle [`crater`] edits.
+pub fn crater_rect(site: &EditSite) -> EditRect {
+    let r = i64::from(site.radius);
+    EditRect {
+        x: site.centre_x.saturating_sub(r),
+        y: site.centre_y.saturating_sub(r),
+        width: site.radius.saturating_mul(2).saturating_add(1),
+        height: site.radius.saturating_mul(2).saturating_add(1),
+    }
+}
+
 /// Apply `f(x, y, column) -> column` over `rect` (unwrapped coordinates;
 /// `x`, `y` passed to `f` are unwrapped too, so distances from a centre
 /// work across the edges). The rectangle is widened to whole pairs and
@@ -151,17 +248,9 @@ pub fn edit_columns(
 ) -> Vec<DirtyRect> {
     let (w, h) = (level.width(), level.height());
     let rule = level.mid_rule;
-    // Widen to whole pairs: even start, even end.
-    // (i128: coordinates may be anywhere in i64, also at its ends.)
-    let x0 = rect.x.div_euclid(2) * 2;
-    let x_end = (i128::from(rect.x) + i128::from(rect.width) + 1).div_euclid(2) * 2;
-    let width = u32::try_from(x_end - i128::from(x0))
-        .unwrap_or(u32::MAX)
-        .min(w);
-    let height = rect.height.min(h);
-    if rect.width == 0 || height == 0 {
+    let Some((x0, width, height)) = pair_extent(level, rect) else {
         return Vec::new();
-    }
+    };
     let wu = w as usize;
     let mut dirty = Vec::new();
     for (sx, sw) in spans(x0, width, w) {
@@ -253,16 +342,9 @@ pub fn fill_single(level: &mut Level, rect: EditRect, height: u8, terrain: u8) -
 /// `depth (1 - d²/r²)` (never below 0) and the upper layer is removed
 /// (dual pairs become single at the lowered floor).
 pub fn crater(level: &mut Level, site: &EditSite) -> Vec<DirtyRect> {
-    let r = i64::from(site.radius);
     let r2 = (site.radius as f32).powi(2);
     let (cx, cy) = (site.centre_x, site.centre_y);
-    let rect = EditRect {
-        x: cx.saturating_sub(r),
-        y: cy.saturating_sub(r),
-        width: site.radius.saturating_mul(2).saturating_add(1),
-        height: site.radius.saturating_mul(2).saturating_add(1),
-    };
-    edit_columns(level, rect, |x, y, c| {
+    edit_columns(level, crater_rect(site), |x, y, c| {
         let (dx, dy) = (x.wrapping_sub(cx) as f32, y.wrapping_sub(cy) as f32);
         let d2 = dx * dx + dy * dy;
         if d2 >= r2 {

@@ -300,3 +300,31 @@ fn crater_lowers_the_floor_removes_slabs_and_wraps() {
     assert_eq!(flat.column(38, 16).low, 200);
     assert_eq!(flat.mid_rule, MidRule::Original);
 }
+
+/// A snapshot taken before a crater undoes it exactly, every bit, also when
+/// the crater wraps over a corner of the map; the edit's changes lie inside
+/// the snapshot's rectangles.
+#[test]
+fn snapshot_undoes_a_crater_exactly_across_the_corner() {
+    use strata_level::edit::{Snapshot, covered_rects, crater_rect};
+    let original = synthetic(64, 32, 11);
+    for (cx, cy) in [(30, 16), (1, 0), (63, 31), (-5, 40)] {
+        let site = EditSite {
+            centre_x: cx,
+            centre_y: cy,
+            radius: 9,
+            depth: 30.0,
+            ..EditSite::fostral()
+        };
+        let mut level = original.clone();
+        let snapshot = Snapshot::take(&level, crater_rect(&site));
+        let dirty = crater(&mut level, &site);
+        assert!(!dirty.is_empty(), "crater at {cx},{cy} changed nothing");
+        let inside = covered(&covered_rects(&level, crater_rect(&site)), &level);
+        assert!(changed(&original, &level).is_subset(&inside));
+        let restored = snapshot.restore(&mut level);
+        assert_eq!(restored, covered_rects(&level, crater_rect(&site)));
+        assert!(level == original, "undo at {cx},{cy} left differences");
+        assert!(snapshot.bytes() <= 2 * 20 * 19);
+    }
+}

@@ -1,11 +1,17 @@
-//! [`Renderer`]: the shared frame plus one method, the API the CLI and the
-//! harness drive: build, `render_frame`, `apply_edit`, read back, report memory.
+//! [`Renderer`]: the shared frame plus the methods built on it, the API the
+//! CLI, the harness and the viewer drive: build, `render_frame`, `apply_edit`,
+//! read back, report memory.
+//!
+//! One method is active and drawn by `render_frame`; others may be kept
+//! (the viewer switches between them without reloading the level). Every kept
+//! method follows every edit, so switching never shows stale terrain.
 
 use crate::frame::{Globals, LevelShape, Shared, TerrainColors};
 use crate::gpu::{ErrorSink, Gpu, read_buffer, wait_device};
 use crate::methods::{self, Frame, Method, MethodSettings, RetainedBytes};
 use crate::shadow::{ShadowFrame, ShadowPass};
 use crate::timing::{FrameTimings, MAX_TIMED_PASSES, PassTimer};
+use std::sync::Arc;
 use std::time::Instant;
 use strata_camera::Camera;
 use strata_level::{DirtyRect, Level};
@@ -18,12 +24,20 @@ pub struct Measured {
     pub timings: Vec<FrameTimings>,
 }
 
-/// One method rendering one level at one size.
-pub struct Renderer {
-    shared: Shared,
+/// A built method and the settings it was built with.
+struct Built {
     method: Box<dyn Method>,
-    shadow: ShadowPass,
     settings: MethodSettings,
+}
+
+/// Methods drawing one level at one size over one shared frame.
+pub struct Renderer {
+    /// Shared with background method builds ([`Renderer::shared_handle`]).
+    shared: Arc<Shared>,
+    /// Every kept method; `methods[active]` is drawn.
+    methods: Vec<Built>,
+    active: usize,
+    shadow: ShadowPass,
     timer: PassTimer,
     /// Resolve target and mappable copy of the timestamps.
     stamps: Option<(wgpu::Buffer, wgpu::Buffer)>,
@@ -54,7 +68,14 @@ impl Renderer {
                 methods::names().join(", ")
             );
         }
-        let shared = Shared::new(&gpu.device, &gpu.queue, level, colors, width, height)?;
+        let shared = Arc::new(Shared::new(
+            &gpu.device,
+            &gpu.queue,
+            level,
+            colors,
+            width,
+            height,
+        )?);
         let method = methods::create(method, &shared, level, settings)?;
         let shadow = ShadowPass::new(&shared)?;
         let timer = PassTimer::new(&gpu.device, gpu.report.timestamps);
@@ -76,9 +97,12 @@ impl Renderer {
         });
         let mut renderer = Renderer {
             shared,
-            method,
+            methods: vec![Built {
+                method,
+                settings: settings.clone(),
+            }],
+            active: 0,
             shadow,
-            settings: settings.clone(),
             timer,
             stamps,
             period_ns: f64::from(gpu.queue.get_timestamp_period()),
@@ -93,8 +117,65 @@ impl Renderer {
         Ok(renderer)
     }
 
+    /// The active method's name.
     pub fn method_name(&self) -> &'static str {
-        self.method.name()
+        self.methods[self.active].method.name()
+    }
+
+    /// The names of the kept methods, in the order they were built.
+    pub fn method_names(&self) -> Vec<&'static str> {
+        self.methods.iter().map(|b| b.method.name()).collect()
+    }
+
+    /// The settings method `name` was built with, if it is kept.
+    pub fn settings_of(&self, name: &str) -> Option<&MethodSettings> {
+        self.find(name).map(|i| &self.methods[i].settings)
+    }
+
+    fn find(&self, name: &str) -> Option<usize> {
+        self.methods.iter().position(|b| b.method.name() == name)
+    }
+
+    /// Build method `name` on this renderer's shared frame (replacing a kept
+    /// one of that name) without activating it.
+    pub fn build_method(
+        &mut self,
+        level: &Level,
+        name: &str,
+        settings: &MethodSettings,
+    ) -> anyhow::Result<()> {
+        let method = methods::create(name, &self.shared, level, settings)?;
+        wait_device(&self.shared.device, &self.errors)?;
+        self.insert_method(method, settings.clone());
+        Ok(())
+    }
+
+    /// Keep a method built elsewhere on [`Renderer::shared_handle`] (a
+    /// background thread, say), replacing a kept one of the same name. The
+    /// caller must have applied every edit made since its build started.
+    pub fn insert_method(&mut self, method: Box<dyn Method>, settings: MethodSettings) {
+        let built = Built { method, settings };
+        match self.find(built.method.name()) {
+            Some(i) => self.methods[i] = built,
+            None => self.methods.push(built),
+        }
+    }
+
+    /// Draw method `name` from the next frame on; it must have been built.
+    pub fn activate(&mut self, name: &str) -> anyhow::Result<()> {
+        self.active = self.find(name).ok_or_else(|| {
+            anyhow::anyhow!(
+                "method `{name}` is not built; kept: {}",
+                self.method_names().join(", ")
+            )
+        })?;
+        Ok(())
+    }
+
+    /// The shared frame, for building methods off the render thread:
+    /// `methods::create(name, &handle, level, settings)`.
+    pub fn shared_handle(&self) -> Arc<Shared> {
+        Arc::clone(&self.shared)
     }
 
     /// The adapter this renderer runs on.
@@ -108,8 +189,9 @@ impl Renderer {
         self.setup_ms
     }
 
+    /// The active method's settings.
     pub fn settings(&self) -> &MethodSettings {
-        &self.settings
+        &self.methods[self.active].settings
     }
 
     /// The shared resources (for tests and tools that inspect them).
@@ -130,19 +212,21 @@ impl Renderer {
             );
         }
         let record_start = Instant::now();
-        let shadow = ShadowFrame::fit(camera, self.settings.shadows);
+        let shadows = self.settings().shadows;
+        let shadow = ShadowFrame::fit(camera, shadows);
         let globals = Globals::new(camera, &self.level_shape, &shadow);
         self.shared
             .queue
             .write_buffer(&self.shared.globals, 0, bytemuck::bytes_of(&globals));
-        self.method.prepare(&self.shared, camera)?;
+        let method = &mut self.methods[self.active].method;
+        method.prepare(&self.shared, camera)?;
 
         let mut encoder = self
             .shared
             .device
             .create_command_encoder(&Default::default());
         self.timer.reset();
-        if self.settings.shadows {
+        if shadows {
             self.shadow.record(&mut encoder, &self.timer);
         }
         let frame = Frame {
@@ -150,7 +234,9 @@ impl Renderer {
             timer: &self.timer,
             index: self.frames,
         };
-        self.method.record(&self.shared, &frame, &mut encoder);
+        self.methods[self.active]
+            .method
+            .record(&self.shared, &frame, &mut encoder);
         let used = self.timer.used();
         if let (Some((resolve, read)), Some(qs)) = (&self.stamps, self.timer.query_set())
             && used > 0
@@ -229,12 +315,14 @@ impl Renderer {
     }
 
     /// The level changed inside `rects` (`level` is the edited level): upload
-    /// only those rectangles, then let the method update its derived data.
+    /// only those rectangles, then let every kept method update its derived data.
     pub fn apply_edit(&mut self, level: &Level, rects: &[DirtyRect]) -> anyhow::Result<()> {
         self.shared
             .terrain
             .upload(&self.shared.queue, level, rects)?;
-        self.method.apply_edit(&self.shared, level, rects)?;
+        for built in &mut self.methods {
+            built.method.apply_edit(&self.shared, level, rects)?;
+        }
         Ok(())
     }
 
@@ -249,9 +337,15 @@ impl Renderer {
         Ok(bytemuck::cast_slice::<u8, f32>(&raw).to_vec())
     }
 
-    /// Bytes the method keeps beyond the shared resources.
+    /// Bytes the active method keeps beyond the shared resources.
     pub fn retained_bytes(&self) -> RetainedBytes {
-        self.method.retained_bytes()
+        self.methods[self.active].method.retained_bytes()
+    }
+
+    /// Bytes kept method `name` keeps beyond the shared resources.
+    pub fn retained_bytes_of(&self, name: &str) -> Option<RetainedBytes> {
+        self.find(name)
+            .map(|i| self.methods[i].method.retained_bytes())
     }
 
     /// Bytes of the shared resources (terrain, uniforms, shadow map, targets).

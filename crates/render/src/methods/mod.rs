@@ -98,8 +98,9 @@ pub struct Frame<'a> {
     pub index: u64,
 }
 
-/// One way of drawing the terrain.
-pub trait Method {
+/// One way of drawing the terrain. `Send`, so a method can be built on a
+/// background thread (the viewer's first use of `mesh`) and handed over.
+pub trait Method: Send {
     /// The name the factory knows it by.
     fn name(&self) -> &'static str;
 
