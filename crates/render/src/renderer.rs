@@ -172,6 +172,14 @@ impl Renderer {
         Ok(())
     }
 
+    /// Turn the shared shadow map on or off for every kept method (a frame
+    /// setting: no method data depends on it).
+    pub fn set_shadows(&mut self, on: bool) {
+        for built in &mut self.methods {
+            built.settings.shadows = on;
+        }
+    }
+
     /// The shared frame, for building methods off the render thread:
     /// `methods::create(name, &handle, level, settings)`.
     pub fn shared_handle(&self) -> Arc<Shared> {

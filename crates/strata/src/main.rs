@@ -34,6 +34,8 @@ enum Command {
     Compare(cmd::compare::Args),
     /// Merge results from several machines into one report.
     Merge(cmd::merge::Args),
+    /// Open a window: fly over the level, switch methods live, dig craters.
+    View(cmd::view::Args),
 }
 
 fn main() -> std::process::ExitCode {
@@ -47,6 +49,7 @@ fn main() -> std::process::ExitCode {
         Command::Fit(args) => cmd::fit::run(args),
         Command::Compare(args) => cmd::compare::run(args),
         Command::Merge(args) => cmd::merge::run(args),
+        Command::View(args) => cmd::view::run(args),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

@@ -8,3 +8,4 @@ pub mod merge;
 pub mod metrics;
 pub mod reference;
 pub mod render;
+pub mod view;

@@ -157,7 +157,7 @@ fn parse_quality(text: &str) -> Result<f32, String> {
     }
 }
 
-fn parse_size(text: &str) -> Result<(u32, u32), String> {
+pub fn parse_size(text: &str) -> Result<(u32, u32), String> {
     let (w, h) = text
         .split_once('x')
         .ok_or("size must be WxH, e.g. 1280x800")?;

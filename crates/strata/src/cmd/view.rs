@@ -1,0 +1,66 @@
+//! `strata view`: the interactive viewer (crate `strata-viewer`). Fly over the
+//! level, switch methods live, dig craters; `--script` or `--frames N
+//! --screenshot PATH` run it without a person.
+
+use crate::cmd::render::{MethodArgs, parse_size};
+use crate::world_arg::WorldArgs;
+use std::path::PathBuf;
+use strata_viewer::{Options, Script};
+
+#[derive(clap::Args)]
+pub struct Args {
+    #[command(flatten)]
+    pub world: WorldArgs,
+    /// The method to draw first (1-8 switch later); built in the background while `ray` shows.
+    #[arg(long, default_value = "ray")]
+    pub method: String,
+    /// One of the level's named views to start at (default: its first).
+    #[arg(long, value_name = "NAME")]
+    pub view: Option<String>,
+    /// Window size at start.
+    #[arg(long, default_value = "1280x800", value_parser = parse_size)]
+    pub size: (u32, u32),
+    /// Render size as a fraction of the window size [default: 1, or 0.5 on a CPU adapter].
+    #[arg(long, value_name = "F")]
+    pub render_scale: Option<f32>,
+    /// Run the commands of FILE (see `strata_viewer::script`), then quit.
+    #[arg(long, value_name = "FILE", conflicts_with = "frames")]
+    pub script: Option<PathBuf>,
+    /// Draw N frames, then quit (with --screenshot: save the last).
+    #[arg(long, value_name = "N")]
+    pub frames: Option<u32>,
+    /// With --frames: save the last frame here as PNG.
+    #[arg(long, value_name = "PATH", requires = "frames")]
+    pub screenshot: Option<PathBuf>,
+    /// Present without waiting for the display's refresh (frame rate unbounded).
+    #[arg(long)]
+    pub no_vsync: bool,
+    #[command(flatten)]
+    pub method_args: MethodArgs,
+    /// Where screenshots (key P) go.
+    #[arg(long, default_value = "out/view")]
+    pub out: PathBuf,
+}
+
+pub fn run(args: Args) -> anyhow::Result<()> {
+    // Check what can be checked before loading the world.
+    let script = match (&args.script, args.frames) {
+        (Some(path), _) => Some(Script::load(path)?),
+        (None, Some(0)) => anyhow::bail!("--frames must be at least 1"),
+        (None, Some(n)) => Some(Script::frames_then_screenshot(n, args.screenshot.clone())),
+        (None, None) => None,
+    };
+    let settings = args.method_args.settings();
+    let world = args.world.load()?;
+    strata_viewer::run(Options {
+        world,
+        method: args.method,
+        settings,
+        size: args.size,
+        render_scale: args.render_scale,
+        view: args.view,
+        script,
+        vsync: !args.no_vsync,
+        out: args.out,
+    })
+}

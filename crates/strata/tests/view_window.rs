@@ -1,0 +1,223 @@
+//! `strata view` in a real window: a scripted flight with one method switch
+//! and digs, checked on its screenshots. Needs a display: `DISPLAY`, or an
+//! `Xvfb` on the PATH that the test starts itself (`apt install xvfb`).
+//! Without one it skips loudly; with `STRATA_REQUIRE_DISPLAY=1` (CI) it fails.
+
+use image::RgbaImage;
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+const STRATA: &str = env!("CARGO_BIN_EXE_strata");
+const WINDOW: (u32, u32) = (480, 300);
+
+/// Print where libtest cannot swallow it; fail instead where CI demands it.
+fn skip_loudly(why: &str, required_by: &str) {
+    use std::io::Write;
+    if std::env::var_os(required_by).is_some_and(|v| v == "1") {
+        panic!("{required_by}=1 but {why}");
+    }
+    let _ = writeln!(std::io::stderr(), "\n*** SKIPPED window test: {why} ***\n");
+}
+
+/// An X display: the session's own, or an Xvfb started for this test.
+struct Display {
+    name: String,
+    xvfb: Option<Child>,
+}
+
+impl Drop for Display {
+    fn drop(&mut self) {
+        if let Some(child) = &mut self.xvfb {
+            let _ = child.kill();
+            let _ = child.wait();
+        }
+    }
+}
+
+fn display() -> Option<Display> {
+    if let Some(name) = std::env::var("DISPLAY").ok().filter(|d| !d.is_empty()) {
+        return Some(Display { name, xvfb: None });
+    }
+    // -displayfd: Xvfb picks a free display and writes its number when ready.
+    let mut child = Command::new("Xvfb")
+        .args([
+            "-displayfd",
+            "1",
+            "-screen",
+            "0",
+            "1024x768x24",
+            "-nolisten",
+            "tcp",
+        ])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .ok()?;
+    let mut line = String::new();
+    let stdout = child.stdout.take()?;
+    let read = BufReader::new(stdout).read_line(&mut line);
+    let number: Option<u32> = read.ok().and_then(|_| line.trim().parse().ok());
+    let display = Display {
+        name: format!(":{}", number?),
+        xvfb: Some(child),
+    };
+    Some(display)
+}
+
+fn run(mut command: Command, limit: Duration) -> (bool, String, String) {
+    let out_path = std::env::temp_dir().join(format!("strata-view-{}.out", std::process::id()));
+    let err_path = out_path.with_extension("err");
+    let mut child = command
+        .stdout(std::fs::File::create(&out_path).unwrap())
+        .stderr(std::fs::File::create(&err_path).unwrap())
+        .spawn()
+        .expect("the strata binary starts");
+    let start = Instant::now();
+    let status = loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            break Some(status);
+        }
+        if start.elapsed() > limit {
+            let _ = child.kill();
+            let _ = child.wait();
+            break None;
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    };
+    let read = |p: &Path| std::fs::read_to_string(p).unwrap_or_default();
+    let (stdout, stderr) = (read(&out_path), read(&err_path));
+    let _ = (
+        std::fs::remove_file(&out_path),
+        std::fs::remove_file(&err_path),
+    );
+    assert!(
+        status.is_some(),
+        "strata view ran past {limit:?}:\n{stderr}"
+    );
+    (status.is_some_and(|s| s.success()), stdout, stderr)
+}
+
+fn load(dir: &Path, name: &str) -> RgbaImage {
+    let path = dir.join(name);
+    image::open(&path)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+        .to_rgba8()
+}
+
+/// Mean absolute channel difference over the central half of the picture.
+fn centre_difference(a: &RgbaImage, b: &RgbaImage) -> f64 {
+    assert_eq!(a.dimensions(), b.dimensions());
+    let (w, h) = a.dimensions();
+    let (mut sum, mut n) = (0u64, 0u64);
+    for y in h / 4..3 * h / 4 {
+        for x in w / 4..3 * w / 4 {
+            let (p, q) = (a.get_pixel(x, y), b.get_pixel(x, y));
+            for c in 0..3 {
+                sum += u64::from(p[c].abs_diff(q[c]));
+            }
+            n += 3;
+        }
+    }
+    sum as f64 / n as f64
+}
+
+#[test]
+fn scripted_flight_switches_method_digs_and_undoes() {
+    let Some(display) = display() else {
+        skip_loudly(
+            "no display (set DISPLAY or install xvfb)",
+            "STRATA_REQUIRE_DISPLAY",
+        );
+        return;
+    };
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("view_window");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let world = dir.join("world");
+    let generated = Command::new(STRATA)
+        .args(["generate", "--size", "256x512", "--out"])
+        .arg(&world)
+        .output()
+        .unwrap();
+    assert!(generated.status.success(), "{generated:?}");
+
+    let shots = dir.join("shots");
+    let script = dir.join("flight.txt");
+    std::fs::write(
+        &script,
+        format!(
+            "# looking straight down on the depot, overlay hidden for exact pictures\n\
+             view depot\noverlay off\nframes 2\n\
+             screenshot {s}/ray-before.png\n\
+             dig 0.5 0.5\nscreenshot {s}/ray-dug.png\n\
+             undo\nscreenshot {s}/ray-undone.png\n\
+             method mesh\nscreenshot {s}/mesh-before.png\n\
+             dig 0.5 0.5\nscreenshot {s}/mesh-dug.png\n\
+             copy-view dug\n\
+             overlay on\nfly -20 0 30 4\nturn 0 20 2\nscreenshot {s}/final.png\n",
+            s = shots.display()
+        ),
+    )
+    .unwrap();
+    let runtime = dir.join("xdg");
+    std::fs::create_dir_all(&runtime).unwrap();
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        std::fs::set_permissions(&runtime, std::fs::Permissions::from_mode(0o700)).unwrap();
+    }
+    let mut command = Command::new(STRATA);
+    command
+        .args(["view", "--level"])
+        .arg(&world)
+        .args(["--size", &format!("{}x{}", WINDOW.0, WINDOW.1)])
+        .args(["--render-scale", "1", "--script"])
+        .arg(&script)
+        .env("DISPLAY", &display.name)
+        .env_remove("WAYLAND_DISPLAY")
+        .env("XDG_RUNTIME_DIR", &runtime);
+    let (ok, stdout, stderr) = run(command, Duration::from_secs(600));
+    if !ok && stderr.contains("no GPU adapter") {
+        skip_loudly("no GPU adapter", "STRATA_REQUIRE_GPU");
+        return;
+    }
+    assert!(ok, "strata view failed:\n{stderr}");
+    eprintln!("{stderr}");
+
+    // The whole window, at the size asked for.
+    let before = load(&shots, "ray-before.png");
+    assert_eq!(before.dimensions(), WINDOW);
+    // The crater shows on the first frame after the dig...
+    let dug = load(&shots, "ray-dug.png");
+    let dig_change = centre_difference(&before, &dug);
+    assert!(
+        dig_change > 5.0,
+        "the dig changed the centre by {dig_change:.2}"
+    );
+    // ...and undo gives back exactly the picture before it.
+    let undone = load(&shots, "ray-undone.png");
+    assert!(undone == before, "undo left a different picture");
+    // After the switch, the mesh follows its own dig on the next frame: its
+    // picture moves towards the ray's picture of the dug terrain.
+    let mesh_before = load(&shots, "mesh-before.png");
+    let mesh_dug = load(&shots, "mesh-dug.png");
+    let (was, is) = (
+        centre_difference(&mesh_before, &dug),
+        centre_difference(&mesh_dug, &dug),
+    );
+    assert!(
+        is < was * 0.5,
+        "mesh vs ray after the dig: {is:.2} (before the dig {was:.2})"
+    );
+    assert!(stderr.contains("drawing mesh"), "{stderr}");
+    // The copied view is a views.txt line that resolves on the level.
+    let line = stdout
+        .lines()
+        .find(|l| l.starts_with("dug "))
+        .unwrap_or_else(|| panic!("no copied view in {stdout}"));
+    let views = strata_level::views::parse_views(line).unwrap();
+    assert_eq!(views[0].pitch, -89.5);
+    assert_eq!(load(&shots, "final.png").dimensions(), WINDOW);
+}

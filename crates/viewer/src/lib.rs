@@ -1,0 +1,129 @@
+//! `strata view`: a window onto a level. Fly around it, switch between the
+//! methods live (each built on first use in the background, then kept), dig
+//! craters with the mouse and undo them, compare two methods side by side,
+//! and read frame rate, GPU time per pass and memory off an overlay. A
+//! script (`--script`) drives the same window without a person.
+//!
+//! Everything is drawn through the harness's [`strata_render::Renderer`],
+//! so what the window shows is what `strata compare` measures.
+//!
+//! Modules: [`fly`] (camera), [`dig`] (pick, crater, undo), [`script`],
+//! [`builds`] (background method builds), [`present`] (picture to window),
+//! [`overlay`] (egui), [`viewer`] (state and frame), and here the event loop.
+
+pub mod builds;
+pub mod dig;
+pub mod fly;
+pub mod overlay;
+pub mod present;
+pub mod script;
+pub mod viewer;
+
+use anyhow::Context;
+use std::path::PathBuf;
+use strata_level::World;
+use strata_render::MethodSettings;
+use winit::application::ApplicationHandler;
+use winit::event::WindowEvent;
+use winit::event_loop::{ActiveEventLoop, EventLoop, OwnedDisplayHandle};
+use winit::window::WindowId;
+
+pub use overlay::CONTROLS;
+pub use script::Script;
+
+/// How to open the viewer.
+pub struct Options {
+    pub world: World,
+    /// The method to draw (built in the background while `ray` shows).
+    pub method: String,
+    /// Settings methods are built with (the overlay changes them).
+    pub settings: MethodSettings,
+    /// The window's inner size at start, pixels.
+    pub size: (u32, u32),
+    /// Render size as a fraction of `size`; `None`: 1, or 0.5 on a CPU adapter.
+    pub render_scale: Option<f32>,
+    /// The level's view to start at (default: its first).
+    pub view: Option<String>,
+    pub script: Option<Script>,
+    pub vsync: bool,
+    /// Where screenshots taken with P or the overlay go.
+    pub out: PathBuf,
+}
+
+/// Open the window and run until it is closed or the script ends.
+pub fn run(options: Options) -> anyhow::Result<()> {
+    let event_loop = EventLoop::new().context(
+        "cannot open a window: no display (set DISPLAY or WAYLAND_DISPLAY, or run under Xvfb)",
+    )?;
+    let mut app = App {
+        options: Some(options),
+        display: event_loop.owned_display_handle(),
+        viewer: None,
+        error: None,
+    };
+    event_loop
+        .run_app(&mut app)
+        .context("the window's event loop failed")?;
+    match app.error {
+        Some(error) => Err(error),
+        None => Ok(()),
+    }
+}
+
+struct App {
+    options: Option<Options>,
+    display: OwnedDisplayHandle,
+    viewer: Option<viewer::Viewer>,
+    error: Option<anyhow::Error>,
+}
+
+impl App {
+    fn fail(&mut self, event_loop: &ActiveEventLoop, error: anyhow::Error) {
+        self.error.get_or_insert(error);
+        // Drop the window and GPU state before the loop ends.
+        self.viewer = None;
+        event_loop.exit();
+    }
+}
+
+impl ApplicationHandler for App {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        let Some(options) = self.options.take() else {
+            return;
+        };
+        let instance =
+            wgpu::Instance::new(wgpu::InstanceDescriptor::new_with_display_handle_from_env(
+                Box::new(self.display.clone()),
+            ));
+        match viewer::Viewer::new(event_loop, options, instance) {
+            Ok(viewer) => {
+                viewer.window().request_redraw();
+                self.viewer = Some(viewer);
+            }
+            Err(error) => self.fail(event_loop, error),
+        }
+    }
+
+    fn window_event(&mut self, event_loop: &ActiveEventLoop, _: WindowId, event: WindowEvent) {
+        let Some(viewer) = &mut self.viewer else {
+            return;
+        };
+        let result = viewer.on_window_event(&event);
+        let quit = viewer.should_quit();
+        match result {
+            Err(error) => self.fail(event_loop, error),
+            Ok(()) if quit => {
+                self.viewer = None;
+                event_loop.exit();
+            }
+            Ok(()) => {}
+        }
+    }
+
+    fn about_to_wait(&mut self, _: &ActiveEventLoop) {
+        // Draw continuously: the frame rate is part of what is shown.
+        if let Some(viewer) = &self.viewer {
+            viewer.window().request_redraw();
+        }
+    }
+}

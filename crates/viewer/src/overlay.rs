@@ -1,0 +1,467 @@
+//! The overlay (egui): frame rate, GPU time per pass, the methods and their
+//! knobs, A/B split, views, digging, memory, the adapter. It draws from a
+//! read-only [`Status`] and edits only the desired settings and crater size;
+//! everything else it asks for comes back as [`Action`]s, applied by the
+//! viewer after the frame.
+
+use crate::fly::FlyCamera;
+use crate::script::Knob;
+use egui_wgpu::ScreenDescriptor;
+use strata_level::ViewSpec;
+use strata_render::{AdapterReport, FrameTimings, MethodSettings, RetainedBytes, methods};
+use winit::window::Window;
+
+/// What the user asked for this frame.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Action {
+    Method(String),
+    Split(Option<String>),
+    View(usize),
+    /// A knob's new value is in the desired settings: rebuild what uses it.
+    Knob(Knob),
+    Undo,
+    CopyView,
+    Screenshot,
+}
+
+/// One drawn method's last frame.
+pub struct Drawn<'a> {
+    pub method: &'a str,
+    pub timings: &'a FrameTimings,
+}
+
+/// What the overlay shows.
+pub struct Status<'a> {
+    pub adapter: &'a AdapterReport,
+    pub frame_ms: f64,
+    pub drawn: Vec<Drawn<'a>>,
+    pub active: &'a str,
+    pub split: Option<&'a str>,
+    /// Kept methods and their memory beyond the shared frame.
+    pub kept: Vec<(&'a str, RetainedBytes)>,
+    pub shared_gpu_bytes: u64,
+    /// Builds running: method, seconds so far.
+    pub building: Vec<(&'a str, f64)>,
+    /// The method the viewer waits for, when it is still being built.
+    pub waiting_for: Option<&'a str>,
+    pub views: &'a [ViewSpec],
+    pub camera: &'a FlyCamera,
+    pub render_size: (u32, u32),
+    pub window_size: (u32, u32),
+    pub undo_depth: usize,
+    pub log: &'a [String],
+}
+
+/// What the overlay may change directly.
+pub struct Editable<'a> {
+    pub settings: &'a mut MethodSettings,
+    pub crater_radius: &'a mut u32,
+    pub crater_depth: &'a mut f32,
+}
+
+pub struct Overlay {
+    context: egui::Context,
+    input: egui_winit::State,
+    painter: egui_wgpu::Renderer,
+    pub visible: bool,
+}
+
+const MIB: f64 = 1024.0 * 1024.0;
+
+/// Keys and mouse, as the help section and the README list them.
+pub const CONTROLS: &[(&str, &str)] = &[
+    ("W A S D", "fly forward / left / back / right"),
+    ("Space, E / C, Q", "up / down"),
+    ("Shift", "4x speed; mouse wheel: base speed"),
+    ("right mouse drag", "look around"),
+    ("left click", "dig a crater at the cursor"),
+    ("Ctrl+Z or U", "undo the last dig"),
+    ("1 .. 8", "switch method (built on first use)"),
+    ("B", "A/B split: this method left, the previous one right"),
+    ("F1 .. F12", "jump to the level's views"),
+    (
+        "V",
+        "copy the view (views.txt line, printed and to the clipboard)",
+    ),
+    ("P", "screenshot to PNG"),
+    ("Tab", "hide / show this overlay"),
+    ("Esc", "quit"),
+];
+
+impl Overlay {
+    pub fn new(window: &Window, device: &wgpu::Device, target_format: wgpu::TextureFormat) -> Self {
+        let context = egui::Context::default();
+        let input = egui_winit::State::new(
+            context.clone(),
+            egui::ViewportId::ROOT,
+            window,
+            Some(window.scale_factor() as f32),
+            None,
+            Some(device.limits().max_texture_dimension_2d as usize),
+        );
+        let painter = egui_wgpu::Renderer::new(device, target_format, Default::default());
+        Overlay {
+            context,
+            input,
+            painter,
+            visible: true,
+        }
+    }
+
+    /// Feed a window event; true when egui used it (the viewer then ignores it).
+    pub fn on_window_event(&mut self, window: &Window, event: &winit::event::WindowEvent) -> bool {
+        self.input.on_window_event(window, event).consumed
+    }
+
+    /// Whether the pointer is over (or dragging) the overlay.
+    pub fn wants_pointer(&self) -> bool {
+        self.visible && self.context.egui_wants_pointer_input()
+    }
+
+    pub fn wants_keyboard(&self) -> bool {
+        self.visible && self.context.egui_wants_keyboard_input()
+    }
+
+    pub fn copy_text(&self, text: String) {
+        self.context.copy_text(text);
+    }
+
+    /// Lay out and paint the overlay onto `target` (loaded, not cleared).
+    #[allow(clippy::too_many_arguments)]
+    pub fn paint(
+        &mut self,
+        window: &Window,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &wgpu::TextureView,
+        status: &Status<'_>,
+        editable: &mut Editable<'_>,
+    ) -> Vec<Action> {
+        let mut actions = Vec::new();
+        let raw = self.input.take_egui_input(window);
+        let visible = self.visible;
+        let mut output = self.context.run_pass(raw, |ctx| {
+            if let Some(method) = status.waiting_for {
+                progress(ctx, method, status);
+            }
+            if visible {
+                panel(ctx, status, editable, &mut actions);
+            }
+        });
+        self.input
+            .handle_platform_output(window, output.platform_output);
+        let primitives = self
+            .context
+            .tessellate(output.shapes, output.pixels_per_point);
+        let screen = ScreenDescriptor {
+            size_in_pixels: [status.window_size.0, status.window_size.1],
+            pixels_per_point: output.pixels_per_point,
+        };
+        let mut textures = std::mem::take(&mut output.textures_delta);
+        for (id, deltas) in textures.set.drain() {
+            for delta in deltas {
+                self.painter.update_texture(device, queue, id, &delta);
+            }
+        }
+        let extra = self
+            .painter
+            .update_buffers(device, queue, encoder, &primitives, &screen);
+        if !extra.is_empty() {
+            queue.submit(extra);
+        }
+        {
+            let pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("overlay"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: target,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Load,
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: None,
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            self.painter
+                .render(&mut pass.forget_lifetime(), &primitives, &screen);
+        }
+        for id in textures.free.drain() {
+            self.painter.free_texture(&id);
+        }
+        actions
+    }
+}
+
+/// The centred note while a wanted method is still being built.
+fn progress(ctx: &egui::Context, method: &str, status: &Status<'_>) {
+    let seconds = status
+        .building
+        .iter()
+        .find(|(m, _)| *m == method)
+        .map_or(0.0, |(_, s)| *s);
+    egui::Area::new(egui::Id::unique("building"))
+        .anchor(egui::Align2::CENTER_CENTER, egui::vec2(0.0, 0.0))
+        .show(ctx, |ui| {
+            egui::Frame::popup(ui.style()).show(ui, |ui| {
+                ui.horizontal(|ui| {
+                    ui.spinner();
+                    ui.heading(format!("building {method}... {seconds:.1} s"));
+                });
+                ui.label(format!(
+                    "still drawing {} meanwhile; it is kept once built",
+                    status.active
+                ));
+            });
+        });
+}
+
+fn panel(
+    ctx: &egui::Context,
+    status: &Status<'_>,
+    editable: &mut Editable<'_>,
+    actions: &mut Vec<Action>,
+) {
+    egui::Window::new("Strata")
+        .default_pos(egui::pos2(8.0, 8.0))
+        .default_width(300.0)
+        .resizable(false)
+        .show(ctx, |ui| {
+            ui.label(format!(
+                "{} ({}, {})",
+                status.adapter.name, status.adapter.backend, status.adapter.device_type
+            ));
+            ui.label(format!(
+                "render {}x{}, window {}x{}",
+                status.render_size.0,
+                status.render_size.1,
+                status.window_size.0,
+                status.window_size.1
+            ));
+            ui.strong(format!(
+                "{:.1} fps ({:.1} ms per frame)",
+                1000.0 / status.frame_ms.max(1e-3),
+                status.frame_ms
+            ));
+            timings(ui, status);
+            ui.separator();
+            methods_section(ui, status, actions);
+            ui.separator();
+            knobs(ui, status, editable, actions);
+            ui.separator();
+            views(ui, status, actions);
+            ui.separator();
+            ui.horizontal(|ui| {
+                ui.label("crater");
+                ui.add(egui::Slider::new(editable.crater_radius, 2..=128).text("radius"));
+            });
+            ui.horizontal(|ui| {
+                ui.add(egui::Slider::new(editable.crater_depth, 5.0..=200.0).text("depth"));
+                let undo = ui.add_enabled(
+                    status.undo_depth > 0,
+                    egui::Button::new(format!("undo ({})", status.undo_depth)),
+                );
+                if undo.clicked() {
+                    actions.push(Action::Undo);
+                }
+            });
+            ui.separator();
+            memory(ui, status);
+            ui.horizontal(|ui| {
+                if ui.button("copy view").clicked() {
+                    actions.push(Action::CopyView);
+                }
+                if ui.button("screenshot").clicked() {
+                    actions.push(Action::Screenshot);
+                }
+            });
+            for line in status.log.iter().rev().take(4).rev() {
+                ui.small(line);
+            }
+            ui.collapsing("controls", |ui| {
+                egui::Grid::new("controls").show(ui, |ui| {
+                    for (keys, what) in CONTROLS {
+                        ui.monospace(*keys);
+                        ui.label(*what);
+                        ui.end_row();
+                    }
+                });
+            });
+        });
+}
+
+fn timings(ui: &mut egui::Ui, status: &Status<'_>) {
+    egui::Grid::new("timings").striped(true).show(ui, |ui| {
+        for drawn in &status.drawn {
+            let t = drawn.timings;
+            ui.strong(drawn.method);
+            ui.label(match t.gpu_ms {
+                Some(ms) => format!("GPU {ms:.2} ms"),
+                None => "GPU: no timestamps".into(),
+            });
+            ui.label(format!("wait {:.1} ms", t.cpu_ms));
+            ui.end_row();
+            for (pass, ms) in &t.passes {
+                ui.label(format!("  {pass}"));
+                ui.label(format!("{ms:.3} ms"));
+                ui.end_row();
+            }
+        }
+    });
+}
+
+fn methods_section(ui: &mut egui::Ui, status: &Status<'_>, actions: &mut Vec<Action>) {
+    ui.label("method (keys 1-8)");
+    ui.horizontal_wrapped(|ui| {
+        for (i, name) in methods::names().into_iter().enumerate() {
+            let building = status.building.iter().any(|(m, _)| *m == name);
+            let kept = status.kept.iter().any(|(m, _)| *m == name);
+            let label = format!(
+                "{} {name}{}",
+                i + 1,
+                if building {
+                    " (building)"
+                } else if kept {
+                    ""
+                } else {
+                    " *"
+                }
+            );
+            if ui
+                .selectable_label(status.active == name, label)
+                .on_hover_text(if kept {
+                    "built and kept"
+                } else if building {
+                    "being built"
+                } else {
+                    "* built on first use"
+                })
+                .clicked()
+            {
+                actions.push(Action::Method(name.to_string()));
+            }
+        }
+    });
+    ui.horizontal(|ui| {
+        let mut split = status.split.is_some();
+        if ui.checkbox(&mut split, "A/B split").changed() {
+            actions.push(Action::Split(
+                split.then(|| other_method(status.active).to_string()),
+            ));
+        }
+        if let Some(b) = status.split {
+            egui::ComboBox::from_id_salt("split method")
+                .selected_text(format!("right: {b}"))
+                .show_ui(ui, |ui| {
+                    for name in methods::names() {
+                        if name != status.active && ui.selectable_label(b == name, name).clicked() {
+                            actions.push(Action::Split(Some(name.to_string())));
+                        }
+                    }
+                });
+        }
+    });
+    for (method, seconds) in &status.building {
+        ui.horizontal(|ui| {
+            ui.spinner();
+            ui.label(format!("building {method}: {seconds:.1} s"));
+        });
+    }
+}
+
+/// A method to compare with when none was chosen.
+pub fn other_method(active: &str) -> &'static str {
+    if active == "ray" { "mesh" } else { "ray" }
+}
+
+/// Which methods read a knob.
+pub fn knob_methods(knob: Knob) -> &'static [&'static str] {
+    match knob {
+        Knob::RaySteps => &["ray", "ray-compute"],
+        Knob::VoxelSteps => &["voxel", "voxel-compute"],
+        Knob::Slices => &["sliced"],
+        Knob::Density => &["scattered"],
+        Knob::MeshQuality => &["mesh"],
+        Knob::Shadows => &[],
+    }
+}
+
+fn knobs(
+    ui: &mut egui::Ui,
+    status: &Status<'_>,
+    editable: &mut Editable<'_>,
+    actions: &mut Vec<Action>,
+) {
+    let shown: Vec<&str> = std::iter::once(status.active).chain(status.split).collect();
+    let relevant = |knob: Knob| knob_methods(knob).iter().any(|m| shown.contains(m));
+    let s = &mut *editable.settings;
+    // A rebuild starts when a drag ends (or a click or key changes a value).
+    let mut knob = |k: Knob, response: egui::Response| {
+        if response.drag_stopped() || (response.changed() && !response.dragged()) {
+            actions.push(Action::Knob(k));
+        }
+    };
+    if relevant(Knob::RaySteps) {
+        let r = ui.add(egui::Slider::new(&mut s.ray_steps, 8..=512).text("ray steps"));
+        knob(Knob::RaySteps, r);
+    }
+    if relevant(Knob::VoxelSteps) {
+        let r = ui.add(egui::Slider::new(&mut s.voxel_steps, 8..=400).text("voxel steps"));
+        knob(Knob::VoxelSteps, r);
+    }
+    if relevant(Knob::Slices) {
+        let r = ui.add(egui::Slider::new(&mut s.slices, 16..=2048).text("slices"));
+        knob(Knob::Slices, r);
+    }
+    if relevant(Knob::Density) {
+        let mut d = s.scatter_density[0];
+        let r = ui.add(egui::Slider::new(&mut d, 0.5..=8.0).text("density"));
+        s.scatter_density = [d; 3];
+        knob(Knob::Density, r);
+    }
+    if relevant(Knob::MeshQuality) {
+        let r = ui.add(egui::Slider::new(&mut s.mesh_quality, 0.0..=1.0).text("mesh quality"));
+        knob(Knob::MeshQuality, r);
+    }
+    let r = ui.checkbox(&mut s.shadows, "shadows");
+    knob(Knob::Shadows, r);
+}
+
+fn views(ui: &mut egui::Ui, status: &Status<'_>, actions: &mut Vec<Action>) {
+    let c = status.camera;
+    ui.label(format!(
+        "eye {:.0}, {:.0}, {:.0}  yaw {:.0}°  pitch {:.0}°  speed {:.0}",
+        c.position.x, c.position.y, c.position.z, c.yaw_deg, c.pitch_deg, c.speed
+    ));
+    egui::ComboBox::from_id_salt("views")
+        .selected_text("jump to view (F1-F12)")
+        .show_ui(ui, |ui| {
+            for (i, view) in status.views.iter().enumerate() {
+                if ui
+                    .selectable_label(false, format!("F{} {}", i + 1, view.name))
+                    .clicked()
+                {
+                    actions.push(Action::View(i));
+                }
+            }
+        });
+}
+
+fn memory(ui: &mut egui::Ui, status: &Status<'_>) {
+    ui.label(format!(
+        "shared frame (terrain, targets, shadow) {:.1} MiB GPU",
+        status.shared_gpu_bytes as f64 / MIB
+    ));
+    egui::Grid::new("memory").show(ui, |ui| {
+        for (method, bytes) in &status.kept {
+            ui.label(*method);
+            ui.label(format!("{:.1} MiB GPU", bytes.gpu as f64 / MIB));
+            ui.label(format!("{:.2} MiB CPU", bytes.cpu as f64 / MIB));
+            ui.end_row();
+        }
+    });
+}

@@ -1,0 +1,408 @@
+//! From the renderer's picture to the window: the picture (or an A/B pair)
+//! is composed into a window-sized image, the overlay is painted on top, and
+//! that image is copied to the swapchain. Screenshots read the window image,
+//! so they show exactly what the window shows.
+//!
+//! The render size is fixed for the session (methods bind the shared
+//! targets); a resized window scales the picture to fit, with bars.
+
+use bytemuck::{Pod, Zeroable};
+use strata_render::Shared;
+use strata_render::gpu::{ErrorSink, read_buffer};
+
+/// The window image's format: what egui paints into and screenshots hold.
+pub const WINDOW_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+
+/// Twin of `Params` in `present.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct Params {
+    viewport: [f32; 4],
+    options: [f32; 4],
+}
+
+/// A texture and its default view.
+struct Image {
+    texture: wgpu::Texture,
+    view: wgpu::TextureView,
+}
+
+fn image(
+    device: &wgpu::Device,
+    label: &str,
+    (width, height): (u32, u32),
+    usage: wgpu::TextureUsages,
+) -> Image {
+    let texture = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: WINDOW_FORMAT,
+        usage,
+        view_formats: &[],
+    });
+    let view = texture.create_view(&Default::default());
+    Image { texture, view }
+}
+
+pub struct Compositor {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    layout: wgpu::BindGroupLayout,
+    sampler: wgpu::Sampler,
+    compose: wgpu::RenderPipeline,
+    present: wgpu::RenderPipeline,
+    compose_params: wgpu::Buffer,
+    present_params: wgpu::Buffer,
+    /// The A picture of an A/B pair, copied out before B is drawn.
+    left: Image,
+    /// Binds the shared picture on both sides / the A copy left of it.
+    single_group: wgpu::BindGroup,
+    split_group: wgpu::BindGroup,
+    window: Image,
+    present_group: wgpu::BindGroup,
+    render_size: (u32, u32),
+    window_size: (u32, u32),
+}
+
+impl Compositor {
+    pub fn new(
+        shared: &Shared,
+        window_size: (u32, u32),
+        surface_format: wgpu::TextureFormat,
+    ) -> anyhow::Result<Self> {
+        let device = shared.device.clone();
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("present.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(include_str!("../shaders/present.wgsl").into()),
+        });
+        let texture_entry = |binding| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty: wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                view_dimension: wgpu::TextureViewDimension::D2,
+                multisampled: false,
+            },
+            count: None,
+        };
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("present"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+                texture_entry(1),
+                texture_entry(2),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 3,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                    count: None,
+                },
+            ],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("present"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = |entry: &str, format: wgpu::TextureFormat| {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(entry),
+                layout: Some(&pipeline_layout),
+                vertex: wgpu::VertexState {
+                    module: &module,
+                    entry_point: Some("vs_fullscreen"),
+                    compilation_options: Default::default(),
+                    buffers: &[],
+                },
+                primitive: Default::default(),
+                depth_stencil: None,
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &module,
+                    entry_point: Some(entry),
+                    compilation_options: Default::default(),
+                    targets: &[Some(format.into())],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        let compose = pipeline("fs_compose", WINDOW_FORMAT);
+        let present = pipeline("fs_present", surface_format);
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("picture"),
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            ..Default::default()
+        });
+        let params = |label| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: std::mem::size_of::<Params>() as u64,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        };
+        let (compose_params, present_params) = (params("compose"), params("present"));
+        shared.queue.write_buffer(
+            &present_params,
+            0,
+            bytemuck::bytes_of(&Params {
+                viewport: [0.0; 4],
+                options: [2.0, f32::from(u8::from(surface_format.is_srgb())), 0.0, 0.0],
+            }),
+        );
+        let render_size = (shared.width, shared.height);
+        let left = image(
+            &device,
+            "A picture",
+            render_size,
+            wgpu::TextureUsages::COPY_DST | wgpu::TextureUsages::TEXTURE_BINDING,
+        );
+        let group = |left: &wgpu::TextureView, right: &wgpu::TextureView, params: &wgpu::Buffer| {
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("present"),
+                layout: &layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: params.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: wgpu::BindingResource::TextureView(left),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: wgpu::BindingResource::TextureView(right),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 3,
+                        resource: wgpu::BindingResource::Sampler(&sampler),
+                    },
+                ],
+            })
+        };
+        let single_group = group(&shared.color_view, &shared.color_view, &compose_params);
+        let split_group = group(&left.view, &shared.color_view, &compose_params);
+        let window = Self::window_image(&device, window_size);
+        let present_group = group(&window.view, &window.view, &present_params);
+        Ok(Compositor {
+            queue: shared.queue.clone(),
+            layout,
+            sampler,
+            compose,
+            present,
+            compose_params,
+            present_params,
+            left,
+            single_group,
+            split_group,
+            window,
+            present_group,
+            render_size,
+            window_size,
+            device,
+        })
+    }
+
+    fn window_image(device: &wgpu::Device, size: (u32, u32)) -> Image {
+        use wgpu::TextureUsages as U;
+        image(
+            device,
+            "window image",
+            (size.0.max(1), size.1.max(1)),
+            U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC,
+        )
+    }
+
+    /// The window's inner size changed.
+    pub fn resize(&mut self, size: (u32, u32)) {
+        if size == self.window_size {
+            return;
+        }
+        self.window_size = size;
+        self.window = Self::window_image(&self.device, size);
+        self.present_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("present"),
+            layout: &self.layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: self.present_params.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::TextureView(&self.window.view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: wgpu::BindingResource::TextureView(&self.window.view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: wgpu::BindingResource::Sampler(&self.sampler),
+                },
+            ],
+        });
+    }
+
+    pub fn window_size(&self) -> (u32, u32) {
+        self.window_size
+    }
+
+    /// Where the picture lies in the window: x, y, width, height in pixels
+    /// (the largest fit that keeps the render's aspect, centred).
+    pub fn picture_rect(&self) -> [f32; 4] {
+        let (ww, wh) = (self.window_size.0 as f32, self.window_size.1 as f32);
+        let (rw, rh) = (self.render_size.0 as f32, self.render_size.1 as f32);
+        let scale = (ww / rw).min(wh / rh);
+        let (w, h) = (rw * scale, rh * scale);
+        [
+            ((ww - w) * 0.5).floor(),
+            ((wh - h) * 0.5).floor(),
+            w.round(),
+            h.round(),
+        ]
+    }
+
+    /// A window position (physical pixels) as a point of the rendered
+    /// picture (render pixels), or `None` on the bars.
+    pub fn window_to_picture(&self, x: f32, y: f32) -> Option<(f32, f32)> {
+        let [px, py, pw, ph] = self.picture_rect();
+        let (u, v) = ((x - px) / pw, (y - py) / ph);
+        ((0.0..1.0).contains(&u) && (0.0..1.0).contains(&v))
+            .then_some((u * self.render_size.0 as f32, v * self.render_size.1 as f32))
+    }
+
+    /// Keep the current picture as the A side of an A/B pair.
+    pub fn keep_left(&self, shared: &Shared, encoder: &mut wgpu::CommandEncoder) {
+        encoder.copy_texture_to_texture(
+            shared.color.as_image_copy(),
+            self.left.texture.as_image_copy(),
+            wgpu::Extent3d {
+                width: self.render_size.0,
+                height: self.render_size.1,
+                depth_or_array_layers: 1,
+            },
+        );
+    }
+
+    /// Draw the picture into the window image: alone, or the kept A left of
+    /// the current picture with the divider at `split` (fraction of the width).
+    pub fn compose(&self, encoder: &mut wgpu::CommandEncoder, split: Option<f32>) {
+        let params = Params {
+            viewport: self.picture_rect(),
+            options: [split.unwrap_or(2.0), 0.0, 0.0, 0.0],
+        };
+        self.queue
+            .write_buffer(&self.compose_params, 0, bytemuck::bytes_of(&params));
+        let group = if split.is_some() {
+            &self.split_group
+        } else {
+            &self.single_group
+        };
+        fullscreen(encoder, "compose", &self.window.view, &self.compose, group);
+    }
+
+    /// The window image, for the overlay to paint on (load, don't clear).
+    pub fn window_view(&self) -> &wgpu::TextureView {
+        &self.window.view
+    }
+
+    /// Copy the window image to the swapchain image `target`.
+    pub fn present(&self, encoder: &mut wgpu::CommandEncoder, target: &wgpu::TextureView) {
+        fullscreen(
+            encoder,
+            "present",
+            target,
+            &self.present,
+            &self.present_group,
+        );
+    }
+
+    /// The window image as RGBA8 (what a screenshot saves).
+    pub fn read_window(&self, errors: &ErrorSink) -> anyhow::Result<image::RgbaImage> {
+        let (w, h) = self.window_size;
+        let row = 4 * w;
+        let align = wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let padded = row.div_ceil(align) * align;
+        let size = u64::from(padded) * u64::from(h);
+        let buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("screenshot"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = self.device.create_command_encoder(&Default::default());
+        encoder.copy_texture_to_buffer(
+            self.window.texture.as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: &buffer,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(padded),
+                    rows_per_image: Some(h),
+                },
+            },
+            wgpu::Extent3d {
+                width: w,
+                height: h,
+                depth_or_array_layers: 1,
+            },
+        );
+        self.queue.submit([encoder.finish()]);
+        let raw = read_buffer(&self.device, errors, &buffer, size)?;
+        let mut pixels = Vec::with_capacity((row * h) as usize);
+        for r in raw.chunks_exact(padded as usize) {
+            pixels.extend_from_slice(&r[..row as usize]);
+        }
+        image::RgbaImage::from_raw(w, h, pixels)
+            .ok_or_else(|| anyhow::anyhow!("screenshot buffer has the wrong size"))
+    }
+}
+
+/// One full-screen triangle into `target`, overwriting it.
+fn fullscreen(
+    encoder: &mut wgpu::CommandEncoder,
+    label: &str,
+    target: &wgpu::TextureView,
+    pipeline: &wgpu::RenderPipeline,
+    group: &wgpu::BindGroup,
+) {
+    let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view: target,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations {
+                load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                store: wgpu::StoreOp::Store,
+            },
+        })],
+        depth_stencil_attachment: None,
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    });
+    pass.set_pipeline(pipeline);
+    pass.set_bind_group(0, group, &[]);
+    pass.draw(0..3, 0..1);
+}

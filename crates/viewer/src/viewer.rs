@@ -1,0 +1,882 @@
+//! The viewer's state and its frame: input to camera, script steps, finished
+//! builds, the method (or A/B pair) drawn through the harness's
+//! [`Renderer`], the overlay, and the swapchain.
+
+use crate::Options;
+use crate::builds::{Builds, Finished};
+use crate::dig::{Digger, pick};
+use crate::fly::{FlyCamera, Motion};
+use crate::overlay::{self, Action, Drawn, Editable, Overlay, Status};
+use crate::present::{Compositor, WINDOW_FORMAT};
+use crate::script::{Command, Knob};
+use anyhow::{Context, bail};
+use glam::Vec3;
+use std::collections::{HashSet, VecDeque};
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::Instant;
+use strata_camera::Camera;
+use strata_level::{DirtyRect, EditSite, Level, ViewSpec};
+use strata_render::{FrameTimings, Gpu, MethodSettings, Renderer, TerrainColors, methods};
+use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
+use winit::event_loop::ActiveEventLoop;
+use winit::keyboard::{KeyCode, PhysicalKey};
+use winit::window::Window;
+
+/// The method the window opens with while the asked-for one is built: the
+/// cheapest to set up.
+const FIRST_METHOD: &str = "ray";
+/// Lines of the overlay's log kept.
+const LOG_LINES: usize = 8;
+
+/// A script command that spans frames.
+enum Running {
+    Fly {
+        per_frame: Vec3,
+        left: u32,
+    },
+    Turn {
+        per_frame: [f32; 2],
+        left: u32,
+    },
+    Frames(u32),
+    /// Until this method is drawn (built and active, or the split's right side).
+    WaitMethod(String),
+}
+
+struct Player {
+    commands: VecDeque<(usize, Command)>,
+    running: Option<(usize, Running)>,
+}
+
+pub struct Viewer {
+    window: Arc<Window>,
+    surface: wgpu::Surface<'static>,
+    config: wgpu::SurfaceConfiguration,
+    gpu: Gpu,
+    renderer: Renderer,
+    compositor: Compositor,
+    overlay: Overlay,
+    builds: Builds,
+    level: Arc<Level>,
+    views: Vec<ViewSpec>,
+    digger: Digger,
+    fly: FlyCamera,
+    render_size: (u32, u32),
+    /// The settings methods are (re)built with; the overlay edits them.
+    settings: MethodSettings,
+    /// Drawn right of the active method in A/B mode.
+    split: Option<String>,
+    /// The method asked for while it is being built.
+    waiting_for: Option<String>,
+    previous_method: String,
+    keys: HashSet<KeyCode>,
+    ctrl: bool,
+    shift: bool,
+    cursor: Option<(f32, f32)>,
+    looking: bool,
+    last_frame: Instant,
+    frame_ms: f64,
+    timings: Vec<(String, FrameTimings)>,
+    log: Vec<String>,
+    player: Option<Player>,
+    screenshot_after_frame: Option<PathBuf>,
+    screenshots: u32,
+    out: PathBuf,
+    quit: bool,
+}
+
+fn surface_config(
+    surface: &wgpu::Surface<'_>,
+    gpu: &Gpu,
+    size: (u32, u32),
+    vsync: bool,
+) -> anyhow::Result<wgpu::SurfaceConfiguration> {
+    let caps = surface.get_capabilities(&gpu.adapter);
+    // A linear-encoding format passes our 8-bit colours through unchanged.
+    let format = caps
+        .formats
+        .iter()
+        .copied()
+        .find(|f| !f.is_srgb())
+        .or_else(|| caps.formats.first().copied())
+        .context("the window's surface offers no format on this adapter")?;
+    let mut config = surface
+        .get_default_config(&gpu.adapter, size.0.max(1), size.1.max(1))
+        .context("the window's surface is not supported by this adapter")?;
+    config.format = format;
+    config.present_mode = if vsync {
+        wgpu::PresentMode::AutoVsync
+    } else {
+        wgpu::PresentMode::AutoNoVsync
+    };
+    Ok(config)
+}
+
+/// The settings of `s` that method `name` reads (the rest at defaults), so
+/// two settings are "the same" for a method when these are equal.
+fn relevant(name: &str, s: &MethodSettings) -> MethodSettings {
+    let d = MethodSettings::default();
+    let uses = |knob| overlay::knob_methods(knob).contains(&name);
+    MethodSettings {
+        ray_steps: if uses(Knob::RaySteps) {
+            s.ray_steps
+        } else {
+            d.ray_steps
+        },
+        voxel_steps: if uses(Knob::VoxelSteps) {
+            s.voxel_steps
+        } else {
+            d.voxel_steps
+        },
+        voxel_size: if name.starts_with("voxel") {
+            s.voxel_size
+        } else {
+            d.voxel_size
+        },
+        slices: if uses(Knob::Slices) {
+            s.slices
+        } else {
+            d.slices
+        },
+        scatter_density: if uses(Knob::Density) {
+            s.scatter_density
+        } else {
+            d.scatter_density
+        },
+        mesh_quality: if uses(Knob::MeshQuality) {
+            s.mesh_quality
+        } else {
+            d.mesh_quality
+        },
+        shadows: d.shadows,
+    }
+}
+
+impl Viewer {
+    pub fn new(
+        event_loop: &ActiveEventLoop,
+        options: Options,
+        instance: wgpu::Instance,
+    ) -> anyhow::Result<Self> {
+        let Options {
+            world,
+            method,
+            settings,
+            size,
+            render_scale,
+            view,
+            script,
+            vsync,
+            out,
+        } = options;
+        if !methods::names().contains(&method.as_str()) {
+            bail!(
+                "unknown method `{method}`; known: {}",
+                methods::names().join(", ")
+            );
+        }
+        let attributes = Window::default_attributes()
+            .with_title(format!("Strata: {}", world.name))
+            .with_inner_size(winit::dpi::PhysicalSize::new(size.0, size.1));
+        let window = Arc::new(
+            event_loop
+                .create_window(attributes)
+                .context("opening the window")?,
+        );
+        let surface = instance
+            .create_surface(Arc::clone(&window))
+            .context("creating a wgpu surface for the window")?;
+        let gpu = Gpu::with_instance(instance, Some(&surface))?;
+        let inner = window.inner_size();
+        let window_size = (inner.width.max(1), inner.height.max(1));
+        let config = surface_config(&surface, &gpu, window_size, vsync)?;
+        surface.configure(&gpu.device, &config);
+
+        // On a CPU rasteriser a full-size picture costs a second per frame.
+        let scale = render_scale.unwrap_or(if gpu.report.device_type == "Cpu" {
+            0.5
+        } else {
+            1.0
+        });
+        if !(scale > 0.0 && scale <= 4.0) {
+            bail!("--render-scale {scale} must be in (0, 4]");
+        }
+        let render_size = (
+            ((size.0 as f32 * scale).round() as u32).max(1),
+            ((size.1 as f32 * scale).round() as u32).max(1),
+        );
+        let level = world.level;
+        let views = world.views;
+        let start = match &view {
+            Some(name) => views
+                .iter()
+                .find(|v| &v.name == name)
+                .with_context(|| {
+                    let names: Vec<_> = views.iter().map(|v| v.name.as_str()).collect();
+                    format!("no view `{name}`; the level has: {}", names.join(", "))
+                })?
+                .clone(),
+            None => views.first().cloned().unwrap_or_else(|| ViewSpec {
+                name: "centre".into(),
+                x: level.width() as f32 * 0.5,
+                y: level.height() as f32 * 0.5,
+                yaw: 0.0,
+                eye: 60.0,
+                under: false,
+                pitch: -20.0,
+            }),
+        };
+        let camera = Camera::from_view(&level, &start, render_size.0, render_size.1)?;
+        let colors = TerrainColors {
+            palette: world.palette.colors,
+            begin: world.config.begin_colors,
+            end: world.config.end_colors,
+        };
+        let renderer = Renderer::new(
+            &gpu,
+            &level,
+            &colors,
+            FIRST_METHOD,
+            &settings,
+            render_size.0,
+            render_size.1,
+        )?;
+        let compositor = Compositor::new(renderer.shared(), window_size, config.format)?;
+        let overlay = Overlay::new(&window, &gpu.device, WINDOW_FORMAT);
+        let digger = Digger::new(world.edit.as_ref().unwrap_or(&EditSite::fostral()));
+        let mut viewer = Viewer {
+            window,
+            surface,
+            config,
+            gpu,
+            renderer,
+            compositor,
+            overlay,
+            builds: Builds::default(),
+            level: Arc::new(level),
+            views,
+            digger,
+            fly: FlyCamera::from_camera(&camera),
+            render_size,
+            settings,
+            split: None,
+            waiting_for: None,
+            previous_method: overlay::other_method(&method).to_string(),
+            keys: HashSet::new(),
+            ctrl: false,
+            shift: false,
+            cursor: None,
+            looking: false,
+            last_frame: Instant::now(),
+            frame_ms: 0.0,
+            timings: Vec::new(),
+            log: Vec::new(),
+            player: script.map(|s| Player {
+                commands: s.commands.into(),
+                running: None,
+            }),
+            screenshot_after_frame: None,
+            screenshots: 0,
+            out,
+            quit: false,
+        };
+        viewer.say(format!(
+            "{} on {} ({}), render {}x{}",
+            world.name,
+            viewer.gpu.report.name,
+            viewer.gpu.report.backend,
+            render_size.0,
+            render_size.1
+        ));
+        viewer.request_method(&method)?;
+        Ok(viewer)
+    }
+
+    pub fn window(&self) -> &Window {
+        &self.window
+    }
+
+    pub fn should_quit(&self) -> bool {
+        self.quit
+    }
+
+    fn say(&mut self, line: String) {
+        eprintln!("strata view: {line}");
+        self.log.push(line);
+        if self.log.len() > LOG_LINES {
+            self.log.remove(0);
+        }
+    }
+
+    /// A window event; `Err` ends the viewer with that error.
+    pub fn on_window_event(&mut self, event: &WindowEvent) -> anyhow::Result<()> {
+        let used = self.overlay.on_window_event(&self.window, event);
+        match event {
+            WindowEvent::CloseRequested => self.quit = true,
+            // A minimised window reports 0x0: keep the old swapchain.
+            WindowEvent::Resized(size) if size.width > 0 && size.height > 0 => {
+                self.config.width = size.width;
+                self.config.height = size.height;
+                self.surface.configure(&self.gpu.device, &self.config);
+                self.compositor.resize((size.width, size.height));
+            }
+            WindowEvent::Focused(false) => {
+                self.keys.clear();
+                self.looking = false;
+            }
+            WindowEvent::ModifiersChanged(m) => {
+                self.ctrl = m.state().control_key();
+                self.shift = m.state().shift_key();
+            }
+            WindowEvent::KeyboardInput { event, .. } => {
+                let PhysicalKey::Code(code) = event.physical_key else {
+                    return Ok(());
+                };
+                if event.state == ElementState::Released {
+                    self.keys.remove(&code);
+                } else if !self.overlay.wants_keyboard() || !used {
+                    let first = self.keys.insert(code);
+                    if first && !event.repeat {
+                        self.on_key(code)?;
+                    }
+                }
+            }
+            WindowEvent::CursorMoved { position, .. } => {
+                let now = (position.x as f32, position.y as f32);
+                if let (true, Some(before)) = (self.looking, self.cursor) {
+                    self.fly.look(now.0 - before.0, now.1 - before.1);
+                }
+                self.cursor = Some(now);
+            }
+            WindowEvent::MouseInput { state, button, .. } => {
+                let pressed = *state == ElementState::Pressed;
+                match button {
+                    MouseButton::Right => self.looking = pressed && !self.overlay.wants_pointer(),
+                    MouseButton::Left if pressed && !used && !self.overlay.wants_pointer() => {
+                        if let Some(at) = self
+                            .cursor
+                            .and_then(|(x, y)| self.compositor.window_to_picture(x, y))
+                        {
+                            self.dig_at(at)?;
+                        }
+                    }
+                    _ => {}
+                }
+            }
+            WindowEvent::MouseWheel { delta, .. } if !used => {
+                let lines = match delta {
+                    MouseScrollDelta::LineDelta(_, y) => *y,
+                    MouseScrollDelta::PixelDelta(p) => p.y as f32 / 40.0,
+                };
+                self.fly.speed = (self.fly.speed * 1.25f32.powf(lines)).clamp(2.0, 2000.0);
+            }
+            WindowEvent::RedrawRequested => self.frame()?,
+            _ => {}
+        }
+        Ok(())
+    }
+
+    fn on_key(&mut self, code: KeyCode) -> anyhow::Result<()> {
+        const DIGITS: [KeyCode; 8] = [
+            KeyCode::Digit1,
+            KeyCode::Digit2,
+            KeyCode::Digit3,
+            KeyCode::Digit4,
+            KeyCode::Digit5,
+            KeyCode::Digit6,
+            KeyCode::Digit7,
+            KeyCode::Digit8,
+        ];
+        const F_KEYS: [KeyCode; 12] = [
+            KeyCode::F1,
+            KeyCode::F2,
+            KeyCode::F3,
+            KeyCode::F4,
+            KeyCode::F5,
+            KeyCode::F6,
+            KeyCode::F7,
+            KeyCode::F8,
+            KeyCode::F9,
+            KeyCode::F10,
+            KeyCode::F11,
+            KeyCode::F12,
+        ];
+        if let Some(i) = DIGITS.iter().position(|&k| k == code) {
+            if let Some(name) = methods::names().get(i) {
+                self.request_method(name)?;
+            }
+        } else if let Some(i) = F_KEYS.iter().position(|&k| k == code) {
+            self.go_to_view(i);
+        } else {
+            match code {
+                KeyCode::Escape => self.quit = true,
+                KeyCode::Tab => self.overlay.visible = !self.overlay.visible,
+                KeyCode::KeyB => {
+                    let split = match self.split {
+                        Some(_) => None,
+                        None => Some(self.previous_method.clone()),
+                    };
+                    self.set_split(split)?;
+                }
+                KeyCode::KeyV => self.copy_view("viewer"),
+                KeyCode::KeyP => self.screenshot_after_frame = Some(self.next_screenshot_path()),
+                KeyCode::KeyU => self.undo()?,
+                KeyCode::KeyZ if self.ctrl => self.undo()?,
+                _ => {}
+            }
+        }
+        Ok(())
+    }
+
+    fn motion(&self) -> Motion {
+        let axis = |plus: &[KeyCode], minus: &[KeyCode]| {
+            let held = |keys: &[KeyCode]| keys.iter().any(|k| self.keys.contains(k));
+            f32::from(u8::from(held(plus))) - f32::from(u8::from(held(minus)))
+        };
+        if self.ctrl {
+            // Ctrl+Z and friends are commands, not movement.
+            return Motion::default();
+        }
+        Motion {
+            forward: axis(
+                &[KeyCode::KeyW, KeyCode::ArrowUp],
+                &[KeyCode::KeyS, KeyCode::ArrowDown],
+            ),
+            right: axis(
+                &[KeyCode::KeyD, KeyCode::ArrowRight],
+                &[KeyCode::KeyA, KeyCode::ArrowLeft],
+            ),
+            up: axis(
+                &[KeyCode::Space, KeyCode::KeyE],
+                &[KeyCode::KeyC, KeyCode::KeyQ],
+            ),
+            fast: self.shift,
+        }
+    }
+
+    fn next_screenshot_path(&mut self) -> PathBuf {
+        self.screenshots += 1;
+        self.out
+            .join(format!("screenshot-{:03}.png", self.screenshots))
+    }
+
+    /// Draw `name` from now on, building it first (in the background) when
+    /// it is not kept with the current settings.
+    fn request_method(&mut self, name: &str) -> anyhow::Result<()> {
+        if !methods::names().contains(&name) {
+            bail!(
+                "unknown method `{name}`; known: {}",
+                methods::names().join(", ")
+            );
+        }
+        let current = self.renderer.method_name();
+        if self.is_current(name) {
+            if current != name {
+                self.previous_method = current.to_string();
+                self.renderer.activate(name)?;
+                self.say(format!("drawing {name}"));
+            }
+            self.waiting_for = None;
+        } else {
+            self.builds
+                .start(&self.renderer, &self.level, name, &self.settings);
+            self.waiting_for = Some(name.to_string());
+        }
+        Ok(())
+    }
+
+    /// Whether `name` is kept, built with the current settings.
+    fn is_current(&self, name: &str) -> bool {
+        self.renderer
+            .settings_of(name)
+            .is_some_and(|s| relevant(name, s) == relevant(name, &self.settings))
+    }
+
+    fn set_split(&mut self, split: Option<String>) -> anyhow::Result<()> {
+        if let Some(name) = &split {
+            if !methods::names().contains(&name.as_str()) {
+                bail!("unknown method `{name}`");
+            }
+            if !self.is_current(name) {
+                self.builds
+                    .start(&self.renderer, &self.level, name, &self.settings);
+            }
+        }
+        self.split = split;
+        Ok(())
+    }
+
+    fn go_to_view(&mut self, index: usize) {
+        let Some(view) = self.views.get(index).cloned() else {
+            self.say(format!("the level has no view {}", index + 1));
+            return;
+        };
+        match Camera::from_view(&self.level, &view, self.render_size.0, self.render_size.1) {
+            Ok(camera) => {
+                let speed = self.fly.speed;
+                self.fly = FlyCamera::from_camera(&camera);
+                self.fly.speed = speed;
+                self.say(format!("view {}", view.name));
+            }
+            Err(e) => self.say(format!("view {}: {e}", view.name)),
+        }
+    }
+
+    fn copy_view(&mut self, name: &str) {
+        let line = self.fly.view_spec(&self.level, name).to_string();
+        println!("{line}");
+        self.overlay.copy_text(line.clone());
+        self.say(format!("copied: {line}"));
+    }
+
+    fn camera(&self) -> anyhow::Result<Camera> {
+        self.fly.camera(self.render_size.0, self.render_size.1)
+    }
+
+    /// Dig where picture point `at` (render pixels) shows terrain.
+    fn dig_at(&mut self, at: (f32, f32)) -> anyhow::Result<()> {
+        let camera = self.camera()?;
+        let start = Instant::now();
+        let Some(hit) = pick(&self.level, &camera, at.0, at.1) else {
+            self.say("nothing to dig there: sky".into());
+            return Ok(());
+        };
+        let pick_ms = start.elapsed().as_secs_f64() * 1e3;
+        let start = Instant::now();
+        let dirty = self.digger.dig(Arc::make_mut(&mut self.level), hit.point);
+        self.edited(&dirty)?;
+        let p = hit.point;
+        self.say(format!(
+            "dug r={} at {:.0}, {:.0}, {:.0}: {} rect(s); pick {pick_ms:.0} ms, edit + upload {:.1} ms",
+            self.digger.radius,
+            p.x,
+            p.y,
+            p.z,
+            dirty.len(),
+            start.elapsed().as_secs_f64() * 1e3
+        ));
+        Ok(())
+    }
+
+    fn undo(&mut self) -> anyhow::Result<()> {
+        match self.digger.undo(Arc::make_mut(&mut self.level)) {
+            Some(dirty) => {
+                self.edited(&dirty)?;
+                self.say(format!("undone ({} left)", self.digger.can_undo()));
+            }
+            None => self.say("nothing to undo".into()),
+        }
+        Ok(())
+    }
+
+    /// Every kept method and running build learns of an edit.
+    fn edited(&mut self, dirty: &[DirtyRect]) -> anyhow::Result<()> {
+        if dirty.is_empty() {
+            return Ok(());
+        }
+        self.builds.record_edit(dirty);
+        self.renderer.apply_edit(&self.level, dirty)
+    }
+
+    fn on_knob(&mut self, knob: Knob) {
+        if knob == Knob::Shadows {
+            self.renderer.set_shadows(self.settings.shadows);
+            return;
+        }
+        // Rebuild what is on screen and reads the knob; other kept methods
+        // are rebuilt when next shown.
+        let shown: Vec<String> = std::iter::once(self.renderer.method_name().to_string())
+            .chain(self.split.clone())
+            .collect();
+        for name in shown {
+            if overlay::knob_methods(knob).contains(&name.as_str()) && !self.is_current(&name) {
+                self.builds
+                    .start(&self.renderer, &self.level, &name, &self.settings);
+            }
+        }
+    }
+
+    fn set_knob(&mut self, knob: Knob, value: f32) -> anyhow::Result<()> {
+        let s = &mut self.settings;
+        let count = |v: f32| -> anyhow::Result<u32> {
+            if v >= 1.0 && v.fract() == 0.0 && v <= 1e6 {
+                Ok(v as u32)
+            } else {
+                bail!("{value} is not a positive whole number")
+            }
+        };
+        match knob {
+            Knob::RaySteps => s.ray_steps = count(value)?,
+            Knob::VoxelSteps => s.voxel_steps = count(value)?,
+            Knob::Slices => s.slices = count(value)?,
+            Knob::Density => s.scatter_density = [value; 3],
+            Knob::MeshQuality => s.mesh_quality = value,
+            Knob::Shadows => s.shadows = value != 0.0,
+        }
+        self.on_knob(knob);
+        Ok(())
+    }
+
+    /// Keep finished builds; activate the one waited for.
+    fn collect_builds(&mut self) -> anyhow::Result<()> {
+        for finished in self.builds.collect(&mut self.renderer, &self.level) {
+            match finished {
+                Finished::Kept { name, seconds } => {
+                    self.say(format!("built {name} in {seconds:.2} s"));
+                    if self.waiting_for.as_deref() == Some(name.as_str()) {
+                        self.request_method(&name)?;
+                    }
+                }
+                Finished::Failed { name, error } => {
+                    if self.waiting_for.as_deref() == Some(name.as_str()) {
+                        self.waiting_for = None;
+                    }
+                    if self.split.as_deref() == Some(name.as_str()) {
+                        self.split = None;
+                    }
+                    if self.player.is_some() {
+                        return Err(error.context(format!("building {name}")));
+                    }
+                    self.say(format!("building {name} failed: {error:#}"));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Advance the script by one frame.
+    fn script_step(&mut self) -> anyhow::Result<()> {
+        let Some(player) = &mut self.player else {
+            return Ok(());
+        };
+        if let Some((line, running)) = player.running.take() {
+            let next = match running {
+                Running::Fly { per_frame, left } => {
+                    self.fly.translate(per_frame, &self.level);
+                    (left > 1).then_some(Running::Fly {
+                        per_frame,
+                        left: left - 1,
+                    })
+                }
+                Running::Turn { per_frame, left } => {
+                    self.fly.turn(per_frame[0], per_frame[1]);
+                    (left > 1).then_some(Running::Turn {
+                        per_frame,
+                        left: left - 1,
+                    })
+                }
+                Running::Frames(left) => (left > 1).then_some(Running::Frames(left - 1)),
+                Running::WaitMethod(name) => {
+                    let drawn = self.renderer.method_name() == name
+                        || (self.split.as_deref() == Some(name.as_str()) && self.is_current(&name));
+                    (!drawn).then_some(Running::WaitMethod(name))
+                }
+            };
+            if let Some(player) = &mut self.player {
+                player.running = next.map(|n| (line, n));
+            }
+            return Ok(());
+        }
+        let Some((line, command)) = player.commands.pop_front() else {
+            self.quit = true;
+            return Ok(());
+        };
+        self.run_command(line, command)
+            .with_context(|| format!("script line {line}"))
+    }
+
+    fn run_command(&mut self, line: usize, command: Command) -> anyhow::Result<()> {
+        let mut running = None;
+        match command {
+            Command::View(name) => {
+                let i = self
+                    .views
+                    .iter()
+                    .position(|v| v.name == name)
+                    .with_context(|| format!("the level has no view `{name}`"))?;
+                self.go_to_view(i);
+            }
+            Command::Method(name) => {
+                self.request_method(&name)?;
+                running = Some(Running::WaitMethod(name));
+            }
+            Command::Split(name) => {
+                self.set_split(name.clone())?;
+                running = name.map(Running::WaitMethod);
+            }
+            Command::Fly { offset, frames } => {
+                running = Some(Running::Fly {
+                    per_frame: Vec3::from(offset) / frames as f32,
+                    left: frames,
+                });
+            }
+            Command::Turn { degrees, frames } => {
+                running = Some(Running::Turn {
+                    per_frame: degrees.map(|d| d / frames as f32),
+                    left: frames,
+                });
+            }
+            Command::Frames(n) => running = Some(Running::Frames(n)),
+            Command::Dig(fx, fy) => {
+                let (w, h) = self.render_size;
+                // The centre of the pixel the fraction falls in.
+                let px = (fx * w as f32).floor().min(w as f32 - 1.0) + 0.5;
+                let py = (fy * h as f32).floor().min(h as f32 - 1.0) + 0.5;
+                self.dig_at((px, py))?;
+            }
+            Command::Undo => self.undo()?,
+            Command::Set(knob, value) => self.set_knob(knob, value)?,
+            Command::Overlay(on) => self.overlay.visible = on,
+            Command::Screenshot(path) => self.screenshot_after_frame = Some(path),
+            Command::CopyView(name) => self.copy_view(&name),
+            Command::Quit => self.quit = true,
+        }
+        // Run the first frame of a multi-frame command now.
+        if let (Some(running), Some(player)) = (running, &mut self.player) {
+            player.running = Some((line, running));
+            return self.script_step();
+        }
+        Ok(())
+    }
+
+    /// One frame: script, builds, camera, the picture(s), overlay, present.
+    fn frame(&mut self) -> anyhow::Result<()> {
+        let now = Instant::now();
+        let dt = now.duration_since(self.last_frame).as_secs_f64();
+        self.last_frame = now;
+        self.frame_ms = if self.frame_ms == 0.0 {
+            dt * 1e3
+        } else {
+            0.9 * self.frame_ms + 0.1 * dt * 1e3
+        };
+        self.collect_builds()?;
+        self.script_step()?;
+        // Held keys fly the camera; a long stall (a build) is not a jump.
+        let motion = self.motion();
+        if !motion.is_still() {
+            self.fly.fly(&motion, dt.min(0.1) as f32, &self.level);
+        }
+
+        let camera = self.camera()?;
+        let active = self.renderer.method_name();
+        let mut timings = vec![(active.to_string(), self.renderer.render_frame(&camera)?)];
+        let split = self
+            .split
+            .clone()
+            .filter(|b| b != active && self.is_current(b));
+        if let Some(b) = &split {
+            let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+            self.compositor
+                .keep_left(self.renderer.shared(), &mut encoder);
+            self.gpu.queue.submit([encoder.finish()]);
+            self.renderer.activate(b)?;
+            let drawn = self.renderer.render_frame(&camera);
+            self.renderer.activate(active)?;
+            timings.push((b.clone(), drawn?));
+        }
+        self.timings = timings;
+
+        let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+        self.compositor
+            .compose(&mut encoder, split.as_ref().map(|_| 0.5));
+        let actions = self.paint_overlay(&mut encoder);
+        let surface_texture = match self.surface.get_current_texture() {
+            wgpu::CurrentSurfaceTexture::Success(t)
+            | wgpu::CurrentSurfaceTexture::Suboptimal(t) => Some(t),
+            wgpu::CurrentSurfaceTexture::Timeout | wgpu::CurrentSurfaceTexture::Occluded => None,
+            wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
+                self.surface.configure(&self.gpu.device, &self.config);
+                None
+            }
+            wgpu::CurrentSurfaceTexture::Validation => {
+                bail!("the window's swapchain refused a frame (validation error)")
+            }
+        };
+        if let Some(texture) = &surface_texture {
+            let view = texture.texture.create_view(&Default::default());
+            self.compositor.present(&mut encoder, &view);
+        }
+        self.gpu.queue.submit([encoder.finish()]);
+        if let Some(texture) = surface_texture {
+            self.window.pre_present_notify();
+            self.gpu.queue.present(texture);
+        }
+        self.gpu.errors.check()?;
+
+        if let Some(path) = self.screenshot_after_frame.take() {
+            let image = self.compositor.read_window(&self.gpu.errors)?;
+            if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+                std::fs::create_dir_all(dir)
+                    .with_context(|| format!("creating {}", dir.display()))?;
+            }
+            image
+                .save(&path)
+                .with_context(|| format!("writing the screenshot {}", path.display()))?;
+            self.say(format!("screenshot {}", path.display()));
+        }
+        for action in actions {
+            self.on_action(action)?;
+        }
+        Ok(())
+    }
+
+    fn paint_overlay(&mut self, encoder: &mut wgpu::CommandEncoder) -> Vec<Action> {
+        let renderer = &self.renderer;
+        let building = self.builds.running();
+        let status = Status {
+            adapter: &self.gpu.report,
+            frame_ms: self.frame_ms,
+            drawn: self
+                .timings
+                .iter()
+                .map(|(method, timings)| Drawn { method, timings })
+                .collect(),
+            active: renderer.method_name(),
+            split: self.split.as_deref(),
+            kept: renderer
+                .method_names()
+                .into_iter()
+                .filter_map(|m| renderer.retained_bytes_of(m).map(|b| (m, b)))
+                .collect(),
+            shared_gpu_bytes: renderer.shared_gpu_bytes(),
+            building,
+            waiting_for: self.waiting_for.as_deref(),
+            views: &self.views,
+            camera: &self.fly,
+            render_size: self.render_size,
+            window_size: self.compositor.window_size(),
+            undo_depth: self.digger.can_undo(),
+            log: &self.log,
+        };
+        let mut editable = Editable {
+            settings: &mut self.settings,
+            crater_radius: &mut self.digger.radius,
+            crater_depth: &mut self.digger.depth,
+        };
+        self.overlay.paint(
+            &self.window,
+            &self.gpu.device,
+            &self.gpu.queue,
+            encoder,
+            self.compositor.window_view(),
+            &status,
+            &mut editable,
+        )
+    }
+
+    fn on_action(&mut self, action: Action) -> anyhow::Result<()> {
+        match action {
+            Action::Method(name) => self.request_method(&name)?,
+            Action::Split(split) => self.set_split(split)?,
+            Action::View(i) => self.go_to_view(i),
+            Action::Knob(knob) => self.on_knob(knob),
+            Action::Undo => self.undo()?,
+            Action::CopyView => self.copy_view("viewer"),
+            Action::Screenshot => {
+                self.screenshot_after_frame = Some(self.next_screenshot_path());
+            }
+        }
+        Ok(())
+    }
+}
