@@ -120,6 +120,19 @@ impl ApplicationHandler for App {
         }
     }
 
+    fn device_event(
+        &mut self,
+        _: &ActiveEventLoop,
+        _: winit::event::DeviceId,
+        event: winit::event::DeviceEvent,
+    ) {
+        if let (Some(viewer), winit::event::DeviceEvent::MouseMotion { delta }) =
+            (&mut self.viewer, event)
+        {
+            viewer.on_mouse_motion(delta.0, delta.1);
+        }
+    }
+
     fn about_to_wait(&mut self, _: &ActiveEventLoop) {
         // Draw continuously: the frame rate is part of what is shown.
         if let Some(viewer) = &self.viewer {

@@ -75,6 +75,8 @@ pub struct Viewer {
     shift: bool,
     cursor: Option<(f32, f32)>,
     looking: bool,
+    /// The platform sends raw mouse motion (used for looking when it does).
+    raw_motion: bool,
     last_frame: Instant,
     frame_ms: f64,
     timings: Vec<(String, FrameTimings)>,
@@ -207,7 +209,13 @@ impl Viewer {
             ((size.1 as f32 * scale).round() as u32).max(1),
         );
         let level = world.level;
-        let views = world.views;
+        let mut views = world.views;
+        // The edit fixture's camera is a view too: it looks at the crater site.
+        if let Some(edit) = &world.edit
+            && !views.iter().any(|v| v.name == edit.camera.name)
+        {
+            views.push(edit.camera.clone());
+        }
         let start = match &view {
             Some(name) => views
                 .iter()
@@ -268,6 +276,7 @@ impl Viewer {
             shift: false,
             cursor: None,
             looking: false,
+            raw_motion: false,
             last_frame: Instant::now(),
             frame_ms: 0.0,
             timings: Vec::new(),
@@ -344,7 +353,9 @@ impl Viewer {
             }
             WindowEvent::CursorMoved { position, .. } => {
                 let now = (position.x as f32, position.y as f32);
-                if let (true, Some(before)) = (self.looking, self.cursor) {
+                // Cursor deltas stop at the window's edge: only a fallback
+                // where the platform sends no raw motion.
+                if let (true, false, Some(before)) = (self.looking, self.raw_motion, self.cursor) {
                     self.fly.look(now.0 - before.0, now.1 - before.1);
                 }
                 self.cursor = Some(now);
@@ -375,6 +386,14 @@ impl Viewer {
             _ => {}
         }
         Ok(())
+    }
+
+    /// Raw mouse motion (unbounded by the window), while looking around.
+    pub fn on_mouse_motion(&mut self, dx: f64, dy: f64) {
+        if self.looking {
+            self.raw_motion = true;
+            self.fly.look(dx as f32, dy as f32);
+        }
     }
 
     fn on_key(&mut self, code: KeyCode) -> anyhow::Result<()> {
