@@ -61,7 +61,17 @@ fn fs_mesh(in: VertexOut) -> @location(0) vec4<f32> {
         // Whichever side is seen is the outside of the solid.
         n = -n;
     }
-    let c = decode_column(i32(floor(p.x)), i32(floor(p.y)));
+    // A wall is a steep ramp between two texel centres, half over the low
+    // column; its colour and light belong to the high one, which lies inside
+    // the solid, against the outward normal. Half a texel inwards maps an
+    // axis-aligned ramp's span [i + 0.5, i + 1.5] onto column i + 1 (what a
+    // ray entering the wall meets). Gentler faces keep their own column.
+    var at = p.xy;
+    let across = length(n.xy);
+    if (across > 0.7) {
+        at -= n.xy / across * 0.5;
+    }
+    let c = decode_column(i32(floor(at.x)), i32(floor(at.y)));
     var kind = SURFACE_FLOOR;
     if (in.kind != KIND_FLOOR) {
         // Slab triangles: tops and walls take the slab top's light, faces
