@@ -156,6 +156,7 @@ fn scripted_flight_switches_method_digs_and_undoes() {
              method mesh\nscreenshot {s}/mesh-before.png\n\
              dig 0.5 0.5\nscreenshot {s}/mesh-dug.png\n\
              copy-view dug\n\
+             method ray\nset ray-steps 32\nscreenshot {s}/ray-32.png\n\
              overlay on\nfly -20 0 30 4\nturn 0 20 2\nscreenshot {s}/final.png\n",
             s = shots.display()
         ),
@@ -212,6 +213,11 @@ fn scripted_flight_switches_method_digs_and_undoes() {
         "mesh vs ray after the dig: {is:.2} (before the dig {was:.2})"
     );
     assert!(stderr.contains("drawing mesh"), "{stderr}");
+    // A changed knob rebuilds the method on screen, which then draws
+    // differently (32 steps instead of 128 over the same dug terrain).
+    assert!(stderr.contains("built ray"), "{stderr}");
+    let coarse = load(&shots, "ray-32.png");
+    assert!(coarse != dug, "32 ray steps drew the same picture as 128");
     // The copied view is a views.txt line that resolves on the level.
     let line = stdout
         .lines()

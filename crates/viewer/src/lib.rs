@@ -113,6 +113,7 @@ impl ApplicationHandler for App {
         match result {
             Err(error) => self.fail(event_loop, error),
             Ok(()) if quit => {
+                eprintln!("strata view: {}", viewer.summary());
                 self.viewer = None;
                 event_loop.exit();
             }

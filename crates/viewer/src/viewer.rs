@@ -42,6 +42,16 @@ enum Running {
     Frames(u32),
     /// Until this method is drawn (built and active, or the split's right side).
     WaitMethod(String),
+    /// Until no build runs (a changed knob's rebuild).
+    WaitBuilds,
+}
+
+/// Sums over the frames a method drew.
+#[derive(Default)]
+struct Totals {
+    frames: u32,
+    gpu_ms: f64,
+    wait_ms: f64,
 }
 
 struct Player {
@@ -80,6 +90,7 @@ pub struct Viewer {
     last_frame: Instant,
     frame_ms: f64,
     timings: Vec<(String, FrameTimings)>,
+    totals: Vec<(String, Totals)>,
     log: Vec<String>,
     player: Option<Player>,
     screenshot_after_frame: Option<PathBuf>,
@@ -280,6 +291,7 @@ impl Viewer {
             last_frame: Instant::now(),
             frame_ms: 0.0,
             timings: Vec::new(),
+            totals: Vec::new(),
             log: Vec::new(),
             player: script.map(|s| Player {
                 commands: s.commands.into(),
@@ -308,6 +320,25 @@ impl Viewer {
 
     pub fn should_quit(&self) -> bool {
         self.quit
+    }
+
+    /// Per method: frames drawn, mean GPU ms (per-pass sum) and mean wait
+    /// from submit to done, over the session (printed when the window closes).
+    pub fn summary(&self) -> String {
+        let mut out = format!(
+            "frames drawn at {}x{} on {}:",
+            self.render_size.0, self.render_size.1, self.gpu.report.name
+        );
+        for (method, t) in &self.totals {
+            let n = f64::from(t.frames);
+            out.push_str(&format!(
+                "\n  {method:<14} {:>6} frames, GPU {:>8.2} ms, submit-to-done {:>8.2} ms",
+                t.frames,
+                t.gpu_ms / n,
+                t.wait_ms / n
+            ));
+        }
+        out
     }
 
     fn say(&mut self, line: String) {
@@ -686,6 +717,9 @@ impl Viewer {
                     })
                 }
                 Running::Frames(left) => (left > 1).then_some(Running::Frames(left - 1)),
+                Running::WaitBuilds => {
+                    (!self.builds.running().is_empty()).then_some(Running::WaitBuilds)
+                }
                 Running::WaitMethod(name) => {
                     let drawn = self.renderer.method_name() == name
                         || (self.split.as_deref() == Some(name.as_str()) && self.is_current(&name));
@@ -745,7 +779,10 @@ impl Viewer {
                 self.dig_at((px, py))?;
             }
             Command::Undo => self.undo()?,
-            Command::Set(knob, value) => self.set_knob(knob, value)?,
+            Command::Set(knob, value) => {
+                self.set_knob(knob, value)?;
+                running = Some(Running::WaitBuilds);
+            }
             Command::Overlay(on) => self.overlay.visible = on,
             Command::Screenshot(path) => self.screenshot_after_frame = Some(path),
             Command::CopyView(name) => self.copy_view(&name),
@@ -793,6 +830,18 @@ impl Viewer {
             let drawn = self.renderer.render_frame(&camera);
             self.renderer.activate(active)?;
             timings.push((b.clone(), drawn?));
+        }
+        for (method, t) in &timings {
+            let totals = match self.totals.iter_mut().find(|(m, _)| m == method) {
+                Some((_, totals)) => totals,
+                None => {
+                    self.totals.push((method.clone(), Totals::default()));
+                    &mut self.totals.last_mut().expect("just pushed").1
+                }
+            };
+            totals.frames += 1;
+            totals.gpu_ms += t.gpu_ms.unwrap_or(f64::NAN);
+            totals.wait_ms += t.cpu_ms;
         }
         self.timings = timings;
 
