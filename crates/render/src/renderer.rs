@@ -47,6 +47,10 @@ pub struct Renderer {
     frames: u64,
     adapter: crate::gpu::AdapterReport,
     setup_ms: f64,
+    /// Skip the shadow pass while the map would come out the same.
+    shadow_reuse: bool,
+    /// The frame the shadow map holds, while no edit has changed it.
+    shadow_drawn: Option<ShadowFrame>,
 }
 
 impl Renderer {
@@ -111,6 +115,8 @@ impl Renderer {
             frames: 0,
             adapter: gpu.report.clone(),
             setup_ms: 0.0,
+            shadow_reuse: false,
+            shadow_drawn: None,
         };
         wait_device(&renderer.shared.device, &renderer.errors)?;
         renderer.setup_ms = ms(start);
@@ -180,6 +186,14 @@ impl Renderer {
         }
     }
 
+    /// Skip the shadow pass when the map would be the one already drawn (the
+    /// same fitted frame, no edit since): for interactive use, where a still
+    /// camera or an A/B pair redraws it for nothing. Off by default, so every
+    /// frame the protocol measures pays for its shadow map.
+    pub fn set_shadow_reuse(&mut self, on: bool) {
+        self.shadow_reuse = on;
+    }
+
     /// The shared frame, for building methods off the render thread:
     /// `methods::create(name, &handle, level, settings)`.
     pub fn shared_handle(&self) -> Arc<Shared> {
@@ -234,8 +248,10 @@ impl Renderer {
             .device
             .create_command_encoder(&Default::default());
         self.timer.reset();
-        if shadows {
+        let current = self.shadow_reuse && self.shadow_drawn == Some(shadow);
+        if shadows && !current {
             self.shadow.record(&mut encoder, &self.timer);
+            self.shadow_drawn = Some(shadow);
         }
         let frame = Frame {
             camera,
@@ -328,6 +344,7 @@ impl Renderer {
         self.shared
             .terrain
             .upload(&self.shared.queue, level, rects)?;
+        self.shadow_drawn = None;
         for built in &mut self.methods {
             built.method.apply_edit(&self.shared, level, rects)?;
         }

@@ -57,6 +57,8 @@ pub struct Editable<'a> {
     pub settings: &'a mut MethodSettings,
     pub crater_radius: &'a mut u32,
     pub crater_depth: &'a mut f32,
+    /// The A/B divider, as a fraction of the picture's width.
+    pub split_at: &'a mut f32,
 }
 
 pub struct Overlay {
@@ -230,6 +232,7 @@ fn panel(
         .default_pos(egui::pos2(8.0, 8.0))
         .default_width(300.0)
         .resizable(false)
+        .vscroll(true)
         .show(ctx, |ui| {
             ui.label(format!(
                 "{} ({}, {})",
@@ -247,30 +250,28 @@ fn panel(
                 1000.0 / status.frame_ms.max(1e-3),
                 status.frame_ms
             ));
-            timings(ui, status);
-            ui.separator();
-            methods_section(ui, status, actions);
-            ui.separator();
-            knobs(ui, status, editable, actions);
-            ui.separator();
-            views(ui, status, actions);
-            ui.separator();
-            ui.horizontal(|ui| {
-                ui.label("crater");
+            section(ui, "GPU time per pass", true, |ui| timings(ui, status));
+            methods_section(ui, status, editable, actions);
+            section(ui, "settings", true, |ui| {
+                knobs(ui, status, editable, actions)
+            });
+            section(ui, "camera and views", true, |ui| {
+                views(ui, status, actions)
+            });
+            section(ui, "dig (left click)", true, |ui| {
                 ui.add(egui::Slider::new(editable.crater_radius, 2..=128).text("radius"));
+                ui.horizontal(|ui| {
+                    ui.add(egui::Slider::new(editable.crater_depth, 5.0..=200.0).text("depth"));
+                    let undo = ui.add_enabled(
+                        status.undo_depth > 0,
+                        egui::Button::new(format!("undo ({})", status.undo_depth)),
+                    );
+                    if undo.clicked() {
+                        actions.push(Action::Undo);
+                    }
+                });
             });
-            ui.horizontal(|ui| {
-                ui.add(egui::Slider::new(editable.crater_depth, 5.0..=200.0).text("depth"));
-                let undo = ui.add_enabled(
-                    status.undo_depth > 0,
-                    egui::Button::new(format!("undo ({})", status.undo_depth)),
-                );
-                if undo.clicked() {
-                    actions.push(Action::Undo);
-                }
-            });
-            ui.separator();
-            memory(ui, status);
+            section(ui, "memory", false, |ui| memory(ui, status));
             ui.horizontal(|ui| {
                 if ui.button("copy view").clicked() {
                     actions.push(Action::CopyView);
@@ -294,6 +295,13 @@ fn panel(
         });
 }
 
+/// A collapsible part of the panel.
+fn section(ui: &mut egui::Ui, title: &str, open: bool, body: impl FnOnce(&mut egui::Ui)) {
+    egui::CollapsingHeader::new(title)
+        .default_open(open)
+        .show(ui, body);
+}
+
 fn timings(ui: &mut egui::Ui, status: &Status<'_>) {
     egui::Grid::new("timings").striped(true).show(ui, |ui| {
         for drawn in &status.drawn {
@@ -314,7 +322,12 @@ fn timings(ui: &mut egui::Ui, status: &Status<'_>) {
     });
 }
 
-fn methods_section(ui: &mut egui::Ui, status: &Status<'_>, actions: &mut Vec<Action>) {
+fn methods_section(
+    ui: &mut egui::Ui,
+    status: &Status<'_>,
+    editable: &mut Editable<'_>,
+    actions: &mut Vec<Action>,
+) {
     ui.label("method (keys 1-8)");
     ui.horizontal_wrapped(|ui| {
         for (i, name) in methods::names().into_iter().enumerate() {
@@ -365,6 +378,9 @@ fn methods_section(ui: &mut egui::Ui, status: &Status<'_>, actions: &mut Vec<Act
                 });
         }
     });
+    if status.split.is_some() {
+        ui.add(egui::Slider::new(editable.split_at, 0.05..=0.95).text("divider"));
+    }
     for (method, seconds) in &status.building {
         ui.horizontal(|ui| {
             ui.spinner();

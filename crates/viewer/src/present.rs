@@ -270,25 +270,13 @@ impl Compositor {
     /// Where the picture lies in the window: x, y, width, height in pixels
     /// (the largest fit that keeps the render's aspect, centred).
     pub fn picture_rect(&self) -> [f32; 4] {
-        let (ww, wh) = (self.window_size.0 as f32, self.window_size.1 as f32);
-        let (rw, rh) = (self.render_size.0 as f32, self.render_size.1 as f32);
-        let scale = (ww / rw).min(wh / rh);
-        let (w, h) = (rw * scale, rh * scale);
-        [
-            ((ww - w) * 0.5).floor(),
-            ((wh - h) * 0.5).floor(),
-            w.round(),
-            h.round(),
-        ]
+        fit_rect(self.render_size, self.window_size)
     }
 
     /// A window position (physical pixels) as a point of the rendered
     /// picture (render pixels), or `None` on the bars.
     pub fn window_to_picture(&self, x: f32, y: f32) -> Option<(f32, f32)> {
-        let [px, py, pw, ph] = self.picture_rect();
-        let (u, v) = ((x - px) / pw, (y - py) / ph);
-        ((0.0..1.0).contains(&u) && (0.0..1.0).contains(&v))
-            .then_some((u * self.render_size.0 as f32, v * self.render_size.1 as f32))
+        window_to_picture(self.render_size, self.window_size, (x, y))
     }
 
     /// Keep the current picture as the A side of an A/B pair.
@@ -378,6 +366,29 @@ impl Compositor {
     }
 }
 
+/// The largest rectangle of the render's aspect inside the window, centred:
+/// x, y, width, height in window pixels.
+pub fn fit_rect(render: (u32, u32), window: (u32, u32)) -> [f32; 4] {
+    let (ww, wh) = (window.0 as f32, window.1 as f32);
+    let (rw, rh) = (render.0 as f32, render.1 as f32);
+    let scale = (ww / rw).min(wh / rh);
+    let (w, h) = ((rw * scale).round(), (rh * scale).round());
+    [((ww - w) * 0.5).floor(), ((wh - h) * 0.5).floor(), w, h]
+}
+
+/// Window pixel position `at` as a point of the picture in render pixels,
+/// or `None` outside the picture (on the bars).
+pub fn window_to_picture(
+    render: (u32, u32),
+    window: (u32, u32),
+    at: (f32, f32),
+) -> Option<(f32, f32)> {
+    let [px, py, pw, ph] = fit_rect(render, window);
+    let (u, v) = ((at.0 - px) / pw, (at.1 - py) / ph);
+    ((0.0..1.0).contains(&u) && (0.0..1.0).contains(&v))
+        .then_some((u * render.0 as f32, v * render.1 as f32))
+}
+
 /// One full-screen triangle into `target`, overwriting it.
 fn fullscreen(
     encoder: &mut wgpu::CommandEncoder,
@@ -405,4 +416,43 @@ fn fullscreen(
     pass.set_pipeline(pipeline);
     pass.set_bind_group(0, group, &[]);
     pass.draw(0..3, 0..1);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_picture_fills_a_same_aspect_window_and_letterboxes_otherwise() {
+        assert_eq!(fit_rect((640, 400), (1280, 800)), [0.0, 0.0, 1280.0, 800.0]);
+        // A taller window: bars above and below.
+        assert_eq!(fit_rect((640, 400), (640, 600)), [0.0, 100.0, 640.0, 400.0]);
+        // A wider one: bars left and right.
+        assert_eq!(
+            fit_rect((640, 400), (1000, 400)),
+            [180.0, 0.0, 640.0, 400.0]
+        );
+    }
+
+    #[test]
+    fn window_positions_map_to_render_pixels() {
+        // Half-size render: window pixel (101, 51) is render (50.5, 25.5).
+        assert_eq!(
+            window_to_picture((640, 400), (1280, 800), (101.0, 51.0)),
+            Some((50.5, 25.5))
+        );
+        // Letterboxed: the bar is outside, the picture's corner is (0, 0).
+        assert_eq!(
+            window_to_picture((640, 400), (640, 600), (10.0, 50.0)),
+            None
+        );
+        assert_eq!(
+            window_to_picture((640, 400), (640, 600), (0.0, 100.0)),
+            Some((0.0, 0.0))
+        );
+        assert_eq!(
+            window_to_picture((640, 400), (640, 600), (639.0, 500.0)),
+            None
+        );
+    }
 }

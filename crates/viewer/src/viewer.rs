@@ -77,6 +77,8 @@ pub struct Viewer {
     settings: MethodSettings,
     /// Drawn right of the active method in A/B mode.
     split: Option<String>,
+    /// Where the A/B divider stands, fraction of the picture's width.
+    split_at: f32,
     /// The method asked for while it is being built.
     waiting_for: Option<String>,
     previous_method: String,
@@ -252,7 +254,7 @@ impl Viewer {
             begin: world.config.begin_colors,
             end: world.config.end_colors,
         };
-        let renderer = Renderer::new(
+        let mut renderer = Renderer::new(
             &gpu,
             &level,
             &colors,
@@ -261,6 +263,8 @@ impl Viewer {
             render_size.0,
             render_size.1,
         )?;
+        // A still camera (or the second side of an A/B pair) keeps its shadow map.
+        renderer.set_shadow_reuse(true);
         let compositor = Compositor::new(renderer.shared(), window_size, config.format)?;
         let overlay = Overlay::new(&window, &gpu.device, WINDOW_FORMAT);
         let digger = Digger::new(world.edit.as_ref().unwrap_or(&EditSite::fostral()));
@@ -280,6 +284,7 @@ impl Viewer {
             render_size,
             settings,
             split: None,
+            split_at: 0.5,
             waiting_for: None,
             previous_method: overlay::other_method(&method).to_string(),
             keys: HashSet::new(),
@@ -364,6 +369,7 @@ impl Viewer {
             WindowEvent::Focused(false) => {
                 self.keys.clear();
                 self.looking = false;
+                self.grab_cursor(false);
             }
             WindowEvent::ModifiersChanged(m) => {
                 self.ctrl = m.state().control_key();
@@ -394,7 +400,10 @@ impl Viewer {
             WindowEvent::MouseInput { state, button, .. } => {
                 let pressed = *state == ElementState::Pressed;
                 match button {
-                    MouseButton::Right => self.looking = pressed && !self.overlay.wants_pointer(),
+                    MouseButton::Right => {
+                        self.looking = pressed && !self.overlay.wants_pointer();
+                        self.grab_cursor(self.looking);
+                    }
                     MouseButton::Left if pressed && !used && !self.overlay.wants_pointer() => {
                         if let Some(at) = self
                             .cursor
@@ -417,6 +426,21 @@ impl Viewer {
             _ => {}
         }
         Ok(())
+    }
+
+    /// Hide and hold the cursor while looking around, where the platform
+    /// allows (X11 confines, Wayland locks); otherwise it just stays visible.
+    fn grab_cursor(&self, grab: bool) {
+        use winit::window::CursorGrabMode;
+        if grab {
+            let _ = self
+                .window
+                .set_cursor_grab(CursorGrabMode::Locked)
+                .or_else(|_| self.window.set_cursor_grab(CursorGrabMode::Confined));
+        } else {
+            let _ = self.window.set_cursor_grab(CursorGrabMode::None);
+        }
+        self.window.set_cursor_visible(!grab);
     }
 
     /// Raw mouse motion (unbounded by the window), while looking around.
@@ -847,7 +871,7 @@ impl Viewer {
 
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
         self.compositor
-            .compose(&mut encoder, split.as_ref().map(|_| 0.5));
+            .compose(&mut encoder, split.as_ref().map(|_| self.split_at));
         let actions = self.paint_overlay(&mut encoder);
         let surface_texture = match self.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(t)
@@ -921,6 +945,7 @@ impl Viewer {
             settings: &mut self.settings,
             crater_radius: &mut self.digger.radius,
             crater_depth: &mut self.digger.depth,
+            split_at: &mut self.split_at,
         };
         self.overlay.paint(
             &self.window,

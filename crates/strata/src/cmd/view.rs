@@ -50,6 +50,14 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         (None, Some(n)) => Some(Script::frames_then_screenshot(n, args.screenshot.clone())),
         (None, None) => None,
     };
+    let names = strata_render::methods::names();
+    if !names.contains(&args.method.as_str()) {
+        anyhow::bail!(
+            "unknown method `{}`; known: {}",
+            args.method,
+            names.join(", ")
+        );
+    }
     let settings = args.method_args.settings();
     let world = args.world.load()?;
     strata_viewer::run(Options {
