@@ -220,3 +220,54 @@ pub fn read_buffer(
     buffer.unmap();
     Ok(data)
 }
+
+/// Copy a 2D texture of 4 bytes per texel (`aspect` of it) to the CPU,
+/// rows unpadded, top row first.
+pub fn read_texture(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    errors: &ErrorSink,
+    texture: &wgpu::Texture,
+    aspect: wgpu::TextureAspect,
+) -> anyhow::Result<Vec<u8>> {
+    let (w, h) = (texture.width(), texture.height());
+    let row = 4 * w;
+    let align = wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+    let padded = row.div_ceil(align) * align;
+    let size = u64::from(padded) * u64::from(h);
+    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("readback"),
+        size,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut encoder = device.create_command_encoder(&Default::default());
+    encoder.copy_texture_to_buffer(
+        wgpu::TexelCopyTextureInfo {
+            texture,
+            mip_level: 0,
+            origin: wgpu::Origin3d::ZERO,
+            aspect,
+        },
+        wgpu::TexelCopyBufferInfo {
+            buffer: &buffer,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(padded),
+                rows_per_image: Some(h),
+            },
+        },
+        wgpu::Extent3d {
+            width: w,
+            height: h,
+            depth_or_array_layers: 1,
+        },
+    );
+    queue.submit([encoder.finish()]);
+    let raw = read_buffer(device, errors, &buffer, size)?;
+    let mut out = Vec::with_capacity((row * h) as usize);
+    for r in raw.chunks_exact(padded as usize) {
+        out.extend_from_slice(&r[..row as usize]);
+    }
+    Ok(out)
+}

@@ -384,49 +384,13 @@ impl Renderer {
         texture: &wgpu::Texture,
         aspect: wgpu::TextureAspect,
     ) -> anyhow::Result<Vec<u8>> {
-        let (w, h) = (self.shared.width, self.shared.height);
-        let row = 4 * w;
-        let padded =
-            row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-        let size = u64::from(padded) * u64::from(h);
-        let buffer = self.shared.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("readback"),
-            size,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let mut encoder = self
-            .shared
-            .device
-            .create_command_encoder(&Default::default());
-        encoder.copy_texture_to_buffer(
-            wgpu::TexelCopyTextureInfo {
-                texture,
-                mip_level: 0,
-                origin: wgpu::Origin3d::ZERO,
-                aspect,
-            },
-            wgpu::TexelCopyBufferInfo {
-                buffer: &buffer,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(padded),
-                    rows_per_image: Some(h),
-                },
-            },
-            wgpu::Extent3d {
-                width: w,
-                height: h,
-                depth_or_array_layers: 1,
-            },
-        );
-        self.shared.queue.submit([encoder.finish()]);
-        let raw = read_buffer(&self.shared.device, &self.errors, &buffer, size)?;
-        let mut out = Vec::with_capacity((row * h) as usize);
-        for r in raw.chunks_exact(padded as usize) {
-            out.extend_from_slice(&r[..row as usize]);
-        }
-        Ok(out)
+        crate::gpu::read_texture(
+            &self.shared.device,
+            &self.shared.queue,
+            &self.errors,
+            texture,
+            aspect,
+        )
     }
 }
 

@@ -8,7 +8,7 @@
 
 use bytemuck::{Pod, Zeroable};
 use strata_render::Shared;
-use strata_render::gpu::{ErrorSink, read_buffer};
+use strata_render::gpu::{ErrorSink, read_texture};
 
 /// The window image's format: what egui paints into and screenshots hold.
 pub const WINDOW_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
@@ -327,40 +327,14 @@ impl Compositor {
 
     /// The window image as RGBA8 (what a screenshot saves).
     pub fn read_window(&self, errors: &ErrorSink) -> anyhow::Result<image::RgbaImage> {
+        let pixels = read_texture(
+            &self.device,
+            &self.queue,
+            errors,
+            &self.window.texture,
+            wgpu::TextureAspect::All,
+        )?;
         let (w, h) = self.window_size;
-        let row = 4 * w;
-        let align = wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-        let padded = row.div_ceil(align) * align;
-        let size = u64::from(padded) * u64::from(h);
-        let buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("screenshot"),
-            size,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let mut encoder = self.device.create_command_encoder(&Default::default());
-        encoder.copy_texture_to_buffer(
-            self.window.texture.as_image_copy(),
-            wgpu::TexelCopyBufferInfo {
-                buffer: &buffer,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(padded),
-                    rows_per_image: Some(h),
-                },
-            },
-            wgpu::Extent3d {
-                width: w,
-                height: h,
-                depth_or_array_layers: 1,
-            },
-        );
-        self.queue.submit([encoder.finish()]);
-        let raw = read_buffer(&self.device, errors, &buffer, size)?;
-        let mut pixels = Vec::with_capacity((row * h) as usize);
-        for r in raw.chunks_exact(padded as usize) {
-            pixels.extend_from_slice(&r[..row as usize]);
-        }
         image::RgbaImage::from_raw(w, h, pixels)
             .ok_or_else(|| anyhow::anyhow!("screenshot buffer has the wrong size"))
     }
