@@ -164,6 +164,60 @@ impl Globals {
     }
 }
 
+/// The colour and depth targets every method draws into.
+struct Targets {
+    color: wgpu::Texture,
+    color_view: wgpu::TextureView,
+    depth: wgpu::Texture,
+    depth_view: wgpu::TextureView,
+}
+
+impl Targets {
+    fn new(device: &wgpu::Device, width: u32, height: u32) -> anyhow::Result<Self> {
+        let max = device.limits().max_texture_dimension_2d;
+        if width == 0 || height == 0 || width > max || height > max {
+            anyhow::bail!(
+                "render size {width}x{height} is outside this adapter's 1..={max} pixels per side"
+            );
+        }
+        use wgpu::TextureUsages as U;
+        let texture = |label, format, usage| {
+            let t = device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d {
+                    width,
+                    height,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage,
+                view_formats: &[],
+            });
+            let v = t.create_view(&Default::default());
+            (t, v)
+        };
+        let (color, color_view) = texture(
+            "color",
+            COLOR_FORMAT,
+            U::RENDER_ATTACHMENT | U::STORAGE_BINDING | U::TEXTURE_BINDING | U::COPY_SRC,
+        );
+        let (depth, depth_view) = texture(
+            "depth",
+            DEPTH_FORMAT,
+            U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC,
+        );
+        Ok(Targets {
+            color,
+            color_view,
+            depth,
+            depth_view,
+        })
+    }
+}
+
 /// The resources shared by all methods, and the helpers methods build with.
 pub struct Shared {
     pub device: wgpu::Device,
@@ -247,12 +301,6 @@ impl Shared {
         width: u32,
         height: u32,
     ) -> anyhow::Result<Self> {
-        let max = device.limits().max_texture_dimension_2d;
-        if width == 0 || height == 0 || width > max || height > max {
-            anyhow::bail!(
-                "render size {width}x{height} is outside this adapter's 1..={max} pixels per side"
-            );
-        }
         let terrain = TerrainTexture::new(device, queue, level)?;
         let globals = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("globals"),
@@ -293,20 +341,12 @@ impl Shared {
             wgpu::TextureFormat::R32Float,
             U::STORAGE_BINDING | U::TEXTURE_BINDING,
         );
-        let (color, color_view) = texture(
-            "color",
-            width,
-            height,
-            COLOR_FORMAT,
-            U::RENDER_ATTACHMENT | U::STORAGE_BINDING | U::TEXTURE_BINDING | U::COPY_SRC,
-        );
-        let (depth, depth_view) = texture(
-            "depth",
-            width,
-            height,
-            DEPTH_FORMAT,
-            U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC,
-        );
+        let Targets {
+            color,
+            color_view,
+            depth,
+            depth_view,
+        } = Targets::new(device, width, height)?;
         let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("frame"),
             entries: &[
@@ -363,6 +403,22 @@ impl Shared {
             frame_layout,
             frame_group,
         })
+    }
+
+    /// Recreate the colour and depth targets at a new size (their content is
+    /// lost). Methods that bound or sized anything for the old ones must then
+    /// be told ([`crate::Method::resize`]); [`crate::Renderer::resize`] does both.
+    pub(crate) fn resize_targets(&mut self, width: u32, height: u32) -> anyhow::Result<()> {
+        let Targets {
+            color,
+            color_view,
+            depth,
+            depth_view,
+        } = Targets::new(&self.device, width, height)?;
+        (self.color, self.color_view, self.depth, self.depth_view) =
+            (color, color_view, depth, depth_view);
+        (self.width, self.height) = (width, height);
+        Ok(())
     }
 
     /// Compose and compile one of `shaders/*.wgsl`.

@@ -186,6 +186,25 @@ impl Renderer {
         }
     }
 
+    /// Draw at `width` x `height` from the next frame on: new shared targets,
+    /// and every kept method rebinds or resizes what depended on the old ones
+    /// (nothing is rebuilt from the level). Refused while a method built on
+    /// [`Renderer::shared_handle`] still holds the shared frame.
+    pub fn resize(&mut self, width: u32, height: u32) -> anyhow::Result<()> {
+        if (width, height) == (self.shared.width, self.shared.height) {
+            return Ok(());
+        }
+        let shared = Arc::get_mut(&mut self.shared).ok_or_else(|| {
+            anyhow::anyhow!("cannot resize while a method is being built on the shared frame")
+        })?;
+        shared.resize_targets(width, height)?;
+        for built in &mut self.methods {
+            built.method.resize(&self.shared)?;
+        }
+        self.shadow_drawn = None;
+        wait_device(&self.shared.device, &self.errors)
+    }
+
     /// Skip the shadow pass when the map would be the one already drawn (the
     /// same fitted frame, no edit since): for interactive use, where a still
     /// camera or an A/B pair redraws it for nothing. Off by default, so every

@@ -157,7 +157,8 @@ fn scripted_flight_switches_method_digs_and_undoes() {
              dig 0.5 0.5\nscreenshot {s}/mesh-dug.png\n\
              copy-view dug\n\
              method ray\nset ray-steps 32\nscreenshot {s}/ray-32.png\n\
-             overlay on\nfly -20 0 30 4\nturn 0 20 2\nscreenshot {s}/final.png\n",
+             overlay on\nfly -20 0 30 4\nturn 0 20 2\nscreenshot {s}/final.png\n\
+             overlay off\nwindow 320 240\nscreenshot {s}/resized.png\n",
             s = shots.display()
         ),
     )
@@ -226,4 +227,11 @@ fn scripted_flight_switches_method_digs_and_undoes() {
     let views = strata_level::views::parse_views(line).unwrap();
     assert_eq!(views[0].pitch, -89.5);
     assert_eq!(load(&shots, "final.png").dimensions(), WINDOW);
+    // The picture follows a resized window (another aspect: no bars).
+    let resized = load(&shots, "resized.png");
+    assert_eq!(resized.dimensions(), (320, 240));
+    let bars = image::Rgba([20, 20, 23, 255]);
+    for (x, y) in [(0, 0), (319, 0), (0, 239), (319, 239), (160, 1), (1, 120)] {
+        assert_ne!(*resized.get_pixel(x, y), bars, "bars at {x},{y}");
+    }
 }

@@ -40,7 +40,7 @@ pub struct Options {
     pub settings: MethodSettings,
     /// The window's inner size at start, pixels.
     pub size: (u32, u32),
-    /// Render size as a fraction of `size`; `None`: 1, or 0.5 on a CPU adapter.
+    /// Picture size as a fraction of the window's; `None`: 1, or 0.5 on a CPU adapter.
     pub render_scale: Option<f32>,
     /// The level's view to start at (default: its first).
     pub view: Option<String>,

@@ -3,8 +3,9 @@
 //! that image is copied to the swapchain. Screenshots read the window image,
 //! so they show exactly what the window shows.
 //!
-//! The render size is fixed for the session (methods bind the shared
-//! targets); a resized window scales the picture to fit, with bars.
+//! The picture follows the window's size (times the render scale) once the
+//! renderer has been resized; until then (a method is being built in the
+//! background) it is scaled to fit, with bars.
 
 use bytemuck::{Pod, Zeroable};
 use strata_render::Shared;
@@ -168,41 +169,13 @@ impl Compositor {
                 options: [2.0, f32::from(u8::from(surface_format.is_srgb())), 0.0, 0.0],
             }),
         );
-        let render_size = (shared.width, shared.height);
-        let left = image(
-            &device,
-            "A picture",
-            render_size,
-            wgpu::TextureUsages::COPY_DST | wgpu::TextureUsages::TEXTURE_BINDING,
-        );
         let group = |left: &wgpu::TextureView, right: &wgpu::TextureView, params: &wgpu::Buffer| {
-            device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("present"),
-                layout: &layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: params.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: wgpu::BindingResource::TextureView(left),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 2,
-                        resource: wgpu::BindingResource::TextureView(right),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 3,
-                        resource: wgpu::BindingResource::Sampler(&sampler),
-                    },
-                ],
-            })
+            bind_images(&device, &layout, &sampler, params, left, right)
         };
-        let single_group = group(&shared.color_view, &shared.color_view, &compose_params);
-        let split_group = group(&left.view, &shared.color_view, &compose_params);
         let window = Self::window_image(&device, window_size);
         let present_group = group(&window.view, &window.view, &present_params);
+        let (left, single_group, split_group) =
+            picture_groups(shared, &layout, &sampler, &compose_params);
         Ok(Compositor {
             queue: shared.queue.clone(),
             layout,
@@ -216,10 +189,17 @@ impl Compositor {
             split_group,
             window,
             present_group,
-            render_size,
+            render_size: (shared.width, shared.height),
             window_size,
             device,
         })
+    }
+
+    /// The renderer's targets were resized: bind the new ones.
+    pub fn rebind_picture(&mut self, shared: &Shared) {
+        (self.left, self.single_group, self.split_group) =
+            picture_groups(shared, &self.layout, &self.sampler, &self.compose_params);
+        self.render_size = (shared.width, shared.height);
     }
 
     fn window_image(device: &wgpu::Device, size: (u32, u32)) -> Image {
@@ -239,28 +219,14 @@ impl Compositor {
         }
         self.window_size = size;
         self.window = Self::window_image(&self.device, size);
-        self.present_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("present"),
-            layout: &self.layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: self.present_params.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::TextureView(&self.window.view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: wgpu::BindingResource::TextureView(&self.window.view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: wgpu::BindingResource::Sampler(&self.sampler),
-                },
-            ],
-        });
+        self.present_group = bind_images(
+            &self.device,
+            &self.layout,
+            &self.sampler,
+            &self.present_params,
+            &self.window.view,
+            &self.window.view,
+        );
     }
 
     pub fn window_size(&self) -> (u32, u32) {
@@ -338,6 +304,60 @@ impl Compositor {
         image::RgbaImage::from_raw(w, h, pixels)
             .ok_or_else(|| anyhow::anyhow!("screenshot buffer has the wrong size"))
     }
+}
+
+/// The pass's bind group: parameters, left and right images, the sampler.
+fn bind_images(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    sampler: &wgpu::Sampler,
+    params: &wgpu::Buffer,
+    left: &wgpu::TextureView,
+    right: &wgpu::TextureView,
+) -> wgpu::BindGroup {
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("present"),
+        layout,
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: params.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: wgpu::BindingResource::TextureView(left),
+            },
+            wgpu::BindGroupEntry {
+                binding: 2,
+                resource: wgpu::BindingResource::TextureView(right),
+            },
+            wgpu::BindGroupEntry {
+                binding: 3,
+                resource: wgpu::BindingResource::Sampler(sampler),
+            },
+        ],
+    })
+}
+
+/// The kept A picture (the renderer's size) and the compose groups: the
+/// renderer's picture alone, and the A copy left of it.
+fn picture_groups(
+    shared: &Shared,
+    layout: &wgpu::BindGroupLayout,
+    sampler: &wgpu::Sampler,
+    params: &wgpu::Buffer,
+) -> (Image, wgpu::BindGroup, wgpu::BindGroup) {
+    let device = &shared.device;
+    let left = image(
+        device,
+        "A picture",
+        (shared.width, shared.height),
+        wgpu::TextureUsages::COPY_DST | wgpu::TextureUsages::TEXTURE_BINDING,
+    );
+    let color = &shared.color_view;
+    let single = bind_images(device, layout, sampler, params, color, color);
+    let split = bind_images(device, layout, sampler, params, &left.view, color);
+    (left, single, split)
 }
 
 /// The largest rectangle of the render's aspect inside the window, centred:

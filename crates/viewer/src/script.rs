@@ -14,6 +14,7 @@
 //! undo                      undo the last dig
 //! set KNOB VALUE            ray-steps, voxel-steps, slices, density, mesh-quality, shadows (0/1)
 //! overlay on|off            show or hide the overlay
+//! window W H                resize the window (the picture follows)
 //! screenshot PATH           save what the window shows as PNG
 //! copy-view [NAME]          print the current view as a views.txt line
 //! quit                      stop here (the end of the file does too)
@@ -43,6 +44,8 @@ pub enum Command {
     Undo,
     Set(Knob, f32),
     Overlay(bool),
+    /// Window inner size, pixels.
+    Window(u32, u32),
     Screenshot(PathBuf),
     CopyView(String),
     Quit,
@@ -218,6 +221,16 @@ fn parse_line(line: &str) -> anyhow::Result<Command> {
                 other => bail!("overlay takes on or off, not `{other}`"),
             }
         }
+        "window" => {
+            arity(2, 2)?;
+            let side = |t: &str| -> anyhow::Result<u32> {
+                match number::<u32>(t, "window size")? {
+                    v @ 1..=16384 => Ok(v),
+                    _ => bail!("window sides are 1..=16384 pixels"),
+                }
+            };
+            Command::Window(side(args[0])?, side(args[1])?)
+        }
         "screenshot" => {
             arity(1, 1)?;
             Command::Screenshot(PathBuf::from(args[0]))
@@ -232,7 +245,7 @@ fn parse_line(line: &str) -> anyhow::Result<Command> {
         }
         other => bail!(
             "unknown command `{other}` (view, method, split, fly, turn, frames, dig, undo, \
-             set, overlay, screenshot, copy-view, quit)"
+             set, overlay, window, screenshot, copy-view, quit)"
         ),
     })
 }
@@ -246,7 +259,7 @@ mod tests {
         let script = Script::parse(
             "# a flight\nview hangar\nmethod mesh  # switch\nsplit ray\nsplit off\n\
              fly 10 -2 3 5\nturn 15 -5\nframes 4\ndig 0.5 0.25\nundo\nset ray-steps 64\n\
-             overlay off\nscreenshot out/a.png\ncopy-view\nquit\n",
+             overlay off\nwindow 640 480\nscreenshot out/a.png\ncopy-view\nquit\n",
         )
         .unwrap();
         let commands: Vec<_> = script.commands.iter().map(|(_, c)| c.clone()).collect();
@@ -270,6 +283,7 @@ mod tests {
                 Command::Undo,
                 Command::Set(Knob::RaySteps, 64.0),
                 Command::Overlay(false),
+                Command::Window(640, 480),
                 Command::Screenshot("out/a.png".into()),
                 Command::CopyView("viewer".into()),
                 Command::Quit,
@@ -288,6 +302,7 @@ mod tests {
             ("set warp 3", "unknown setting"),
             ("turn nan 2", "finite"),
             ("overlay maybe", "on or off"),
+            ("window 0 100", "1..=16384"),
         ] {
             let err = format!("{:#}", Script::parse(text).unwrap_err());
             assert!(err.contains(needle), "`{text}` gave `{err}`");

@@ -44,6 +44,11 @@ enum Running {
     WaitMethod(String),
     /// Until no build runs (a changed knob's rebuild).
     WaitBuilds,
+    /// Until the picture has this size; an error after `left` frames.
+    WaitSize {
+        size: (u32, u32),
+        left: u32,
+    },
 }
 
 /// Sums over the frames a method drew.
@@ -73,6 +78,10 @@ pub struct Viewer {
     digger: Digger,
     fly: FlyCamera,
     render_size: (u32, u32),
+    render_scale: f32,
+    /// The render size the window asks for, applied once no build holds
+    /// the shared frame.
+    resize_to: Option<(u32, u32)>,
     /// The settings methods are (re)built with; the overlay edits them.
     settings: MethodSettings,
     /// Drawn right of the active method in A/B mode.
@@ -126,6 +135,12 @@ fn surface_config(
         wgpu::PresentMode::AutoNoVsync
     };
     Ok(config)
+}
+
+/// The render size for a window size.
+fn scaled(window: (u32, u32), scale: f32) -> (u32, u32) {
+    let side = |v: u32| ((v as f32 * scale).round() as u32).max(1);
+    (side(window.0), side(window.1))
 }
 
 /// The settings of `s` that method `name` reads (the rest at defaults), so
@@ -217,10 +232,7 @@ impl Viewer {
         if !(scale > 0.0 && scale <= 4.0) {
             bail!("--render-scale {scale} must be in (0, 4]");
         }
-        let render_size = (
-            ((size.0 as f32 * scale).round() as u32).max(1),
-            ((size.1 as f32 * scale).round() as u32).max(1),
-        );
+        let render_size = scaled(window_size, scale);
         let level = world.level;
         let mut views = world.views;
         // The edit fixture's camera is a view too: it looks at the crater site.
@@ -282,6 +294,8 @@ impl Viewer {
             digger,
             fly: FlyCamera::from_camera(&camera),
             render_size,
+            render_scale: scale,
+            resize_to: None,
             settings,
             split: None,
             split_at: 0.5,
@@ -365,6 +379,7 @@ impl Viewer {
                 self.config.height = size.height;
                 self.surface.configure(&self.gpu.device, &self.config);
                 self.compositor.resize((size.width, size.height));
+                self.resize_to = Some(scaled((size.width, size.height), self.render_scale));
             }
             WindowEvent::Focused(false) => {
                 self.keys.clear();
@@ -741,6 +756,24 @@ impl Viewer {
                     })
                 }
                 Running::Frames(left) => (left > 1).then_some(Running::Frames(left - 1)),
+                Running::WaitSize { size, left } => {
+                    if self.render_size == size {
+                        None
+                    } else if left == 0 {
+                        bail!(
+                            "the window system left the picture at {}x{}, not {}x{}",
+                            self.render_size.0,
+                            self.render_size.1,
+                            size.0,
+                            size.1
+                        );
+                    } else {
+                        Some(Running::WaitSize {
+                            size,
+                            left: left - 1,
+                        })
+                    }
+                }
                 Running::WaitBuilds => {
                     (!self.builds.running().is_empty()).then_some(Running::WaitBuilds)
                 }
@@ -808,6 +841,17 @@ impl Viewer {
                 running = Some(Running::WaitBuilds);
             }
             Command::Overlay(on) => self.overlay.visible = on,
+            Command::Window(w, h) => {
+                // The reply comes as a Resized event; the size may differ
+                // from the request only where a window manager refuses it.
+                let _ = self
+                    .window
+                    .request_inner_size(winit::dpi::PhysicalSize::new(w, h));
+                running = Some(Running::WaitSize {
+                    size: scaled((w, h), self.render_scale),
+                    left: 200,
+                });
+            }
             Command::Screenshot(path) => self.screenshot_after_frame = Some(path),
             Command::CopyView(name) => self.copy_view(&name),
             Command::Quit => self.quit = true,
@@ -838,6 +882,15 @@ impl Viewer {
             self.fly.fly(&motion, dt.min(0.1) as f32, &self.level);
         }
 
+        if let Some(size) = self.resize_to
+            && self.builds.running().is_empty()
+        {
+            self.renderer.resize(size.0, size.1)?;
+            self.compositor.rebind_picture(self.renderer.shared());
+            self.render_size = size;
+            self.resize_to = None;
+            self.say(format!("picture {}x{}", size.0, size.1));
+        }
         let camera = self.camera()?;
         let active = self.renderer.method_name();
         let mut timings = vec![(active.to_string(), self.renderer.render_frame(&camera)?)];

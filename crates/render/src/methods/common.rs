@@ -220,10 +220,46 @@ pub(crate) fn dispatch_per_pixel(
 /// texture, so the march writes an R32Float storage image and a full-screen
 /// pass (`depth_blit.wgsl`) copies it into the shared depth target.
 pub(crate) struct DepthCopy {
+    label: String,
     view: wgpu::TextureView,
     bytes: u64,
     blit: wgpu::RenderPipeline,
+    layout: wgpu::BindGroupLayout,
     blit_group: wgpu::BindGroup,
+}
+
+/// The R32Float storage image of the shared targets' size, and the copy
+/// pass's bind group reading it.
+fn depth_image(
+    shared: &Shared,
+    label: &str,
+    layout: &wgpu::BindGroupLayout,
+) -> (wgpu::TextureView, wgpu::BindGroup) {
+    let device = &shared.device;
+    let depth = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d {
+            width: shared.width,
+            height: shared.height,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::R32Float,
+        usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING,
+        view_formats: &[],
+    });
+    let view = depth.create_view(&Default::default());
+    let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout,
+        entries: &[wgpu::BindGroupEntry {
+            binding: 0,
+            resource: wgpu::BindingResource::TextureView(&view),
+        }],
+    });
+    (view, group)
 }
 
 impl DepthCopy {
@@ -231,21 +267,6 @@ impl DepthCopy {
     /// (labelled `blit_label`).
     pub(crate) fn new(shared: &Shared, method: &str, blit_label: &str) -> anyhow::Result<Self> {
         let device = &shared.device;
-        let depth = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some(&format!("{method} depth")),
-            size: wgpu::Extent3d {
-                width: shared.width,
-                height: shared.height,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::R32Float,
-            usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING,
-            view_formats: &[],
-        });
-        let view = depth.create_view(&Default::default());
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some(blit_label),
             entries: &[texture_entry(
@@ -254,14 +275,8 @@ impl DepthCopy {
                 wgpu::TextureViewDimension::D2,
             )],
         });
-        let blit_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some(blit_label),
-            layout: &layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: wgpu::BindingResource::TextureView(&view),
-            }],
-        });
+        let label = format!("{method} depth");
+        let (view, blit_group) = depth_image(shared, &label, &layout);
         let module = shared.shader("depth_blit.wgsl")?;
         // No frame group: the copy reads only the storage image.
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -279,11 +294,20 @@ impl DepthCopy {
             &[],
         );
         Ok(Self {
+            label,
             view,
             bytes: u64::from(shared.width) * u64::from(shared.height) * 4,
             blit,
+            layout,
             blit_group,
         })
+    }
+
+    /// A new storage image at the shared targets' new size; the caller
+    /// rebinds [`DepthCopy::bindings`].
+    pub(crate) fn resize(&mut self, shared: &Shared) {
+        (self.view, self.blit_group) = depth_image(shared, &self.label, &self.layout);
+        self.bytes = u64::from(shared.width) * u64::from(shared.height) * 4;
     }
 
     /// Layout entries for the march's outputs: the shared colour target at

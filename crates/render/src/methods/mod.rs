@@ -29,6 +29,8 @@
 //! - `apply_edit` runs after the shared terrain texture has been updated;
 //!   methods that only read the texture need not override it.
 //! - `retained_bytes` counts only what the method allocates beyond [`Shared`].
+//! - A method that binds the shared targets, or sizes anything by them, in
+//!   `create` must redo that in `resize` (the viewer follows its window).
 
 mod common;
 pub mod forward;
@@ -112,6 +114,13 @@ pub trait Method: Send {
         _level: &Level,
         _rects: &[DirtyRect],
     ) -> anyhow::Result<()> {
+        Ok(())
+    }
+
+    /// The shared targets were recreated at `shared.width` x `shared.height`:
+    /// rebuild what was sized for or bound to the old ones (methods that only
+    /// attach the targets when recording need nothing).
+    fn resize(&mut self, _shared: &Shared) -> anyhow::Result<()> {
         Ok(())
     }
 

@@ -13,8 +13,32 @@ use strata_level::Level;
 
 pub struct RayCompute {
     march: wgpu::ComputePipeline,
+    params: wgpu::Buffer,
+    march_layout: wgpu::BindGroupLayout,
     march_group: wgpu::BindGroup,
     depth: DepthCopy,
+}
+
+/// The march's outputs (shared colour, own depth image) and its parameters.
+fn march_group(
+    shared: &Shared,
+    layout: &wgpu::BindGroupLayout,
+    params: &wgpu::Buffer,
+    depth: &DepthCopy,
+) -> wgpu::BindGroup {
+    let [color_binding, depth_binding] = depth.bindings(shared, 1);
+    shared.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("ray-compute"),
+        layout,
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: params.as_entire_binding(),
+            },
+            color_binding,
+            depth_binding,
+        ],
+    })
 }
 
 pub fn create(
@@ -31,19 +55,7 @@ pub fn create(
             label: Some("ray-compute"),
             entries: &[uniform_layout_entry(0), color_entry, depth_entry],
         });
-    let [color_binding, depth_binding] = depth.bindings(shared, 1);
-    let march_group = shared.device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("ray-compute"),
-        layout: &march_layout,
-        entries: &[
-            wgpu::BindGroupEntry {
-                binding: 0,
-                resource: params.as_entire_binding(),
-            },
-            color_binding,
-            depth_binding,
-        ],
-    });
+    let march_group = march_group(shared, &march_layout, &params, &depth);
     let march = compute_pipeline(
         shared,
         "ray-compute",
@@ -53,6 +65,8 @@ pub fn create(
     )?;
     Ok(Box::new(RayCompute {
         march,
+        params,
+        march_layout,
         march_group,
         depth,
     }))
@@ -61,6 +75,12 @@ pub fn create(
 impl Method for RayCompute {
     fn name(&self) -> &'static str {
         "ray-compute"
+    }
+
+    fn resize(&mut self, shared: &Shared) -> anyhow::Result<()> {
+        self.depth.resize(shared);
+        self.march_group = march_group(shared, &self.march_layout, &self.params, &self.depth);
+        Ok(())
     }
 
     fn record(&self, shared: &Shared, frame: &Frame<'_>, encoder: &mut wgpu::CommandEncoder) {

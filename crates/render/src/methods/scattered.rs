@@ -162,12 +162,12 @@ pub struct Scattered {
     density: [f32; 3],
     tops: TopMax,
     params: wgpu::Buffer,
-    screen_bytes: u64,
+    scatter_layout: wgpu::BindGroupLayout,
+    resolve_layout: wgpu::BindGroupLayout,
+    screen: ScreenBuffer,
     clear: wgpu::ComputePipeline,
     scatter: wgpu::ComputePipeline,
-    scatter_group: wgpu::BindGroup,
     resolve: wgpu::RenderPipeline,
-    resolve_group: wgpu::BindGroup,
     /// Most samples one frame may have: [`MAX_GRID`] and the dispatch limits.
     max_samples: u64,
     max_groups: u32,
@@ -193,6 +193,68 @@ fn storage_entry(
     }
 }
 
+/// One packed depth + info word per pixel, and the groups that bind it.
+struct ScreenBuffer {
+    bytes: u64,
+    scatter_group: wgpu::BindGroup,
+    resolve_group: wgpu::BindGroup,
+}
+
+impl ScreenBuffer {
+    /// Sized by the shared targets.
+    fn new(
+        shared: &Shared,
+        params: &wgpu::Buffer,
+        scatter_layout: &wgpu::BindGroupLayout,
+        resolve_layout: &wgpu::BindGroupLayout,
+    ) -> anyhow::Result<Self> {
+        let device = &shared.device;
+        let bytes = u64::from(shared.width) * u64::from(shared.height) * 4;
+        let max_binding = device.limits().max_storage_buffer_binding_size;
+        if bytes > max_binding {
+            anyhow::bail!(
+                "scattered: a {}x{} screen buffer needs {bytes} bytes, over this adapter's \
+                 storage binding limit of {max_binding}",
+                shared.width,
+                shared.height
+            );
+        }
+        let screen = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("scattered screen"),
+            size: bytes,
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        });
+        let scatter_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("scattered"),
+            layout: scatter_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: params.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: screen.as_entire_binding(),
+                },
+            ],
+        });
+        let resolve_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("scattered resolve"),
+            layout: resolve_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: screen.as_entire_binding(),
+            }],
+        });
+        Ok(ScreenBuffer {
+            bytes,
+            scatter_group,
+            resolve_group,
+        })
+    }
+}
+
 pub fn create(
     shared: &Shared,
     level: &Level,
@@ -201,42 +263,12 @@ pub fn create(
     let density = checked_density(settings.scatter_density)?;
     let device = &shared.device;
     let limits = device.limits();
-    let screen_bytes = u64::from(shared.width) * u64::from(shared.height) * 4;
-    let max_binding = limits.max_storage_buffer_binding_size;
-    if screen_bytes > max_binding {
-        anyhow::bail!(
-            "scattered: a {}x{} screen buffer needs {screen_bytes} bytes, over this adapter's \
-             storage binding limit of {max_binding}",
-            shared.width,
-            shared.height
-        );
-    }
     let params = shared.uniform_buffer("scattered", bytemuck::bytes_of(&ScatterParams::default()));
-    let screen = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("scattered screen"),
-        size: screen_bytes,
-        usage: wgpu::BufferUsages::STORAGE,
-        mapped_at_creation: false,
-    });
     let scatter_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("scattered"),
         entries: &[
             uniform_layout_entry(0),
             storage_entry(1, false, wgpu::ShaderStages::COMPUTE),
-        ],
-    });
-    let scatter_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("scattered"),
-        layout: &scatter_layout,
-        entries: &[
-            wgpu::BindGroupEntry {
-                binding: 0,
-                resource: params.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 1,
-                resource: screen.as_entire_binding(),
-            },
         ],
     });
     let module = shared.shader("scattered.wgsl")?;
@@ -257,14 +289,7 @@ pub fn create(
         label: Some("scattered resolve"),
         entries: &[storage_entry(0, true, wgpu::ShaderStages::FRAGMENT)],
     });
-    let resolve_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("scattered resolve"),
-        layout: &resolve_layout,
-        entries: &[wgpu::BindGroupEntry {
-            binding: 0,
-            resource: screen.as_entire_binding(),
-        }],
-    });
+    let screen = ScreenBuffer::new(shared, &params, &scatter_layout, &resolve_layout)?;
     let resolve_module = shared.shader("scattered_resolve.wgsl")?;
     let resolve = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some("scattered resolve"),
@@ -299,12 +324,12 @@ pub fn create(
         density,
         tops: TopMax::new(level),
         params,
-        screen_bytes,
+        scatter_layout,
+        resolve_layout,
+        screen,
         clear,
         scatter,
-        scatter_group,
         resolve,
-        resolve_group,
         max_samples: MAX_GRID.min(dispatchable),
         max_groups,
         groups: (0, 0),
@@ -315,6 +340,16 @@ pub fn create(
 impl Method for Scattered {
     fn name(&self) -> &'static str {
         "scattered"
+    }
+
+    fn resize(&mut self, shared: &Shared) -> anyhow::Result<()> {
+        self.screen = ScreenBuffer::new(
+            shared,
+            &self.params,
+            &self.scatter_layout,
+            &self.resolve_layout,
+        )?;
+        Ok(())
     }
 
     fn apply_edit(
@@ -364,7 +399,7 @@ impl Method for Scattered {
             });
             pass.set_pipeline(&self.clear);
             pass.set_bind_group(0, &shared.frame_group, &[]);
-            pass.set_bind_group(1, &self.scatter_group, &[]);
+            pass.set_bind_group(1, &self.screen.scatter_group, &[]);
             pass.dispatch_workgroups(shared.width.div_ceil(8), shared.height.div_ceil(8), 1);
         }
         if self.groups.0 > 0 {
@@ -374,7 +409,7 @@ impl Method for Scattered {
             });
             pass.set_pipeline(&self.scatter);
             pass.set_bind_group(0, &shared.frame_group, &[]);
-            pass.set_bind_group(1, &self.scatter_group, &[]);
+            pass.set_bind_group(1, &self.screen.scatter_group, &[]);
             pass.dispatch_workgroups(self.groups.0, self.groups.1, 1);
         }
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -402,14 +437,14 @@ impl Method for Scattered {
         });
         pass.set_pipeline(&self.resolve);
         pass.set_bind_group(0, &shared.frame_group, &[]);
-        pass.set_bind_group(1, &self.resolve_group, &[]);
+        pass.set_bind_group(1, &self.screen.resolve_group, &[]);
         pass.draw(0..3, 0..1);
     }
 
     fn retained_bytes(&self) -> RetainedBytes {
         // The screen buffer (4 bytes per pixel) and the grid uniform.
         RetainedBytes {
-            gpu: self.screen_bytes + std::mem::size_of::<ScatterParams>() as u64,
+            gpu: self.screen.bytes + std::mem::size_of::<ScatterParams>() as u64,
             cpu: 0,
         }
     }

@@ -40,6 +40,8 @@ struct ComputeParts {
 pub struct Voxel {
     name: &'static str,
     pyramid: GpuPyramid,
+    params: wgpu::Buffer,
+    group_layout: wgpu::BindGroupLayout,
     group: wgpu::BindGroup,
     fragment: Option<wgpu::RenderPipeline>,
     compute: Option<ComputeParts>,
@@ -160,24 +162,7 @@ pub fn build(
         label: Some("voxel"),
         entries: &entries,
     });
-    let mut bindings = vec![
-        wgpu::BindGroupEntry {
-            binding: 0,
-            resource: params.as_entire_binding(),
-        },
-        wgpu::BindGroupEntry {
-            binding: 1,
-            resource: pyramid.buffer.as_entire_binding(),
-        },
-    ];
-    if let Some(depth) = &depth {
-        bindings.extend(depth.bindings(shared, 2));
-    }
-    let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("voxel"),
-        layout: &group_layout,
-        entries: &bindings,
-    });
+    let group = voxel_group(shared, &group_layout, &params, &pyramid, depth.as_ref());
     let pipeline_layout = shared.pipeline_layout("voxel", &[&group_layout]);
 
     let (fragment, compute_parts, name) = match depth {
@@ -200,9 +185,39 @@ pub fn build(
     Ok(Voxel {
         name,
         pyramid,
+        params,
+        group_layout,
         group,
         fragment,
         compute: compute_parts,
+    })
+}
+
+/// Parameters, the pyramid and, for the compute variant, its outputs.
+fn voxel_group(
+    shared: &Shared,
+    layout: &wgpu::BindGroupLayout,
+    params: &wgpu::Buffer,
+    pyramid: &GpuPyramid,
+    depth: Option<&DepthCopy>,
+) -> wgpu::BindGroup {
+    let mut bindings = vec![
+        wgpu::BindGroupEntry {
+            binding: 0,
+            resource: params.as_entire_binding(),
+        },
+        wgpu::BindGroupEntry {
+            binding: 1,
+            resource: pyramid.buffer.as_entire_binding(),
+        },
+    ];
+    if let Some(depth) = depth {
+        bindings.extend(depth.bindings(shared, 2));
+    }
+    shared.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("voxel"),
+        layout,
+        entries: &bindings,
     })
 }
 
@@ -218,6 +233,21 @@ impl Method for Voxel {
         rects: &[DirtyRect],
     ) -> anyhow::Result<()> {
         self.pyramid.enqueue(rects)
+    }
+
+    fn resize(&mut self, shared: &Shared) -> anyhow::Result<()> {
+        // Only the compute variant binds the targets.
+        if let Some(c) = &mut self.compute {
+            c.depth.resize(shared);
+            self.group = voxel_group(
+                shared,
+                &self.group_layout,
+                &self.params,
+                &self.pyramid,
+                Some(&c.depth),
+            );
+        }
+        Ok(())
     }
 
     fn prepare(&mut self, shared: &Shared, _camera: &Camera) -> anyhow::Result<()> {

@@ -20,7 +20,7 @@ pub struct Args {
     /// Window size at start.
     #[arg(long, default_value = "1280x800", value_parser = parse_size)]
     pub size: (u32, u32),
-    /// Render size as a fraction of the window size [default: 1, or 0.5 on a CPU adapter].
+    /// Picture size as a fraction of the window's (it follows resizes) [default: 1, or 0.5 on a CPU adapter].
     #[arg(long, value_name = "F")]
     pub render_scale: Option<f32>,
     /// Run the commands of FILE (see `strata_viewer::script`), then quit.
