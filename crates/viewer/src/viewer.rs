@@ -99,6 +99,8 @@ pub struct Viewer {
     /// The platform sends raw mouse motion (used for looking when it does).
     raw_motion: bool,
     last_frame: Instant,
+    /// When `new` started (for the first-frame time).
+    opened: Instant,
     frame_ms: f64,
     timings: Vec<(String, FrameTimings)>,
     totals: Vec<(String, Totals)>,
@@ -200,6 +202,7 @@ impl Viewer {
             vsync,
             out,
         } = options;
+        let opened = Instant::now();
         if !methods::names().contains(&method.as_str()) {
             bail!(
                 "unknown method `{method}`; known: {}",
@@ -308,6 +311,7 @@ impl Viewer {
             looking: false,
             raw_motion: false,
             last_frame: Instant::now(),
+            opened,
             frame_ms: 0.0,
             timings: Vec::new(),
             totals: Vec::new(),
@@ -322,12 +326,13 @@ impl Viewer {
             quit: false,
         };
         viewer.say(format!(
-            "{} on {} ({}), render {}x{}",
+            "{} on {} ({}), render {}x{}; window, device and {FIRST_METHOD} ready in {:.2} s",
             world.name,
             viewer.gpu.report.name,
             viewer.gpu.report.backend,
             render_size.0,
-            render_size.1
+            render_size.1,
+            opened.elapsed().as_secs_f64()
         ));
         viewer.request_method(&method)?;
         Ok(viewer)
@@ -874,6 +879,7 @@ impl Viewer {
         } else {
             0.9 * self.frame_ms + 0.1 * dt * 1e3
         };
+        let first = self.totals.is_empty();
         self.collect_builds()?;
         self.script_step()?;
         // Held keys fly the camera; a long stall (a build) is not a jump.
@@ -948,6 +954,12 @@ impl Viewer {
             self.gpu.queue.present(texture);
         }
         self.gpu.errors.check()?;
+        if first {
+            self.say(format!(
+                "first frame shown {:.2} s after the window opened",
+                self.opened.elapsed().as_secs_f64()
+            ));
+        }
 
         if let Some(path) = self.screenshot_after_frame.take() {
             let image = self.compositor.read_window(&self.gpu.errors)?;

@@ -59,7 +59,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         );
     }
     let settings = args.method_args.settings();
+    let start = std::time::Instant::now();
     let world = args.world.load()?;
+    eprintln!(
+        "strata view: {} loaded in {:.2} s",
+        world.name,
+        start.elapsed().as_secs_f64()
+    );
     strata_viewer::run(Options {
         world,
         method: args.method,
