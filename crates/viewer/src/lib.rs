@@ -7,13 +7,15 @@
 //! Everything is drawn through the harness's [`strata_render::Renderer`],
 //! so what the window shows is what `strata compare` measures.
 //!
-//! Modules: [`fly`] (camera), [`dig`] (pick, crater, undo), [`script`],
+//! Modules: [`fly`] (camera), [`dig`] (pick, crater, undo), [`knobs`]
+//! (settings), [`script`],
 //! [`builds`] (background method builds), [`present`] (picture to window),
 //! [`overlay`] (egui), [`viewer`] (state and frame), and here the event loop.
 
 pub mod builds;
 pub mod dig;
 pub mod fly;
+pub mod knobs;
 pub mod overlay;
 pub mod present;
 pub mod script;

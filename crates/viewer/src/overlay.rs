@@ -5,7 +5,7 @@
 //! viewer after the frame.
 
 use crate::fly::FlyCamera;
-use crate::script::Knob;
+use crate::knobs::Knob;
 use egui_wgpu::ScreenDescriptor;
 use strata_level::ViewSpec;
 use strata_render::{AdapterReport, FrameTimings, MethodSettings, RetainedBytes, methods};
@@ -394,18 +394,6 @@ pub fn other_method(active: &str) -> &'static str {
     if active == "ray" { "mesh" } else { "ray" }
 }
 
-/// Which methods read a knob.
-pub fn knob_methods(knob: Knob) -> &'static [&'static str] {
-    match knob {
-        Knob::RaySteps => &["ray", "ray-compute"],
-        Knob::VoxelSteps => &["voxel", "voxel-compute"],
-        Knob::Slices => &["sliced"],
-        Knob::Density => &["scattered"],
-        Knob::MeshQuality => &["mesh"],
-        Knob::Shadows => &[],
-    }
-}
-
 fn knobs(
     ui: &mut egui::Ui,
     status: &Status<'_>,
@@ -413,7 +401,7 @@ fn knobs(
     actions: &mut Vec<Action>,
 ) {
     let shown: Vec<&str> = std::iter::once(status.active).chain(status.split).collect();
-    let relevant = |knob: Knob| knob_methods(knob).iter().any(|m| shown.contains(m));
+    let relevant = |knob: Knob| knob.methods().iter().any(|m| shown.contains(m));
     let s = &mut *editable.settings;
     // A rebuild starts when a drag ends (or a click or key changes a value).
     let mut knob = |k: Knob, response: egui::Response| {

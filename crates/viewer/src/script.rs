@@ -20,6 +20,7 @@
 //! quit                      stop here (the end of the file does too)
 //! ```
 
+use crate::knobs::Knob;
 use anyhow::{Context, bail};
 use std::path::{Path, PathBuf};
 
@@ -49,39 +50,6 @@ pub enum Command {
     Screenshot(PathBuf),
     CopyView(String),
     Quit,
-}
-
-/// The settings a script (and the overlay) can change.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Knob {
-    RaySteps,
-    VoxelSteps,
-    Slices,
-    Density,
-    MeshQuality,
-    Shadows,
-}
-
-impl Knob {
-    pub const ALL: [(&'static str, Knob); 6] = [
-        ("ray-steps", Knob::RaySteps),
-        ("voxel-steps", Knob::VoxelSteps),
-        ("slices", Knob::Slices),
-        ("density", Knob::Density),
-        ("mesh-quality", Knob::MeshQuality),
-        ("shadows", Knob::Shadows),
-    ];
-
-    fn parse(name: &str) -> anyhow::Result<Knob> {
-        Knob::ALL
-            .iter()
-            .find(|(n, _)| *n == name)
-            .map(|(_, k)| *k)
-            .with_context(|| {
-                let names: Vec<_> = Knob::ALL.iter().map(|(n, _)| *n).collect();
-                format!("unknown setting `{name}`; known: {}", names.join(", "))
-            })
-    }
 }
 
 /// A parsed script with each command's line number, for messages.

@@ -1,26 +1,29 @@
 //! The viewer's state and its frame: input to camera, script steps, finished
 //! builds, the method (or A/B pair) drawn through the harness's
-//! [`Renderer`], the overlay, and the swapchain.
+//! [`Renderer`], the overlay, and the swapchain. Input handling is in
+//! [`input`], script running in [`scripted`].
+
+mod input;
+mod scripted;
 
 use crate::Options;
 use crate::builds::{Builds, Finished};
 use crate::dig::{Digger, pick};
-use crate::fly::{FlyCamera, Motion};
+use crate::fly::FlyCamera;
+use crate::knobs::{Knob, relevant};
 use crate::overlay::{self, Action, Drawn, Editable, Overlay, Status};
 use crate::present::{Compositor, WINDOW_FORMAT};
-use crate::script::{Command, Knob};
 use anyhow::{Context, bail};
-use glam::Vec3;
-use std::collections::{HashSet, VecDeque};
+use scripted::Player;
+use std::collections::HashSet;
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
 use strata_camera::Camera;
 use strata_level::{DirtyRect, EditSite, Level, ViewSpec};
 use strata_render::{FrameTimings, Gpu, MethodSettings, Renderer, TerrainColors, methods};
-use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
 use winit::event_loop::ActiveEventLoop;
-use winit::keyboard::{KeyCode, PhysicalKey};
+use winit::keyboard::KeyCode;
 use winit::window::Window;
 
 /// The method the window opens with while the asked-for one is built: the
@@ -29,39 +32,12 @@ const FIRST_METHOD: &str = "ray";
 /// Lines of the overlay's log kept.
 const LOG_LINES: usize = 8;
 
-/// A script command that spans frames.
-enum Running {
-    Fly {
-        per_frame: Vec3,
-        left: u32,
-    },
-    Turn {
-        per_frame: [f32; 2],
-        left: u32,
-    },
-    Frames(u32),
-    /// Until this method is drawn (built and active, or the split's right side).
-    WaitMethod(String),
-    /// Until no build runs (a changed knob's rebuild).
-    WaitBuilds,
-    /// Until the picture has this size; an error after `left` frames.
-    WaitSize {
-        size: (u32, u32),
-        left: u32,
-    },
-}
-
 /// Sums over the frames a method drew.
 #[derive(Default)]
 struct Totals {
     frames: u32,
     gpu_ms: f64,
     wait_ms: f64,
-}
-
-struct Player {
-    commands: VecDeque<(usize, Command)>,
-    running: Option<(usize, Running)>,
 }
 
 pub struct Viewer {
@@ -143,46 +119,6 @@ fn surface_config(
 fn scaled(window: (u32, u32), scale: f32) -> (u32, u32) {
     let side = |v: u32| ((v as f32 * scale).round() as u32).max(1);
     (side(window.0), side(window.1))
-}
-
-/// The settings of `s` that method `name` reads (the rest at defaults), so
-/// two settings are "the same" for a method when these are equal.
-fn relevant(name: &str, s: &MethodSettings) -> MethodSettings {
-    let d = MethodSettings::default();
-    let uses = |knob| overlay::knob_methods(knob).contains(&name);
-    MethodSettings {
-        ray_steps: if uses(Knob::RaySteps) {
-            s.ray_steps
-        } else {
-            d.ray_steps
-        },
-        voxel_steps: if uses(Knob::VoxelSteps) {
-            s.voxel_steps
-        } else {
-            d.voxel_steps
-        },
-        voxel_size: if name.starts_with("voxel") {
-            s.voxel_size
-        } else {
-            d.voxel_size
-        },
-        slices: if uses(Knob::Slices) {
-            s.slices
-        } else {
-            d.slices
-        },
-        scatter_density: if uses(Knob::Density) {
-            s.scatter_density
-        } else {
-            d.scatter_density
-        },
-        mesh_quality: if uses(Knob::MeshQuality) {
-            s.mesh_quality
-        } else {
-            d.mesh_quality
-        },
-        shadows: d.shadows,
-    }
 }
 
 impl Viewer {
@@ -316,10 +252,7 @@ impl Viewer {
             timings: Vec::new(),
             totals: Vec::new(),
             log: Vec::new(),
-            player: script.map(|s| Player {
-                commands: s.commands.into(),
-                running: None,
-            }),
+            player: script.map(Player::new),
             screenshot_after_frame: None,
             screenshots: 0,
             out,
@@ -370,182 +303,6 @@ impl Viewer {
         self.log.push(line);
         if self.log.len() > LOG_LINES {
             self.log.remove(0);
-        }
-    }
-
-    /// A window event; `Err` ends the viewer with that error.
-    pub fn on_window_event(&mut self, event: &WindowEvent) -> anyhow::Result<()> {
-        let used = self.overlay.on_window_event(&self.window, event);
-        match event {
-            WindowEvent::CloseRequested => self.quit = true,
-            // A minimised window reports 0x0: keep the old swapchain.
-            WindowEvent::Resized(size) if size.width > 0 && size.height > 0 => {
-                self.config.width = size.width;
-                self.config.height = size.height;
-                self.surface.configure(&self.gpu.device, &self.config);
-                self.compositor.resize((size.width, size.height));
-                self.resize_to = Some(scaled((size.width, size.height), self.render_scale));
-            }
-            WindowEvent::Focused(false) => {
-                self.keys.clear();
-                self.looking = false;
-                self.grab_cursor(false);
-            }
-            WindowEvent::ModifiersChanged(m) => {
-                self.ctrl = m.state().control_key();
-                self.shift = m.state().shift_key();
-            }
-            WindowEvent::KeyboardInput { event, .. } => {
-                let PhysicalKey::Code(code) = event.physical_key else {
-                    return Ok(());
-                };
-                if event.state == ElementState::Released {
-                    self.keys.remove(&code);
-                } else if !self.overlay.wants_keyboard() || !used {
-                    let first = self.keys.insert(code);
-                    if first && !event.repeat {
-                        self.on_key(code)?;
-                    }
-                }
-            }
-            WindowEvent::CursorMoved { position, .. } => {
-                let now = (position.x as f32, position.y as f32);
-                // Cursor deltas stop at the window's edge: only a fallback
-                // where the platform sends no raw motion.
-                if let (true, false, Some(before)) = (self.looking, self.raw_motion, self.cursor) {
-                    self.fly.look(now.0 - before.0, now.1 - before.1);
-                }
-                self.cursor = Some(now);
-            }
-            WindowEvent::MouseInput { state, button, .. } => {
-                let pressed = *state == ElementState::Pressed;
-                match button {
-                    MouseButton::Right => {
-                        self.looking = pressed && !self.overlay.wants_pointer();
-                        self.grab_cursor(self.looking);
-                    }
-                    MouseButton::Left if pressed && !used && !self.overlay.wants_pointer() => {
-                        if let Some(at) = self
-                            .cursor
-                            .and_then(|(x, y)| self.compositor.window_to_picture(x, y))
-                        {
-                            self.dig_at(at)?;
-                        }
-                    }
-                    _ => {}
-                }
-            }
-            WindowEvent::MouseWheel { delta, .. } if !used => {
-                let lines = match delta {
-                    MouseScrollDelta::LineDelta(_, y) => *y,
-                    MouseScrollDelta::PixelDelta(p) => p.y as f32 / 40.0,
-                };
-                self.fly.speed = (self.fly.speed * 1.25f32.powf(lines)).clamp(2.0, 2000.0);
-            }
-            WindowEvent::RedrawRequested => self.frame()?,
-            _ => {}
-        }
-        Ok(())
-    }
-
-    /// Hide and hold the cursor while looking around, where the platform
-    /// allows (X11 confines, Wayland locks); otherwise it just stays visible.
-    fn grab_cursor(&self, grab: bool) {
-        use winit::window::CursorGrabMode;
-        if grab {
-            let _ = self
-                .window
-                .set_cursor_grab(CursorGrabMode::Locked)
-                .or_else(|_| self.window.set_cursor_grab(CursorGrabMode::Confined));
-        } else {
-            let _ = self.window.set_cursor_grab(CursorGrabMode::None);
-        }
-        self.window.set_cursor_visible(!grab);
-    }
-
-    /// Raw mouse motion (unbounded by the window), while looking around.
-    pub fn on_mouse_motion(&mut self, dx: f64, dy: f64) {
-        if self.looking {
-            self.raw_motion = true;
-            self.fly.look(dx as f32, dy as f32);
-        }
-    }
-
-    fn on_key(&mut self, code: KeyCode) -> anyhow::Result<()> {
-        const DIGITS: [KeyCode; 8] = [
-            KeyCode::Digit1,
-            KeyCode::Digit2,
-            KeyCode::Digit3,
-            KeyCode::Digit4,
-            KeyCode::Digit5,
-            KeyCode::Digit6,
-            KeyCode::Digit7,
-            KeyCode::Digit8,
-        ];
-        const F_KEYS: [KeyCode; 12] = [
-            KeyCode::F1,
-            KeyCode::F2,
-            KeyCode::F3,
-            KeyCode::F4,
-            KeyCode::F5,
-            KeyCode::F6,
-            KeyCode::F7,
-            KeyCode::F8,
-            KeyCode::F9,
-            KeyCode::F10,
-            KeyCode::F11,
-            KeyCode::F12,
-        ];
-        if let Some(i) = DIGITS.iter().position(|&k| k == code) {
-            if let Some(name) = methods::names().get(i) {
-                self.request_method(name)?;
-            }
-        } else if let Some(i) = F_KEYS.iter().position(|&k| k == code) {
-            self.go_to_view(i);
-        } else {
-            match code {
-                KeyCode::Escape => self.quit = true,
-                KeyCode::Tab => self.overlay.visible = !self.overlay.visible,
-                KeyCode::KeyB => {
-                    let split = match self.split {
-                        Some(_) => None,
-                        None => Some(self.previous_method.clone()),
-                    };
-                    self.set_split(split)?;
-                }
-                KeyCode::KeyV => self.copy_view("viewer"),
-                KeyCode::KeyP => self.screenshot_after_frame = Some(self.next_screenshot_path()),
-                KeyCode::KeyU => self.undo()?,
-                KeyCode::KeyZ if self.ctrl => self.undo()?,
-                _ => {}
-            }
-        }
-        Ok(())
-    }
-
-    fn motion(&self) -> Motion {
-        let axis = |plus: &[KeyCode], minus: &[KeyCode]| {
-            let held = |keys: &[KeyCode]| keys.iter().any(|k| self.keys.contains(k));
-            f32::from(u8::from(held(plus))) - f32::from(u8::from(held(minus)))
-        };
-        if self.ctrl {
-            // Ctrl+Z and friends are commands, not movement.
-            return Motion::default();
-        }
-        Motion {
-            forward: axis(
-                &[KeyCode::KeyW, KeyCode::ArrowUp],
-                &[KeyCode::KeyS, KeyCode::ArrowDown],
-            ),
-            right: axis(
-                &[KeyCode::KeyD, KeyCode::ArrowRight],
-                &[KeyCode::KeyA, KeyCode::ArrowLeft],
-            ),
-            up: axis(
-                &[KeyCode::Space, KeyCode::KeyE],
-                &[KeyCode::KeyC, KeyCode::KeyQ],
-            ),
-            fast: self.shift,
         }
     }
 
@@ -684,7 +441,7 @@ impl Viewer {
             .chain(self.split.clone())
             .collect();
         for name in shown {
-            if overlay::knob_methods(knob).contains(&name.as_str()) && !self.is_current(&name) {
+            if knob.methods().contains(&name.as_str()) && !self.is_current(&name) {
                 self.builds
                     .start(&self.renderer, &self.level, &name, &self.settings);
             }
@@ -692,22 +449,7 @@ impl Viewer {
     }
 
     fn set_knob(&mut self, knob: Knob, value: f32) -> anyhow::Result<()> {
-        let s = &mut self.settings;
-        let count = |v: f32| -> anyhow::Result<u32> {
-            if v >= 1.0 && v.fract() == 0.0 && v <= 1e6 {
-                Ok(v as u32)
-            } else {
-                bail!("{value} is not a positive whole number")
-            }
-        };
-        match knob {
-            Knob::RaySteps => s.ray_steps = count(value)?,
-            Knob::VoxelSteps => s.voxel_steps = count(value)?,
-            Knob::Slices => s.slices = count(value)?,
-            Knob::Density => s.scatter_density = [value; 3],
-            Knob::MeshQuality => s.mesh_quality = value,
-            Knob::Shadows => s.shadows = value != 0.0,
-        }
+        knob.set(&mut self.settings, value)?;
         self.on_knob(knob);
         Ok(())
     }
@@ -735,136 +477,6 @@ impl Viewer {
                     self.say(format!("building {name} failed: {error:#}"));
                 }
             }
-        }
-        Ok(())
-    }
-
-    /// Advance the script by one frame.
-    fn script_step(&mut self) -> anyhow::Result<()> {
-        let Some(player) = &mut self.player else {
-            return Ok(());
-        };
-        if let Some((line, running)) = player.running.take() {
-            let next = match running {
-                Running::Fly { per_frame, left } => {
-                    self.fly.translate(per_frame, &self.level);
-                    (left > 1).then_some(Running::Fly {
-                        per_frame,
-                        left: left - 1,
-                    })
-                }
-                Running::Turn { per_frame, left } => {
-                    self.fly.turn(per_frame[0], per_frame[1]);
-                    (left > 1).then_some(Running::Turn {
-                        per_frame,
-                        left: left - 1,
-                    })
-                }
-                Running::Frames(left) => (left > 1).then_some(Running::Frames(left - 1)),
-                Running::WaitSize { size, left } => {
-                    if self.render_size == size {
-                        None
-                    } else if left == 0 {
-                        bail!(
-                            "the window system left the picture at {}x{}, not {}x{}",
-                            self.render_size.0,
-                            self.render_size.1,
-                            size.0,
-                            size.1
-                        );
-                    } else {
-                        Some(Running::WaitSize {
-                            size,
-                            left: left - 1,
-                        })
-                    }
-                }
-                Running::WaitBuilds => {
-                    (!self.builds.running().is_empty()).then_some(Running::WaitBuilds)
-                }
-                Running::WaitMethod(name) => {
-                    let drawn = self.renderer.method_name() == name
-                        || (self.split.as_deref() == Some(name.as_str()) && self.is_current(&name));
-                    (!drawn).then_some(Running::WaitMethod(name))
-                }
-            };
-            if let Some(player) = &mut self.player {
-                player.running = next.map(|n| (line, n));
-            }
-            return Ok(());
-        }
-        let Some((line, command)) = player.commands.pop_front() else {
-            self.quit = true;
-            return Ok(());
-        };
-        self.run_command(line, command)
-            .with_context(|| format!("script line {line}"))
-    }
-
-    fn run_command(&mut self, line: usize, command: Command) -> anyhow::Result<()> {
-        let mut running = None;
-        match command {
-            Command::View(name) => {
-                let i = self
-                    .views
-                    .iter()
-                    .position(|v| v.name == name)
-                    .with_context(|| format!("the level has no view `{name}`"))?;
-                self.go_to_view(i);
-            }
-            Command::Method(name) => {
-                self.request_method(&name)?;
-                running = Some(Running::WaitMethod(name));
-            }
-            Command::Split(name) => {
-                self.set_split(name.clone())?;
-                running = name.map(Running::WaitMethod);
-            }
-            Command::Fly { offset, frames } => {
-                running = Some(Running::Fly {
-                    per_frame: Vec3::from(offset) / frames as f32,
-                    left: frames,
-                });
-            }
-            Command::Turn { degrees, frames } => {
-                running = Some(Running::Turn {
-                    per_frame: degrees.map(|d| d / frames as f32),
-                    left: frames,
-                });
-            }
-            Command::Frames(n) => running = Some(Running::Frames(n)),
-            Command::Dig(fx, fy) => {
-                let (w, h) = self.render_size;
-                // The centre of the pixel the fraction falls in.
-                let px = (fx * w as f32).floor().min(w as f32 - 1.0) + 0.5;
-                let py = (fy * h as f32).floor().min(h as f32 - 1.0) + 0.5;
-                self.dig_at((px, py))?;
-            }
-            Command::Undo => self.undo()?,
-            Command::Set(knob, value) => {
-                self.set_knob(knob, value)?;
-                running = Some(Running::WaitBuilds);
-            }
-            Command::Overlay(on) => self.overlay.visible = on,
-            Command::Window(w, h) => {
-                // The reply comes as a Resized event; the size may differ
-                // from the request only where a window manager refuses it.
-                let _ = self
-                    .window
-                    .request_inner_size(winit::dpi::PhysicalSize::new(w, h));
-                running = Some(Running::WaitSize {
-                    size: scaled((w, h), self.render_scale),
-                    left: 200,
-                });
-            }
-            Command::Screenshot(path) => self.screenshot_after_frame = Some(path),
-            Command::CopyView(name) => self.copy_view(&name),
-            Command::Quit => self.quit = true,
-        }
-        // Run the first frame of a multi-frame command now.
-        if let (Some(running), Some(player)) = (running, &mut self.player) {
-            player.running = Some((line, running));
-            return self.script_step();
         }
         Ok(())
     }

@@ -1,0 +1,176 @@
+//! Running a `--script` through the live viewer: one command per frame, or
+//! several frames for the commands that move, wait or count.
+
+use super::{Viewer, scaled};
+use crate::script::Command;
+use anyhow::{Context, bail};
+use glam::Vec3;
+use std::collections::VecDeque;
+
+/// A script command that spans frames.
+enum Running {
+    Fly {
+        per_frame: Vec3,
+        left: u32,
+    },
+    Turn {
+        per_frame: [f32; 2],
+        left: u32,
+    },
+    Frames(u32),
+    /// Until this method is drawn (built and active, or the split's right side).
+    WaitMethod(String),
+    /// Until no build runs (a changed knob's rebuild).
+    WaitBuilds,
+    /// Until the picture has this size; an error after `left` frames.
+    WaitSize {
+        size: (u32, u32),
+        left: u32,
+    },
+}
+
+pub(super) struct Player {
+    commands: VecDeque<(usize, Command)>,
+    running: Option<(usize, Running)>,
+}
+
+impl Player {
+    pub(super) fn new(script: crate::Script) -> Self {
+        Player {
+            commands: script.commands.into(),
+            running: None,
+        }
+    }
+}
+
+impl Viewer {
+    /// Advance the script by one frame.
+    pub(super) fn script_step(&mut self) -> anyhow::Result<()> {
+        let Some(player) = &mut self.player else {
+            return Ok(());
+        };
+        if let Some((line, running)) = player.running.take() {
+            let next = match running {
+                Running::Fly { per_frame, left } => {
+                    self.fly.translate(per_frame, &self.level);
+                    (left > 1).then_some(Running::Fly {
+                        per_frame,
+                        left: left - 1,
+                    })
+                }
+                Running::Turn { per_frame, left } => {
+                    self.fly.turn(per_frame[0], per_frame[1]);
+                    (left > 1).then_some(Running::Turn {
+                        per_frame,
+                        left: left - 1,
+                    })
+                }
+                Running::Frames(left) => (left > 1).then_some(Running::Frames(left - 1)),
+                Running::WaitSize { size, left } => {
+                    if self.render_size == size {
+                        None
+                    } else if left == 0 {
+                        bail!(
+                            "the window system left the picture at {}x{}, not {}x{}",
+                            self.render_size.0,
+                            self.render_size.1,
+                            size.0,
+                            size.1
+                        );
+                    } else {
+                        Some(Running::WaitSize {
+                            size,
+                            left: left - 1,
+                        })
+                    }
+                }
+                Running::WaitBuilds => {
+                    (!self.builds.running().is_empty()).then_some(Running::WaitBuilds)
+                }
+                Running::WaitMethod(name) => {
+                    let drawn = self.renderer.method_name() == name
+                        || (self.split.as_deref() == Some(name.as_str()) && self.is_current(&name));
+                    (!drawn).then_some(Running::WaitMethod(name))
+                }
+            };
+            if let Some(player) = &mut self.player {
+                player.running = next.map(|n| (line, n));
+            }
+            return Ok(());
+        }
+        let Some((line, command)) = player.commands.pop_front() else {
+            self.quit = true;
+            return Ok(());
+        };
+        self.run_command(line, command)
+            .with_context(|| format!("script line {line}"))
+    }
+
+    fn run_command(&mut self, line: usize, command: Command) -> anyhow::Result<()> {
+        let mut running = None;
+        match command {
+            Command::View(name) => {
+                let i = self
+                    .views
+                    .iter()
+                    .position(|v| v.name == name)
+                    .with_context(|| format!("the level has no view `{name}`"))?;
+                self.go_to_view(i);
+            }
+            Command::Method(name) => {
+                self.request_method(&name)?;
+                running = Some(Running::WaitMethod(name));
+            }
+            Command::Split(name) => {
+                self.set_split(name.clone())?;
+                running = name.map(Running::WaitMethod);
+            }
+            Command::Fly { offset, frames } => {
+                running = Some(Running::Fly {
+                    per_frame: Vec3::from(offset) / frames as f32,
+                    left: frames,
+                });
+            }
+            Command::Turn { degrees, frames } => {
+                running = Some(Running::Turn {
+                    per_frame: degrees.map(|d| d / frames as f32),
+                    left: frames,
+                });
+            }
+            Command::Frames(n) => running = Some(Running::Frames(n)),
+            Command::Dig(fx, fy) => {
+                let (w, h) = self.render_size;
+                // The centre of the pixel the fraction falls in.
+                let px = (fx * w as f32).floor().min(w as f32 - 1.0) + 0.5;
+                let py = (fy * h as f32).floor().min(h as f32 - 1.0) + 0.5;
+                self.dig_at((px, py))?;
+            }
+            Command::Undo => self.undo()?,
+            Command::Set(knob, value) => {
+                self.set_knob(knob, value)?;
+                running = Some(Running::WaitBuilds);
+            }
+            Command::Overlay(on) => self.overlay.visible = on,
+            Command::Window(w, h) => {
+                // The reply comes as a Resized event; the size may differ
+                // from the request only where a window manager refuses it.
+                let _ = self
+                    .window
+                    .request_inner_size(winit::dpi::PhysicalSize::new(w, h));
+                running = Some(Running::WaitSize {
+                    size: scaled((w, h), self.render_scale),
+                    left: 200,
+                });
+            }
+            Command::Screenshot(path) => self.screenshot_after_frame = Some(path),
+            Command::CopyView(name) => self.copy_view(&name),
+            Command::Quit => self.quit = true,
+        }
+        // Run the first frame of a multi-frame command now.
+        if let (Some(running), Some(player)) = (running, &mut self.player) {
+            player.running = Some((line, running));
+            return self.script_step();
+        }
+        Ok(())
+    }
+}
