@@ -35,13 +35,28 @@ impl LevelMesh {
     /// in parallel on the current rayon pool. The result does not depend on
     /// the number of threads: chunks are independent and collected in order.
     pub fn fit(level: &Level, tolerance: f64) -> Self {
+        Self::fit_with_progress(level, tolerance, &|_, _| {})
+    }
+
+    /// [`fit`](Self::fit), calling `progress(chunks done, chunks)` as chunks
+    /// finish (from the fitting threads, in no particular order).
+    pub fn fit_with_progress(
+        level: &Level,
+        tolerance: f64,
+        progress: &(dyn Fn(usize, usize) + Sync),
+    ) -> Self {
         let layout = ChunkLayout::of(level);
         let tol = sanitize(tolerance);
-        let chunks = (0..layout.count())
+        let total = layout.count();
+        let done = std::sync::atomic::AtomicUsize::new(0);
+        let chunks = (0..total)
             .into_par_iter()
             .map_init(ChunkFitter::default, |f, i| {
                 let (cx, cy) = layout.coords(i);
-                f.fit(level, &layout, cx, cy, tol)
+                let mesh = f.fit(level, &layout, cx, cy, tol);
+                let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+                progress(n, total);
+                mesh
             })
             .collect();
         LevelMesh {

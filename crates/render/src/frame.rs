@@ -237,6 +237,39 @@ pub struct Shared {
     /// Bind group 0 of every method pipeline (`frame.wgsl`).
     pub frame_layout: wgpu::BindGroupLayout,
     pub frame_group: wgpu::BindGroup,
+    /// How far slow method builds have come (for a viewer's progress bar).
+    pub progress: BuildProgress,
+}
+
+/// Fractions done of method builds in flight, by method name: a build that
+/// takes long (the mesh fit) reports here; anyone holding the shared frame
+/// may read it, from any thread.
+#[derive(Default)]
+pub struct BuildProgress(std::sync::Mutex<Vec<(String, f32)>>);
+
+impl BuildProgress {
+    /// Method `name`'s build is `fraction` (0..=1) done.
+    pub fn report(&self, name: &str, fraction: f32) {
+        if let Ok(mut all) = self.0.lock() {
+            match all.iter_mut().find(|(n, _)| n == name) {
+                Some(entry) => entry.1 = fraction,
+                None => all.push((name.to_string(), fraction)),
+            }
+        }
+    }
+
+    /// The last fraction method `name` reported, if its build reports.
+    pub fn get(&self, name: &str) -> Option<f32> {
+        let all = self.0.lock().ok()?;
+        all.iter().find(|(n, _)| n == name).map(|e| e.1)
+    }
+
+    /// Forget `name` (its build ended).
+    pub fn clear(&self, name: &str) {
+        if let Ok(mut all) = self.0.lock() {
+            all.retain(|(n, _)| n != name);
+        }
+    }
 }
 
 fn uniform_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
@@ -402,6 +435,7 @@ impl Shared {
             depth_view,
             frame_layout,
             frame_group,
+            progress: BuildProgress::default(),
         })
     }
 

@@ -30,6 +30,32 @@ pub struct Drawn<'a> {
     pub timings: &'a FrameTimings,
 }
 
+/// A method build in flight.
+pub struct Building<'a> {
+    pub method: &'a str,
+    pub seconds: f64,
+    /// Fraction done, for builds that report it (the mesh fit).
+    pub done: Option<f32>,
+}
+
+impl Building<'_> {
+    /// A spinner and the time so far, with a bar where the fraction is known.
+    fn show(&self, ui: &mut egui::Ui, heading: bool) {
+        ui.horizontal(|ui| {
+            ui.spinner();
+            let text = format!("building {}: {:.1} s", self.method, self.seconds);
+            if heading {
+                ui.heading(text);
+            } else {
+                ui.label(text);
+            }
+        });
+        if let Some(done) = self.done {
+            ui.add(egui::ProgressBar::new(done).show_percentage());
+        }
+    }
+}
+
 /// What the overlay shows.
 pub struct Status<'a> {
     pub adapter: &'a AdapterReport,
@@ -41,7 +67,7 @@ pub struct Status<'a> {
     pub kept: Vec<(&'a str, RetainedBytes)>,
     pub shared_gpu_bytes: u64,
     /// Builds running: method, seconds so far.
-    pub building: Vec<(&'a str, f64)>,
+    pub building: Vec<Building<'a>>,
     /// The method the viewer waits for, when it is still being built.
     pub waiting_for: Option<&'a str>,
     pub views: &'a [ViewSpec],
@@ -201,19 +227,16 @@ impl Overlay {
 
 /// The centred note while a wanted method is still being built.
 fn progress(ctx: &egui::Context, method: &str, status: &Status<'_>) {
-    let seconds = status
-        .building
-        .iter()
-        .find(|(m, _)| *m == method)
-        .map_or(0.0, |(_, s)| *s);
     egui::Area::new(egui::Id::unique("building"))
         .anchor(egui::Align2::CENTER_CENTER, egui::vec2(0.0, 0.0))
         .show(ctx, |ui| {
             egui::Frame::popup(ui.style()).show(ui, |ui| {
-                ui.horizontal(|ui| {
-                    ui.spinner();
-                    ui.heading(format!("building {method}... {seconds:.1} s"));
-                });
+                match status.building.iter().find(|b| b.method == method) {
+                    Some(build) => build.show(ui, true),
+                    None => {
+                        ui.heading(format!("waiting for {method}"));
+                    }
+                }
                 ui.label(format!(
                     "still drawing {} meanwhile; it is kept once built",
                     status.active
@@ -331,7 +354,7 @@ fn methods_section(
     ui.label("method (keys 1-8)");
     ui.horizontal_wrapped(|ui| {
         for (i, name) in methods::names().into_iter().enumerate() {
-            let building = status.building.iter().any(|(m, _)| *m == name);
+            let building = status.building.iter().any(|b| b.method == name);
             let kept = status.kept.iter().any(|(m, _)| *m == name);
             let label = format!(
                 "{} {name}{}",
@@ -381,11 +404,8 @@ fn methods_section(
     if status.split.is_some() {
         ui.add(egui::Slider::new(editable.split_at, 0.05..=0.95).text("divider"));
     }
-    for (method, seconds) in &status.building {
-        ui.horizontal(|ui| {
-            ui.spinner();
-            ui.label(format!("building {method}: {seconds:.1} s"));
-        });
+    for build in &status.building {
+        build.show(ui, false);
     }
 }
 

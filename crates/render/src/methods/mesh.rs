@@ -118,9 +118,17 @@ fn draws_binding(
     (buffer, group)
 }
 
-/// The chunks of `level`, fitted at `tolerance`, each with its altitude range.
-fn fit_all(level: &Level, tolerance: f64) -> (ChunkLayout, Vec<Fitted>) {
-    let mesh = LevelMesh::fit(level, tolerance);
+/// The chunks of `level`, fitted at `tolerance`, each with its altitude range
+/// (reporting the fit's progress to `shared`).
+fn fit_all(shared: &Shared, level: &Level, tolerance: f64) -> (ChunkLayout, Vec<Fitted>) {
+    // Every 1/64th is enough for a progress bar and keeps the lock cold.
+    let report = |done: usize, total: usize| {
+        if done * 64 / total != (done - 1) * 64 / total {
+            shared.progress.report("mesh", done as f32 / total as f32);
+        }
+    };
+    let mesh = LevelMesh::fit_with_progress(level, tolerance, &report);
+    shared.progress.clear("mesh");
     let layout = mesh.layout;
     let chunks = mesh
         .chunks
@@ -143,7 +151,7 @@ pub fn create(
     let Some(tolerance) = tolerance_for_quality(f64::from(q)) else {
         anyhow::bail!("mesh quality {q} is outside [0, 1] (max error 2^(4(1-q)))");
     };
-    let (layout, chunks) = fit_all(level, tolerance);
+    let (layout, chunks) = fit_all(shared, level, tolerance);
     let headroom = pool_headroom(&chunks);
     let (pool, slots) = IndexPool::build(&shared.device, &shared.queue, &chunks, headroom)?;
     drop(chunks);
@@ -321,7 +329,7 @@ impl Method for Mesh {
         let layout = ChunkLayout::of(level);
         if layout != self.layout {
             // Another map size: nothing local survives.
-            let (layout, chunks) = fit_all(level, self.tolerance);
+            let (layout, chunks) = fit_all(shared, level, self.tolerance);
             let headroom = pool_headroom(&chunks);
             let (pool, slots) = IndexPool::build(&shared.device, &shared.queue, &chunks, headroom)?;
             (self.layout, self.pool, self.slots) = (layout, pool, slots);

@@ -11,7 +11,7 @@ use crate::builds::{Builds, Finished};
 use crate::dig::{Digger, pick};
 use crate::fly::FlyCamera;
 use crate::knobs::{Knob, relevant};
-use crate::overlay::{self, Action, Drawn, Editable, Overlay, Status};
+use crate::overlay::{self, Action, Building, Drawn, Editable, Overlay, Status};
 use crate::present::{Compositor, WINDOW_FORMAT};
 use anyhow::{Context, bail};
 use scripted::Player;
@@ -592,7 +592,17 @@ impl Viewer {
 
     fn paint_overlay(&mut self, encoder: &mut wgpu::CommandEncoder) -> Vec<Action> {
         let renderer = &self.renderer;
-        let building = self.builds.running();
+        let progress = &renderer.shared().progress;
+        let building = self
+            .builds
+            .running()
+            .into_iter()
+            .map(|(method, seconds)| Building {
+                method,
+                seconds,
+                done: progress.get(method),
+            })
+            .collect();
         let status = Status {
             adapter: &self.gpu.report,
             frame_ms: self.frame_ms,
