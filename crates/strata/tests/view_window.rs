@@ -10,7 +10,7 @@ use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
 const STRATA: &str = env!("CARGO_BIN_EXE_strata");
-const WINDOW: (u32, u32) = (480, 300);
+const WINDOW: (u32, u32) = (640, 400);
 
 /// Print where libtest cannot swallow it; fail instead where CI demands it.
 fn skip_loudly(why: &str, required_by: &str) {
@@ -148,8 +148,8 @@ fn scripted_flight_switches_method_digs_and_undoes() {
     std::fs::write(
         &script,
         format!(
-            "# looking straight down on the depot, overlay hidden for exact pictures\n\
-             view depot\noverlay off\nframes 2\n\
+            "# the world's crater camera, overlay hidden for exact pictures\n\
+             view edit\noverlay off\nframes 2\n\
              screenshot {s}/ray-before.png\n\
              dig 0.5 0.5\nscreenshot {s}/ray-dug.png\n\
              undo\nscreenshot {s}/ray-undone.png\n\
@@ -157,7 +157,7 @@ fn scripted_flight_switches_method_digs_and_undoes() {
              dig 0.5 0.5\nscreenshot {s}/mesh-dug.png\n\
              copy-view dug\n\
              method ray\nset ray-steps 32\nscreenshot {s}/ray-32.png\n\
-             overlay on\nfly -20 0 30 4\nturn 0 20 2\nscreenshot {s}/final.png\n\
+             overlay on\nfly -30 0 10 4\nturn -10 5 2\nscreenshot {s}/final.png\n\
              overlay off\nwindow 320 240\nscreenshot {s}/resized.png\n",
             s = shots.display()
         ),
@@ -225,7 +225,7 @@ fn scripted_flight_switches_method_digs_and_undoes() {
         .find(|l| l.starts_with("dug "))
         .unwrap_or_else(|| panic!("no copied view in {stdout}"));
     let views = strata_level::views::parse_views(line).unwrap();
-    assert_eq!(views[0].pitch, -89.5);
+    assert_eq!(views[0].pitch, -30.0);
     assert_eq!(load(&shots, "final.png").dimensions(), WINDOW);
     // The picture follows a resized window (another aspect: no bars).
     let resized = load(&shots, "resized.png");
