@@ -194,6 +194,17 @@ impl Renderer {
         if (width, height) == (self.shared.width, self.shared.height) {
             return Ok(());
         }
+        let old = (self.shared.width, self.shared.height);
+        self.resize_all(width, height).or_else(|error| {
+            // Leave the renderer as it was: every method at the old size.
+            self.resize_all(old.0, old.1)?;
+            Err(error)
+        })?;
+        self.shadow_drawn = None;
+        wait_device(&self.shared.device, &self.errors)
+    }
+
+    fn resize_all(&mut self, width: u32, height: u32) -> anyhow::Result<()> {
         let shared = Arc::get_mut(&mut self.shared).ok_or_else(|| {
             anyhow::anyhow!("cannot resize while a method is being built on the shared frame")
         })?;
@@ -201,8 +212,7 @@ impl Renderer {
         for built in &mut self.methods {
             built.method.resize(&self.shared)?;
         }
-        self.shadow_drawn = None;
-        wait_device(&self.shared.device, &self.errors)
+        Ok(())
     }
 
     /// Skip the shadow pass when the map would be the one already drawn (the

@@ -503,11 +503,16 @@ impl Viewer {
         if let Some(size) = self.resize_to
             && self.builds.running().is_empty()
         {
-            self.renderer.resize(size.0, size.1)?;
-            self.compositor.rebind_picture(self.renderer.shared());
-            self.render_size = size;
             self.resize_to = None;
-            self.say(format!("picture {}x{}", size.0, size.1));
+            match self.renderer.resize(size.0, size.1) {
+                Ok(()) => {
+                    self.compositor.rebind_picture(self.renderer.shared());
+                    self.render_size = size;
+                    self.say(format!("picture {}x{}", size.0, size.1));
+                }
+                // Too large for this adapter: keep the picture, scaled.
+                Err(e) => self.say(format!("picture stays {:?}: {e:#}", self.render_size)),
+            }
         }
         let camera = self.camera()?;
         let active = self.renderer.method_name();
