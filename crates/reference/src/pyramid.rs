@@ -74,7 +74,16 @@ impl Pyramid {
 
     /// The coarsest level index.
     pub(crate) fn top_level(&self) -> usize {
-        self.planes.len() - 1
+        self.planes.len().saturating_sub(1)
+    }
+
+    /// No tiles, and the highest altitude any column can have: a tracer
+    /// over it visits every texel column (nothing to build first).
+    pub(crate) fn none() -> Self {
+        Pyramid {
+            planes: Vec::new(),
+            global_max: u8::MAX,
+        }
     }
 
     /// Highest solid altitude anywhere on the map.

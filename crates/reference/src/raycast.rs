@@ -38,6 +38,16 @@ impl<'a> Tracer<'a> {
         }
     }
 
+    /// A tracer that builds nothing first and visits every texel column a
+    /// ray crosses: exact like the others, and cheaper for a few short rays
+    /// (a viewer's pick) than building the pyramid over the whole map.
+    pub fn unaccelerated(level: &'a Level) -> Self {
+        Tracer {
+            level,
+            pyramid: Arc::new(Pyramid::none()),
+        }
+    }
+
     /// A tracer for `level` reusing a pyramid built for identical content.
     pub(crate) fn with_pyramid(level: &'a Level, pyramid: Arc<Pyramid>) -> Self {
         Tracer { level, pyramid }
@@ -124,7 +134,7 @@ impl<'a> Tracer<'a> {
         // The start point is not a column entry: being on a surface there
         // (the ray starts exactly at the highest top) is a floor, not a wall.
         let t_start = t;
-        let top = if settings.accelerate {
+        let top = if settings.accelerate && self.pyramid.top_level() > 0 {
             self.pyramid.top_level()
         } else {
             0

@@ -8,7 +8,7 @@ mod common;
 use glam::{DVec3, Vec3};
 use strata_camera::Camera;
 use strata_level::Level;
-use strata_reference::{HitClass, Reference, ReferenceSettings, render_reference_with};
+use strata_reference::{HitClass, Reference, ReferenceSettings, Tracer, render_reference_with};
 
 /// Cameras over the rough level: several pitches, eyes low over the terrain
 /// (where grazing rays are), plus one inside a cave.
@@ -93,6 +93,9 @@ fn halving_the_step_changes_no_class_and_no_distance() {
             })
             .count();
         assert_eq!(differ, 0, "pyramid changed {differ} pixels, {cam:?}");
+        // Nor does a tracer that never built one (the viewer's pick).
+        let bare = Tracer::unaccelerated(&level).render(&cam, &ReferenceSettings::default());
+        assert!(bare == base, "the unaccelerated tracer differs, {cam:?}");
     }
     for class in HitClass::ALL {
         assert!(

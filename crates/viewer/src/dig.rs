@@ -27,7 +27,9 @@ pub fn pick(level: &Level, camera: &Camera, px: f32, py: f32) -> Option<Pick> {
     let t_max = f64::from(camera.far) * dir.length() / f64::from(camera.focal_px);
     let dir = dir.normalize();
     let origin: DVec3 = camera.position.as_dvec3();
-    let hit = Tracer::new(level).trace(origin, dir, t_max, &ReferenceSettings::default())?;
+    // A few hundred texel columns at most: cheaper than building the pyramid.
+    let hit =
+        Tracer::unaccelerated(level).trace(origin, dir, t_max, &ReferenceSettings::default())?;
     Some(Pick {
         point: (origin + dir * hit.distance).as_vec3(),
         distance: hit.distance as f32,
