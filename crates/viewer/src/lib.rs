@@ -27,7 +27,7 @@ use strata_level::World;
 use strata_render::MethodSettings;
 use winit::application::ApplicationHandler;
 use winit::event::WindowEvent;
-use winit::event_loop::{ActiveEventLoop, EventLoop, OwnedDisplayHandle};
+use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop, OwnedDisplayHandle};
 use winit::window::WindowId;
 
 pub use overlay::CONTROLS;
@@ -136,10 +136,18 @@ impl ApplicationHandler for App {
         }
     }
 
-    fn about_to_wait(&mut self, _: &ActiveEventLoop) {
-        // Draw continuously: the frame rate is part of what is shown.
-        if let Some(viewer) = &self.viewer {
-            viewer.window().request_redraw();
+    fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
+        // Draw continuously (the frame rate is part of what is shown), except
+        // where the viewer asks to wait.
+        let Some(viewer) = &self.viewer else { return };
+        match viewer.next_frame_due() {
+            Some(at) if at > std::time::Instant::now() => {
+                event_loop.set_control_flow(ControlFlow::WaitUntil(at));
+            }
+            _ => {
+                event_loop.set_control_flow(ControlFlow::Poll);
+                viewer.window().request_redraw();
+            }
         }
     }
 }

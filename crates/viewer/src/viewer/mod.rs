@@ -29,6 +29,8 @@ use winit::window::Window;
 /// The method the window opens with while the asked-for one is built: the
 /// cheapest to set up.
 const FIRST_METHOD: &str = "ray";
+/// Redraw interval while a build runs on a CPU adapter and nothing moves.
+const BUILD_FRAME_INTERVAL: std::time::Duration = std::time::Duration::from_millis(250);
 /// Lines of the overlay's log kept.
 const LOG_LINES: usize = 8;
 
@@ -279,6 +281,19 @@ impl Viewer {
         self.quit
     }
 
+    /// When to draw next: now (`None`), or later. On a CPU rasteriser every
+    /// frame takes the cores a background build needs (the mesh fit took
+    /// twice as long with frames drawn meanwhile), so while one runs and
+    /// nothing moves, the view is redrawn only a few times a second.
+    pub fn next_frame_due(&self) -> Option<Instant> {
+        let cpu_adapter = self.gpu.report.device_type == "Cpu";
+        let still = !self.looking
+            && self.motion().is_still()
+            && self.player.as_ref().is_none_or(Player::is_waiting);
+        (cpu_adapter && still && !self.builds.running().is_empty())
+            .then(|| self.last_frame + BUILD_FRAME_INTERVAL)
+    }
+
     /// Per method: frames drawn, mean GPU ms (per-pass sum) and mean wait
     /// from submit to done, over the session (printed when the window closes).
     pub fn summary(&self) -> String {
@@ -399,7 +414,7 @@ impl Viewer {
         self.edited(&dirty)?;
         let p = hit.point;
         self.say(format!(
-            "dug r={} at {:.0}, {:.0}, {:.0}: {} rect(s); pick {pick_ms:.0} ms, edit + upload {:.1} ms",
+            "dug r={} at {:.0}, {:.0}, {:.0}: {} rect(s); pick {pick_ms:.2} ms, edit + upload {:.2} ms",
             self.digger.radius,
             p.x,
             p.y,

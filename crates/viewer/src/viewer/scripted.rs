@@ -41,6 +41,14 @@ impl Player {
             running: None,
         }
     }
+
+    /// Waiting for a build: frames until then only poll.
+    pub(super) fn is_waiting(&self) -> bool {
+        matches!(
+            self.running,
+            Some((_, Running::WaitMethod(_) | Running::WaitBuilds))
+        )
+    }
 }
 
 impl Viewer {
