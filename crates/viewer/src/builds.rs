@@ -4,6 +4,7 @@
 //! the build's progress. Edits made while a build runs are replayed on the
 //! new method before it is kept, so it never shows stale terrain.
 
+use anyhow::Context;
 use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::Instant;
@@ -40,36 +41,25 @@ impl Builds {
         level: &Arc<Level>,
         name: &str,
         settings: &MethodSettings,
-    ) {
+    ) -> anyhow::Result<()> {
         if self.is_building(name, settings) {
-            return;
+            return Ok(());
         }
         let shared = renderer.shared_handle();
         let level = Arc::clone(level);
         let (owned_name, owned_settings) = (name.to_string(), settings.clone());
         let thread = std::thread::Builder::new()
             .name(format!("build {name}"))
-            .spawn(move || methods::create(&owned_name, &shared, &level, &owned_settings));
-        match thread {
-            Ok(thread) => self.pending.push(Pending {
-                name: name.to_string(),
-                settings: settings.clone(),
-                started: Instant::now(),
-                thread,
-                edits: Vec::new(),
-            }),
-            Err(e) => {
-                // No thread to spare: report like a failed build.
-                let error = anyhow::anyhow!("could not start a build thread: {e}");
-                self.pending.push(Pending {
-                    name: name.to_string(),
-                    settings: settings.clone(),
-                    started: Instant::now(),
-                    thread: std::thread::spawn(move || Err(error)),
-                    edits: Vec::new(),
-                });
-            }
-        }
+            .spawn(move || methods::create(&owned_name, &shared, &level, &owned_settings))
+            .with_context(|| format!("starting a thread to build {name}"))?;
+        self.pending.push(Pending {
+            name: name.to_string(),
+            settings: settings.clone(),
+            started: Instant::now(),
+            thread,
+            edits: Vec::new(),
+        });
+        Ok(())
     }
 
     pub fn is_building(&self, name: &str, settings: &MethodSettings) -> bool {

@@ -97,11 +97,16 @@ impl FlyCamera {
     }
 
     fn basis(&self) -> strata_camera::Basis {
+        // The basis depends only on yaw and pitch.
         Camera {
             position: self.position,
             yaw_deg: self.yaw_deg,
             pitch_deg: self.pitch_deg,
-            ..Camera::new(Vec3::ZERO, 0.0, 0.0, 1, 1).expect("a 1x1 camera is valid")
+            focal_px: strata_camera::DEFAULT_FOCAL_PX,
+            near: strata_camera::DEFAULT_NEAR,
+            far: strata_camera::DEFAULT_FAR,
+            width: 1,
+            height: 1,
         }
         .basis()
     }

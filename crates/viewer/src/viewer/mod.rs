@@ -38,6 +38,8 @@ const LOG_LINES: usize = 8;
 #[derive(Default)]
 struct Totals {
     frames: u32,
+    /// Frames with GPU timestamps (none on adapters without them).
+    timed_frames: u32,
     gpu_ms: f64,
     wait_ms: f64,
 }
@@ -55,7 +57,7 @@ pub struct Viewer {
     views: Vec<ViewSpec>,
     digger: Digger,
     fly: FlyCamera,
-    render_size: (u32, u32),
+    /// Picture size over window size.
     render_scale: f32,
     /// The render size the window asks for, applied once no build holds
     /// the shared frame.
@@ -234,7 +236,6 @@ impl Viewer {
             views,
             digger,
             fly: FlyCamera::from_camera(&camera),
-            render_size,
             render_scale: scale,
             resize_to: None,
             settings,
@@ -273,6 +274,12 @@ impl Viewer {
         Ok(viewer)
     }
 
+    /// The picture's size: the renderer's targets.
+    fn render_size(&self) -> (u32, u32) {
+        let shared = self.renderer.shared();
+        (shared.width, shared.height)
+    }
+
     pub fn window(&self) -> &Window {
         &self.window
     }
@@ -299,15 +306,19 @@ impl Viewer {
     pub fn summary(&self) -> String {
         let mut out = format!(
             "frames drawn at {}x{} on {}:",
-            self.render_size.0, self.render_size.1, self.gpu.report.name
+            self.render_size().0,
+            self.render_size().1,
+            self.gpu.report.name
         );
         for (method, t) in &self.totals {
-            let n = f64::from(t.frames);
+            let gpu = match t.timed_frames {
+                0 => "no timestamps".to_string(),
+                n => format!("{:>8.2} ms", t.gpu_ms / f64::from(n)),
+            };
             out.push_str(&format!(
-                "\n  {method:<14} {:>6} frames, GPU {:>8.2} ms, submit-to-done {:>8.2} ms",
+                "\n  {method:<14} {:>6} frames, GPU {gpu}, submit-to-done {:>8.2} ms",
                 t.frames,
-                t.gpu_ms / n,
-                t.wait_ms / n
+                t.wait_ms / f64::from(t.frames)
             ));
         }
         out
@@ -346,7 +357,7 @@ impl Viewer {
             self.waiting_for = None;
         } else {
             self.builds
-                .start(&self.renderer, &self.level, name, &self.settings);
+                .start(&self.renderer, &self.level, name, &self.settings)?;
             self.waiting_for = Some(name.to_string());
         }
         Ok(())
@@ -366,7 +377,7 @@ impl Viewer {
             }
             if !self.is_current(name) {
                 self.builds
-                    .start(&self.renderer, &self.level, name, &self.settings);
+                    .start(&self.renderer, &self.level, name, &self.settings)?;
             }
         }
         self.split = split;
@@ -378,7 +389,8 @@ impl Viewer {
             self.say(format!("the level has no view {}", index + 1));
             return;
         };
-        match Camera::from_view(&self.level, &view, self.render_size.0, self.render_size.1) {
+        let (w, h) = self.render_size();
+        match Camera::from_view(&self.level, &view, w, h) {
             Ok(camera) => {
                 let speed = self.fly.speed;
                 self.fly = FlyCamera::from_camera(&camera);
@@ -397,7 +409,8 @@ impl Viewer {
     }
 
     fn camera(&self) -> anyhow::Result<Camera> {
-        self.fly.camera(self.render_size.0, self.render_size.1)
+        let (w, h) = self.render_size();
+        self.fly.camera(w, h)
     }
 
     /// Dig where picture point `at` (render pixels) shows terrain.
@@ -445,10 +458,10 @@ impl Viewer {
         self.renderer.apply_edit(&self.level, dirty)
     }
 
-    fn on_knob(&mut self, knob: Knob) {
+    fn on_knob(&mut self, knob: Knob) -> anyhow::Result<()> {
         if knob == Knob::Shadows {
             self.renderer.set_shadows(self.settings.shadows);
-            return;
+            return Ok(());
         }
         // Rebuild what is on screen and reads the knob; other kept methods
         // are rebuilt when next shown.
@@ -458,15 +471,15 @@ impl Viewer {
         for name in shown {
             if knob.methods().contains(&name.as_str()) && !self.is_current(&name) {
                 self.builds
-                    .start(&self.renderer, &self.level, &name, &self.settings);
+                    .start(&self.renderer, &self.level, &name, &self.settings)?;
             }
         }
+        Ok(())
     }
 
     fn set_knob(&mut self, knob: Knob, value: f32) -> anyhow::Result<()> {
         knob.set(&mut self.settings, value)?;
-        self.on_knob(knob);
-        Ok(())
+        self.on_knob(knob)
     }
 
     /// Keep finished builds; activate the one waited for.
@@ -522,11 +535,10 @@ impl Viewer {
             match self.renderer.resize(size.0, size.1) {
                 Ok(()) => {
                     self.compositor.rebind_picture(self.renderer.shared());
-                    self.render_size = size;
                     self.say(format!("picture {}x{}", size.0, size.1));
                 }
                 // Too large for this adapter: keep the picture, scaled.
-                Err(e) => self.say(format!("picture stays {:?}: {e:#}", self.render_size)),
+                Err(e) => self.say(format!("picture stays {:?}: {e:#}", self.render_size())),
             }
         }
         let camera = self.camera()?;
@@ -547,15 +559,17 @@ impl Viewer {
             timings.push((b.clone(), drawn?));
         }
         for (method, t) in &timings {
-            let totals = match self.totals.iter_mut().find(|(m, _)| m == method) {
-                Some((_, totals)) => totals,
+            let i = match self.totals.iter().position(|(m, _)| m == method) {
+                Some(i) => i,
                 None => {
                     self.totals.push((method.clone(), Totals::default()));
-                    &mut self.totals.last_mut().expect("just pushed").1
+                    self.totals.len() - 1
                 }
             };
+            let totals = &mut self.totals[i].1;
             totals.frames += 1;
-            totals.gpu_ms += t.gpu_ms.unwrap_or(f64::NAN);
+            totals.gpu_ms += t.gpu_ms.unwrap_or(0.0);
+            totals.timed_frames += u32::from(t.gpu_ms.is_some());
             totals.wait_ms += t.cpu_ms;
         }
         self.timings = timings;
@@ -643,7 +657,7 @@ impl Viewer {
             waiting_for: self.waiting_for.as_deref(),
             views: &self.views,
             camera: &self.fly,
-            render_size: self.render_size,
+            render_size: self.render_size(),
             window_size: self.compositor.window_size(),
             undo_depth: self.digger.can_undo(),
             log: &self.log,
@@ -670,7 +684,7 @@ impl Viewer {
             Action::Method(name) => self.request_method(&name)?,
             Action::Split(split) => self.set_split(split)?,
             Action::View(i) => self.go_to_view(i),
-            Action::Knob(knob) => self.on_knob(knob),
+            Action::Knob(knob) => self.on_knob(knob)?,
             Action::Undo => self.undo()?,
             Action::CopyView => self.copy_view("viewer"),
             Action::Screenshot => {

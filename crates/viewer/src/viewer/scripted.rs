@@ -75,13 +75,13 @@ impl Viewer {
                 }
                 Running::Frames(left) => (left > 1).then_some(Running::Frames(left - 1)),
                 Running::WaitSize { size, left } => {
-                    if self.render_size == size {
+                    if self.render_size() == size {
                         None
                     } else if left == 0 {
                         bail!(
                             "the window system left the picture at {}x{}, not {}x{}",
-                            self.render_size.0,
-                            self.render_size.1,
+                            self.render_size().0,
+                            self.render_size().1,
                             size.0,
                             size.1
                         );
@@ -147,7 +147,7 @@ impl Viewer {
             }
             Command::Frames(n) => running = Some(Running::Frames(n)),
             Command::Dig(fx, fy) => {
-                let (w, h) = self.render_size;
+                let (w, h) = self.render_size();
                 // The centre of the pixel the fraction falls in.
                 let px = (fx * w as f32).floor().min(w as f32 - 1.0) + 0.5;
                 let py = (fy * h as f32).floor().min(h as f32 - 1.0) + 0.5;
