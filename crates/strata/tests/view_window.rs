@@ -155,7 +155,7 @@ fn scripted_flight_switches_method_digs_and_undoes() {
              undo\nscreenshot {s}/ray-undone.png\n\
              method mesh\nscreenshot {s}/mesh-before.png\n\
              dig 0.5 0.5\nscreenshot {s}/mesh-dug.png\n\
-             copy-view dug\n\
+             copy-view dug\nscore\n\
              method ray\nset ray-steps 32\nscreenshot {s}/ray-32.png\n\
              overlay on\nfly -30 0 10 4\nturn -10 5 2\nscreenshot {s}/final.png\n\
              overlay off\nwindow 320 240\nscreenshot {s}/resized.png\n",
@@ -226,6 +226,24 @@ fn scripted_flight_switches_method_digs_and_undoes() {
         .unwrap_or_else(|| panic!("no copied view in {stdout}"));
     let views = strata_level::views::parse_views(line).unwrap();
     assert_eq!(views[0].pitch, -30.0);
+    // The mesh scored against the CPU reference from the same camera, after
+    // the dig: measured 0.0x % see-through here; the limits leave margin.
+    let score = stdout
+        .lines()
+        .find(|l| l.starts_with("score mesh:"))
+        .unwrap_or_else(|| panic!("no mesh score in {stdout}"));
+    let percent = |name: &str| -> f64 {
+        let rest = &score[score.find(name).expect(name) + name.len()..];
+        rest.trim_start()
+            .split(' ')
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap()
+    };
+    assert!(percent("see-through") < 1.0, "{score}");
+    assert!(percent("covers-sky") < 1.0, "{score}");
+    assert!(percent("coherence") < 2.0, "{score}");
     assert_eq!(load(&shots, "final.png").dimensions(), WINDOW);
     // The picture follows a resized window (another aspect: no bars).
     let resized = load(&shots, "resized.png");

@@ -22,6 +22,8 @@ pub enum Action {
     Undo,
     CopyView,
     Screenshot,
+    /// Score the drawn method(s) against the CPU reference.
+    Score,
 }
 
 /// One drawn method's last frame.
@@ -75,6 +77,8 @@ pub struct Status<'a> {
     pub render_size: (u32, u32),
     pub window_size: (u32, u32),
     pub undo_depth: usize,
+    /// The last scores against the reference.
+    pub scores: &'a [(String, strata_reference::Metrics)],
     pub log: &'a [String],
 }
 
@@ -294,6 +298,9 @@ fn panel(
                     }
                 });
             });
+            section(ui, "accuracy (M)", false, |ui| {
+                accuracy(ui, status, actions)
+            });
             section(ui, "memory", false, |ui| memory(ui, status));
             ui.horizontal(|ui| {
                 if ui.button("copy view").clicked() {
@@ -473,6 +480,37 @@ fn views(ui: &mut egui::Ui, status: &Status<'_>, actions: &mut Vec<Action>) {
                 }
             }
         });
+}
+
+fn accuracy(ui: &mut egui::Ui, status: &Status<'_>, actions: &mut Vec<Action>) {
+    if ui
+        .button("score this view against the CPU reference")
+        .clicked()
+    {
+        actions.push(Action::Score);
+    }
+    egui::Grid::new("scores").striped(true).show(ui, |ui| {
+        if !status.scores.is_empty() {
+            for head in [
+                "",
+                "see-through",
+                "covers sky",
+                "depth p50/p95",
+                "coherence",
+            ] {
+                ui.strong(head);
+            }
+            ui.end_row();
+        }
+        for (method, m) in status.scores {
+            ui.label(method);
+            ui.label(format!("{:.2} %", m.see_through));
+            ui.label(format!("{:.2} %", m.covers_sky));
+            ui.label(format!("{:.2} / {:.2}", m.depth_p50, m.depth_p95));
+            ui.label(format!("{:.2} %", m.coherence));
+            ui.end_row();
+        }
+    });
 }
 
 fn memory(ui: &mut egui::Ui, status: &Status<'_>) {

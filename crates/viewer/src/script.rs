@@ -17,6 +17,7 @@
 //! window W H                resize the window (the picture follows)
 //! screenshot PATH           save what the window shows as PNG
 //! copy-view [NAME]          print the current view as a views.txt line
+//! score                     print the drawn method(s)' metrics against the CPU reference
 //! quit                      stop here (the end of the file does too)
 //! ```
 
@@ -49,6 +50,7 @@ pub enum Command {
     Window(u32, u32),
     Screenshot(PathBuf),
     CopyView(String),
+    Score,
     Quit,
 }
 
@@ -207,13 +209,17 @@ fn parse_line(line: &str) -> anyhow::Result<Command> {
             arity(0, 1)?;
             Command::CopyView(args.first().unwrap_or(&"viewer").to_string())
         }
+        "score" => {
+            arity(0, 0)?;
+            Command::Score
+        }
         "quit" => {
             arity(0, 0)?;
             Command::Quit
         }
         other => bail!(
             "unknown command `{other}` (view, method, split, fly, turn, frames, dig, undo, \
-             set, overlay, window, screenshot, copy-view, quit)"
+             set, overlay, window, screenshot, copy-view, score, quit)"
         ),
     })
 }
@@ -227,7 +233,7 @@ mod tests {
         let script = Script::parse(
             "# a flight\nview hangar\nmethod mesh  # switch\nsplit ray\nsplit off\n\
              fly 10 -2 3 5\nturn 15 -5\nframes 4\ndig 0.5 0.25\nundo\nset ray-steps 64\n\
-             overlay off\nwindow 640 480\nscreenshot out/a.png\ncopy-view\nquit\n",
+             overlay off\nwindow 640 480\nscreenshot out/a.png\ncopy-view\nscore\nquit\n",
         )
         .unwrap();
         let commands: Vec<_> = script.commands.iter().map(|(_, c)| c.clone()).collect();
@@ -254,6 +260,7 @@ mod tests {
                 Command::Window(640, 480),
                 Command::Screenshot("out/a.png".into()),
                 Command::CopyView("viewer".into()),
+                Command::Score,
                 Command::Quit,
             ]
         );

@@ -149,6 +149,7 @@ impl Viewer {
                     self.set_split(split)?;
                 }
                 KeyCode::KeyV => self.copy_view("viewer"),
+                KeyCode::KeyM => self.score()?,
                 KeyCode::KeyP => self.screenshot_after_frame = Some(self.next_screenshot_path()),
                 KeyCode::KeyU => self.undo()?,
                 KeyCode::KeyZ if self.ctrl => self.undo()?,

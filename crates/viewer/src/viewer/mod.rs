@@ -85,6 +85,8 @@ pub struct Viewer {
     timings: Vec<(String, FrameTimings)>,
     totals: Vec<(String, Totals)>,
     log: Vec<String>,
+    /// The last scores against the reference (method, metrics).
+    scores: Vec<(String, strata_reference::Metrics)>,
     player: Option<Player>,
     screenshot_after_frame: Option<PathBuf>,
     screenshots: u32,
@@ -255,6 +257,7 @@ impl Viewer {
             timings: Vec::new(),
             totals: Vec::new(),
             log: Vec::new(),
+            scores: Vec::new(),
             player: script.map(Player::new),
             screenshot_after_frame: None,
             screenshots: 0,
@@ -406,6 +409,46 @@ impl Viewer {
         println!("{line}");
         self.overlay.copy_text(line.clone());
         self.say(format!("copied: {line}"));
+    }
+
+    /// Score what the drawn method(s) show from here against the CPU
+    /// reference for the same camera (DESIGN §3 metrics), print and keep it.
+    fn score(&mut self) -> anyhow::Result<()> {
+        let camera = self.camera()?;
+        let start = Instant::now();
+        let reference = strata_reference::render_reference(&self.level, &camera);
+        let reference_ms = start.elapsed().as_secs_f64() * 1e3;
+        let active = self.renderer.method_name();
+        let shown: Vec<&'static str> = std::iter::once(active)
+            .chain(
+                self.split
+                    .as_deref()
+                    .and_then(|b| self.renderer.method_names().into_iter().find(|m| *m == b)),
+            )
+            .collect();
+        let mut scores = Vec::new();
+        for method in shown {
+            // Draw it again: in A/B mode the depth target holds the other side.
+            self.renderer.activate(method)?;
+            self.renderer.render_frame(&camera)?;
+            let depth = self.renderer.read_depth()?;
+            let distance = strata_reference::distance_from_depth(&camera, &depth);
+            let metrics = strata_reference::metrics::try_compare(&reference, &distance)?;
+            scores.push((method.to_string(), metrics));
+        }
+        self.renderer.activate(active)?;
+        for (method, m) in &scores {
+            let line = format!(
+                "score {method}: see-through {:.3} %, covers-sky {:.3} %, depth p50 {:.3} p95 {:.3}, \
+                 coherence {:.3} %",
+                m.see_through, m.covers_sky, m.depth_p50, m.depth_p95, m.coherence
+            );
+            println!("{line}");
+            self.say(line);
+        }
+        self.say(format!("reference {reference_ms:.0} ms"));
+        self.scores = scores;
+        Ok(())
     }
 
     fn camera(&self) -> anyhow::Result<Camera> {
@@ -660,6 +703,7 @@ impl Viewer {
             render_size: self.render_size(),
             window_size: self.compositor.window_size(),
             undo_depth: self.digger.can_undo(),
+            scores: &self.scores,
             log: &self.log,
         };
         let mut editable = Editable {
@@ -687,6 +731,7 @@ impl Viewer {
             Action::Knob(knob) => self.on_knob(knob)?,
             Action::Undo => self.undo()?,
             Action::CopyView => self.copy_view("viewer"),
+            Action::Score => self.score()?,
             Action::Screenshot => {
                 self.screenshot_after_frame = Some(self.next_screenshot_path());
             }

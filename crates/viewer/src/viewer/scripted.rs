@@ -172,6 +172,7 @@ impl Viewer {
             }
             Command::Screenshot(path) => self.screenshot_after_frame = Some(path),
             Command::CopyView(name) => self.copy_view(&name),
+            Command::Score => self.score()?,
             Command::Quit => self.quit = true,
         }
         // Run the first frame of a multi-frame command now.
