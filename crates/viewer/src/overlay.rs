@@ -259,70 +259,76 @@ fn panel(
         .default_pos(egui::pos2(8.0, 8.0))
         .default_width(300.0)
         .resizable(false)
+        // As tall as the window allows; it scrolls beyond that.
+        .default_height(ctx.content_rect().height() - 60.0)
         .vscroll(true)
-        .show(ctx, |ui| {
-            ui.label(format!(
-                "{} ({}, {})",
-                status.adapter.name, status.adapter.backend, status.adapter.device_type
-            ));
-            ui.label(format!(
-                "render {}x{}, window {}x{}",
-                status.render_size.0,
-                status.render_size.1,
-                status.window_size.0,
-                status.window_size.1
-            ));
-            ui.strong(format!(
-                "{:.1} fps ({:.1} ms per frame)",
-                1000.0 / status.frame_ms.max(1e-3),
-                status.frame_ms
-            ));
-            section(ui, "GPU time per pass", true, |ui| timings(ui, status));
-            methods_section(ui, status, editable, actions);
-            section(ui, "settings", true, |ui| {
-                knobs(ui, status, editable, actions)
-            });
-            section(ui, "camera and views", true, |ui| {
-                views(ui, status, actions)
-            });
-            section(ui, "dig (left click)", true, |ui| {
-                ui.add(egui::Slider::new(editable.crater_radius, 2..=128).text("radius"));
-                ui.horizontal(|ui| {
-                    ui.add(egui::Slider::new(editable.crater_depth, 5.0..=200.0).text("depth"));
-                    let undo = ui.add_enabled(
-                        status.undo_depth > 0,
-                        egui::Button::new(format!("undo ({})", status.undo_depth)),
-                    );
-                    if undo.clicked() {
-                        actions.push(Action::Undo);
-                    }
-                });
-            });
-            section(ui, "accuracy (M)", false, |ui| {
-                accuracy(ui, status, actions)
-            });
-            section(ui, "memory", false, |ui| memory(ui, status));
-            ui.horizontal(|ui| {
-                if ui.button("copy view").clicked() {
-                    actions.push(Action::CopyView);
-                }
-                if ui.button("screenshot").clicked() {
-                    actions.push(Action::Screenshot);
-                }
-            });
-            for line in status.log.iter().rev().take(4).rev() {
-                ui.small(line);
+        .show(ctx, |ui| panel_contents(ui, status, editable, actions));
+}
+
+fn panel_contents(
+    ui: &mut egui::Ui,
+    status: &Status<'_>,
+    editable: &mut Editable<'_>,
+    actions: &mut Vec<Action>,
+) {
+    ui.label(format!(
+        "{} ({}, {})",
+        status.adapter.name, status.adapter.backend, status.adapter.device_type
+    ));
+    ui.label(format!(
+        "render {}x{}, window {}x{}",
+        status.render_size.0, status.render_size.1, status.window_size.0, status.window_size.1
+    ));
+    ui.strong(format!(
+        "{:.1} fps ({:.1} ms per frame)",
+        1000.0 / status.frame_ms.max(1e-3),
+        status.frame_ms
+    ));
+    section(ui, "GPU time per pass", true, |ui| timings(ui, status));
+    methods_section(ui, status, editable, actions);
+    section(ui, "settings", true, |ui| {
+        knobs(ui, status, editable, actions)
+    });
+    section(ui, "camera and views", true, |ui| {
+        views(ui, status, actions)
+    });
+    section(ui, "dig (left click)", true, |ui| {
+        ui.add(egui::Slider::new(editable.crater_radius, 2..=128).text("radius"));
+        ui.horizontal(|ui| {
+            ui.add(egui::Slider::new(editable.crater_depth, 5.0..=200.0).text("depth"));
+            let undo = ui.add_enabled(
+                status.undo_depth > 0,
+                egui::Button::new(format!("undo ({})", status.undo_depth)),
+            );
+            if undo.clicked() {
+                actions.push(Action::Undo);
             }
-            ui.collapsing("controls", |ui| {
-                egui::Grid::new("controls").show(ui, |ui| {
-                    for (keys, what) in CONTROLS {
-                        ui.monospace(*keys);
-                        ui.label(*what);
-                        ui.end_row();
-                    }
-                });
-            });
         });
+    });
+    section(ui, "accuracy (M)", false, |ui| {
+        accuracy(ui, status, actions)
+    });
+    section(ui, "memory", false, |ui| memory(ui, status));
+    ui.horizontal(|ui| {
+        if ui.button("copy view").clicked() {
+            actions.push(Action::CopyView);
+        }
+        if ui.button("screenshot").clicked() {
+            actions.push(Action::Screenshot);
+        }
+    });
+    for line in status.log.iter().rev().take(4).rev() {
+        ui.small(line);
+    }
+    ui.collapsing("controls", |ui| {
+        egui::Grid::new("controls").show(ui, |ui| {
+            for (keys, what) in CONTROLS {
+                ui.monospace(*keys);
+                ui.label(*what);
+                ui.end_row();
+            }
+        });
+    });
 }
 
 /// A collapsible part of the panel.
