@@ -167,6 +167,25 @@ impl Renderer {
         }
     }
 
+    /// Give kept method `name` new settings in place where it can (see
+    /// [`Method::update_settings`]): `Ok(true)` when it took them, `Ok(false)`
+    /// when it must be rebuilt (or is not kept).
+    pub fn update_settings(
+        &mut self,
+        name: &str,
+        settings: &MethodSettings,
+    ) -> anyhow::Result<bool> {
+        let Some(i) = self.find(name) else {
+            return Ok(false);
+        };
+        let built = &mut self.methods[i];
+        let taken = built.method.update_settings(&self.shared, settings)?;
+        if taken {
+            built.settings = settings.clone();
+        }
+        Ok(taken)
+    }
+
     /// Draw method `name` from the next frame on; it must have been built.
     pub fn activate(&mut self, name: &str) -> anyhow::Result<()> {
         self.active = self.find(name).ok_or_else(|| {

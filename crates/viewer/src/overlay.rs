@@ -17,7 +17,8 @@ pub enum Action {
     Method(String),
     Split(Option<String>),
     View(usize),
-    /// A knob's new value is in the desired settings: rebuild what uses it.
+    /// A knob's new value is in the desired settings: apply it to what uses
+    /// it (in place, or by a background rebuild).
     Knob(Knob),
     Undo,
     CopyView,
@@ -436,9 +437,11 @@ fn knobs(
     let shown: Vec<&str> = std::iter::once(status.active).chain(status.split).collect();
     let relevant = |knob: Knob| knob.methods().iter().any(|m| shown.contains(m));
     let s = &mut *editable.settings;
-    // A rebuild starts when a drag ends (or a click or key changes a value).
+    // Knobs methods take in place apply while dragging; the mesh quality (a
+    // new fit, in the background) when the drag ends or a click changes it.
     let mut knob = |k: Knob, response: egui::Response| {
-        if response.drag_stopped() || (response.changed() && !response.dragged()) {
+        let live = k != Knob::MeshQuality && response.changed();
+        if live || response.drag_stopped() || (response.changed() && !response.dragged()) {
             actions.push(Action::Knob(k));
         }
     };

@@ -320,6 +320,16 @@ impl Method for Mesh {
         "mesh"
     }
 
+    fn update_settings(
+        &mut self,
+        _shared: &Shared,
+        settings: &MethodSettings,
+    ) -> anyhow::Result<bool> {
+        // A new quality is a new fit: only the same tolerance is taken.
+        let q = f64::from(settings.mesh_quality);
+        Ok(tolerance_for_quality(q) == Some(self.tolerance))
+    }
+
     fn apply_edit(
         &mut self,
         shared: &Shared,

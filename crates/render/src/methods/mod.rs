@@ -29,6 +29,8 @@
 //! - `apply_edit` runs after the shared terrain texture has been updated;
 //!   methods that only read the texture need not override it.
 //! - `retained_bytes` counts only what the method allocates beyond [`Shared`].
+//! - `update_settings` takes what it can in place (the viewer's sliders);
+//!   the default asks for a rebuild.
 //! - A method that binds the shared targets, or sizes anything by them, in
 //!   `create` must redo that in `resize` (the viewer follows its window).
 
@@ -122,6 +124,18 @@ pub trait Method: Send {
     /// attach the targets when recording need nothing).
     fn resize(&mut self, _shared: &Shared) -> anyhow::Result<()> {
         Ok(())
+    }
+
+    /// Take new settings without a rebuild where the method can (a uniform,
+    /// a count): `Ok(true)`. `Ok(false)` when a setting it reads needs a
+    /// rebuild (the mesh's quality, the voxel size); an invalid value is an
+    /// error and changes nothing.
+    fn update_settings(
+        &mut self,
+        _shared: &Shared,
+        _settings: &MethodSettings,
+    ) -> anyhow::Result<bool> {
+        Ok(false)
     }
 
     /// CPU work and uploads before recording a frame (the frame's globals are

@@ -58,6 +58,11 @@ impl Method for Painted {
         "painted"
     }
 
+    fn update_settings(&mut self, _: &Shared, _: &MethodSettings) -> anyhow::Result<bool> {
+        // Painted has no setting of its own.
+        Ok(true)
+    }
+
     fn prepare(&mut self, shared: &Shared, camera: &Camera) -> anyhow::Result<()> {
         let f = forward::footprint(camera, Some("painted"));
         self.samples = f.count[0];

@@ -8,7 +8,16 @@ use strata_level::Level;
 
 pub struct Ray {
     pipeline: wgpu::RenderPipeline,
+    params: wgpu::Buffer,
     group: wgpu::BindGroup,
+}
+
+/// Check `--ray-steps`: the method's uniform (`RayParams`).
+fn ray_params_data(settings: &MethodSettings) -> anyhow::Result<[u32; 4]> {
+    if settings.ray_steps == 0 {
+        anyhow::bail!("ray steps must be at least 1 (got 0)");
+    }
+    Ok([settings.ray_steps, 0, 0, 0])
 }
 
 /// Check `--ray-steps` and build the method's uniform (`RayParams`).
@@ -16,13 +25,21 @@ pub(crate) fn ray_params(
     shared: &Shared,
     settings: &MethodSettings,
 ) -> anyhow::Result<wgpu::Buffer> {
-    if settings.ray_steps == 0 {
-        anyhow::bail!("ray steps must be at least 1 (got 0)");
-    }
-    Ok(shared.uniform_buffer(
-        "ray params",
-        bytemuck::cast_slice(&[settings.ray_steps, 0, 0, 0]),
-    ))
+    let data = ray_params_data(settings)?;
+    Ok(shared.uniform_buffer("ray params", bytemuck::cast_slice(&data)))
+}
+
+/// Rewrite the uniform for new settings (the steps are all it holds).
+pub(crate) fn update_ray_params(
+    shared: &Shared,
+    params: &wgpu::Buffer,
+    settings: &MethodSettings,
+) -> anyhow::Result<bool> {
+    let data = ray_params_data(settings)?;
+    shared
+        .queue
+        .write_buffer(params, 0, bytemuck::cast_slice(&data));
+    Ok(true)
 }
 
 pub fn create(
@@ -39,12 +56,24 @@ pub fn create(
         &shared.pipeline_layout("ray", &[&layout]),
         "fs_ray",
     )?;
-    Ok(Box::new(Ray { pipeline, group }))
+    Ok(Box::new(Ray {
+        pipeline,
+        params,
+        group,
+    }))
 }
 
 impl Method for Ray {
     fn name(&self) -> &'static str {
         "ray"
+    }
+
+    fn update_settings(
+        &mut self,
+        shared: &Shared,
+        settings: &MethodSettings,
+    ) -> anyhow::Result<bool> {
+        update_ray_params(shared, &self.params, settings)
     }
 
     fn record(&self, shared: &Shared, frame: &Frame<'_>, encoder: &mut wgpu::CommandEncoder) {

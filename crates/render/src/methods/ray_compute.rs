@@ -6,7 +6,7 @@
 //! colour one). Both passes are timed; the copy is part of the method's cost.
 
 use super::common::{DepthCopy, compute_pipeline, dispatch_per_pixel};
-use super::ray::ray_params;
+use super::ray::{ray_params, update_ray_params};
 use super::{Frame, Method, MethodSettings, RetainedBytes};
 use crate::frame::{Shared, uniform_layout_entry};
 use strata_level::Level;
@@ -75,6 +75,14 @@ pub fn create(
 impl Method for RayCompute {
     fn name(&self) -> &'static str {
         "ray-compute"
+    }
+
+    fn update_settings(
+        &mut self,
+        shared: &Shared,
+        settings: &MethodSettings,
+    ) -> anyhow::Result<bool> {
+        update_ray_params(shared, &self.params, settings)
     }
 
     fn resize(&mut self, shared: &Shared) -> anyhow::Result<()> {

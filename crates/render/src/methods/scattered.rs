@@ -342,6 +342,16 @@ impl Method for Scattered {
         "scattered"
     }
 
+    fn update_settings(
+        &mut self,
+        _shared: &Shared,
+        settings: &MethodSettings,
+    ) -> anyhow::Result<bool> {
+        // The density only sizes next frame's grid.
+        self.density = checked_density(settings.scatter_density)?;
+        Ok(true)
+    }
+
     fn resize(&mut self, shared: &Shared) -> anyhow::Result<()> {
         self.screen = ScreenBuffer::new(
             shared,

@@ -24,15 +24,20 @@ pub struct Sliced {
     empty: bool,
 }
 
+fn checked_slices(settings: &MethodSettings) -> anyhow::Result<u32> {
+    let slices = settings.slices;
+    if slices == 0 || slices > MAX_SLICES {
+        anyhow::bail!("slices must be in 1..={MAX_SLICES} (got {slices})");
+    }
+    Ok(slices)
+}
+
 pub fn create(
     shared: &Shared,
     _level: &Level,
     settings: &MethodSettings,
 ) -> anyhow::Result<Box<dyn Method>> {
-    let slices = settings.slices;
-    if slices == 0 || slices > MAX_SLICES {
-        anyhow::bail!("slices must be in 1..={MAX_SLICES} (got {slices})");
-    }
+    let slices = checked_slices(settings)?;
     let (params, layout, group) = footprint_binding(shared, "sliced");
     let pipeline = forward_pipeline(
         shared,
@@ -59,6 +64,15 @@ fn slice_near(z: f32, slices: u32) -> u32 {
 impl Method for Sliced {
     fn name(&self) -> &'static str {
         "sliced"
+    }
+
+    fn update_settings(
+        &mut self,
+        _shared: &Shared,
+        settings: &MethodSettings,
+    ) -> anyhow::Result<bool> {
+        self.slices = checked_slices(settings)?;
+        Ok(true)
     }
 
     fn prepare(&mut self, shared: &Shared, camera: &Camera) -> anyhow::Result<()> {

@@ -40,6 +40,8 @@ struct ComputeParts {
 pub struct Voxel {
     name: &'static str,
     pyramid: GpuPyramid,
+    /// The grid the pyramid was built for (a new one needs a rebuild).
+    voxel_size: [u32; 3],
     params: wgpu::Buffer,
     group_layout: wgpu::BindGroupLayout,
     group: wgpu::BindGroup,
@@ -185,6 +187,7 @@ pub fn build(
     Ok(Voxel {
         name,
         pyramid,
+        voxel_size: settings.voxel_size,
         params,
         group_layout,
         group,
@@ -233,6 +236,22 @@ impl Method for Voxel {
         rects: &[DirtyRect],
     ) -> anyhow::Result<()> {
         self.pyramid.enqueue(rects)
+    }
+
+    fn update_settings(
+        &mut self,
+        shared: &Shared,
+        settings: &MethodSettings,
+    ) -> anyhow::Result<bool> {
+        voxel_size(settings)?;
+        if settings.voxel_size != self.voxel_size {
+            return Ok(false);
+        }
+        // The step budget is `VoxelParams.config[0]`, the uniform's first word.
+        shared
+            .queue
+            .write_buffer(&self.params, 0, bytemuck::bytes_of(&settings.voxel_steps));
+        Ok(true)
     }
 
     fn resize(&mut self, shared: &Shared) -> anyhow::Result<()> {

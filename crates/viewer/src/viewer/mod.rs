@@ -351,7 +351,7 @@ impl Viewer {
             );
         }
         let current = self.renderer.method_name();
-        if self.is_current(name) {
+        if self.make_current(name)? {
             if current != name {
                 self.previous_method = current.to_string();
                 self.renderer.activate(name)?;
@@ -366,6 +366,15 @@ impl Viewer {
         Ok(())
     }
 
+    /// Whether `name` is kept with the current settings, giving them to it
+    /// in place where it can take them (otherwise it needs a rebuild).
+    fn make_current(&mut self, name: &str) -> anyhow::Result<bool> {
+        if self.is_current(name) {
+            return Ok(true);
+        }
+        self.renderer.update_settings(name, &self.settings)
+    }
+
     /// Whether `name` is kept, built with the current settings.
     fn is_current(&self, name: &str) -> bool {
         self.renderer
@@ -378,7 +387,7 @@ impl Viewer {
             if !methods::names().contains(&name.as_str()) {
                 bail!("unknown method `{name}`");
             }
-            if !self.is_current(name) {
+            if !self.make_current(name)? {
                 self.builds
                     .start(&self.renderer, &self.level, name, &self.settings)?;
             }
@@ -506,13 +515,13 @@ impl Viewer {
             self.renderer.set_shadows(self.settings.shadows);
             return Ok(());
         }
-        // Rebuild what is on screen and reads the knob; other kept methods
-        // are rebuilt when next shown.
+        // What is on screen and reads the knob takes it in place or is
+        // rebuilt; other kept methods catch up when next shown.
         let shown: Vec<String> = std::iter::once(self.renderer.method_name().to_string())
             .chain(self.split.clone())
             .collect();
         for name in shown {
-            if knob.methods().contains(&name.as_str()) && !self.is_current(&name) {
+            if knob.methods().contains(&name.as_str()) && !self.make_current(&name)? {
                 self.builds
                     .start(&self.renderer, &self.level, &name, &self.settings)?;
             }
