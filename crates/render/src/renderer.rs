@@ -7,10 +7,10 @@
 //! method follows every edit, so switching never shows stale terrain.
 
 use crate::frame::{Globals, LevelShape, Shared, TerrainColors};
-use crate::gpu::{ErrorSink, Gpu, read_buffer, wait_device};
+use crate::gpu::{ErrorSink, Gpu, wait_device};
 use crate::methods::{self, Frame, Method, MethodSettings, RetainedBytes};
 use crate::shadow::{ShadowFrame, ShadowPass};
-use crate::timing::{FrameTimings, MAX_TIMED_PASSES, PassTimer};
+use crate::timing::{FrameTimings, PassTimer};
 use std::sync::Arc;
 use std::time::Instant;
 use strata_camera::Camera;
@@ -39,9 +39,6 @@ pub struct Renderer {
     active: usize,
     shadow: ShadowPass,
     timer: PassTimer,
-    /// Resolve target and mappable copy of the timestamps.
-    stamps: Option<(wgpu::Buffer, wgpu::Buffer)>,
-    period_ns: f64,
     errors: ErrorSink,
     level_shape: LevelShape,
     frames: u64,
@@ -82,23 +79,7 @@ impl Renderer {
         )?);
         let method = methods::create(method, &shared, level, settings)?;
         let shadow = ShadowPass::new(&shared)?;
-        let timer = PassTimer::new(&gpu.device, gpu.report.timestamps);
-        let stamps = gpu.report.timestamps.then(|| {
-            let size = u64::from(2 * MAX_TIMED_PASSES) * 8;
-            let resolve = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("timestamps resolve"),
-                size,
-                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-                mapped_at_creation: false,
-            });
-            let read = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("timestamps read"),
-                size,
-                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            });
-            (resolve, read)
-        });
+        let timer = PassTimer::new(&gpu.device, &gpu.queue, gpu.report.timestamps);
         let mut renderer = Renderer {
             shared,
             methods: vec![Built {
@@ -108,8 +89,6 @@ impl Renderer {
             active: 0,
             shadow,
             timer,
-            stamps,
-            period_ns: f64::from(gpu.queue.get_timestamp_period()),
             errors: gpu.errors.clone(),
             level_shape: LevelShape::of(level),
             frames: 0,
@@ -309,13 +288,7 @@ impl Renderer {
         self.methods[self.active]
             .method
             .record(&self.shared, &frame, &mut encoder);
-        let used = self.timer.used();
-        if let (Some((resolve, read)), Some(qs)) = (&self.stamps, self.timer.query_set())
-            && used > 0
-        {
-            encoder.resolve_query_set(qs, 0..2 * used, resolve, 0);
-            encoder.copy_buffer_to_buffer(resolve, 0, read, 0, u64::from(2 * used) * 8);
-        }
+        self.timer.resolve(&mut encoder);
         let commands = encoder.finish();
         let record_ms = ms(record_start);
 
@@ -325,31 +298,7 @@ impl Renderer {
         let cpu_ms = ms(submit_start);
         self.frames += 1;
 
-        let (gpu_ms, passes) = match &self.stamps {
-            Some((_, read)) if used > 0 => {
-                let raw = read_buffer(
-                    &self.shared.device,
-                    &self.errors,
-                    read,
-                    u64::from(2 * used) * 8,
-                )?;
-                let ticks: &[u64] = bytemuck::cast_slice(&raw);
-                let passes: Vec<(String, f64)> = self
-                    .timer
-                    .labels()
-                    .into_iter()
-                    .zip(ticks.chunks_exact(2))
-                    .map(|(label, t)| {
-                        (
-                            label,
-                            t[1].wrapping_sub(t[0]) as f64 * self.period_ns * 1e-6,
-                        )
-                    })
-                    .collect();
-                (Some(passes.iter().map(|p| p.1).sum()), passes)
-            }
-            _ => (None, Vec::new()),
-        };
+        let (gpu_ms, passes) = self.timer.read(&self.shared.device, &self.errors)?;
         Ok(FrameTimings {
             gpu_ms,
             cpu_ms,

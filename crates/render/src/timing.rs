@@ -19,20 +19,31 @@ pub struct FrameTimings {
     /// CPU time to prepare and record the frame (before submit), ms.
     pub record_ms: f64,
     /// Each timed pass: label and GPU ms.
-    pub passes: Vec<(String, f64)>,
+    pub passes: PassTimes,
     /// Passes beyond [`MAX_TIMED_PASSES`] that ran untimed.
     pub untimed_passes: u32,
 }
 
-/// Hands out timestamp slots to the passes of one frame.
+/// Each timed pass's label and GPU ms, in recording order.
+pub type PassTimes = Vec<(String, f64)>;
+
+/// Hands out timestamp slots to the passes of one frame, then resolves and
+/// reads them back: `reset`, passes take `render` / `compute` writes,
+/// `resolve` into the frame's encoder, submit and wait, `read`.
 pub struct PassTimer {
     query_set: Option<wgpu::QuerySet>,
+    /// Resolve target and mappable copy of the stamps.
+    buffers: Option<(wgpu::Buffer, wgpu::Buffer)>,
+    /// Nanoseconds per tick.
+    period_ns: f64,
     labels: RefCell<Vec<String>>,
     untimed: RefCell<u32>,
 }
 
 impl PassTimer {
-    pub(crate) fn new(device: &wgpu::Device, enabled: bool) -> Self {
+    /// A timer over `queue`'s clock; without `enabled` (the adapter has no
+    /// timestamp queries) every pass runs untimed.
+    pub fn new(device: &wgpu::Device, queue: &wgpu::Queue, enabled: bool) -> Self {
         let query_set = enabled.then(|| {
             device.create_query_set(&wgpu::QuerySetDescriptor {
                 label: Some("pass timestamps"),
@@ -40,14 +51,71 @@ impl PassTimer {
                 count: 2 * MAX_TIMED_PASSES,
             })
         });
+        let buffers = enabled.then(|| {
+            let size = u64::from(2 * MAX_TIMED_PASSES) * 8;
+            let buffer = |label, usage| {
+                device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some(label),
+                    size,
+                    usage,
+                    mapped_at_creation: false,
+                })
+            };
+            use wgpu::BufferUsages as U;
+            (
+                buffer("timestamps resolve", U::QUERY_RESOLVE | U::COPY_SRC),
+                buffer("timestamps read", U::MAP_READ | U::COPY_DST),
+            )
+        });
         PassTimer {
             query_set,
+            buffers,
+            period_ns: f64::from(queue.get_timestamp_period()),
             labels: RefCell::new(Vec::new()),
             untimed: RefCell::new(0),
         }
     }
 
-    pub(crate) fn reset(&self) {
+    /// Copy this frame's stamps out (after its last timed pass).
+    pub fn resolve(&self, encoder: &mut wgpu::CommandEncoder) {
+        let used = self.used();
+        if let (Some((resolve, read)), Some(qs)) = (&self.buffers, &self.query_set)
+            && used > 0
+        {
+            encoder.resolve_query_set(qs, 0..2 * used, resolve, 0);
+            encoder.copy_buffer_to_buffer(resolve, 0, read, 0, u64::from(2 * used) * 8);
+        }
+    }
+
+    /// Each timed pass's label and GPU ms, and their sum (`None` without
+    /// timestamps). Call after the frame's work has finished.
+    pub fn read(
+        &self,
+        device: &wgpu::Device,
+        errors: &crate::gpu::ErrorSink,
+    ) -> anyhow::Result<(Option<f64>, PassTimes)> {
+        let used = self.used();
+        let Some((_, read)) = self.buffers.as_ref().filter(|_| used > 0) else {
+            return Ok((None, Vec::new()));
+        };
+        let raw = crate::gpu::read_buffer(device, errors, read, u64::from(2 * used) * 8)?;
+        let ticks: &[u64] = bytemuck::cast_slice(&raw);
+        let passes: PassTimes = self
+            .labels()
+            .into_iter()
+            .zip(ticks.chunks_exact(2))
+            .map(|(label, t)| {
+                (
+                    label,
+                    t[1].wrapping_sub(t[0]) as f64 * self.period_ns * 1e-6,
+                )
+            })
+            .collect();
+        Ok((Some(passes.iter().map(|p| p.1).sum()), passes))
+    }
+
+    /// Start a frame: no pass timed yet.
+    pub fn reset(&self) {
         self.labels.borrow_mut().clear();
         *self.untimed.borrow_mut() = 0;
     }
@@ -88,16 +156,13 @@ impl PassTimer {
         self.labels.borrow().len() as u32
     }
 
-    pub(crate) fn untimed(&self) -> u32 {
+    /// Passes beyond [`MAX_TIMED_PASSES`] this frame.
+    pub fn untimed(&self) -> u32 {
         *self.untimed.borrow()
     }
 
     pub(crate) fn labels(&self) -> Vec<String> {
         self.labels.borrow().clone()
-    }
-
-    pub(crate) fn query_set(&self) -> Option<&wgpu::QuerySet> {
-        self.query_set.as_ref()
     }
 }
 

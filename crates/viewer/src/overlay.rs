@@ -170,6 +170,7 @@ impl Overlay {
         target: &wgpu::TextureView,
         status: &Status<'_>,
         editable: &mut Editable<'_>,
+        timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
     ) -> Vec<Action> {
         let mut actions = Vec::new();
         let raw = self.input.take_egui_input(window);
@@ -216,7 +217,7 @@ impl Overlay {
                     },
                 })],
                 depth_stencil_attachment: None,
-                timestamp_writes: None,
+                timestamp_writes: timestamps,
                 occlusion_query_set: None,
                 multiview_mask: None,
             });

@@ -260,7 +260,12 @@ impl Compositor {
 
     /// Draw the picture into the window image: alone, or the kept A left of
     /// the current picture with the divider at `split` (fraction of the width).
-    pub fn compose(&self, encoder: &mut wgpu::CommandEncoder, split: Option<f32>) {
+    pub fn compose(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        split: Option<f32>,
+        timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
+    ) {
         let params = Params {
             viewport: self.picture_rect(),
             options: [split.unwrap_or(2.0), 0.0, 0.0, 0.0],
@@ -272,7 +277,8 @@ impl Compositor {
         } else {
             &self.single_group
         };
-        fullscreen(encoder, "compose", &self.window.view, &self.compose, group);
+        let target = &self.window.view;
+        fullscreen(encoder, "compose", target, &self.compose, group, timestamps);
     }
 
     /// The window image, for the overlay to paint on (load, don't clear).
@@ -281,14 +287,14 @@ impl Compositor {
     }
 
     /// Copy the window image to the swapchain image `target`.
-    pub fn present(&self, encoder: &mut wgpu::CommandEncoder, target: &wgpu::TextureView) {
-        fullscreen(
-            encoder,
-            "present",
-            target,
-            &self.present,
-            &self.present_group,
-        );
+    pub fn present(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &wgpu::TextureView,
+        timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
+    ) {
+        let group = &self.present_group;
+        fullscreen(encoder, "present", target, &self.present, group, timestamps);
     }
 
     /// The window image as RGBA8 (what a screenshot saves).
@@ -390,6 +396,7 @@ fn fullscreen(
     target: &wgpu::TextureView,
     pipeline: &wgpu::RenderPipeline,
     group: &wgpu::BindGroup,
+    timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
 ) {
     let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
         label: Some(label),
@@ -403,7 +410,7 @@ fn fullscreen(
             },
         })],
         depth_stencil_attachment: None,
-        timestamp_writes: None,
+        timestamp_writes: timestamps,
         occlusion_query_set: None,
         multiview_mask: None,
     });

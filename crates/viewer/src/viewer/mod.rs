@@ -21,6 +21,7 @@ use std::sync::Arc;
 use std::time::Instant;
 use strata_camera::Camera;
 use strata_level::{DirtyRect, EditSite, Level, ViewSpec};
+use strata_render::timing::PassTimer;
 use strata_render::{FrameTimings, Gpu, MethodSettings, Renderer, TerrainColors, methods};
 use winit::event_loop::ActiveEventLoop;
 use winit::keyboard::KeyCode;
@@ -51,6 +52,8 @@ pub struct Viewer {
     gpu: Gpu,
     renderer: Renderer,
     compositor: Compositor,
+    /// Times the viewer's own passes: compose, overlay, present.
+    passes: PassTimer,
     overlay: Overlay,
     builds: Builds,
     level: Arc<Level>,
@@ -83,6 +86,8 @@ pub struct Viewer {
     opened: Instant,
     frame_ms: f64,
     timings: Vec<(String, FrameTimings)>,
+    /// The viewer's own passes in the last frame.
+    window_timings: FrameTimings,
     totals: Vec<(String, Totals)>,
     log: Vec<String>,
     /// The last scores against the reference (method, metrics).
@@ -223,6 +228,7 @@ impl Viewer {
         // A still camera (or the second side of an A/B pair) keeps its shadow map.
         renderer.set_shadow_reuse(true);
         let compositor = Compositor::new(renderer.shared(), window_size, config.format)?;
+        let passes = PassTimer::new(&gpu.device, &gpu.queue, gpu.report.timestamps);
         let overlay = Overlay::new(&window, &gpu.device, WINDOW_FORMAT);
         let digger = Digger::new(world.edit.as_ref().unwrap_or(&EditSite::fostral()));
         let mut viewer = Viewer {
@@ -232,6 +238,7 @@ impl Viewer {
             gpu,
             renderer,
             compositor,
+            passes,
             overlay,
             builds: Builds::default(),
             level: Arc::new(level),
@@ -255,6 +262,7 @@ impl Viewer {
             opened,
             frame_ms: 0.0,
             timings: Vec::new(),
+            window_timings: FrameTimings::default(),
             totals: Vec::new(),
             log: Vec::new(),
             scores: Vec::new(),
@@ -627,8 +635,12 @@ impl Viewer {
         self.timings = timings;
 
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
-        self.compositor
-            .compose(&mut encoder, split.as_ref().map(|_| self.split_at));
+        self.passes.reset();
+        self.compositor.compose(
+            &mut encoder,
+            split.as_ref().map(|_| self.split_at),
+            self.passes.render("compose"),
+        );
         let actions = self.paint_overlay(&mut encoder);
         let surface_texture = match self.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(t)
@@ -644,14 +656,23 @@ impl Viewer {
         };
         if let Some(texture) = &surface_texture {
             let view = texture.texture.create_view(&Default::default());
-            self.compositor.present(&mut encoder, &view);
+            self.compositor
+                .present(&mut encoder, &view, self.passes.render("present"));
         }
+        self.passes.resolve(&mut encoder);
+        let submitted = Instant::now();
         self.gpu.queue.submit([encoder.finish()]);
         if let Some(texture) = surface_texture {
             self.window.pre_present_notify();
             self.gpu.queue.present(texture);
         }
-        self.gpu.errors.check()?;
+        let (gpu_ms, passes) = self.passes.read(&self.gpu.device, &self.gpu.errors)?;
+        self.window_timings = FrameTimings {
+            gpu_ms,
+            cpu_ms: submitted.elapsed().as_secs_f64() * 1e3,
+            passes,
+            ..Default::default()
+        };
         if first {
             self.say(format!(
                 "first frame shown {:.2} s after the window opened",
@@ -696,6 +717,10 @@ impl Viewer {
                 .timings
                 .iter()
                 .map(|(method, timings)| Drawn { method, timings })
+                .chain(std::iter::once(Drawn {
+                    method: "window",
+                    timings: &self.window_timings,
+                }))
                 .collect(),
             active: renderer.method_name(),
             split: self.split.as_deref(),
@@ -729,6 +754,7 @@ impl Viewer {
             self.compositor.window_view(),
             &status,
             &mut editable,
+            self.passes.render("overlay"),
         )
     }
 
