@@ -158,7 +158,8 @@ fn scripted_flight_switches_method_digs_and_undoes() {
              copy-view dug\nscore\n\
              method ray\nset ray-steps 32\nscreenshot {s}/ray-32.png\n\
              overlay on\nfly -30 0 10 4\nturn -10 5 2\nscreenshot {s}/final.png\n\
-             overlay off\nwindow 320 240\nscreenshot {s}/resized.png\n",
+             overlay off\nwindow 320 240\nscreenshot {s}/resized.png\n\
+             goto 100 400\ncopy-view moved\n",
             s = shots.display()
         ),
     )
@@ -226,6 +227,13 @@ fn scripted_flight_switches_method_digs_and_undoes() {
         .unwrap_or_else(|| panic!("no copied view in {stdout}"));
     let views = strata_level::views::parse_views(line).unwrap();
     assert_eq!(views[0].pitch, -30.0);
+    // A map click (the script's goto) moves the eye there.
+    let moved = stdout
+        .lines()
+        .find(|l| l.starts_with("moved "))
+        .unwrap_or_else(|| panic!("no second copied view in {stdout}"));
+    let moved = strata_level::views::parse_views(moved).unwrap();
+    assert_eq!((moved[0].x, moved[0].y), (100.0, 400.0));
     // The mesh scored against the CPU reference from the same camera, after
     // the dig: measured 0.0x % see-through here; the limits leave margin.
     let score = stdout

@@ -8,7 +8,7 @@
 //! so what the window shows is what `strata compare` measures.
 //!
 //! Modules: [`fly`] (camera), [`dig`] (pick, crater, undo), [`knobs`]
-//! (settings), [`script`],
+//! (settings), [`minimap`], [`script`],
 //! [`builds`] (background method builds), [`present`] (picture to window),
 //! [`overlay`] (egui), [`viewer`] (state and frame), and here the event loop.
 
@@ -16,6 +16,7 @@ pub mod builds;
 pub mod dig;
 pub mod fly;
 pub mod knobs;
+pub mod minimap;
 pub mod overlay;
 pub mod present;
 pub mod script;

@@ -25,6 +25,8 @@ pub enum Action {
     Screenshot,
     /// Score the drawn method(s) against the CPU reference.
     Score,
+    /// Fly to this world position (x, y), from a click on the map.
+    Teleport(glam::Vec2),
 }
 
 /// One drawn method's last frame.
@@ -97,6 +99,15 @@ pub struct Overlay {
     input: egui_winit::State,
     painter: egui_wgpu::Renderer,
     pub visible: bool,
+    map: Option<Map>,
+}
+
+/// The map's texture and how its pixels relate to the level.
+struct Map {
+    texture: egui::TextureHandle,
+    /// Texels per map pixel.
+    scale: f32,
+    size: egui::Vec2,
 }
 
 const MIB: f64 = 1024.0 * 1024.0;
@@ -138,6 +149,24 @@ impl Overlay {
             input,
             painter,
             visible: true,
+            map: None,
+        }
+    }
+
+    /// Show `map` (again, after an edit).
+    pub fn set_map(&mut self, map: &crate::minimap::Minimap) {
+        let size = [map.width as usize, map.height as usize];
+        let image = egui::ColorImage::from_rgba_unmultiplied(size, &map.rgba);
+        let options = egui::TextureOptions::NEAREST;
+        match &mut self.map {
+            Some(m) => m.texture.set(image, options),
+            None => {
+                self.map = Some(Map {
+                    texture: self.context.load_texture("map", image, options),
+                    scale: map.scale as f32,
+                    size: egui::vec2(map.width as f32, map.height as f32),
+                })
+            }
         }
     }
 
@@ -175,12 +204,13 @@ impl Overlay {
         let mut actions = Vec::new();
         let raw = self.input.take_egui_input(window);
         let visible = self.visible;
+        let map = self.map.as_ref();
         let mut output = self.context.run_pass(raw, |ctx| {
             if let Some(method) = status.waiting_for {
                 progress(ctx, method, status);
             }
             if visible {
-                panel(ctx, status, editable, &mut actions);
+                panel(ctx, status, map, editable, &mut actions);
             }
         });
         self.input
@@ -254,6 +284,7 @@ fn progress(ctx: &egui::Context, method: &str, status: &Status<'_>) {
 fn panel(
     ctx: &egui::Context,
     status: &Status<'_>,
+    map: Option<&Map>,
     editable: &mut Editable<'_>,
     actions: &mut Vec<Action>,
 ) {
@@ -264,12 +295,13 @@ fn panel(
         // As tall as the window allows; it scrolls beyond that.
         .default_height(ctx.content_rect().height() - 60.0)
         .vscroll(true)
-        .show(ctx, |ui| panel_contents(ui, status, editable, actions));
+        .show(ctx, |ui| panel_contents(ui, status, map, editable, actions));
 }
 
 fn panel_contents(
     ui: &mut egui::Ui,
     status: &Status<'_>,
+    map: Option<&Map>,
     editable: &mut Editable<'_>,
     actions: &mut Vec<Action>,
 ) {
@@ -294,6 +326,11 @@ fn panel_contents(
     section(ui, "camera and views", true, |ui| {
         views(ui, status, actions)
     });
+    if let Some(map) = map {
+        section(ui, "map (click to fly there)", true, |ui| {
+            map_view(ui, map, status.camera, actions)
+        });
+    }
     section(ui, "dig (left click)", true, |ui| {
         ui.add(egui::Slider::new(editable.crater_radius, 2..=128).text("radius"));
         ui.horizontal(|ui| {
@@ -521,6 +558,43 @@ fn accuracy(ui: &mut egui::Ui, status: &Status<'_>, actions: &mut Vec<Action>) {
             ui.end_row();
         }
     });
+}
+
+/// A square of the map around the eye (the map's full width), the eye and
+/// its heading on it; a click flies there.
+fn map_view(ui: &mut egui::Ui, map: &Map, camera: &FlyCamera, actions: &mut Vec<Action>) {
+    let side = ui.available_width().min(220.0);
+    let zoom = side / map.size.x;
+    // Rows shown: as many map pixels as fit, centred on the eye, kept inside.
+    let rows = (side / zoom).min(map.size.y);
+    let eye = egui::vec2(camera.position.x, camera.position.y) / map.scale;
+    let top = (eye.y - rows * 0.5).clamp(0.0, map.size.y - rows);
+    let uv = egui::Rect::from_min_max(
+        egui::pos2(0.0, top / map.size.y),
+        egui::pos2(1.0, (top + rows) / map.size.y),
+    );
+    let response = ui.add(
+        egui::Image::new((map.texture.id(), egui::vec2(side, rows * zoom)))
+            .uv(uv)
+            .sense(egui::Sense::click()),
+    );
+    let origin = response.rect.min;
+    let at = origin + egui::vec2(eye.x, eye.y - top) * zoom;
+    let (sin, cos) = camera.yaw_deg.to_radians().sin_cos();
+    let painter = ui.painter_at(response.rect);
+    let marker = egui::Color32::from_rgb(255, 220, 60);
+    painter.line_segment(
+        [at, at + egui::vec2(sin, cos) * 14.0],
+        egui::Stroke::new(2.0, marker),
+    );
+    painter.circle_filled(at, 3.5, marker);
+    if let Some(click) = response
+        .interact_pointer_pos()
+        .filter(|_| response.clicked())
+    {
+        let p = (click - origin) / zoom + egui::vec2(0.0, top);
+        actions.push(Action::Teleport(glam::Vec2::new(p.x, p.y) * map.scale));
+    }
 }
 
 fn memory(ui: &mut egui::Ui, status: &Status<'_>) {

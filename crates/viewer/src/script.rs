@@ -8,6 +8,7 @@
 //! method NAME               switch the method (waits while it is built)
 //! split NAME | split off    A/B: the current method left, NAME right
 //! fly F R U [FRAMES]        move F units along the view, R to the screen's right, U up
+//! goto X Y                  fly to (X, Y) at the same height above the ground (a map click)
 //! turn RIGHT UP [FRAMES]    turn, degrees
 //! frames N                  render N frames
 //! dig X Y                   click at (X, Y) of the picture, fractions 0..1 (0.5 0.5 = centre)
@@ -41,6 +42,8 @@ pub enum Command {
         frames: u32,
     },
     Frames(u32),
+    /// World x, y.
+    Goto(f32, f32),
     /// Fractions of the picture's width and height.
     Dig(f32, f32),
     Undo,
@@ -163,6 +166,10 @@ fn parse_line(line: &str) -> anyhow::Result<Command> {
                 frames: frames_arg(args.get(2))?,
             }
         }
+        "goto" => {
+            arity(2, 2)?;
+            Command::Goto(finite(args[0], "x")?, finite(args[1], "y")?)
+        }
         "frames" => {
             arity(1, 1)?;
             Command::Frames(frames_arg(args.first())?)
@@ -218,7 +225,7 @@ fn parse_line(line: &str) -> anyhow::Result<Command> {
             Command::Quit
         }
         other => bail!(
-            "unknown command `{other}` (view, method, split, fly, turn, frames, dig, undo, \
+            "unknown command `{other}` (view, method, split, fly, goto, turn, frames, dig, undo, \
              set, overlay, window, screenshot, copy-view, score, quit)"
         ),
     })
@@ -232,7 +239,7 @@ mod tests {
     fn parses_every_command() {
         let script = Script::parse(
             "# a flight\nview hangar\nmethod mesh  # switch\nsplit ray\nsplit off\n\
-             fly 10 -2 3 5\nturn 15 -5\nframes 4\ndig 0.5 0.25\nundo\nset ray-steps 64\n\
+             fly 10 -2 3 5\ngoto 100 2000\nturn 15 -5\nframes 4\ndig 0.5 0.25\nundo\nset ray-steps 64\n\
              overlay off\nwindow 640 480\nscreenshot out/a.png\ncopy-view\nscore\nquit\n",
         )
         .unwrap();
@@ -248,6 +255,7 @@ mod tests {
                     offset: [10.0, -2.0, 3.0],
                     frames: 5
                 },
+                Command::Goto(100.0, 2000.0),
                 Command::Turn {
                     degrees: [15.0, -5.0],
                     frames: 1

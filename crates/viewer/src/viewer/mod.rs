@@ -11,6 +11,7 @@ use crate::builds::{Builds, Finished};
 use crate::dig::{Digger, pick};
 use crate::fly::FlyCamera;
 use crate::knobs::{Knob, relevant};
+use crate::minimap::Minimap;
 use crate::overlay::{self, Action, Building, Drawn, Editable, Overlay, Status};
 use crate::present::{Compositor, WINDOW_FORMAT};
 use anyhow::{Context, bail};
@@ -57,6 +58,8 @@ pub struct Viewer {
     overlay: Overlay,
     builds: Builds,
     level: Arc<Level>,
+    /// The palette ramps, for the map.
+    colors: TerrainColors,
     views: Vec<ViewSpec>,
     digger: Digger,
     fly: FlyCamera,
@@ -216,6 +219,7 @@ impl Viewer {
             begin: world.config.begin_colors,
             end: world.config.end_colors,
         };
+        let map = Minimap::new(&level, &colors);
         let mut renderer = Renderer::new(
             &gpu,
             &level,
@@ -229,7 +233,8 @@ impl Viewer {
         renderer.set_shadow_reuse(true);
         let compositor = Compositor::new(renderer.shared(), window_size, config.format)?;
         let passes = PassTimer::new(&gpu.device, &gpu.queue, gpu.report.timestamps);
-        let overlay = Overlay::new(&window, &gpu.device, WINDOW_FORMAT);
+        let mut overlay = Overlay::new(&window, &gpu.device, WINDOW_FORMAT);
+        overlay.set_map(&map);
         let digger = Digger::new(world.edit.as_ref().unwrap_or(&EditSite::fostral()));
         let mut viewer = Viewer {
             window,
@@ -242,6 +247,7 @@ impl Viewer {
             overlay,
             builds: Builds::default(),
             level: Arc::new(level),
+            colors,
             views,
             digger,
             fly: FlyCamera::from_camera(&camera),
@@ -468,6 +474,20 @@ impl Viewer {
         Ok(())
     }
 
+    /// Fly to `to` (x, y), keeping the eye's height above the ground.
+    fn teleport(&mut self, to: glam::Vec2) {
+        let here = self
+            .level
+            .column_at(self.fly.position.x, self.fly.position.y);
+        let clearance = (self.fly.position.z - f32::from(here.top())).max(20.0);
+        let (w, h) = (self.level.width() as f32, self.level.height() as f32);
+        let (x, y) = (to.x.rem_euclid(w), to.y.rem_euclid(h));
+        let there = self.level.column_at(x, y);
+        let z = (f32::from(there.top()) + clearance).min(400.0);
+        self.fly.position = glam::Vec3::new(x, y, z);
+        self.say(format!("flew to {x:.0}, {y:.0}"));
+    }
+
     fn camera(&self) -> anyhow::Result<Camera> {
         let (w, h) = self.render_size();
         self.fly.camera(w, h)
@@ -515,7 +535,10 @@ impl Viewer {
             return Ok(());
         }
         self.builds.record_edit(dirty);
-        self.renderer.apply_edit(&self.level, dirty)
+        self.renderer.apply_edit(&self.level, dirty)?;
+        self.overlay
+            .set_map(&Minimap::new(&self.level, &self.colors));
+        Ok(())
     }
 
     fn on_knob(&mut self, knob: Knob) -> anyhow::Result<()> {
@@ -767,6 +790,7 @@ impl Viewer {
             Action::Undo => self.undo()?,
             Action::CopyView => self.copy_view("viewer"),
             Action::Score => self.score()?,
+            Action::Teleport(to) => self.teleport(to),
             Action::Screenshot => {
                 self.screenshot_after_frame = Some(self.next_screenshot_path());
             }

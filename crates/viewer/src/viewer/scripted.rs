@@ -146,6 +146,7 @@ impl Viewer {
                 });
             }
             Command::Frames(n) => running = Some(Running::Frames(n)),
+            Command::Goto(x, y) => self.teleport(glam::Vec2::new(x, y)),
             Command::Dig(fx, fy) => {
                 let (w, h) = self.render_size();
                 // The centre of the pixel the fraction falls in.
