@@ -4,7 +4,7 @@
 //! across it takes minutes, the map a click.
 
 use glam::Vec2;
-use strata_level::Level;
+use strata_level::{DirtyRect, Level};
 use strata_render::TerrainColors;
 
 /// The picture's largest sides, pixels (the level's aspect is kept).
@@ -22,8 +22,7 @@ pub struct Minimap {
 }
 
 impl Minimap {
-    /// Sample each pixel's centre column: its top's terrain colour, from the
-    /// type's palette ramp by height (as the renderers' base colour).
+    /// The whole level's map.
     pub fn new(level: &Level, colors: &TerrainColors) -> Self {
         let (lw, lh) = (level.width(), level.height());
         let mut scale = 1;
@@ -31,9 +30,55 @@ impl Minimap {
             scale *= 2;
         }
         let (width, height) = ((lw / scale).max(1), (lh / scale).max(1));
-        let mut rgba = Vec::with_capacity((width * height * 4) as usize);
-        for py in 0..height {
-            for px in 0..width {
+        let mut map = Minimap {
+            scale,
+            width,
+            height,
+            rgba: vec![0; (width * height * 4) as usize],
+        };
+        map.paint(level, colors, [0, 0, width, height]);
+        map
+    }
+
+    /// Repaint the pixels over the texels in `rects` (after an edit); the
+    /// map-pixel rectangles `[x, y, width, height]` that changed.
+    pub fn update(
+        &mut self,
+        level: &Level,
+        colors: &TerrainColors,
+        rects: &[DirtyRect],
+    ) -> Vec<[u32; 4]> {
+        let mut changed = Vec::new();
+        for r in rects {
+            let x0 = r.x / self.scale;
+            let y0 = r.y / self.scale;
+            let x1 = (r.x + r.width).div_ceil(self.scale).min(self.width);
+            let y1 = (r.y + r.height).div_ceil(self.scale).min(self.height);
+            if x1 > x0 && y1 > y0 {
+                let region = [x0, y0, x1 - x0, y1 - y0];
+                self.paint(level, colors, region);
+                changed.push(region);
+            }
+        }
+        changed
+    }
+
+    /// The RGBA8 pixels of `[x, y, width, height]`, row-major.
+    pub fn region(&self, [x, y, w, h]: [u32; 4]) -> Vec<u8> {
+        let mut out = Vec::with_capacity((w * h * 4) as usize);
+        for row in y..y + h {
+            let start = ((row * self.width + x) * 4) as usize;
+            out.extend_from_slice(&self.rgba[start..start + (w * 4) as usize]);
+        }
+        out
+    }
+
+    /// Sample each pixel's centre column: its top's terrain colour, from the
+    /// type's palette ramp by height (as the renderers' base colour).
+    fn paint(&mut self, level: &Level, colors: &TerrainColors, [x0, y0, w, h]: [u32; 4]) {
+        let scale = self.scale;
+        for py in y0..y0 + h {
+            for px in x0..x0 + w {
                 let x = i64::from(px * scale + scale / 2);
                 let y = i64::from(py * scale + scale / 2);
                 let c = level.column(x, y);
@@ -43,14 +88,9 @@ impl Minimap {
                 let span = f32::from(end.saturating_sub(begin));
                 let index = begin as usize + (span * f32::from(c.top()) / 255.0).round() as usize;
                 let [r, g, b] = colors.palette[index.min(255)];
-                rgba.extend_from_slice(&[r, g, b, 255]);
+                let at = ((py * self.width + px) * 4) as usize;
+                self.rgba[at..at + 4].copy_from_slice(&[r, g, b, 255]);
             }
-        }
-        Minimap {
-            scale,
-            width,
-            height,
-            rgba,
         }
     }
 
@@ -83,5 +123,27 @@ mod tests {
         assert_eq!(&map.rgba[..3], &want);
         let small = Minimap::new(&Level::flat(256, 256, 0, 0).unwrap(), &colors);
         assert_eq!((small.scale, small.width, small.height), (1, 256, 256));
+    }
+
+    #[test]
+    fn an_edit_repaints_only_its_pixels_to_what_a_new_map_shows() {
+        let colors = TerrainColors::test_ramps();
+        let mut level = Level::flat(2048, 4096, 100, 3).unwrap();
+        let mut map = Minimap::new(&level, &colors);
+        let site = strata_level::EditSite {
+            centre_x: 2040,
+            centre_y: 5,
+            radius: 30,
+            depth: 60.0,
+            ..strata_level::EditSite::fostral()
+        };
+        let rects = strata_level::edit::crater(&mut level, &site);
+        let changed = map.update(&level, &colors, &rects);
+        assert_eq!(changed.len(), rects.len(), "the crater wraps the corner");
+        let fresh = Minimap::new(&level, &colors);
+        assert!(map.rgba == fresh.rgba);
+        let [x, y, w, h] = changed[0];
+        assert_eq!(map.region(changed[0]).len(), (w * h * 4) as usize);
+        assert!(x + w <= map.width && y + h <= map.height);
     }
 }

@@ -153,7 +153,22 @@ impl Overlay {
         }
     }
 
-    /// Show `map` (again, after an edit).
+    /// Upload the `regions` of `map` that an edit repainted.
+    pub fn update_map(&mut self, map: &crate::minimap::Minimap, regions: &[[u32; 4]]) {
+        let Some(m) = &mut self.map else {
+            return self.set_map(map);
+        };
+        for &region in regions {
+            let [x, y, w, h] = region;
+            let size = [w as usize, h as usize];
+            let image = egui::ColorImage::from_rgba_unmultiplied(size, &map.region(region));
+            let at = [x as usize, y as usize];
+            m.texture
+                .set_partial(at, image, egui::TextureOptions::NEAREST);
+        }
+    }
+
+    /// Show `map`.
     pub fn set_map(&mut self, map: &crate::minimap::Minimap) {
         let size = [map.width as usize, map.height as usize];
         let image = egui::ColorImage::from_rgba_unmultiplied(size, &map.rgba);

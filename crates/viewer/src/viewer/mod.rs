@@ -60,6 +60,8 @@ pub struct Viewer {
     level: Arc<Level>,
     /// The palette ramps, for the map.
     colors: TerrainColors,
+    /// The level from above, repainted where it is dug.
+    map: Minimap,
     views: Vec<ViewSpec>,
     digger: Digger,
     fly: FlyCamera,
@@ -248,6 +250,7 @@ impl Viewer {
             builds: Builds::default(),
             level: Arc::new(level),
             colors,
+            map,
             views,
             digger,
             fly: FlyCamera::from_camera(&camera),
@@ -536,8 +539,8 @@ impl Viewer {
         }
         self.builds.record_edit(dirty);
         self.renderer.apply_edit(&self.level, dirty)?;
-        self.overlay
-            .set_map(&Minimap::new(&self.level, &self.colors));
+        let repainted = self.map.update(&self.level, &self.colors, dirty);
+        self.overlay.update_map(&self.map, &repainted);
         Ok(())
     }
 
