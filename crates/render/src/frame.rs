@@ -164,6 +164,32 @@ impl Globals {
     }
 }
 
+/// A single-level 2D texture and its default view.
+pub fn texture_2d(
+    device: &wgpu::Device,
+    label: &str,
+    (width, height): (u32, u32),
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+) -> (wgpu::Texture, wgpu::TextureView) {
+    let texture = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage,
+        view_formats: &[],
+    });
+    let view = texture.create_view(&Default::default());
+    (texture, view)
+}
+
 /// The colour and depth targets every method draws into.
 struct Targets {
     color: wgpu::Texture,
@@ -181,31 +207,17 @@ impl Targets {
             );
         }
         use wgpu::TextureUsages as U;
-        let texture = |label, format, usage| {
-            let t = device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d {
-                    width,
-                    height,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage,
-                view_formats: &[],
-            });
-            let v = t.create_view(&Default::default());
-            (t, v)
-        };
-        let (color, color_view) = texture(
+        let (color, color_view) = texture_2d(
+            device,
             "color",
+            (width, height),
             COLOR_FORMAT,
             U::RENDER_ATTACHMENT | U::STORAGE_BINDING | U::TEXTURE_BINDING | U::COPY_SRC,
         );
-        let (depth, depth_view) = texture(
+        let (depth, depth_view) = texture_2d(
+            device,
             "depth",
+            (width, height),
             DEPTH_FORMAT,
             U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC,
         );
@@ -348,31 +360,12 @@ impl Shared {
             mapped_at_creation: false,
         });
         queue.write_buffer(&shading, 0, bytemuck::bytes_of(&ShadingParams::new(colors)));
-        let texture = |label, w, h, format, usage| {
-            let t = device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d {
-                    width: w,
-                    height: h,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage,
-                view_formats: &[],
-            });
-            let v = t.create_view(&Default::default());
-            (t, v)
-        };
-        use wgpu::TextureUsages as U;
-        let (shadow_map, shadow_view) = texture(
+        let (shadow_map, shadow_view) = texture_2d(
+            device,
             "shadow map",
-            SHADOW_SIZE,
-            SHADOW_SIZE,
+            (SHADOW_SIZE, SHADOW_SIZE),
             wgpu::TextureFormat::R32Float,
-            U::STORAGE_BINDING | U::TEXTURE_BINDING,
+            wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING,
         );
         let Targets {
             color,

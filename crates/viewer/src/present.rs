@@ -9,6 +9,7 @@
 
 use bytemuck::{Pod, Zeroable};
 use strata_render::Shared;
+use strata_render::frame::texture_2d;
 use strata_render::gpu::{ErrorSink, read_texture};
 
 /// The window image's format: what egui paints into and screenshots hold.
@@ -28,27 +29,14 @@ struct Image {
     view: wgpu::TextureView,
 }
 
+/// A window-format image (RGBA8) of `size`.
 fn image(
     device: &wgpu::Device,
     label: &str,
-    (width, height): (u32, u32),
+    size: (u32, u32),
     usage: wgpu::TextureUsages,
 ) -> Image {
-    let texture = device.create_texture(&wgpu::TextureDescriptor {
-        label: Some(label),
-        size: wgpu::Extent3d {
-            width,
-            height,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: WINDOW_FORMAT,
-        usage,
-        view_formats: &[],
-    });
-    let view = texture.create_view(&Default::default());
+    let (texture, view) = texture_2d(device, label, size, WINDOW_FORMAT, usage);
     Image { texture, view }
 }
 
