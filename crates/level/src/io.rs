@@ -9,7 +9,7 @@ use crate::palette::Palette;
 use crate::views::{EditSite, ViewSpec, format_views, parse_views};
 use crate::{World, vmc, vmp, vpr};
 use std::path::{Path, PathBuf};
-use std::time::Instant;
+use web_time::Instant;
 
 pub const WORLD_INI: &str = "world.ini";
 pub const VIEWS_TXT: &str = "views.txt";

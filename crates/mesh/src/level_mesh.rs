@@ -1,7 +1,7 @@
 //! The whole level: every chunk fitted in parallel, exact local refit after
 //! edits, and the level-wide statistics `strata fit` reports.
 
-use std::time::Instant;
+use web_time::Instant;
 
 use rayon::prelude::*;
 use serde::Serialize;

@@ -65,6 +65,7 @@ impl Gpu {
     /// A headless device. Honours `WGPU_BACKEND` (backend list),
     /// `WGPU_ADAPTER_NAME` (substring of the adapter name, case-insensitive)
     /// and `WGPU_POWER_PREF`.
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn headless() -> anyhow::Result<Self> {
         let instance =
             wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
@@ -73,28 +74,43 @@ impl Gpu {
 
     /// A device able to present to `surface` (for a future viewer), chosen by the
     /// same environment variables.
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn with_instance(
         instance: wgpu::Instance,
         surface: Option<&wgpu::Surface<'_>>,
     ) -> anyhow::Result<Self> {
-        let adapter = pollster::block_on(pick_adapter(&instance, surface))?;
+        pollster::block_on(Self::with_instance_async(instance, surface))
+    }
+
+    /// [`Gpu::with_instance`] as a future: the browser answers adapter and
+    /// device requests only once the page has control back.
+    pub async fn with_instance_async(
+        instance: wgpu::Instance,
+        surface: Option<&wgpu::Surface<'_>>,
+    ) -> anyhow::Result<Self> {
+        let adapter = pick_adapter(&instance, surface).await?;
         let info = adapter.get_info();
-        let timestamps = adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
+        // In the browser a timestamp read-back completes only after the page
+        // yields, and the frame loop reads its stamps at once: untimed there.
+        let timestamps = !cfg!(target_arch = "wasm32")
+            && adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
         let features = if timestamps {
             wgpu::Features::TIMESTAMP_QUERY
         } else {
             wgpu::Features::empty()
         };
         let limits = device_limits(&adapter.limits());
-        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
-            label: Some("strata"),
-            required_features: features,
-            required_limits: limits,
-            experimental_features: wgpu::ExperimentalFeatures::disabled(),
-            memory_hints: wgpu::MemoryHints::Performance,
-            trace: wgpu::Trace::Off,
-        }))
-        .map_err(|e| anyhow::anyhow!("adapter `{}` refused a device: {e}", info.name))?;
+        let (device, queue) = adapter
+            .request_device(&wgpu::DeviceDescriptor {
+                label: Some("strata"),
+                required_features: features,
+                required_limits: limits,
+                experimental_features: wgpu::ExperimentalFeatures::disabled(),
+                memory_hints: wgpu::MemoryHints::Performance,
+                trace: wgpu::Trace::Off,
+            })
+            .await
+            .map_err(|e| anyhow::anyhow!("adapter `{}` refused a device: {e}", info.name))?;
 
         let errors = ErrorSink::default();
         let sink = errors.clone();
@@ -147,6 +163,15 @@ pub fn wait_device(device: &wgpu::Device, errors: &ErrorSink) -> anyhow::Result<
 /// so large render targets and method buffers work where the hardware allows.
 fn device_limits(adapter: &wgpu::Limits) -> wgpu::Limits {
     let mut limits = wgpu::Limits::default();
+    // In the browser: WebGPU's default limits and never more (a page must run
+    // on every WebGPU adapter), or WebGL2's where the adapter is below them.
+    if cfg!(target_arch = "wasm32") {
+        return if limits.check_limits(adapter) {
+            limits
+        } else {
+            wgpu::Limits::downlevel_webgl2_defaults().using_resolution(adapter.clone())
+        };
+    }
     if limits.check_limits(adapter) {
         limits.max_texture_dimension_2d = adapter.max_texture_dimension_2d;
         limits.max_buffer_size = adapter.max_buffer_size;
@@ -210,8 +235,14 @@ pub fn read_buffer(
         let _ = tx.send(r);
     });
     wait_device(device, errors)?;
-    rx.recv()
-        .map_err(|_| anyhow::anyhow!("buffer map callback never ran"))?
+    // After the wait the callback has run; in the browser it runs only once
+    // the page yields, so there this read fails instead of blocking the page.
+    rx.try_recv()
+        .map_err(|_| {
+            anyhow::anyhow!(
+                "buffer map callback never ran (a blocking read-back is not possible in a browser)"
+            )
+        })?
         .map_err(|e| anyhow::anyhow!("mapping a readback buffer failed: {e}"))?;
     let data = slice
         .get_mapped_range()
@@ -230,44 +261,115 @@ pub fn read_texture(
     texture: &wgpu::Texture,
     aspect: wgpu::TextureAspect,
 ) -> anyhow::Result<Vec<u8>> {
-    let (w, h) = (texture.width(), texture.height());
-    let row = 4 * w;
-    let align = wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-    let padded = row.div_ceil(align) * align;
-    let size = u64::from(padded) * u64::from(h);
-    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("readback"),
-        size,
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    let mut encoder = device.create_command_encoder(&Default::default());
-    encoder.copy_texture_to_buffer(
-        wgpu::TexelCopyTextureInfo {
-            texture,
-            mip_level: 0,
-            origin: wgpu::Origin3d::ZERO,
-            aspect,
-        },
-        wgpu::TexelCopyBufferInfo {
-            buffer: &buffer,
-            layout: wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(padded),
-                rows_per_image: Some(h),
+    TextureReadback::start(device, queue, texture, aspect).wait(device, errors)
+}
+
+/// The result of a buffer map, once its callback has run.
+type MapState = Arc<Mutex<Option<Result<(), wgpu::BufferAsyncError>>>>;
+
+/// A texture on its way to the CPU without blocking: the copy is submitted
+/// and the map requested at start; [`TextureReadback::try_take`] answers once
+/// the map has completed (after a device poll natively, after the page has
+/// yielded in a browser), so a frame loop can poll it once per frame.
+pub struct TextureReadback {
+    buffer: wgpu::Buffer,
+    /// Bytes of one row, unpadded and padded.
+    row: u32,
+    padded: u32,
+    mapped: MapState,
+}
+
+impl TextureReadback {
+    /// Submit a copy of `texture` (4 bytes per texel of `aspect`) and ask for its map.
+    pub fn start(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        texture: &wgpu::Texture,
+        aspect: wgpu::TextureAspect,
+    ) -> Self {
+        let (w, h) = (texture.width(), texture.height());
+        let row = 4 * w;
+        let align = wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let padded = row.div_ceil(align) * align;
+        let size = u64::from(padded) * u64::from(h);
+        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = device.create_command_encoder(&Default::default());
+        encoder.copy_texture_to_buffer(
+            wgpu::TexelCopyTextureInfo {
+                texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d::ZERO,
+                aspect,
             },
-        },
-        wgpu::Extent3d {
-            width: w,
-            height: h,
-            depth_or_array_layers: 1,
-        },
-    );
-    queue.submit([encoder.finish()]);
-    let raw = read_buffer(device, errors, &buffer, size)?;
-    let mut out = Vec::with_capacity((row * h) as usize);
-    for r in raw.chunks_exact(padded as usize) {
-        out.extend_from_slice(&r[..row as usize]);
+            wgpu::TexelCopyBufferInfo {
+                buffer: &buffer,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(padded),
+                    rows_per_image: Some(h),
+                },
+            },
+            wgpu::Extent3d {
+                width: w,
+                height: h,
+                depth_or_array_layers: 1,
+            },
+        );
+        queue.submit([encoder.finish()]);
+        let mapped = MapState::default();
+        let sink = Arc::clone(&mapped);
+        buffer.slice(..).map_async(wgpu::MapMode::Read, move |r| {
+            if let Ok(mut state) = sink.lock() {
+                *state = Some(r);
+            }
+        });
+        TextureReadback {
+            buffer,
+            row,
+            padded,
+            mapped,
+        }
     }
-    Ok(out)
+
+    /// The texels (rows unpadded, top row first) once the map has completed;
+    /// `None` while it has not.
+    pub fn try_take(&self, device: &wgpu::Device) -> Option<anyhow::Result<Vec<u8>>> {
+        // Natively the map completes in a poll; in a browser this does nothing.
+        let _ = device.poll(wgpu::PollType::Poll);
+        let state = self.mapped.lock().ok()?.take()?;
+        Some(
+            state
+                .map_err(|e| anyhow::anyhow!("mapping a readback buffer failed: {e}"))
+                .and_then(|()| {
+                    let slice = self.buffer.slice(..);
+                    let raw = slice
+                        .get_mapped_range()
+                        .map_err(|e| anyhow::anyhow!("reading a mapped buffer failed: {e}"))?;
+                    let mut out =
+                        Vec::with_capacity(raw.len() / self.padded as usize * self.row as usize);
+                    for r in raw.chunks_exact(self.padded as usize) {
+                        out.extend_from_slice(&r[..self.row as usize]);
+                    }
+                    drop(raw);
+                    self.buffer.unmap();
+                    Ok(out)
+                }),
+        )
+    }
+
+    /// Block until the texels are here (not possible in a browser: there
+    /// this fails; poll [`TextureReadback::try_take`] per frame instead).
+    pub fn wait(self, device: &wgpu::Device, errors: &ErrorSink) -> anyhow::Result<Vec<u8>> {
+        wait_device(device, errors)?;
+        self.try_take(device).unwrap_or_else(|| {
+            Err(anyhow::anyhow!(
+                "buffer map callback never ran (a blocking read-back is not possible in a browser)"
+            ))
+        })
+    }
 }

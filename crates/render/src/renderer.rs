@@ -12,9 +12,9 @@ use crate::methods::{self, Frame, Method, MethodSettings, RetainedBytes};
 use crate::shadow::{ShadowFrame, ShadowPass};
 use crate::timing::{FrameTimings, PassTimer};
 use std::sync::Arc;
-use std::time::Instant;
 use strata_camera::Camera;
 use strata_level::{DirtyRect, Level};
+use web_time::Instant;
 
 /// What [`Renderer::measure`] saw.
 #[derive(Clone, Debug, Default)]
@@ -357,6 +357,17 @@ impl Renderer {
     pub fn read_depth(&self) -> anyhow::Result<Vec<f32>> {
         let raw = self.read_texture(&self.shared.depth, wgpu::TextureAspect::DepthOnly)?;
         Ok(bytemuck::cast_slice::<u8, f32>(&raw).to_vec())
+    }
+
+    /// Start copying the depth target to the CPU without waiting (the
+    /// browser's way: poll the result per frame; its bytes are `f32` depths).
+    pub fn start_read_depth(&self) -> crate::gpu::TextureReadback {
+        crate::gpu::TextureReadback::start(
+            &self.shared.device,
+            &self.shared.queue,
+            &self.shared.depth,
+            wgpu::TextureAspect::DepthOnly,
+        )
     }
 
     /// Bytes the active method keeps beyond the shared resources.

@@ -128,14 +128,23 @@ fn compose_into(name: &str, out: &mut String, seen: &mut Vec<String>) -> Result<
 /// into an `Err` (wgpu would otherwise report it asynchronously).
 pub fn create_module(device: &wgpu::Device, name: &str) -> anyhow::Result<wgpu::ShaderModule> {
     let text = compose(name)?;
-    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+    let descriptor = wgpu::ShaderModuleDescriptor {
         label: Some(name),
         source: wgpu::ShaderSource::Wgsl(text.into()),
-    });
-    if let Some(err) = pollster::block_on(scope.pop()) {
-        anyhow::bail!("shader `{name}` failed to compile: {err}");
-    }
+    };
+    // A browser answers an error scope only after the page yields: there a
+    // bad shader reaches the device's error sink (checked after each frame).
+    #[cfg(target_arch = "wasm32")]
+    let module = device.create_shader_module(descriptor);
+    #[cfg(not(target_arch = "wasm32"))]
+    let module = {
+        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let module = device.create_shader_module(descriptor);
+        if let Some(err) = pollster::block_on(scope.pop()) {
+            anyhow::bail!("shader `{name}` failed to compile: {err}");
+        }
+        module
+    };
     Ok(module)
 }
 

@@ -4,18 +4,80 @@
 //! the build's progress. Edits made while a build runs are replayed on the
 //! new method before it is kept, so it never shows stale terrain.
 
-use anyhow::Context;
 use std::sync::Arc;
-use std::thread::JoinHandle;
-use std::time::Instant;
 use strata_level::{DirtyRect, Level};
 use strata_render::{Method, MethodSettings, Renderer, methods};
+use web_time::Instant;
+
+type Built = anyhow::Result<Box<dyn Method>>;
+
+/// A build on a thread of its own.
+#[cfg(not(target_arch = "wasm32"))]
+struct Job(std::thread::JoinHandle<Built>);
+
+#[cfg(not(target_arch = "wasm32"))]
+impl Job {
+    fn spawn(name: &str, build: impl FnOnce() -> Built + Send + 'static) -> anyhow::Result<Self> {
+        use anyhow::Context;
+        std::thread::Builder::new()
+            .name(format!("build {name}"))
+            .spawn(build)
+            .map(Job)
+            .with_context(|| format!("starting a thread to build {name}"))
+    }
+
+    fn is_finished(&mut self) -> bool {
+        self.0.is_finished()
+    }
+
+    fn join(self) -> Built {
+        self.0
+            .join()
+            .unwrap_or_else(|_| Err(anyhow::anyhow!("the build thread panicked")))
+    }
+}
+
+/// A browser page has one thread: the build runs on it, in the second
+/// frame after it was asked for (so the frame between shows that it runs),
+/// and that frame waits for it.
+#[cfg(target_arch = "wasm32")]
+struct Job {
+    build: Option<Box<dyn FnOnce() -> Built>>,
+    result: Option<Built>,
+    polls: u32,
+}
+
+#[cfg(target_arch = "wasm32")]
+impl Job {
+    fn spawn(_name: &str, build: impl FnOnce() -> Built + 'static) -> anyhow::Result<Self> {
+        Ok(Job {
+            build: Some(Box::new(build)),
+            result: None,
+            polls: 0,
+        })
+    }
+
+    fn is_finished(&mut self) -> bool {
+        self.polls += 1;
+        if self.polls >= 2
+            && let Some(build) = self.build.take()
+        {
+            self.result = Some(build());
+        }
+        self.result.is_some()
+    }
+
+    fn join(self) -> Built {
+        self.result
+            .unwrap_or_else(|| Err(anyhow::anyhow!("the build never ran")))
+    }
+}
 
 struct Pending {
     name: String,
     settings: MethodSettings,
     started: Instant,
-    thread: JoinHandle<anyhow::Result<Box<dyn Method>>>,
+    thread: Job,
     /// Edits made since the build took its copy of the level.
     edits: Vec<DirtyRect>,
 }
@@ -48,10 +110,9 @@ impl Builds {
         let shared = renderer.shared_handle();
         let level = Arc::clone(level);
         let (owned_name, owned_settings) = (name.to_string(), settings.clone());
-        let thread = std::thread::Builder::new()
-            .name(format!("build {name}"))
-            .spawn(move || methods::create(&owned_name, &shared, &level, &owned_settings))
-            .with_context(|| format!("starting a thread to build {name}"))?;
+        let thread = Job::spawn(name, move || {
+            methods::create(&owned_name, &shared, &level, &owned_settings)
+        })?;
         self.pending.push(Pending {
             name: name.to_string(),
             settings: settings.clone(),
@@ -99,10 +160,7 @@ impl Builds {
                 // A newer build of this method (other settings) supersedes it.
                 continue;
             }
-            let result = match p.thread.join() {
-                Ok(r) => r,
-                Err(_) => Err(anyhow::anyhow!("the build thread panicked")),
-            };
+            let result = p.thread.join();
             let result = result.and_then(|mut method| {
                 if !p.edits.is_empty() {
                     method.apply_edit(renderer.shared(), level, &p.edits)?;

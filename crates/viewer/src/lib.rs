@@ -18,17 +18,19 @@ pub mod fly;
 pub mod knobs;
 pub mod minimap;
 pub mod overlay;
+pub mod platform;
 pub mod present;
 pub mod script;
 pub mod viewer;
+#[cfg(target_arch = "wasm32")]
+pub mod web;
 
-use anyhow::Context;
 use std::path::PathBuf;
 use strata_level::World;
 use strata_render::MethodSettings;
 use winit::application::ApplicationHandler;
 use winit::event::WindowEvent;
-use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop, OwnedDisplayHandle};
+use winit::event_loop::{ActiveEventLoop, ControlFlow};
 use winit::window::WindowId;
 
 pub use overlay::CONTROLS;
@@ -54,8 +56,10 @@ pub struct Options {
 }
 
 /// Open the window and run until it is closed or the script ends.
+#[cfg(not(target_arch = "wasm32"))]
 pub fn run(options: Options) -> anyhow::Result<()> {
-    let event_loop = EventLoop::new().context(
+    use anyhow::Context;
+    let event_loop = winit::event_loop::EventLoop::new().context(
         "cannot open a window: no display (set DISPLAY or WAYLAND_DISPLAY, or run under Xvfb)",
     )?;
     let mut app = App {
@@ -73,24 +77,18 @@ pub fn run(options: Options) -> anyhow::Result<()> {
     }
 }
 
+/// Natively: the window, then the device (blocking), then the viewer.
+#[cfg(not(target_arch = "wasm32"))]
 struct App {
     options: Option<Options>,
-    display: OwnedDisplayHandle,
+    display: winit::event_loop::OwnedDisplayHandle,
     viewer: Option<viewer::Viewer>,
     error: Option<anyhow::Error>,
 }
 
+#[cfg(not(target_arch = "wasm32"))]
 impl App {
-    fn fail(&mut self, event_loop: &ActiveEventLoop, error: anyhow::Error) {
-        self.error.get_or_insert(error);
-        // Drop the window and GPU state before the loop ends.
-        self.viewer = None;
-        event_loop.exit();
-    }
-}
-
-impl ApplicationHandler for App {
-    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+    fn open(&mut self, event_loop: &ActiveEventLoop) {
         let Some(options) = self.options.take() else {
             return;
         };
@@ -98,13 +96,59 @@ impl ApplicationHandler for App {
             wgpu::Instance::new(wgpu::InstanceDescriptor::new_with_display_handle_from_env(
                 Box::new(self.display.clone()),
             ));
-        match viewer::Viewer::new(event_loop, options, instance) {
+        let opened = viewer::Viewer::open_window(event_loop, &options, &instance).and_then(
+            |(window, surface)| {
+                let gpu = strata_render::Gpu::with_instance(instance, Some(&surface))?;
+                viewer::Viewer::new(window, surface, gpu, options)
+            },
+        );
+        self.opened(event_loop, opened);
+    }
+
+    fn finish(&mut self, event_loop: &ActiveEventLoop) {
+        if let Some(viewer) = &self.viewer {
+            eprintln!("strata view: {}", viewer.summary());
+        }
+        self.viewer = None;
+        event_loop.exit();
+    }
+
+    fn fail(&mut self, event_loop: &ActiveEventLoop, error: anyhow::Error) {
+        self.error.get_or_insert(error);
+        // Drop the window and GPU state before the loop ends.
+        self.viewer = None;
+        event_loop.exit();
+    }
+
+    /// Nothing to wait for natively: the device came in `open`.
+    fn poll_opening(&mut self, _: &ActiveEventLoop) {}
+}
+
+/// In a browser: the window, the device awaited (see [`web`]), the viewer.
+#[cfg(target_arch = "wasm32")]
+struct App {
+    options: Option<Options>,
+    backend: web::Backend,
+    opening: Option<web::Opening>,
+    viewer: Option<viewer::Viewer>,
+    error: Option<anyhow::Error>,
+}
+
+impl App {
+    fn opened(&mut self, event_loop: &ActiveEventLoop, opened: anyhow::Result<viewer::Viewer>) {
+        match opened {
             Ok(viewer) => {
                 viewer.window().request_redraw();
                 self.viewer = Some(viewer);
             }
             Err(error) => self.fail(event_loop, error),
         }
+    }
+}
+
+impl ApplicationHandler for App {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        self.open(event_loop);
     }
 
     fn window_event(&mut self, event_loop: &ActiveEventLoop, _: WindowId, event: WindowEvent) {
@@ -115,11 +159,7 @@ impl ApplicationHandler for App {
         let quit = viewer.should_quit();
         match result {
             Err(error) => self.fail(event_loop, error),
-            Ok(()) if quit => {
-                eprintln!("strata view: {}", viewer.summary());
-                self.viewer = None;
-                event_loop.exit();
-            }
+            Ok(()) if quit => self.finish(event_loop),
             Ok(()) => {}
         }
     }
@@ -138,11 +178,12 @@ impl ApplicationHandler for App {
     }
 
     fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
+        self.poll_opening(event_loop);
         // Draw continuously (the frame rate is part of what is shown), except
         // where the viewer asks to wait.
         let Some(viewer) = &self.viewer else { return };
         match viewer.next_frame_due() {
-            Some(at) if at > std::time::Instant::now() => {
+            Some(at) if at > web_time::Instant::now() => {
                 event_loop.set_control_flow(ControlFlow::WaitUntil(at));
             }
             _ => {

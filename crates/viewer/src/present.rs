@@ -10,7 +10,7 @@
 use bytemuck::{Pod, Zeroable};
 use strata_render::Shared;
 use strata_render::frame::texture_2d;
-use strata_render::gpu::{ErrorSink, read_texture};
+use strata_render::gpu::TextureReadback;
 
 /// The window image's format: what egui paints into and screenshots hold.
 pub const WINDOW_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
@@ -286,17 +286,14 @@ impl Compositor {
     }
 
     /// The window image as RGBA8 (what a screenshot saves).
-    pub fn read_window(&self, errors: &ErrorSink) -> anyhow::Result<image::RgbaImage> {
-        let pixels = read_texture(
+    /// Start copying what the window shows (RGBA8, top row first) to the CPU.
+    pub fn start_read_window(&self) -> TextureReadback {
+        TextureReadback::start(
             &self.device,
             &self.queue,
-            errors,
             &self.window.texture,
             wgpu::TextureAspect::All,
-        )?;
-        let (w, h) = self.window_size;
-        image::RgbaImage::from_raw(w, h, pixels)
-            .ok_or_else(|| anyhow::anyhow!("screenshot buffer has the wrong size"))
+        )
     }
 }
 

@@ -177,50 +177,124 @@ fn encode_pair(a: Texel, b: Texel, heights: &mut [u8], metas: &mut [u8]) {
 
 /// Generate the world for `params`.
 pub fn generate(params: &GenerateParams) -> Result<World, GenerateError> {
-    let GenerateParams {
-        seed,
-        width,
-        height,
-    } = *params;
-    check_size(width, height)?;
-    let terrain = terrain::Terrain::new(seed, width, height);
-    let layout = landmarks::place(&terrain)?;
-    let w = width as usize;
-    let mut heights = vec![0u8; w * height as usize];
-    let mut metas = vec![0u8; w * height as usize];
+    let mut generation = Generation::new(params)?;
+    let Generation {
+        terrain,
+        layout,
+        heights,
+        metas,
+        ..
+    } = &mut generation;
+    let w = params.width as usize;
     heights
         .par_chunks_mut(w)
         .zip(metas.par_chunks_mut(w))
         .enumerate()
-        .for_each(|(y, (hrow, mrow))| {
-            let y = y as u32;
-            let sites: Vec<&landmarks::Landmark> =
-                layout.list.iter().filter(|l| l.covers_row(y)).collect();
-            let row = terrain.row(y);
-            let texel = |x: u32| match sites.iter().find(|l| l.covers_x(x)) {
-                Some(site) => site.texel(&terrain, x, y),
-                None => terrain.texel(x, &row),
-            };
-            for x in (0..width).step_by(2) {
-                let i = x as usize;
-                encode_pair(
-                    texel(x),
-                    texel(x + 1),
-                    &mut hrow[i..i + 2],
-                    &mut mrow[i..i + 2],
-                );
-            }
-        });
-    let level = Level::from_planes(width, height, heights, metas, MidRule::Original)?;
-    Ok(World {
-        name: format!("generated-{seed}"),
-        config: world_config(width, height)?,
-        palette: palette(),
-        water: Some(vec![SEA; (height as usize).div_ceil(128)]),
-        views: layout.views(&terrain),
-        edit: Some(layout.edit_site()),
-        level,
-    })
+        .for_each(|(y, (hrow, mrow))| fill_row(terrain, layout, y as u32, hrow, mrow));
+    generation.next_row = params.height;
+    generation.finish()
+}
+
+/// [`generate`] a band of rows at a time, for a caller that must stay
+/// responsive meanwhile (the browser page, which has one thread): the same
+/// rows, so the same world byte for byte.
+pub struct Generation {
+    params: GenerateParams,
+    terrain: terrain::Terrain,
+    layout: landmarks::Layout,
+    heights: Vec<u8>,
+    metas: Vec<u8>,
+    next_row: u32,
+}
+
+impl Generation {
+    /// Set up the terrain and place the landmarks (no rows yet).
+    pub fn new(params: &GenerateParams) -> Result<Self, GenerateError> {
+        check_size(params.width, params.height)?;
+        let terrain = terrain::Terrain::new(params.seed, params.width, params.height);
+        let layout = landmarks::place(&terrain)?;
+        let texels = params.width as usize * params.height as usize;
+        Ok(Generation {
+            params: *params,
+            terrain,
+            layout,
+            heights: vec![0u8; texels],
+            metas: vec![0u8; texels],
+            next_row: 0,
+        })
+    }
+
+    /// Generate up to `rows` more rows; true when every row is done.
+    pub fn step(&mut self, rows: u32) -> bool {
+        let w = self.params.width as usize;
+        let end = (self.next_row + rows).min(self.params.height);
+        for y in self.next_row..end {
+            let span = y as usize * w..(y as usize + 1) * w;
+            fill_row(
+                &self.terrain,
+                &self.layout,
+                y,
+                &mut self.heights[span.clone()],
+                &mut self.metas[span],
+            );
+        }
+        self.next_row = end;
+        self.is_done()
+    }
+
+    pub fn is_done(&self) -> bool {
+        self.next_row >= self.params.height
+    }
+
+    /// Fraction of the rows done, 0..=1.
+    pub fn progress(&self) -> f32 {
+        self.next_row as f32 / self.params.height as f32
+    }
+
+    /// The world, once every row is done (generating any left first).
+    pub fn finish(mut self) -> Result<World, GenerateError> {
+        self.step(u32::MAX - self.next_row);
+        let GenerateParams {
+            seed,
+            width,
+            height,
+        } = self.params;
+        let level = Level::from_planes(width, height, self.heights, self.metas, MidRule::Original)?;
+        Ok(World {
+            name: format!("generated-{seed}"),
+            config: world_config(width, height)?,
+            palette: palette(),
+            water: Some(vec![SEA; (height as usize).div_ceil(128)]),
+            views: self.layout.views(&self.terrain),
+            edit: Some(self.layout.edit_site()),
+            level,
+        })
+    }
+}
+
+/// One row of the map: landmarks where they cover it, the terrain elsewhere.
+fn fill_row(
+    terrain: &terrain::Terrain,
+    layout: &landmarks::Layout,
+    y: u32,
+    hrow: &mut [u8],
+    mrow: &mut [u8],
+) {
+    let sites: Vec<&landmarks::Landmark> = layout.list.iter().filter(|l| l.covers_row(y)).collect();
+    let row = terrain.row(y);
+    let texel = |x: u32| match sites.iter().find(|l| l.covers_x(x)) {
+        Some(site) => site.texel(terrain, x, y),
+        None => terrain.texel(x, &row),
+    };
+    for x in (0..terrain.width).step_by(2) {
+        let i = x as usize;
+        encode_pair(
+            texel(x),
+            texel(x + 1),
+            &mut hrow[i..i + 2],
+            &mut mrow[i..i + 2],
+        );
+    }
 }
 
 /// The landmarks of the world `params` would generate: name, description,

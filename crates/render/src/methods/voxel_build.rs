@@ -10,10 +10,10 @@
 
 use crate::frame::{Globals, LevelShape, Shared};
 use std::collections::VecDeque;
-use std::time::Instant;
 use strata_camera::Camera;
 use strata_level::{DirtyRect, Level};
 use strata_occupancy::{Layout, TileRange, VoxelSize};
+use web_time::Instant;
 
 /// Default level-0 texels rebuilt per frame (and per creation submission).
 pub const DEFAULT_BUDGET_TEXELS: u64 = 1 << 20;

@@ -19,11 +19,12 @@ use scripted::Player;
 use std::collections::HashSet;
 use std::path::PathBuf;
 use std::sync::Arc;
-use std::time::Instant;
 use strata_camera::Camera;
 use strata_level::{DirtyRect, EditSite, Level, ViewSpec};
+use strata_render::gpu::TextureReadback;
 use strata_render::timing::PassTimer;
 use strata_render::{FrameTimings, Gpu, MethodSettings, Renderer, TerrainColors, methods};
+use web_time::Instant;
 use winit::event_loop::ActiveEventLoop;
 use winit::keyboard::KeyCode;
 use winit::window::Window;
@@ -97,8 +98,17 @@ pub struct Viewer {
     log: Vec<String>,
     /// The last scores against the reference (method, metrics).
     scores: Vec<(String, strata_reference::Metrics)>,
+    /// Scores finished so far (a script waits for the next one).
+    scored: u32,
+    /// Frames drawn since the window opened.
+    frames: u64,
     player: Option<Player>,
+    /// A score waiting for its depth read-backs (they complete a frame
+    /// later: in a browser only once the page has yielded).
+    scoring: Option<Scoring>,
     screenshot_after_frame: Option<PathBuf>,
+    /// A screenshot waiting for its read-back.
+    screenshot_reading: Option<(PathBuf, TextureReadback)>,
     screenshots: u32,
     out: PathBuf,
     quit: bool,
@@ -131,6 +141,15 @@ fn surface_config(
     Ok(config)
 }
 
+/// A score on its way: the reference, and each drawn method's depth.
+struct Scoring {
+    camera: Camera,
+    reference: strata_reference::Reference,
+    reference_ms: f64,
+    reads: Vec<(String, TextureReadback)>,
+    done: Vec<(String, Vec<u8>)>,
+}
+
 /// The render size for a window size.
 fn scaled(window: (u32, u32), scale: f32) -> (u32, u32) {
     let side = |v: u32| ((v as f32 * scale).round() as u32).max(1);
@@ -138,10 +157,39 @@ fn scaled(window: (u32, u32), scale: f32) -> (u32, u32) {
 }
 
 impl Viewer {
-    pub fn new(
+    /// The window and its surface (the first half of opening the viewer;
+    /// the device for the surface comes between, awaited in a browser).
+    pub fn open_window(
         event_loop: &ActiveEventLoop,
+        options: &Options,
+        instance: &wgpu::Instance,
+    ) -> anyhow::Result<(Arc<Window>, wgpu::Surface<'static>)> {
+        let attributes = Window::default_attributes()
+            .with_title(format!("Strata: {}", options.world.name))
+            .with_inner_size(winit::dpi::PhysicalSize::new(
+                options.size.0,
+                options.size.1,
+            ));
+        #[cfg(target_arch = "wasm32")]
+        let attributes = crate::web::canvas_attributes(attributes);
+        let window = Arc::new(
+            event_loop
+                .create_window(attributes)
+                .context("opening the window")?,
+        );
+        let surface = instance
+            .create_surface(Arc::clone(&window))
+            .context("creating a wgpu surface for the window")?;
+        Ok((window, surface))
+    }
+
+    /// The viewer on a window [`Viewer::open_window`] opened and a device
+    /// able to present to its surface.
+    pub fn new(
+        window: Arc<Window>,
+        surface: wgpu::Surface<'static>,
+        gpu: Gpu,
         options: Options,
-        instance: wgpu::Instance,
     ) -> anyhow::Result<Self> {
         let Options {
             world,
@@ -155,24 +203,13 @@ impl Viewer {
             out,
         } = options;
         let opened = Instant::now();
+        let _ = size;
         if !methods::names().contains(&method.as_str()) {
             bail!(
                 "unknown method `{method}`; known: {}",
                 methods::names().join(", ")
             );
         }
-        let attributes = Window::default_attributes()
-            .with_title(format!("Strata: {}", world.name))
-            .with_inner_size(winit::dpi::PhysicalSize::new(size.0, size.1));
-        let window = Arc::new(
-            event_loop
-                .create_window(attributes)
-                .context("opening the window")?,
-        );
-        let surface = instance
-            .create_surface(Arc::clone(&window))
-            .context("creating a wgpu surface for the window")?;
-        let gpu = Gpu::with_instance(instance, Some(&surface))?;
         let inner = window.inner_size();
         let window_size = (inner.width.max(1), inner.height.max(1));
         let config = surface_config(&surface, &gpu, window_size, vsync)?;
@@ -275,8 +312,12 @@ impl Viewer {
             totals: Vec::new(),
             log: Vec::new(),
             scores: Vec::new(),
+            scored: 0,
+            frames: 0,
             player: script.map(Player::new),
+            scoring: None,
             screenshot_after_frame: None,
+            screenshot_reading: None,
             screenshots: 0,
             out,
             quit: false,
@@ -438,7 +479,8 @@ impl Viewer {
     }
 
     /// Score what the drawn method(s) show from here against the CPU
-    /// reference for the same camera (DESIGN §3 metrics), print and keep it.
+    /// reference for the same camera (DESIGN §3 metrics): draw each and start
+    /// its depth read-back; [`Viewer::poll_score`] finishes it.
     fn score(&mut self) -> anyhow::Result<()> {
         let camera = self.camera()?;
         let start = Instant::now();
@@ -452,17 +494,52 @@ impl Viewer {
                     .and_then(|b| self.renderer.method_names().into_iter().find(|m| *m == b)),
             )
             .collect();
-        let mut scores = Vec::new();
+        let mut reads = Vec::new();
         for method in shown {
             // Draw it again: in A/B mode the depth target holds the other side.
             self.renderer.activate(method)?;
             self.renderer.render_frame(&camera)?;
-            let depth = self.renderer.read_depth()?;
-            let distance = strata_reference::distance_from_depth(&camera, &depth);
-            let metrics = strata_reference::metrics::try_compare(&reference, &distance)?;
-            scores.push((method.to_string(), metrics));
+            reads.push((method.to_string(), self.renderer.start_read_depth()));
         }
         self.renderer.activate(active)?;
+        self.scoring = Some(Scoring {
+            camera,
+            reference,
+            reference_ms,
+            reads,
+            done: Vec::new(),
+        });
+        self.poll_score()
+    }
+
+    /// Finish a score whose read-backs have all arrived.
+    fn poll_score(&mut self) -> anyhow::Result<()> {
+        let Some(scoring) = &mut self.scoring else {
+            return Ok(());
+        };
+        let mut i = 0;
+        while i < scoring.reads.len() {
+            match scoring.reads[i].1.try_take(&self.gpu.device) {
+                Some(bytes) => {
+                    let (method, _) = scoring.reads.remove(i);
+                    scoring.done.push((method, bytes?));
+                }
+                None => i += 1,
+            }
+        }
+        if !scoring.reads.is_empty() {
+            return Ok(());
+        }
+        let Some(scoring) = self.scoring.take() else {
+            return Ok(());
+        };
+        let mut scores = Vec::new();
+        for (method, bytes) in scoring.done {
+            let depth: Vec<f32> = bytemuck::pod_collect_to_vec(&bytes);
+            let distance = strata_reference::distance_from_depth(&scoring.camera, &depth);
+            let metrics = strata_reference::metrics::try_compare(&scoring.reference, &distance)?;
+            scores.push((method, metrics));
+        }
         for (method, m) in &scores {
             let line = format!(
                 "score {method}: see-through {:.3} %, covers-sky {:.3} %, depth p50 {:.3} p95 {:.3}, \
@@ -472,8 +549,32 @@ impl Viewer {
             println!("{line}");
             self.say(line);
         }
-        self.say(format!("reference {reference_ms:.0} ms"));
+        self.say(format!("reference {:.0} ms", scoring.reference_ms));
         self.scores = scores;
+        self.scored += 1;
+        Ok(())
+    }
+
+    /// Save a screenshot whose read-back has arrived.
+    fn poll_screenshot(&mut self) -> anyhow::Result<()> {
+        let Some((path, read)) = &self.screenshot_reading else {
+            return Ok(());
+        };
+        let Some(pixels) = read.try_take(&self.gpu.device) else {
+            return Ok(());
+        };
+        let path = path.clone();
+        self.screenshot_reading = None;
+        let (w, h) = self.compositor.window_size();
+        let image = image::RgbaImage::from_raw(w, h, pixels?)
+            .ok_or_else(|| anyhow::anyhow!("screenshot buffer has the wrong size"))?;
+        let mut png = Vec::new();
+        image
+            .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+            .context("encoding the screenshot")?;
+        crate::platform::save_file(&path, &png)
+            .with_context(|| format!("writing the screenshot {}", path.display()))?;
+        self.say(format!("screenshot {}", path.display()));
         Ok(())
     }
 
@@ -606,6 +707,11 @@ impl Viewer {
             0.9 * self.frame_ms + 0.1 * dt * 1e3
         };
         let first = self.totals.is_empty();
+        self.frames += 1;
+        #[cfg(target_arch = "wasm32")]
+        for script in crate::web::take_commands() {
+            self.player.get_or_insert_with(Player::waiting).push(script);
+        }
         self.collect_builds()?;
         self.script_step()?;
         // Held keys fly the camera; a long stall (a build) is not a jump.
@@ -707,20 +813,49 @@ impl Viewer {
         }
 
         if let Some(path) = self.screenshot_after_frame.take() {
-            let image = self.compositor.read_window(&self.gpu.errors)?;
-            if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-                std::fs::create_dir_all(dir)
-                    .with_context(|| format!("creating {}", dir.display()))?;
-            }
-            image
-                .save(&path)
-                .with_context(|| format!("writing the screenshot {}", path.display()))?;
-            self.say(format!("screenshot {}", path.display()));
+            let read = self.compositor.start_read_window();
+            self.screenshot_reading = Some((path, read));
         }
+        self.poll_screenshot()?;
+        self.poll_score()?;
         for action in actions {
             self.on_action(action)?;
         }
+        #[cfg(target_arch = "wasm32")]
+        crate::web::publish(self.page_state(), self.frames);
         Ok(())
+    }
+
+    /// What the page's scripts (and the browser test) read after each frame.
+    #[cfg(target_arch = "wasm32")]
+    fn page_state(&self) -> serde_json::Value {
+        let building: Vec<_> = self.builds.running().into_iter().map(|(m, _)| m).collect();
+        serde_json::json!({
+            "phase": "running",
+            "frames": self.frames,
+            "adapter": self.gpu.report,
+            "active": self.renderer.method_name(),
+            "split": self.split,
+            "kept": self.renderer.method_names(),
+            "building": building,
+            "waiting_for": self.waiting_for,
+            "idle": self.player.as_ref().is_none_or(Player::is_idle)
+                && building.is_empty()
+                && self.scoring.is_none()
+                && self.screenshot_reading.is_none(),
+            "frame_ms": self.frame_ms,
+            "timings": self.timings.iter().map(|(m, t)| serde_json::json!({
+                "method": m, "cpu_ms": t.cpu_ms, "gpu_ms": t.gpu_ms, "record_ms": t.record_ms,
+            })).collect::<Vec<_>>(),
+            "render_size": self.render_size(),
+            "window_size": self.compositor.window_size(),
+            "undo_depth": self.digger.can_undo(),
+            "scored": self.scored,
+            "scores": self.scores.iter().map(|(m, metrics)| serde_json::json!({
+                "method": m, "metrics": metrics,
+            })).collect::<Vec<_>>(),
+            "log": self.log,
+        })
     }
 
     fn paint_overlay(&mut self, encoder: &mut wgpu::CommandEncoder) -> Vec<Action> {

@@ -22,6 +22,8 @@ enum Running {
     WaitMethod(String),
     /// Until no build runs (a changed knob's rebuild).
     WaitBuilds,
+    /// Until this many scores have finished (their read-backs arrive later).
+    WaitScore(u32),
     /// Until the picture has this size; an error after `left` frames.
     WaitSize {
         size: (u32, u32),
@@ -32,6 +34,9 @@ enum Running {
 pub(super) struct Player {
     commands: VecDeque<(usize, Command)>,
     running: Option<(usize, Running)>,
+    /// Quit when the commands run out (a `--script`); a page's player
+    /// instead waits for more ([`Player::push`]).
+    quit_at_end: bool,
 }
 
 impl Player {
@@ -39,14 +44,39 @@ impl Player {
         Player {
             commands: script.commands.into(),
             running: None,
+            quit_at_end: true,
         }
+    }
+
+    /// A player that waits for commands (the page's `strataRun`).
+    #[cfg_attr(not(target_arch = "wasm32"), allow(dead_code))]
+    pub(super) fn waiting() -> Self {
+        Player {
+            quit_at_end: false,
+            ..Player::new(crate::Script::default())
+        }
+    }
+
+    /// Queue more commands.
+    #[cfg_attr(not(target_arch = "wasm32"), allow(dead_code))]
+    pub(super) fn push(&mut self, script: crate::Script) {
+        self.commands.extend(script.commands);
+    }
+
+    /// Nothing queued or running.
+    #[cfg_attr(not(target_arch = "wasm32"), allow(dead_code))]
+    pub(super) fn is_idle(&self) -> bool {
+        self.running.is_none() && self.commands.is_empty()
     }
 
     /// Waiting for a build: frames until then only poll.
     pub(super) fn is_waiting(&self) -> bool {
         matches!(
             self.running,
-            Some((_, Running::WaitMethod(_) | Running::WaitBuilds))
+            Some((
+                _,
+                Running::WaitMethod(_) | Running::WaitBuilds | Running::WaitScore(_)
+            ))
         )
     }
 }
@@ -92,6 +122,7 @@ impl Viewer {
                         })
                     }
                 }
+                Running::WaitScore(n) => (self.scored < n).then_some(Running::WaitScore(n)),
                 Running::WaitBuilds => {
                     (!self.builds.running().is_empty()).then_some(Running::WaitBuilds)
                 }
@@ -107,7 +138,7 @@ impl Viewer {
             return Ok(());
         }
         let Some((line, command)) = player.commands.pop_front() else {
-            self.quit = true;
+            self.quit |= player.quit_at_end;
             return Ok(());
         };
         self.run_command(line, command)
@@ -173,7 +204,10 @@ impl Viewer {
             }
             Command::Screenshot(path) => self.screenshot_after_frame = Some(path),
             Command::CopyView(name) => self.copy_view(&name),
-            Command::Score => self.score()?,
+            Command::Score => {
+                self.score()?;
+                running = Some(Running::WaitScore(self.scored + 1));
+            }
             Command::Quit => self.quit = true,
         }
         // Run the first frame of a multi-frame command now.
