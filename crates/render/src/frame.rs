@@ -284,10 +284,16 @@ impl BuildProgress {
     }
 }
 
+/// The stages the shared bindings are visible to: the three WebGPU knows
+/// (`ShaderStages::all()` adds wgpu's mesh and ray-tracing stages, which a
+/// browser refuses).
+const SHARED_STAGES: wgpu::ShaderStages =
+    wgpu::ShaderStages::VERTEX_FRAGMENT.union(wgpu::ShaderStages::COMPUTE);
+
 fn uniform_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
-        visibility: wgpu::ShaderStages::all(),
+        visibility: SHARED_STAGES,
         ty: wgpu::BindingType::Buffer {
             ty: wgpu::BufferBindingType::Uniform,
             has_dynamic_offset: false,
@@ -305,7 +311,7 @@ pub fn texture_entry(
 ) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
-        visibility: wgpu::ShaderStages::all(),
+        visibility: SHARED_STAGES,
         ty: wgpu::BindingType::Texture {
             sample_type,
             view_dimension,

@@ -36,6 +36,8 @@ enum Command {
     Merge(cmd::merge::Args),
     /// Open a window: fly over the level, switch methods live, dig craters.
     View(cmd::view::Args),
+    /// Serve the browser build of the viewer (and a world directory) on localhost.
+    Serve(cmd::serve::Args),
 }
 
 fn main() -> std::process::ExitCode {
@@ -50,6 +52,7 @@ fn main() -> std::process::ExitCode {
         Command::Compare(args) => cmd::compare::run(args),
         Command::Merge(args) => cmd::merge::run(args),
         Command::View(args) => cmd::view::run(args),
+        Command::Serve(args) => cmd::serve::run(args),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

@@ -8,4 +8,5 @@ pub mod merge;
 pub mod metrics;
 pub mod reference;
 pub mod render;
+pub mod serve;
 pub mod view;

@@ -1,0 +1,24 @@
+#!/usr/bin/env bash
+# Build the browser bundle of the viewer into target/web (index.html + pkg/):
+#   crates/web/build.sh            # then: cargo run --release -- serve
+# Needs the wasm32-unknown-unknown target and wasm-bindgen-cli at the
+# version of wasm-bindgen in Cargo.lock; both are installed when missing.
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+version=$(grep -A1 '^name = "wasm-bindgen"$' Cargo.lock | sed -n 's/^version = "\(.*\)"/\1/p')
+rustup target list --installed 2>/dev/null | grep -qx wasm32-unknown-unknown ||
+    rustup target add wasm32-unknown-unknown
+if [ "$(wasm-bindgen --version 2>/dev/null | cut -d' ' -f2)" != "$version" ]; then
+    cargo install wasm-bindgen-cli --locked --version "$version"
+fi
+# Line tables (the native release profile's) would double the .wasm.
+CARGO_PROFILE_RELEASE_DEBUG=false \
+    cargo build --release --target wasm32-unknown-unknown -p strata-web
+out=target/web
+rm -rf "$out/pkg"
+mkdir -p "$out"
+wasm-bindgen --target web --no-typescript --out-dir "$out/pkg" \
+    target/wasm32-unknown-unknown/release/strata_web.wasm
+cp crates/web/www/index.html "$out/"
+wasm="$out/pkg/strata_web_bg.wasm"
+echo "bundle: $out ($(wc -c <"$wasm") bytes of wasm, $(gzip -9c "$wasm" | wc -c) gzipped)"

@@ -1,0 +1,39 @@
+//! The page's entry point for the browser build of the viewer (see
+//! `www/index.html`): read the URL's parameters, get the world (generated in
+//! the page a band of rows at a time under a progress bar, or fetched with
+//! `?level=URL`), then hand [`strata_viewer`] to the browser's event loop.
+//! Errors and panics are shown in the page.
+//!
+//! URL parameters: `backend=webgl2`, `method=NAME`, `view=NAME`,
+//! `size=WxH` (canvas), `scale=F` (picture / canvas), `world=WxH` and
+//! `seed=N` (the generated world), `level=URL` (a world directory).
+#![cfg(target_arch = "wasm32")]
+
+mod page;
+
+use wasm_bindgen::prelude::*;
+
+/// Runs when the module is instantiated.
+#[wasm_bindgen(start)]
+pub fn main() {
+    std::panic::set_hook(Box::new(|info| {
+        strata_viewer::web::show_error(&format!("Strata panicked: {info}"));
+    }));
+    wasm_bindgen_futures::spawn_local(async {
+        if let Err(error) = page::run().await {
+            strata_viewer::web::show_error(&format!("{error:#}"));
+        }
+    });
+}
+
+/// Queue viewer script commands (the `--script` language, one per line).
+#[wasm_bindgen(js_name = strataRun)]
+pub fn strata_run(text: &str) -> Result<(), JsValue> {
+    strata_viewer::web::push_commands(text).map_err(|e| JsValue::from_str(&format!("{e:#}")))
+}
+
+/// The viewer's state after its last frame, JSON (see the viewer's `page_state`).
+#[wasm_bindgen(js_name = strataState)]
+pub fn strata_state() -> String {
+    strata_viewer::web::state()
+}

@@ -1,0 +1,175 @@
+//! URL parameters, the world in the page, the progress bar.
+
+use anyhow::{Context, bail};
+use strata_level::World;
+use strata_level::generate::{GenerateParams, Generation, parse_size};
+use strata_render::MethodSettings;
+use strata_viewer::web::{Backend, now_ms, set_state};
+use wasm_bindgen::JsCast;
+use wasm_bindgen_futures::JsFuture;
+
+/// What the URL asks for.
+pub struct Params {
+    pub backend: Backend,
+    pub method: String,
+    pub view: Option<String>,
+    pub size: (u32, u32),
+    pub scale: Option<f32>,
+    pub world: GenerateParams,
+    pub level: Option<String>,
+}
+
+impl Params {
+    pub fn from_url() -> anyhow::Result<Params> {
+        let search = web_sys::window()
+            .context("no window")?
+            .location()
+            .search()
+            .map_err(|_| anyhow::anyhow!("cannot read the page's URL"))?;
+        let query = web_sys::UrlSearchParams::new_with_str(&search)
+            .map_err(|_| anyhow::anyhow!("cannot parse the page's URL parameters"))?;
+        let get = |name: &str| query.get(name).filter(|v| !v.is_empty());
+        let backend = match get("backend").as_deref() {
+            None | Some("webgpu") => Backend::WebGpu,
+            Some("webgl2") => Backend::WebGl2,
+            Some(other) => bail!("?backend={other}: use webgpu (default) or webgl2"),
+        };
+        let size = match get("size") {
+            Some(text) => parse_size(&text).with_context(|| format!("?size={text}"))?,
+            None => (960, 600),
+        };
+        if !(1..=8192).contains(&size.0) || !(1..=8192).contains(&size.1) {
+            bail!("?size: each side 1..=8192 pixels");
+        }
+        let scale = match get("scale") {
+            Some(text) => Some(
+                text.parse::<f32>()
+                    .ok()
+                    .filter(|s| *s > 0.0 && *s <= 4.0)
+                    .with_context(|| format!("?scale={text}: a number in (0, 4]"))?,
+            ),
+            None => None,
+        };
+        let mut world = GenerateParams::default();
+        if let Some(text) = get("world") {
+            (world.width, world.height) =
+                parse_size(&text).with_context(|| format!("?world={text}"))?;
+        }
+        if let Some(text) = get("seed") {
+            world.seed = text
+                .parse()
+                .ok()
+                .with_context(|| format!("?seed={text}: a whole number"))?;
+        }
+        Ok(Params {
+            backend,
+            method: get("method").unwrap_or_else(|| "ray".into()),
+            view: get("view"),
+            size,
+            scale,
+            world,
+            level: get("level"),
+        })
+    }
+}
+
+/// Read the URL, get the world, start the viewer.
+pub async fn run() -> anyhow::Result<()> {
+    let params = Params::from_url()?;
+    let world = match &params.level {
+        Some(url) => bail!("?level={url}: loading a world over HTTP is not built yet"),
+        None => generate(&params.world).await?,
+    };
+    progress(None, "");
+    strata_viewer::web::start(
+        strata_viewer::Options {
+            world,
+            method: params.method,
+            settings: MethodSettings::default(),
+            size: params.size,
+            render_scale: params.scale,
+            view: params.view,
+            script: None,
+            vsync: true,
+            out: "screenshots".into(),
+        },
+        params.backend,
+    )
+}
+
+/// Let the browser paint and handle input.
+pub async fn yield_to_browser() {
+    let promise = js_sys::Promise::new(&mut |resolve, _| {
+        if let Some(window) = web_sys::window() {
+            let _ = window.set_timeout_with_callback_and_timeout_and_arguments_0(&resolve, 0);
+        }
+    });
+    let _ = JsFuture::from(promise).await;
+}
+
+/// Show (or with `None` hide) the page's progress bar and its line.
+pub fn progress(fraction: Option<f64>, text: &str) {
+    let Some(document) = web_sys::window().and_then(|w| w.document()) else {
+        return;
+    };
+    if let Some(bar) = document
+        .get_element_by_id("strata-progress")
+        .and_then(|e| e.dyn_into::<web_sys::HtmlProgressElement>().ok())
+    {
+        match fraction {
+            Some(f) => {
+                bar.set_value(f);
+                let _ = bar.set_attribute("style", "display: inline-block");
+            }
+            None => {
+                let _ = bar.set_attribute("style", "display: none");
+            }
+        }
+    }
+    if let Some(line) = document.get_element_by_id("strata-status") {
+        line.set_text_content(Some(text));
+    }
+}
+
+/// The built-in world, generated here a band of rows per turn of the
+/// browser's loop (about 50 ms each), so the page stays responsive.
+async fn generate(params: &GenerateParams) -> anyhow::Result<World> {
+    let label = format!(
+        "generating the {}x{} world (seed {})",
+        params.width, params.height, params.seed
+    );
+    progress(Some(0.0), &label);
+    yield_to_browser().await;
+    let start = now_ms();
+    let mut generation = Generation::new(params)?;
+    let setup_ms = now_ms() - start;
+    let mut rows = 16;
+    loop {
+        let band = now_ms();
+        if generation.step(rows) {
+            break;
+        }
+        // Aim at about 50 ms of work between yields.
+        let took = (now_ms() - band).max(1.0);
+        rows = ((f64::from(rows) * 50.0 / took) as u32).clamp(1, 4096);
+        progress(Some(f64::from(generation.progress())), &label);
+        set_state(serde_json::json!({
+            "phase": "generating",
+            "progress": generation.progress(),
+        }));
+        yield_to_browser().await;
+    }
+    let world = generation.finish()?;
+    let generate_ms = now_ms() - start;
+    web_sys::console::log_1(
+        &format!("strata: generated {label} in {generate_ms:.0} ms (setup {setup_ms:.0} ms)")
+            .into(),
+    );
+    GENERATE_MS.with(|g| g.set(Some(generate_ms)));
+    Ok(world)
+}
+
+thread_local! {
+    /// How long the world took to generate, for the state the page publishes.
+    pub static GENERATE_MS: std::cell::Cell<Option<f64>> = const { std::cell::Cell::new(None) };
+}
