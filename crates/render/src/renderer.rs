@@ -6,6 +6,7 @@
 //! (the viewer switches between them without reloading the level). Every kept
 //! method follows every edit, so switching never shows stale terrain.
 
+use crate::depth_read::DepthReader;
 use crate::frame::{Globals, LevelShape, Shared, TerrainColors};
 use crate::gpu::{ErrorSink, Gpu, wait_device};
 use crate::methods::{self, Frame, Method, MethodSettings, RetainedBytes};
@@ -48,6 +49,8 @@ pub struct Renderer {
     shadow_reuse: bool,
     /// The frame the shadow map holds, while no edit has changed it.
     shadow_drawn: Option<ShadowFrame>,
+    /// Depth read-back through a pass, where depth copies are missing.
+    depth_reader: Option<DepthReader>,
 }
 
 impl Renderer {
@@ -62,16 +65,13 @@ impl Renderer {
         height: u32,
     ) -> anyhow::Result<Self> {
         let start = Instant::now();
-        // Unknown names fail before any GPU work.
-        if !methods::names().contains(&method) {
-            anyhow::bail!(
-                "unknown method `{method}`; known: {}",
-                methods::names().join(", ")
-            );
-        }
+        // Unknown names, and methods this adapter cannot run, fail before
+        // any GPU work.
+        methods::check_support(method, &gpu.caps)?;
         let shared = Arc::new(Shared::new(
             &gpu.device,
             &gpu.queue,
+            &gpu.caps,
             level,
             colors,
             width,
@@ -79,6 +79,7 @@ impl Renderer {
         )?);
         let method = methods::create(method, &shared, level, settings)?;
         let shadow = ShadowPass::new(&shared)?;
+        let depth_reader = DepthReader::new(&gpu.device, &gpu.caps)?;
         let timer = PassTimer::new(&gpu.device, &gpu.queue, gpu.report.timestamps);
         let mut renderer = Renderer {
             shared,
@@ -96,6 +97,7 @@ impl Renderer {
             setup_ms: 0.0,
             shadow_reuse: false,
             shadow_drawn: None,
+            depth_reader,
         };
         wait_device(&renderer.shared.device, &renderer.errors)?;
         renderer.setup_ms = ms(start);
@@ -355,6 +357,10 @@ impl Renderer {
 
     /// The depth target: depth-buffer values (0 near .. 1 far, 1 = sky), row-major.
     pub fn read_depth(&self) -> anyhow::Result<Vec<f32>> {
+        if let Some(reader) = &self.depth_reader {
+            let s = &self.shared;
+            return reader.read(&s.device, &s.queue, &self.errors, &s.depth);
+        }
         let raw = self.read_texture(&self.shared.depth, wgpu::TextureAspect::DepthOnly)?;
         Ok(bytemuck::cast_slice::<u8, f32>(&raw).to_vec())
     }
@@ -362,6 +368,10 @@ impl Renderer {
     /// Start copying the depth target to the CPU without waiting (the
     /// browser's way: poll the result per frame; its bytes are `f32` depths).
     pub fn start_read_depth(&self) -> crate::gpu::TextureReadback {
+        if let Some(reader) = &self.depth_reader {
+            let s = &self.shared;
+            return reader.start(&s.device, &s.queue, &s.depth);
+        }
         crate::gpu::TextureReadback::start(
             &self.shared.device,
             &self.shared.queue,

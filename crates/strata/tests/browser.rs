@@ -311,15 +311,14 @@ async fn drive(client: Client, url: String) {
         s["page_to_first_frame_ms"], s["adapter"]
     );
     assert_eq!(s["adapter"]["backend"], "browserwebgpu", "{s}");
-    let mut s = run(&client, "overlay off\nframes 2", 60).await;
+    run(&client, "overlay off\nframes 2", 60).await;
     let mut failures = Vec::new();
     for (method, ..) in LIMITS {
         run(&client, &format!("method {method}"), 300).await;
         let start = Instant::now();
-        s = run(&client, "frames 5", 120).await;
+        let s = run(&client, "frames 5", 120).await;
         let frame_ms = start.elapsed().as_secs_f64() * 1e3 / 5.0;
         check(method, score(&client, &s, method).await, &mut failures);
-        s = state(&client).await;
         eprintln!("{method:14} {frame_ms:.0} ms per frame (5 frames, wall clock)");
     }
     assert!(

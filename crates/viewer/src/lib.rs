@@ -51,6 +51,8 @@ pub struct Options {
     pub view: Option<String>,
     pub script: Option<Script>,
     pub vsync: bool,
+    /// The backend and adapter to draw on (`--backend`, `--adapter`).
+    pub adapter: strata_render::AdapterChoice,
     /// Where screenshots taken with P or the overlay go.
     pub out: PathBuf,
 }
@@ -92,13 +94,15 @@ impl App {
         let Some(options) = self.options.take() else {
             return;
         };
-        let instance =
-            wgpu::Instance::new(wgpu::InstanceDescriptor::new_with_display_handle_from_env(
-                Box::new(self.display.clone()),
-            ));
+        let mut desc = wgpu::InstanceDescriptor::new_with_display_handle_from_env(Box::new(
+            self.display.clone(),
+        ));
+        desc.backends = options.adapter.backend.backends();
+        let instance = wgpu::Instance::new(desc);
         let opened = viewer::Viewer::open_window(event_loop, &options, &instance).and_then(
             |(window, surface)| {
-                let gpu = strata_render::Gpu::with_instance(instance, Some(&surface))?;
+                let gpu =
+                    strata_render::Gpu::with_instance(instance, Some(&surface), &options.adapter)?;
                 viewer::Viewer::new(window, surface, gpu, options)
             },
         );

@@ -172,8 +172,9 @@ impl App {
         let device = Rc::new(RefCell::new(None));
         let slot = Rc::clone(&device);
         let backend = self.backend;
+        let choice = options.adapter;
         wasm_bindgen_futures::spawn_local(async move {
-            let result = Gpu::with_instance_async(instance, Some(&surface))
+            let result = Gpu::with_instance_async(instance, Some(&surface), &choice)
                 .await
                 .map(|gpu| (gpu, surface))
                 .map_err(|e| match backend {

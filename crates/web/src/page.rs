@@ -91,6 +91,7 @@ pub async fn run() -> anyhow::Result<()> {
             view: params.view,
             script: None,
             vsync: true,
+            adapter: Default::default(),
             out: "screenshots".into(),
         },
         params.backend,

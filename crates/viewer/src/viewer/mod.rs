@@ -200,16 +200,12 @@ impl Viewer {
             view,
             script,
             vsync,
+            adapter: _,
             out,
         } = options;
         let opened = Instant::now();
         let _ = size;
-        if !methods::names().contains(&method.as_str()) {
-            bail!(
-                "unknown method `{method}`; known: {}",
-                methods::names().join(", ")
-            );
-        }
+        methods::entry(&method)?;
         let inner = window.inner_size();
         let window_size = (inner.width.max(1), inner.height.max(1));
         let config = surface_config(&surface, &gpu, window_size, vsync)?;
