@@ -305,6 +305,12 @@ impl Gpu {
 
 /// Block until the device is idle, then report any collected error.
 pub fn wait_device(device: &wgpu::Device, errors: &ErrorSink) -> anyhow::Result<()> {
+    // A page cannot block: the browser finishes the work after it yields
+    // (read-backs are polled per frame there, see `TextureReadback`).
+    if cfg!(target_arch = "wasm32") {
+        let _ = device.poll(wgpu::PollType::Poll);
+        return errors.check();
+    }
     let polled = device.poll(wgpu::PollType::Wait {
         submission_index: None,
         timeout: Some(GPU_WAIT_TIMEOUT),

@@ -64,6 +64,8 @@ impl Building<'_> {
 /// What the overlay shows.
 pub struct Status<'a> {
     pub adapter: &'a AdapterReport,
+    /// What the adapter can do: methods it cannot run are listed as unavailable.
+    pub caps: &'a strata_render::caps::Capabilities,
     pub frame_ms: f64,
     pub drawn: Vec<Drawn<'a>>,
     pub active: &'a str,
@@ -421,6 +423,15 @@ fn methods_section(
     ui.label("method (keys 1-8)");
     ui.horizontal_wrapped(|ui| {
         for (i, name) in methods::names().into_iter().enumerate() {
+            let refused = methods::check_support(name, status.caps).err();
+            if let Some(why) = refused {
+                ui.add_enabled(
+                    false,
+                    egui::Button::selectable(false, format!("{} {name} (unavailable)", i + 1)),
+                )
+                .on_disabled_hover_text(format!("{why:#}"));
+                continue;
+            }
             let building = status.building.iter().any(|b| b.method == name);
             let kept = status.kept.iter().any(|(m, _)| *m == name);
             let label = format!(
@@ -449,6 +460,21 @@ fn methods_section(
             }
         }
     });
+    let unavailable: Vec<String> = methods::names()
+        .into_iter()
+        .filter_map(|name| methods::check_support(name, status.caps).err())
+        .map(|why| format!("{why:#}"))
+        .collect();
+    if !unavailable.is_empty() {
+        ui.collapsing(
+            format!("{} unavailable on this adapter", unavailable.len()),
+            |ui| {
+                for line in unavailable {
+                    ui.label(line);
+                }
+            },
+        );
+    }
     ui.horizontal(|ui| {
         let mut split = status.split.is_some();
         if ui.checkbox(&mut split, "A/B split").changed() {

@@ -833,6 +833,11 @@ impl Viewer {
             "active": self.renderer.method_name(),
             "split": self.split,
             "kept": self.renderer.method_names(),
+            "unavailable": methods::names()
+                .into_iter()
+                .filter_map(|m| methods::check_support(m, &self.gpu.caps).err().map(|e| (m, e)))
+                .map(|(m, e)| serde_json::json!({ "method": m, "reason": format!("{e:#}") }))
+                .collect::<Vec<_>>(),
             "building": building,
             "waiting_for": self.waiting_for,
             "idle": self.player.as_ref().is_none_or(Player::is_idle)
@@ -869,6 +874,7 @@ impl Viewer {
             .collect();
         let status = Status {
             adapter: &self.gpu.report,
+            caps: &self.gpu.caps,
             frame_ms: self.frame_ms,
             drawn: self
                 .timings
