@@ -39,19 +39,28 @@ thread_local! {
     static COMMANDS: RefCell<VecDeque<Script>> = const { RefCell::new(VecDeque::new()) };
     static STATE: RefCell<String> = RefCell::new("{\"phase\":\"loading\"}".into());
     static FIRST_FRAME_MS: RefCell<Option<f64>> = const { RefCell::new(None) };
+    /// Scripts pushed and taken by the viewer so far (a page script waits
+    /// for `taken` to reach what its push returned, then for `idle`).
+    static PUSHED: std::cell::Cell<u32> = const { std::cell::Cell::new(0) };
+    static TAKEN: std::cell::Cell<u32> = const { std::cell::Cell::new(0) };
 }
 
 /// Queue script commands (the `--script` language) for the viewer; a bad
-/// line is refused whole, with its reason.
-pub fn push_commands(text: &str) -> anyhow::Result<()> {
+/// line is refused whole, with its reason. Returns how many scripts have
+/// been pushed so far (the state's `taken` reaches it once the viewer has
+/// them).
+pub fn push_commands(text: &str) -> anyhow::Result<u32> {
     let script = Script::parse(text)?;
     COMMANDS.with(|c| c.borrow_mut().push_back(script));
-    Ok(())
+    PUSHED.set(PUSHED.get() + 1);
+    Ok(PUSHED.get())
 }
 
 /// Commands queued since the last frame.
 pub(crate) fn take_commands() -> Vec<Script> {
-    COMMANDS.with(|c| c.borrow_mut().drain(..).collect())
+    let taken: Vec<Script> = COMMANDS.with(|c| c.borrow_mut().drain(..).collect());
+    TAKEN.set(TAKEN.get() + taken.len() as u32);
+    taken
 }
 
 /// The viewer's last published state, JSON.
@@ -65,6 +74,7 @@ pub(crate) fn publish(mut state: serde_json::Value, frames: u64) {
         let first = FIRST_FRAME_MS.with(|f| *f.borrow_mut().get_or_insert_with(now_ms));
         state["page_to_first_frame_ms"] = first.into();
     }
+    state["taken"] = TAKEN.get().into();
     set_state(state);
 }
 

@@ -26,9 +26,10 @@ pub fn main() {
     });
 }
 
-/// Queue viewer script commands (the `--script` language, one per line).
+/// Queue viewer script commands (the `--script` language, one per line);
+/// returns the count the state's `taken` reaches once the viewer has them.
 #[wasm_bindgen(js_name = strataRun)]
-pub fn strata_run(text: &str) -> Result<(), JsValue> {
+pub fn strata_run(text: &str) -> Result<u32, JsValue> {
     strata_viewer::web::push_commands(text).map_err(|e| JsValue::from_str(&format!("{e:#}")))
 }
 
