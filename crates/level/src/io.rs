@@ -80,42 +80,89 @@ pub fn load_world_timed(dir: &Path, mid_rule: MidRule) -> Result<(World, MapLoad
     };
     drop(bytes);
 
-    let palette = Palette::read(&dir.join(&config.palette_file))?;
-    let vpr = vpr_path(dir, &config);
-    let water = if vpr.exists() {
-        Some(vpr::read_vpr(&vpr, water_sections(&config))?)
-    } else {
-        None
+    let optional = |path: PathBuf| -> Result<Option<Vec<u8>>, LevelError> {
+        if path.exists() {
+            read_file(&path).map(Some)
+        } else {
+            Ok(None)
+        }
     };
-    let views_file = dir.join(VIEWS_TXT);
-    let edit_file = dir.join(EDIT_TXT);
+    let palette = read_file(&dir.join(&config.palette_file))?;
+    let vpr = optional(vpr_path(dir, &config))?;
+    let views = optional(dir.join(VIEWS_TXT))?;
+    let edit = optional(dir.join(EDIT_TXT))?;
+    let world = world_from_parts(
+        dir_name(dir),
+        dir,
+        config,
+        level,
+        WorldFiles {
+            palette: &palette,
+            vpr: vpr.as_deref(),
+            views: views.as_deref(),
+            edit: edit.as_deref(),
+        },
+    )?;
+    Ok((world, load))
+}
+
+/// A world directory's files besides `world.ini` and the map, as bytes
+/// (read from disk, or fetched over HTTP by the browser page).
+pub struct WorldFiles<'a> {
+    pub palette: &'a [u8],
+    pub vpr: Option<&'a [u8]>,
+    pub views: Option<&'a [u8]>,
+    pub edit: Option<&'a [u8]>,
+}
+
+/// The world from its parsed config, decoded map and the other files'
+/// bytes; `dir` names the files in errors (a path, or a URL's).
+pub fn world_from_parts(
+    name: String,
+    dir: &Path,
+    config: WorldConfig,
+    level: Level,
+    files: WorldFiles<'_>,
+) -> Result<World, LevelError> {
+    let palette = Palette::from_bytes(files.palette, &dir.join(&config.palette_file))?;
+    let water = match files.vpr {
+        Some(bytes) => Some(vpr::parse_vpr(
+            bytes,
+            water_sections(&config),
+            &vpr_path(dir, &config),
+        )?),
+        None => None,
+    };
     let fostral = is_fostral(&config);
-    let views = if views_file.exists() {
-        let text = String::from_utf8_lossy(&read_file(&views_file)?).into_owned();
-        parse_views(&text).map_err(|e| LevelError::format(&views_file, e.to_string()))?
-    } else if fostral {
-        fostral_views()
-    } else {
-        Vec::new()
+    let views = match files.views {
+        Some(bytes) => {
+            let text = String::from_utf8_lossy(bytes);
+            parse_views(&text)
+                .map_err(|e| LevelError::format(&dir.join(VIEWS_TXT), e.to_string()))?
+        }
+        None if fostral => fostral_views(),
+        None => Vec::new(),
     };
-    let edit = if edit_file.exists() {
-        let text = String::from_utf8_lossy(&read_file(&edit_file)?).into_owned();
-        Some(EditSite::parse(&text).map_err(|e| LevelError::format(&edit_file, e.to_string()))?)
-    } else if fostral {
-        Some(EditSite::fostral())
-    } else {
-        None
+    let edit = match files.edit {
+        Some(bytes) => {
+            let text = String::from_utf8_lossy(bytes);
+            Some(
+                EditSite::parse(&text)
+                    .map_err(|e| LevelError::format(&dir.join(EDIT_TXT), e.to_string()))?,
+            )
+        }
+        None if fostral => Some(EditSite::fostral()),
+        None => None,
     };
-    let world = World {
-        name: dir_name(dir),
+    Ok(World {
+        name,
         level,
         config,
         palette,
         water,
         views,
         edit,
-    };
-    Ok((world, load))
+    })
 }
 
 /// Load a world directory (DESIGN §1). `World.name` is the directory's name.

@@ -77,7 +77,7 @@ impl Params {
 pub async fn run() -> anyhow::Result<()> {
     let params = Params::from_url()?;
     let world = match &params.level {
-        Some(url) => bail!("?level={url}: loading a world over HTTP is not built yet"),
+        Some(url) => fetch_world(url).await?,
         None => generate(&params.world).await?,
     };
     progress(None, "");
@@ -173,4 +173,85 @@ async fn generate(params: &GenerateParams) -> anyhow::Result<World> {
 thread_local! {
     /// How long the world took to generate, for the state the page publishes.
     pub static GENERATE_MS: std::cell::Cell<Option<f64>> = const { std::cell::Cell::new(None) };
+}
+
+/// GET `url`: its bytes, `None` on 404, an error on anything else.
+async fn fetch(url: &str) -> anyhow::Result<Option<Vec<u8>>> {
+    let window = web_sys::window().context("no window")?;
+    let response = JsFuture::from(window.fetch_with_str(url))
+        .await
+        .map_err(|e| anyhow::anyhow!("GET {url} failed: {e:?}"))?;
+    let response: web_sys::Response = response
+        .dyn_into()
+        .map_err(|_| anyhow::anyhow!("GET {url}: not a response"))?;
+    if response.status() == 404 {
+        return Ok(None);
+    }
+    if !response.ok() {
+        bail!(
+            "GET {url}: HTTP {} {}",
+            response.status(),
+            response.status_text()
+        );
+    }
+    let buffer = response
+        .array_buffer()
+        .map_err(|e| anyhow::anyhow!("GET {url}: {e:?}"))?;
+    let buffer = JsFuture::from(buffer)
+        .await
+        .map_err(|e| anyhow::anyhow!("GET {url}: reading the body failed: {e:?}"))?;
+    Ok(Some(js_sys::Uint8Array::new(&buffer).to_vec()))
+}
+
+async fn fetch_required(url: &str) -> anyhow::Result<Vec<u8>> {
+    fetch(url)
+        .await?
+        .with_context(|| format!("GET {url}: 404 Not Found (a world directory needs this file)"))
+}
+
+/// A world directory served over HTTP (`world.ini`, the map, the palette,
+/// optionally `.vpr`, `views.txt`, `edit.txt`), through the native readers.
+async fn fetch_world(url: &str) -> anyhow::Result<World> {
+    use std::path::Path;
+    use strata_level::config::WorldConfig;
+    use strata_level::{MidRule, io};
+    let base = if url.ends_with('/') {
+        url.to_string()
+    } else {
+        format!("{url}/")
+    };
+    let dir = Path::new(base.trim_end_matches('/'));
+    progress(Some(0.0), &format!("loading the world at {base}"));
+    let ini = fetch_required(&format!("{base}{}", io::WORLD_INI)).await?;
+    let config = WorldConfig::parse(&String::from_utf8_lossy(&ini), &dir.join(io::WORLD_INI))?;
+    let map_path = io::map_path(dir, &config);
+    let map_name = map_path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    progress(Some(0.1), &format!("loading {base}{map_name}"));
+    let map = fetch_required(&format!("{base}{map_name}")).await?;
+    let palette = fetch_required(&format!("{base}{}", config.palette_file)).await?;
+    let vpr = fetch(&format!("{base}{}.vpr", config.file_name)).await?;
+    let views = fetch(&format!("{base}{}", io::VIEWS_TXT)).await?;
+    let edit = fetch(&format!("{base}{}", io::EDIT_TXT)).await?;
+    progress(Some(0.5), &format!("decoding {base}{map_name}"));
+    yield_to_browser().await;
+    let level = io::decode_map(&map, &config, MidRule::Original, &map_path)?;
+    drop(map);
+    let name = dir
+        .file_name()
+        .map_or_else(|| "world".into(), |n| n.to_string_lossy().into_owned());
+    Ok(io::world_from_parts(
+        name,
+        dir,
+        config,
+        level,
+        io::WorldFiles {
+            palette: &palette,
+            vpr: vpr.as_deref(),
+            views: views.as_deref(),
+            edit: edit.as_deref(),
+        },
+    )?)
 }
