@@ -189,7 +189,9 @@ impl Overlay {
 
     /// Feed a window event; true when egui used it (the viewer then ignores it).
     pub fn on_window_event(&mut self, window: &Window, event: &winit::event::WindowEvent) -> bool {
-        self.input.on_window_event(window, event).consumed
+        // A hidden overlay takes nothing (egui still tracks the input, and
+        // its last drawn panels would otherwise swallow clicks).
+        self.input.on_window_event(window, event).consumed && self.visible
     }
 
     /// Whether the pointer is over (or dragging) the overlay.

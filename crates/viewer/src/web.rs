@@ -43,6 +43,14 @@ thread_local! {
     /// for `taken` to reach what its push returned, then for `idle`).
     static PUSHED: std::cell::Cell<u32> = const { std::cell::Cell::new(0) };
     static TAKEN: std::cell::Cell<u32> = const { std::cell::Cell::new(0) };
+    /// What the page measured before the viewer started (world generation
+    /// or download time), carried in every published state.
+    static PAGE_INFO: RefCell<serde_json::Map<String, serde_json::Value>> = RefCell::new(serde_json::Map::new());
+}
+
+/// Remember a page measurement (shown in every published state).
+pub fn set_page_info(key: &str, value: serde_json::Value) {
+    PAGE_INFO.with(|p| p.borrow_mut().insert(key.to_string(), value));
 }
 
 /// Queue script commands (the `--script` language) for the viewer; a bad
@@ -75,6 +83,11 @@ pub(crate) fn publish(mut state: serde_json::Value, frames: u64) {
         state["page_to_first_frame_ms"] = first.into();
     }
     state["taken"] = TAKEN.get().into();
+    PAGE_INFO.with(|p| {
+        for (k, v) in p.borrow().iter() {
+            state[k] = v.clone();
+        }
+    });
     set_state(state);
 }
 

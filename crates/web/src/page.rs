@@ -166,13 +166,12 @@ async fn generate(params: &GenerateParams) -> anyhow::Result<World> {
         &format!("strata: generated {label} in {generate_ms:.0} ms (setup {setup_ms:.0} ms)")
             .into(),
     );
-    GENERATE_MS.with(|g| g.set(Some(generate_ms)));
+    strata_viewer::web::set_page_info("generate_ms", generate_ms.into());
+    strata_viewer::web::set_page_info(
+        "world_size",
+        serde_json::json!([params.width, params.height]),
+    );
     Ok(world)
-}
-
-thread_local! {
-    /// How long the world took to generate, for the state the page publishes.
-    pub static GENERATE_MS: std::cell::Cell<Option<f64>> = const { std::cell::Cell::new(None) };
 }
 
 /// GET `url`: its bytes, `None` on 404, an error on anything else.

@@ -851,6 +851,8 @@ impl Viewer {
             "render_size": self.render_size(),
             "window_size": self.compositor.window_size(),
             "undo_depth": self.digger.can_undo(),
+            "eye": [self.fly.position.x, self.fly.position.y, self.fly.position.z],
+            "cursor": self.cursor,
             "scored": self.scored,
             "scores": self.scores.iter().map(|(m, metrics)| serde_json::json!({
                 "method": m, "metrics": metrics,
