@@ -358,8 +358,35 @@ async fn drive(client: Client, url: String) {
     eprintln!("WebGL2 page on {}", s["adapter"]);
     assert_eq!(s["adapter"]["backend"], "gl", "{s}");
     let s = run(&client, "overlay off\nframes 2", 60).await;
-    let mut failures = Vec::new();
-    check("ray", score(&client, &s, "ray").await, &mut failures);
-    assert!(failures.is_empty(), "WebGL2: {failures:?}");
-    assert_not_blank(&canvas_pixels(&client).await, "WebGL2 ray");
+    let unavailable = s["unavailable"].as_array().cloned().unwrap_or_default();
+    for u in &unavailable {
+        eprintln!("WebGL2 unavailable: {}", u["reason"]);
+        assert!(
+            u["reason"].as_str().is_some_and(|r| r.contains("needs")),
+            "an unavailable method without the capability named: {u}"
+        );
+    }
+    assert!(
+        !unavailable.iter().any(|u| u["method"] == "ray"),
+        "ray must run on WebGL2"
+    );
+    let gl = canvas_pixels(&client).await;
+    assert_not_blank(&gl, "WebGL2 ray");
+    // The same view, the same WGSL: WebGL2 draws what WebGPU drew.
+    let apart = differing(&before, &gl);
+    eprintln!(
+        "WebGL2 ray differs from WebGPU ray in {apart} of {} pixels",
+        gl.pixels().len()
+    );
+    assert!(
+        apart * 50 < gl.pixels().len(),
+        "WebGL2 ray differs from WebGPU ray in {apart} pixels"
+    );
+    // Scored too, but not asserted: on Chromium's WebGL2 the depth read-back
+    // returns a constant (depth p50 ~182 against the reference), so its
+    // see-through and coherence would pass vacuously. A known defect.
+    let (see, sky, coh) = score(&client, &s, "ray").await;
+    eprintln!(
+        "WebGL2 ray (not asserted): see-through {see:.3} %, covers-sky {sky:.3} %, coherence {coh:.3} %"
+    );
 }
