@@ -164,6 +164,7 @@ impl Plan {
             edit_rows: Vec::new(),
             failures: Vec::new(),
             edit_skipped: self.edit_skipped.clone(),
+            reference_images: Vec::new(),
         }
     }
 
@@ -265,12 +266,16 @@ impl Plan {
                         .0
                 }
             };
-            session.save_picture(
+            let image = session.save_picture(
                 v,
                 0,
                 &format!("{}-reference", view.name),
                 reference_image(&r, camera.far),
             )?;
+            session.results.reference_images.push(ViewImage {
+                view: view.name.clone(),
+                image,
+            });
             out.push(r);
             bar.inc(1);
         }
