@@ -3,6 +3,7 @@
 //! colour + depth targets. Bind group 0 of every method's pipelines is
 //! [`Shared::frame_layout`]; `shaders/frame.wgsl` declares it.
 
+use crate::caps::{Capabilities, Capability, ShadowPassKind};
 use crate::terrain::TerrainTexture;
 use bytemuck::{Pod, Zeroable};
 use strata_camera::Camera;
@@ -199,7 +200,12 @@ struct Targets {
 }
 
 impl Targets {
-    fn new(device: &wgpu::Device, width: u32, height: u32) -> anyhow::Result<Self> {
+    fn new(
+        device: &wgpu::Device,
+        caps: &Capabilities,
+        width: u32,
+        height: u32,
+    ) -> anyhow::Result<Self> {
         let max = device.limits().max_texture_dimension_2d;
         if width == 0 || height == 0 || width > max || height > max {
             anyhow::bail!(
@@ -207,19 +213,31 @@ impl Targets {
             );
         }
         use wgpu::TextureUsages as U;
+        // Compute methods write colour as a storage texture; depth is copied
+        // out directly where the adapter can (else `depth_read` samples it).
+        let storage = if caps.storage_textures {
+            U::STORAGE_BINDING
+        } else {
+            U::empty()
+        };
+        let depth_copy = if caps.depth_copies {
+            U::COPY_SRC
+        } else {
+            U::empty()
+        };
         let (color, color_view) = texture_2d(
             device,
             "color",
             (width, height),
             COLOR_FORMAT,
-            U::RENDER_ATTACHMENT | U::STORAGE_BINDING | U::TEXTURE_BINDING | U::COPY_SRC,
+            U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC | storage,
         );
         let (depth, depth_view) = texture_2d(
             device,
             "depth",
             (width, height),
             DEPTH_FORMAT,
-            U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC,
+            U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | depth_copy,
         );
         Ok(Targets {
             color,
@@ -249,6 +267,8 @@ pub struct Shared {
     /// Bind group 0 of every method pipeline (`frame.wgsl`).
     pub frame_layout: wgpu::BindGroupLayout,
     pub frame_group: wgpu::BindGroup,
+    /// What the adapter can do: methods check it before building.
+    pub caps: Capabilities,
     /// How far slow method builds have come (for a viewer's progress bar).
     pub progress: BuildProgress,
 }
@@ -341,12 +361,22 @@ impl Shared {
     pub(crate) fn new(
         device: &wgpu::Device,
         queue: &wgpu::Queue,
+        caps: &Capabilities,
         level: &Level,
         colors: &TerrainColors,
         width: u32,
         height: u32,
     ) -> anyhow::Result<Self> {
         let terrain = TerrainTexture::new(device, queue, level)?;
+        let shadow_usage = match caps.shadow_pass() {
+            Some(ShadowPassKind::Compute) => wgpu::TextureUsages::STORAGE_BINDING,
+            Some(ShadowPassKind::Fragment) => wgpu::TextureUsages::RENDER_ATTACHMENT,
+            None => anyhow::bail!(
+                "the shared shadow map needs {} or {}, which this adapter lacks",
+                Capability::ComputeShaders,
+                Capability::Float32Targets
+            ),
+        };
         let globals = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("globals"),
             size: std::mem::size_of::<Globals>() as u64,
@@ -365,14 +395,14 @@ impl Shared {
             "shadow map",
             (SHADOW_SIZE, SHADOW_SIZE),
             wgpu::TextureFormat::R32Float,
-            wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING,
+            shadow_usage | wgpu::TextureUsages::TEXTURE_BINDING,
         );
         let Targets {
             color,
             color_view,
             depth,
             depth_view,
-        } = Targets::new(device, width, height)?;
+        } = Targets::new(device, caps, width, height)?;
         let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("frame"),
             entries: &[
@@ -428,6 +458,7 @@ impl Shared {
             depth_view,
             frame_layout,
             frame_group,
+            caps: caps.clone(),
             progress: BuildProgress::default(),
         })
     }
@@ -441,7 +472,7 @@ impl Shared {
             color_view,
             depth,
             depth_view,
-        } = Targets::new(&self.device, width, height)?;
+        } = Targets::new(&self.device, &self.caps, width, height)?;
         (self.color, self.color_view, self.depth, self.depth_view) =
             (color, color_view, depth, depth_view);
         (self.width, self.height) = (width, height);

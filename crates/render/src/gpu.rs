@@ -2,6 +2,7 @@
 //! it runs on, and the error sinks that turn validation errors and a lost
 //! device into `Err` values instead of panics or hangs.
 
+use crate::caps::Capabilities;
 use serde::Serialize;
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
@@ -54,38 +55,187 @@ pub struct Gpu {
     pub device: wgpu::Device,
     pub queue: wgpu::Queue,
     pub report: AdapterReport,
+    /// What the adapter can do, under the limits requested for the device.
+    pub caps: Capabilities,
     pub errors: ErrorSink,
 }
 
 const NO_ADAPTER_HELP: &str = "no GPU adapter found. On a machine without a GPU install Mesa's \
-     software Vulkan driver (`apt install mesa-vulkan-drivers`, the lavapipe adapter); \
-     WGPU_BACKEND=vulkan|gl|metal|dx12 selects a backend, WGPU_ADAPTER_NAME a named adapter";
+     software Vulkan driver (`apt install mesa-vulkan-drivers`, the lavapipe adapter) or its GL \
+     driver (`libegl1 libgl1-mesa-dri`, llvmpipe); --backend vulkan|gl|dx12|metal (or \
+     WGPU_BACKEND) selects a backend, --adapter N an adapter listed by `strata adapters`";
+
+/// Which wgpu backend to look for adapters on.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum BackendChoice {
+    /// Every backend, or those `WGPU_BACKEND` names.
+    #[default]
+    Auto,
+    Vulkan,
+    Gl,
+    Dx12,
+    Metal,
+}
+
+impl BackendChoice {
+    pub const NAMES: &[&str] = &["auto", "vulkan", "gl", "dx12", "metal"];
+
+    /// The instance backends to create.
+    pub fn backends(self) -> wgpu::Backends {
+        match self {
+            BackendChoice::Auto => wgpu::Backends::from_env().unwrap_or(wgpu::Backends::all()),
+            BackendChoice::Vulkan => wgpu::Backends::VULKAN,
+            BackendChoice::Gl => wgpu::Backends::GL,
+            BackendChoice::Dx12 => wgpu::Backends::DX12,
+            BackendChoice::Metal => wgpu::Backends::METAL,
+        }
+    }
+}
+
+impl std::str::FromStr for BackendChoice {
+    type Err = anyhow::Error;
+    fn from_str(s: &str) -> anyhow::Result<Self> {
+        Ok(match s.to_ascii_lowercase().as_str() {
+            "auto" => BackendChoice::Auto,
+            "vulkan" | "vk" => BackendChoice::Vulkan,
+            "gl" | "gles" | "opengl" => BackendChoice::Gl,
+            "dx12" | "d3d12" => BackendChoice::Dx12,
+            "metal" | "mtl" => BackendChoice::Metal,
+            _ => anyhow::bail!(
+                "unknown backend `{s}`; known: {}",
+                BackendChoice::NAMES.join(", ")
+            ),
+        })
+    }
+}
+
+impl std::fmt::Display for BackendChoice {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let i = match self {
+            BackendChoice::Auto => 0,
+            BackendChoice::Vulkan => 1,
+            BackendChoice::Gl => 2,
+            BackendChoice::Dx12 => 3,
+            BackendChoice::Metal => 4,
+        };
+        f.write_str(BackendChoice::NAMES[i])
+    }
+}
+
+/// Which adapter to open: a backend, and optionally the adapter's index in
+/// [`list_adapters`] for that backend (else the high-performance default,
+/// or the one `WGPU_ADAPTER_NAME` names).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct AdapterChoice {
+    pub backend: BackendChoice,
+    pub index: Option<usize>,
+}
+
+impl AdapterChoice {
+    /// A wgpu instance for this choice's backends (`WGPU_*` variables apply
+    /// to everything the choice leaves open).
+    pub fn instance(&self) -> wgpu::Instance {
+        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+        desc.backends = self.backend.backends();
+        wgpu::Instance::new(desc)
+    }
+}
+
+/// One adapter as `strata adapters` lists it.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct AdapterListing {
+    /// Pass as `--adapter N` (with the same `--backend`).
+    pub index: usize,
+    pub name: String,
+    pub backend: String,
+    pub driver: String,
+    pub driver_info: String,
+    pub device_type: String,
+    pub capabilities: Capabilities,
+    /// Every method, and whether it runs here.
+    pub methods: Vec<MethodSupport>,
+}
+
+/// Whether one method runs on an adapter.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct MethodSupport {
+    pub name: String,
+    /// `None` when it runs; else why not (the capabilities missing).
+    pub refused: Option<String>,
+}
+
+/// Every adapter the chosen backend offers, in `--adapter` index order, with
+/// what each can do under the limits Strata would request.
+pub fn list_adapters(backend: BackendChoice) -> Vec<AdapterListing> {
+    let choice = AdapterChoice {
+        backend,
+        index: None,
+    };
+    let instance = choice.instance();
+    let adapters = pollster::block_on(instance.enumerate_adapters(backend.backends()));
+    adapters
+        .into_iter()
+        .enumerate()
+        .map(|(index, adapter)| {
+            let info = adapter.get_info();
+            let (features, limits) = device_request(&adapter);
+            let capabilities = Capabilities::of(&adapter, &limits, features);
+            let methods = crate::methods::METHODS
+                .iter()
+                .map(|entry| MethodSupport {
+                    name: entry.name.to_string(),
+                    refused: entry.check(&capabilities).err().map(|r| r.to_string()),
+                })
+                .collect();
+            AdapterListing {
+                index,
+                name: info.name.clone(),
+                backend: backend_name(info.backend),
+                driver: info.driver.clone(),
+                driver_info: info.driver_info.clone(),
+                device_type: format!("{:?}", info.device_type),
+                capabilities,
+                methods,
+            }
+        })
+        .collect()
+}
+
+fn backend_name(backend: wgpu::Backend) -> String {
+    format!("{backend:?}").to_lowercase()
+}
+
+/// The features and limits Strata requests of `adapter`.
+fn device_request(adapter: &wgpu::Adapter) -> (wgpu::Features, wgpu::Limits) {
+    let features = adapter.features() & wgpu::Features::TIMESTAMP_QUERY;
+    (features, device_limits(&adapter.limits()))
+}
 
 impl Gpu {
-    /// A headless device. Honours `WGPU_BACKEND` (backend list),
-    /// `WGPU_ADAPTER_NAME` (substring of the adapter name, case-insensitive)
-    /// and `WGPU_POWER_PREF`.
+    /// A headless device on the default adapter. Honours `WGPU_BACKEND`
+    /// (backend list), `WGPU_ADAPTER_NAME` (substring of the adapter name,
+    /// case-insensitive) and `WGPU_POWER_PREF`.
     pub fn headless() -> anyhow::Result<Self> {
-        let instance =
-            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
-        Self::with_instance(instance, None)
+        Self::open(&AdapterChoice::default())
     }
 
-    /// A device able to present to `surface` (for a future viewer), chosen by the
-    /// same environment variables.
+    /// A headless device on the adapter `choice` names.
+    pub fn open(choice: &AdapterChoice) -> anyhow::Result<Self> {
+        Self::with_instance(choice.instance(), None, choice)
+    }
+
+    /// A device able to present to `surface` (the viewer), on `instance`
+    /// (made by [`AdapterChoice::instance`]) and the adapter `choice` names.
     pub fn with_instance(
         instance: wgpu::Instance,
         surface: Option<&wgpu::Surface<'_>>,
+        choice: &AdapterChoice,
     ) -> anyhow::Result<Self> {
-        let adapter = pollster::block_on(pick_adapter(&instance, surface))?;
+        let adapter = pollster::block_on(pick_adapter(&instance, surface, choice))?;
         let info = adapter.get_info();
-        let timestamps = adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
-        let features = if timestamps {
-            wgpu::Features::TIMESTAMP_QUERY
-        } else {
-            wgpu::Features::empty()
-        };
-        let limits = device_limits(&adapter.limits());
+        let (features, limits) = device_request(&adapter);
+        let caps = Capabilities::of(&adapter, &limits, features);
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("strata"),
             required_features: features,
@@ -109,11 +259,11 @@ impl Gpu {
 
         let report = AdapterReport {
             name: info.name.clone(),
-            backend: format!("{:?}", info.backend).to_lowercase(),
+            backend: backend_name(info.backend),
             driver: info.driver.clone(),
             driver_info: info.driver_info.clone(),
             device_type: format!("{:?}", info.device_type),
-            timestamps,
+            timestamps: caps.timestamps,
         };
         Ok(Gpu {
             instance,
@@ -121,6 +271,7 @@ impl Gpu {
             device,
             queue,
             report,
+            caps,
             errors,
         })
     }
@@ -161,29 +312,55 @@ fn device_limits(adapter: &wgpu::Limits) -> wgpu::Limits {
 async fn pick_adapter(
     instance: &wgpu::Instance,
     surface: Option<&wgpu::Surface<'_>>,
+    choice: &AdapterChoice,
 ) -> anyhow::Result<wgpu::Adapter> {
+    let listed = |adapters: &[wgpu::Adapter]| -> String {
+        if adapters.is_empty() {
+            return NO_ADAPTER_HELP.to_string();
+        }
+        let names: Vec<String> = adapters
+            .iter()
+            .enumerate()
+            .map(|(i, a)| {
+                let info = a.get_info();
+                format!("{i}: {} ({})", info.name, backend_name(info.backend))
+            })
+            .collect();
+        names.join(", ")
+    };
+    if let Some(index) = choice.index {
+        let adapters = instance.enumerate_adapters(choice.backend.backends()).await;
+        let (count, names) = (adapters.len(), listed(&adapters));
+        let Some(adapter) = adapters.into_iter().nth(index) else {
+            anyhow::bail!(
+                "--adapter {index}: backend `{}` has {count} adapter(s): {names}",
+                choice.backend
+            );
+        };
+        if surface.is_some_and(|s| !adapter.is_surface_supported(s)) {
+            anyhow::bail!(
+                "--adapter {index} (`{}`) cannot present to this window",
+                adapter.get_info().name
+            );
+        }
+        return Ok(adapter);
+    }
     if let Ok(wanted) = std::env::var("WGPU_ADAPTER_NAME") {
         let wanted = wanted.to_lowercase();
-        let adapters = instance.enumerate_adapters(wgpu::Backends::all()).await;
-        let mut names = Vec::new();
-        for adapter in adapters {
-            let info = adapter.get_info();
-            if surface.is_some_and(|s| !adapter.is_surface_supported(s)) {
-                continue;
-            }
-            if info.name.to_lowercase().contains(&wanted) {
-                return Ok(adapter);
-            }
-            names.push(format!("{} ({:?})", info.name, info.backend));
-        }
-        anyhow::bail!(
-            "WGPU_ADAPTER_NAME=`{wanted}` matches no adapter; available: {}",
-            if names.is_empty() {
-                NO_ADAPTER_HELP.to_string()
-            } else {
-                names.join(", ")
-            }
-        );
+        let adapters = instance.enumerate_adapters(choice.backend.backends()).await;
+        let usable: Vec<wgpu::Adapter> = adapters
+            .into_iter()
+            .filter(|a| surface.is_none_or(|s| a.is_surface_supported(s)))
+            .collect();
+        let names = listed(&usable);
+        return usable
+            .into_iter()
+            .find(|a| a.get_info().name.to_lowercase().contains(&wanted))
+            .ok_or_else(|| {
+                anyhow::anyhow!(
+                    "WGPU_ADAPTER_NAME=`{wanted}` matches no adapter; available: {names}"
+                )
+            });
     }
     instance
         .request_adapter(&wgpu::RequestAdapterOptions {
@@ -194,7 +371,13 @@ async fn pick_adapter(
             apply_limit_buckets: false,
         })
         .await
-        .map_err(|e| anyhow::anyhow!("{NO_ADAPTER_HELP} ({e})"))
+        .map_err(|e| {
+            let on = match choice.backend {
+                BackendChoice::Auto => String::new(),
+                b => format!(" on backend `{b}`"),
+            };
+            anyhow::anyhow!("{NO_ADAPTER_HELP}{on} ({e})")
+        })
 }
 
 /// Map `buffer`'s first `size` bytes and copy them out.

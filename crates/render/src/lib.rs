@@ -19,6 +19,7 @@
 #[cfg(test)]
 extern crate self as strata_render;
 
+pub mod caps;
 pub mod frame;
 pub mod gpu;
 pub mod methods;
@@ -29,8 +30,9 @@ pub mod shadow;
 pub mod terrain;
 pub mod timing;
 
+pub use caps::{Capabilities, Capability, Refusal};
 pub use frame::{COLOR_FORMAT, DEPTH_FORMAT, SHADOW_SIZE, Shared, TerrainColors};
-pub use gpu::{AdapterReport, Gpu};
+pub use gpu::{AdapterChoice, AdapterReport, BackendChoice, Gpu};
 pub use methods::{Method, MethodSettings, RetainedBytes};
 pub use renderer::Renderer;
 pub use timing::{FrameTimings, Stats};

@@ -62,16 +62,13 @@ impl Renderer {
         height: u32,
     ) -> anyhow::Result<Self> {
         let start = Instant::now();
-        // Unknown names fail before any GPU work.
-        if !methods::names().contains(&method) {
-            anyhow::bail!(
-                "unknown method `{method}`; known: {}",
-                methods::names().join(", ")
-            );
-        }
+        // Unknown names, and methods this adapter cannot run, fail before
+        // any GPU work.
+        methods::check_support(method, &gpu.caps)?;
         let shared = Arc::new(Shared::new(
             &gpu.device,
             &gpu.queue,
+            &gpu.caps,
             level,
             colors,
             width,

@@ -1,5 +1,6 @@
 //! `strata`: render and measure editable multi-layer height fields.
 
+mod adapter_arg;
 mod cmd;
 mod world_arg;
 
@@ -34,6 +35,8 @@ enum Command {
     Compare(cmd::compare::Args),
     /// Merge results from several machines into one report.
     Merge(cmd::merge::Args),
+    /// List every GPU adapter: backend, driver, capabilities, limits, the methods it runs.
+    Adapters(cmd::adapters::Args),
     /// Open a window: fly over the level, switch methods live, dig craters.
     View(cmd::view::Args),
 }
@@ -50,6 +53,7 @@ fn main() -> std::process::ExitCode {
         Command::Compare(args) => cmd::compare::run(args),
         Command::Merge(args) => cmd::merge::run(args),
         Command::View(args) => cmd::view::run(args),
+        Command::Adapters(args) => cmd::adapters::run(args),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

@@ -49,6 +49,8 @@ pub struct Options {
     pub view: Option<String>,
     pub script: Option<Script>,
     pub vsync: bool,
+    /// The backend and adapter to draw on (`--backend`, `--adapter`).
+    pub adapter: strata_render::AdapterChoice,
     /// Where screenshots taken with P or the overlay go.
     pub out: PathBuf,
 }
@@ -94,10 +96,11 @@ impl ApplicationHandler for App {
         let Some(options) = self.options.take() else {
             return;
         };
-        let instance =
-            wgpu::Instance::new(wgpu::InstanceDescriptor::new_with_display_handle_from_env(
-                Box::new(self.display.clone()),
-            ));
+        let mut desc = wgpu::InstanceDescriptor::new_with_display_handle_from_env(Box::new(
+            self.display.clone(),
+        ));
+        desc.backends = options.adapter.backend.backends();
+        let instance = wgpu::Instance::new(desc);
         match viewer::Viewer::new(event_loop, options, instance) {
             Ok(viewer) => {
                 viewer.window().request_redraw();

@@ -9,7 +9,10 @@
 //!    `#include "frame.wgsl"`, `"surface.wgsl"`, `"shading.wgsl"` (and
 //!    `"ray_core.wgsl"`, `"fullscreen.wgsl"` as needed); add the file to
 //!    `shaders::SOURCES` and `shaders::ENTRY_SHADERS` (the naga test validates it).
-//! 3. Add one line to [`METHODS`] below: the only place a name maps to code.
+//! 3. Add one entry to [`METHODS`] below: the only place a name maps to code,
+//!    with the [`Capability`]s beyond WebGL2's baseline the method uses
+//!    (compute, storage textures, storage buffers per stage), so an adapter
+//!    without them refuses it before any GPU work.
 //!
 //! # The contract
 //! - Group 0 of every pipeline is the shared frame ([`Shared::frame_layout`],
@@ -47,6 +50,7 @@ pub mod sliced;
 pub mod voxel;
 pub mod voxel_build;
 
+use crate::caps::{Capabilities, Capability, Refusal};
 use crate::frame::Shared;
 use crate::timing::PassTimer;
 use serde::{Deserialize, Serialize};
@@ -154,32 +158,117 @@ pub trait Method: Send {
 /// Builds a method.
 pub type Constructor = fn(&Shared, &Level, &MethodSettings) -> anyhow::Result<Box<dyn Method>>;
 
-/// Every method by name: the only place a name maps to code.
-pub const METHODS: &[(&str, Constructor)] = &[
-    ("ray", ray::create),
-    ("ray-compute", ray_compute::create),
-    ("voxel", voxel::create),
-    ("voxel-compute", voxel::create_compute),
-    ("painted", painted::create),
-    ("sliced", sliced::create),
-    ("mesh", mesh::create),
-    ("scattered", scattered::create),
+/// A method by name: how to build it and what it needs of the adapter.
+pub struct MethodEntry {
+    pub name: &'static str,
+    pub create: Constructor,
+    /// Capabilities beyond WebGL2's baseline (a fragment pass reading the
+    /// terrain texture) that its pipelines use.
+    pub needs: &'static [Capability],
+}
+
+impl MethodEntry {
+    /// `Err` naming what `caps` lacks for this method.
+    pub fn check(&self, caps: &Capabilities) -> Result<(), Refusal> {
+        let missing = caps.missing(self.needs);
+        if missing.is_empty() {
+            Ok(())
+        } else {
+            Err(Refusal {
+                method: self.name.to_string(),
+                missing,
+            })
+        }
+    }
+}
+
+use Capability::{ComputeShaders, FragmentStorage, StorageTextures, VertexStorage};
+
+/// Every method: the only place a name maps to code.
+pub const METHODS: &[MethodEntry] = &[
+    MethodEntry {
+        name: "ray",
+        create: ray::create,
+        needs: &[],
+    },
+    MethodEntry {
+        name: "ray-compute",
+        create: ray_compute::create,
+        needs: &[ComputeShaders, StorageTextures],
+    },
+    MethodEntry {
+        name: "voxel",
+        // The occupancy pyramid is built and edited by compute passes.
+        create: voxel::create,
+        needs: &[ComputeShaders, FragmentStorage],
+    },
+    MethodEntry {
+        name: "voxel-compute",
+        create: voxel::create_compute,
+        needs: &[ComputeShaders, StorageTextures],
+    },
+    MethodEntry {
+        name: "painted",
+        create: painted::create,
+        needs: &[],
+    },
+    MethodEntry {
+        name: "sliced",
+        create: sliced::create,
+        needs: &[],
+    },
+    MethodEntry {
+        name: "mesh",
+        // Vertices fetch their chunk's placement from a storage buffer.
+        create: mesh::create,
+        needs: &[VertexStorage],
+    },
+    MethodEntry {
+        name: "scattered",
+        // Compute scatters into an atomic screen buffer; a fragment pass resolves it.
+        create: scattered::create,
+        needs: &[ComputeShaders, FragmentStorage],
+    },
 ];
 
 /// The names [`create`] accepts.
 pub fn names() -> Vec<&'static str> {
-    METHODS.iter().map(|(n, _)| *n).collect()
+    METHODS.iter().map(|m| m.name).collect()
 }
 
-/// Build the method called `name`.
+/// The method called `name`, or an error listing the known ones.
+pub fn entry(name: &str) -> anyhow::Result<&'static MethodEntry> {
+    METHODS
+        .iter()
+        .find(|m| m.name == name)
+        .ok_or_else(|| anyhow::anyhow!("unknown method `{name}`; known: {}", names().join(", ")))
+}
+
+/// Whether method `name` runs on an adapter with `caps`: `Err` with the
+/// reason (an unknown name, or the capabilities it lacks).
+pub fn check_support(name: &str, caps: &Capabilities) -> anyhow::Result<()> {
+    entry(name)?.check(caps)?;
+    Ok(())
+}
+
+/// The methods an adapter with `caps` can run.
+pub fn supported(caps: &Capabilities) -> Vec<&'static str> {
+    METHODS
+        .iter()
+        .filter(|m| m.check(caps).is_ok())
+        .map(|m| m.name)
+        .collect()
+}
+
+/// Build the method called `name`; refused before any GPU work when the
+/// shared frame's adapter lacks what it needs.
 pub fn create(
     name: &str,
     shared: &Shared,
     level: &Level,
     settings: &MethodSettings,
 ) -> anyhow::Result<Box<dyn Method>> {
-    let Some((_, ctor)) = METHODS.iter().find(|(n, _)| *n == name) else {
-        anyhow::bail!("unknown method `{name}`; known: {}", names().join(", "));
-    };
-    ctor(shared, level, settings)
+    let entry = entry(name)?;
+    entry.check(&shared.caps)?;
+    (entry.create)(shared, level, settings)
 }

@@ -67,6 +67,7 @@ fn gpu_pyramid_equals_cpu_twin_before_and_after_an_edit() {
         let shared = Shared::new(
             &gpu.device,
             &gpu.queue,
+            &gpu.caps,
             &level,
             &TerrainColors::test_ramps(),
             8,
@@ -231,7 +232,7 @@ fn fostral_sized_build_and_frame_times() {
         start.elapsed().as_secs_f64() * 1e3
     );
     let colors = TerrainColors::from_world(&w);
-    let shared = Shared::new(&gpu.device, &gpu.queue, &w.level, &colors, 8, 8).unwrap();
+    let shared = Shared::new(&gpu.device, &gpu.queue, &gpu.caps, &w.level, &colors, 8, 8).unwrap();
     for voxel in [VoxelSize::COARSE, VoxelSize::FINE] {
         let start = std::time::Instant::now();
         match GpuPyramid::new(

@@ -3,6 +3,7 @@
 //! level's views, 1280x800, far 600, shadows on, per-method warm-up, 40 timed
 //! frames, and the edit protocol. Every input is checked before GPU work.
 
+use crate::adapter_arg::AdapterArgs;
 use crate::world_arg::WorldArgs;
 use anyhow::Context;
 use std::path::PathBuf;
@@ -46,6 +47,8 @@ pub struct Args {
     /// renderer's first view goes on while an incremental build is in flight.
     #[arg(long, value_name = "N")]
     pub warmup: Option<u32>,
+    #[command(flatten)]
+    pub adapter: AdapterArgs,
     /// Reference cache directory (default: $STRATA_CACHE_DIR/reference or ~/.cache/strata/reference).
     #[arg(long, value_name = "DIR")]
     pub cache: Option<PathBuf>,
@@ -86,7 +89,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     } else {
         EditMode::Auto
     };
-    let gpu = strata_render::Gpu::headless()?;
+    let gpu = strata_render::Gpu::open(&args.adapter.choice())?;
     eprintln!(
         "adapter: {} ({}, {}); timestamps {}",
         gpu.report.name,

@@ -1,5 +1,6 @@
 //! One module per subcommand: its arguments and its `run`.
 
+pub mod adapters;
 pub mod compare;
 pub mod fit;
 pub mod generate;

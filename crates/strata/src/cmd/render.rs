@@ -2,6 +2,7 @@
 //! `color.png`, `depth.f32` (little-endian f32 depth-buffer values, row-major,
 //! 1.0 = sky) and `render.json` per view; `--json` prints one line per view.
 
+use crate::adapter_arg::AdapterArgs;
 use crate::world_arg::WorldArgs;
 use anyhow::{Context, bail};
 use std::path::PathBuf;
@@ -40,6 +41,8 @@ pub struct Args {
     pub warmup: u32,
     #[command(flatten)]
     pub method_args: MethodArgs,
+    #[command(flatten)]
+    pub adapter: AdapterArgs,
     /// Output directory (one sub-directory per view when there are several).
     #[arg(long, default_value = "render-out")]
     pub out: PathBuf,
@@ -213,6 +216,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     if args.frames == 0 {
         bail!("--frames must be at least 1");
     }
+    strata_render::methods::entry(&args.method)?;
     let world = args.world.load()?;
     let views = select_views(&args, &world)?;
     let (w, h) = args.size;
@@ -223,7 +227,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         })
         .collect::<anyhow::Result<Vec<_>>>()?;
     let settings = args.method_args.settings();
-    let gpu = Gpu::headless()?;
+    let gpu = Gpu::open(&args.adapter.choice())?;
     let mut renderer = Renderer::new(
         &gpu,
         &world.level,

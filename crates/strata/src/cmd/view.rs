@@ -2,6 +2,7 @@
 //! level, switch methods live, dig craters; `--script` or `--frames N
 //! --screenshot PATH` run it without a person.
 
+use crate::adapter_arg::AdapterArgs;
 use crate::cmd::render::{MethodArgs, parse_size};
 use crate::world_arg::WorldArgs;
 use std::path::PathBuf;
@@ -37,6 +38,8 @@ pub struct Args {
     pub no_vsync: bool,
     #[command(flatten)]
     pub method_args: MethodArgs,
+    #[command(flatten)]
+    pub adapter: AdapterArgs,
     /// Where screenshots (key P) go.
     #[arg(long, default_value = "out/view")]
     pub out: PathBuf,
@@ -50,14 +53,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         (None, Some(n)) => Some(Script::frames_then_screenshot(n, args.screenshot.clone())),
         (None, None) => None,
     };
-    let names = strata_render::methods::names();
-    if !names.contains(&args.method.as_str()) {
-        anyhow::bail!(
-            "unknown method `{}`; known: {}",
-            args.method,
-            names.join(", ")
-        );
-    }
+    strata_render::methods::entry(&args.method)?;
     let settings = args.method_args.settings();
     let start = std::time::Instant::now();
     let world = args.world.load()?;
@@ -75,6 +71,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         view: args.view,
         script,
         vsync: !args.no_vsync,
+        adapter: args.adapter.choice(),
         out: args.out,
     })
 }

@@ -152,15 +152,11 @@ impl Viewer {
             view,
             script,
             vsync,
+            adapter,
             out,
         } = options;
         let opened = Instant::now();
-        if !methods::names().contains(&method.as_str()) {
-            bail!(
-                "unknown method `{method}`; known: {}",
-                methods::names().join(", ")
-            );
-        }
+        methods::entry(&method)?;
         let attributes = Window::default_attributes()
             .with_title(format!("Strata: {}", world.name))
             .with_inner_size(winit::dpi::PhysicalSize::new(size.0, size.1));
@@ -172,7 +168,7 @@ impl Viewer {
         let surface = instance
             .create_surface(Arc::clone(&window))
             .context("creating a wgpu surface for the window")?;
-        let gpu = Gpu::with_instance(instance, Some(&surface))?;
+        let gpu = Gpu::with_instance(instance, Some(&surface), &adapter)?;
         let inner = window.inner_size();
         let window_size = (inner.width.max(1), inner.height.max(1));
         let config = surface_config(&surface, &gpu, window_size, vsync)?;
