@@ -112,6 +112,8 @@ pub struct ProtocolGroup {
     pub pitch_means: Vec<PitchMean>,
     /// Per method and pitch: the spread of those means across adapters.
     pub pitch_spreads: Vec<PitchSpread>,
+    /// Per method: the largest spread of each field over its cells.
+    pub method_max_spreads: Vec<MethodSpread>,
     /// Every cell; those that disagree first.
     pub cells: Vec<CellSpread>,
     pub disagreeing_cells: usize,
@@ -198,6 +200,13 @@ pub struct PitchSpread {
     pub method: String,
     pub pitch: f32,
     pub spread: Accuracy,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct MethodSpread {
+    pub method: String,
+    /// Field-wise maximum of the cells' spreads.
+    pub max: Accuracy,
 }
 
 /// One adapter's value of a cell.
@@ -640,6 +649,28 @@ fn build_group(
         })
     });
     let disagreeing_cells = cells.iter().filter(|c| !c.disagrees.is_empty()).count();
+    let method_max_spreads = s
+        .methods
+        .iter()
+        .filter_map(|m| {
+            let spreads: Vec<Accuracy> = cells
+                .iter()
+                .filter(|c| c.method == *m)
+                .filter_map(|c| c.spread)
+                .collect();
+            let max = |f: fn(&Accuracy) -> f64| spreads.iter().map(f).reduce(f64::max);
+            Some(MethodSpread {
+                method: m.clone(),
+                max: Accuracy {
+                    see_through: max(|a| a.see_through)?,
+                    covers_sky: max(|a| a.covers_sky)?,
+                    depth_p50: max(|a| a.depth_p50)?,
+                    depth_p95: max(|a| a.depth_p95)?,
+                    coherence: max(|a| a.coherence)?,
+                },
+            })
+        })
+        .collect();
 
     let failures = members
         .iter()
@@ -720,6 +751,7 @@ fn build_group(
         separate_because,
         pitch_means,
         pitch_spreads,
+        method_max_spreads,
         cells,
         disagreeing_cells,
         failures,
@@ -1153,6 +1185,29 @@ fn group_markdown(md: &mut String, g: &ProtocolGroup) {
         },
     );
 
+    if !g.method_max_spreads.is_empty() {
+        md.push_str("### Largest spread per method\n\n");
+        md.push_str(
+            "The largest max − min across adapters over the method's cells, each field on its own.\n\n\
+             | method | see-through % | covers-sky % | p50 | p95 | coherence % |\n\
+             |---|---:|---:|---:|---:|---:|\n",
+        );
+        for m in &g.method_max_spreads {
+            let a = &m.max;
+            let _ = writeln!(
+                md,
+                "| {} | {} | {} | {} | {} | {} |",
+                cell_text(&m.method),
+                num(a.see_through, 3),
+                num(a.covers_sky, 3),
+                num(a.depth_p50, 3),
+                num(a.depth_p95, 3),
+                num(a.coherence, 3)
+            );
+        }
+        md.push('\n');
+    }
+
     // Every cell's spread.
     if g.adapters.len() > 1 {
         md.push_str("### Spread per cell\n\n");
@@ -1374,7 +1429,25 @@ mod tests {
             .unwrap();
         assert!((ps.spread.see_through - 0.8).abs() < 1e-12);
 
+        let ray_max = g
+            .method_max_spreads
+            .iter()
+            .find(|m| m.method == "ray")
+            .unwrap();
+        assert!((ray_max.max.see_through - 0.8).abs() < 1e-12);
+        assert_eq!(ray_max.max.depth_p95, 0.0);
+        let mesh_max = g
+            .method_max_spreads
+            .iter()
+            .find(|m| m.method == "mesh")
+            .unwrap();
+        assert!((mesh_max.max.depth_p95 - 3.0).abs() < 1e-12);
+        assert!((mesh_max.max.coherence - 0.4).abs() < 1e-12);
         let md = render_markdown(&p);
+        assert!(
+            md.contains("| mesh | 0.000 | 0.000 | 0.000 | 3.000 | 0.400 |"),
+            "{md}"
+        );
         let first = md.find("**spiral / mesh**").expect("spiral/mesh listed");
         let second = md.find("**river / ray**").expect("river/ray listed");
         assert!(first < second, "{md}");

@@ -67,11 +67,7 @@ fn all_adapters_batch_and_portability_merge() {
         .success()
     );
     let views = dir.join("views.txt");
-    std::fs::write(
-        &views,
-        "level 100,100:0:30 0\ndown 128,300:90:60 -60\n",
-    )
-    .unwrap();
+    std::fs::write(&views, "level 100,100:0:30 0\ndown 128,300:90:60 -60\n").unwrap();
     let out = dir.join("batch");
     let run = strata(&[
         "compare",
@@ -103,7 +99,11 @@ fn all_adapters_batch_and_portability_merge() {
         adapters.len(),
         "{report:#?}"
     );
-    assert!(!report.runs.is_empty(), "no adapter ran: {:?}", report.skipped);
+    assert!(
+        !report.runs.is_empty(),
+        "no adapter ran: {:?}",
+        report.skipped
+    );
     // One protocol (the size and frames were explicit): one group.
     assert_eq!(report.groups.len(), 1, "{report:#?}");
     let g = &report.groups[0];
@@ -134,7 +134,10 @@ fn all_adapters_batch_and_portability_merge() {
         assert!(r.complete, "{r:?}");
         assert!(r.results.contains('/'), "{} is in a subfolder", r.results);
     }
-    eprintln!("{}", std::fs::read_to_string(out.join("portability.md")).unwrap());
+    eprintln!(
+        "{}",
+        std::fs::read_to_string(out.join("portability.md")).unwrap()
+    );
 
     // The same report from the results files.
     let merged = dir.join("merged");

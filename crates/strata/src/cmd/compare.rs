@@ -293,6 +293,9 @@ pub fn summarize(report: &portability::Portability) {
         }
     }
     for s in &report.skipped {
-        println!("adapter {} ({}) did not finish: {}", s.adapter, s.backend, s.error);
+        println!(
+            "adapter {} ({}) did not finish: {}",
+            s.adapter, s.backend, s.error
+        );
     }
 }
