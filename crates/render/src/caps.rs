@@ -19,8 +19,8 @@ pub enum Capability {
     FragmentStorage,
     /// Storage buffers bound to vertex shaders.
     VertexStorage,
-    /// `R32Float` as a colour attachment (the fragment shadow pass and the
-    /// depth read-back pass where depth copies are missing).
+    /// `R32Float` as a colour attachment (the shadow map drawn by a
+    /// fragment pass where compute is missing).
     Float32Targets,
 }
 
@@ -56,7 +56,7 @@ pub struct Capabilities {
     pub vertex_storage: bool,
     pub float32_targets: bool,
     /// Depth textures copy to buffers; without it depth is read back
-    /// through a pass into an `R32Float` target.
+    /// through a pass into an `R32Uint` target (`depth_read.rs`).
     pub depth_copies: bool,
     /// Per-pass GPU timestamps; without them frames are timed on the CPU
     /// (submit until done).
@@ -199,3 +199,34 @@ impl fmt::Display for Refusal {
 }
 
 impl std::error::Error for Refusal {}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::methods::{METHODS, check_support, supported};
+
+    #[test]
+    fn webgl2_runs_the_fragment_methods_and_names_what_the_rest_lack() {
+        let caps = Capabilities::webgl2();
+        assert_eq!(supported(&caps), ["ray", "painted", "sliced"]);
+        let error = check_support("ray-compute", &caps).unwrap_err().to_string();
+        assert_eq!(
+            error,
+            "ray-compute: needs compute shaders and storage textures, which this adapter lacks"
+        );
+        let error = check_support("mesh", &caps).unwrap_err().to_string();
+        assert_eq!(
+            error,
+            "mesh: needs storage buffers in vertex shaders, which this adapter lacks"
+        );
+        assert_eq!(caps.shadow_pass(), Some(ShadowPassKind::Fragment));
+    }
+
+    #[test]
+    fn a_full_adapter_runs_every_method() {
+        let caps = Capabilities::full();
+        assert_eq!(supported(&caps).len(), METHODS.len());
+        assert_eq!(caps.shadow_pass(), Some(ShadowPassKind::Compute));
+        assert!(check_support("no-such-method", &caps).is_err());
+    }
+}

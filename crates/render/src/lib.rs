@@ -20,6 +20,7 @@
 extern crate self as strata_render;
 
 pub mod caps;
+pub mod depth_read;
 pub mod frame;
 pub mod gpu;
 pub mod methods;

@@ -6,6 +6,7 @@
 //! (the viewer switches between them without reloading the level). Every kept
 //! method follows every edit, so switching never shows stale terrain.
 
+use crate::depth_read::DepthReader;
 use crate::frame::{Globals, LevelShape, Shared, TerrainColors};
 use crate::gpu::{ErrorSink, Gpu, wait_device};
 use crate::methods::{self, Frame, Method, MethodSettings, RetainedBytes};
@@ -48,6 +49,8 @@ pub struct Renderer {
     shadow_reuse: bool,
     /// The frame the shadow map holds, while no edit has changed it.
     shadow_drawn: Option<ShadowFrame>,
+    /// Depth read-back through a pass, where depth copies are missing.
+    depth_reader: Option<DepthReader>,
 }
 
 impl Renderer {
@@ -76,6 +79,7 @@ impl Renderer {
         )?);
         let method = methods::create(method, &shared, level, settings)?;
         let shadow = ShadowPass::new(&shared)?;
+        let depth_reader = DepthReader::new(&gpu.device, &gpu.caps)?;
         let timer = PassTimer::new(&gpu.device, &gpu.queue, gpu.report.timestamps);
         let mut renderer = Renderer {
             shared,
@@ -93,6 +97,7 @@ impl Renderer {
             setup_ms: 0.0,
             shadow_reuse: false,
             shadow_drawn: None,
+            depth_reader,
         };
         wait_device(&renderer.shared.device, &renderer.errors)?;
         renderer.setup_ms = ms(start);
@@ -352,6 +357,10 @@ impl Renderer {
 
     /// The depth target: depth-buffer values (0 near .. 1 far, 1 = sky), row-major.
     pub fn read_depth(&self) -> anyhow::Result<Vec<f32>> {
+        if let Some(reader) = &self.depth_reader {
+            let s = &self.shared;
+            return reader.read(&s.device, &s.queue, &self.errors, &s.depth);
+        }
         let raw = self.read_texture(&self.shared.depth, wgpu::TextureAspect::DepthOnly)?;
         Ok(bytemuck::cast_slice::<u8, f32>(&raw).to_vec())
     }

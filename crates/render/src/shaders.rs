@@ -25,6 +25,10 @@ pub const SOURCES: &[(&str, &str)] = &[
         "depth_blit.wgsl",
         include_str!("../shaders/depth_blit.wgsl"),
     ),
+    (
+        "depth_read.wgsl",
+        include_str!("../shaders/depth_read.wgsl"),
+    ),
     ("shadow.wgsl", include_str!("../shaders/shadow.wgsl")),
     (
         "decode_test.wgsl",
@@ -63,6 +67,7 @@ pub const ENTRY_SHADERS: &[&str] = &[
     "ray.wgsl",
     "ray_compute.wgsl",
     "depth_blit.wgsl",
+    "depth_read.wgsl",
     "shadow.wgsl",
     "decode_test.wgsl",
     "voxel.wgsl",

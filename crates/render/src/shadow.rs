@@ -3,6 +3,7 @@
 //! (`shaders/shadow.wgsl`) before the method's passes, and sampled with 4-tap
 //! PCF by `shading.wgsl`.
 
+use crate::caps::{Capability, ShadowPassKind};
 use crate::frame::{SHADOW_SIZE, Shared, storage_texture_entry};
 use glam::Vec3;
 use strata_camera::Camera;
@@ -84,11 +85,23 @@ impl ShadowFrame {
     }
 }
 
-/// The compute pass that fills the shadow map.
+/// How the shadow map is filled: a compute pass writing it as a storage
+/// texture, or (no compute: WebGL2) a full-screen fragment pass drawing it as
+/// a render target. Both run `shadow_distance` of `shadow.wgsl`.
+enum ShadowPipeline {
+    Compute {
+        pipeline: wgpu::ComputePipeline,
+        out_group: wgpu::BindGroup,
+    },
+    Fragment(wgpu::RenderPipeline),
+}
+
+/// The pass that fills the shadow map.
 pub struct ShadowPass {
-    pipeline: wgpu::ComputePipeline,
+    pipeline: ShadowPipeline,
     frame_group: wgpu::BindGroup,
-    out_group: wgpu::BindGroup,
+    /// The map as a render target (the fragment pass).
+    target: wgpu::TextureView,
 }
 
 impl ShadowPass {
@@ -121,47 +134,129 @@ impl ShadowPass {
                 },
             ],
         });
-        let out_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("shadow out"),
-            entries: &[storage_texture_entry(0, wgpu::TextureFormat::R32Float)],
-        });
-        let out_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("shadow out"),
-            layout: &out_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: wgpu::BindingResource::TextureView(&shared.shadow_view),
-            }],
-        });
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("shadow"),
-            bind_group_layouts: &[Some(&frame_layout), Some(&out_layout)],
-            immediate_size: 0,
-        });
         let module = shared.shader("shadow.wgsl")?;
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("shadow"),
-            layout: Some(&layout),
-            module: &module,
-            entry_point: Some("cs_shadow"),
-            compilation_options: Default::default(),
-            cache: None,
-        });
+        let kind = shared.caps.shadow_pass().ok_or_else(|| {
+            anyhow::anyhow!(
+                "the shadow map needs {} or {}, which this adapter lacks",
+                Capability::ComputeShaders,
+                Capability::Float32Targets
+            )
+        })?;
+        let pipeline = match kind {
+            ShadowPassKind::Compute => {
+                let out_layout =
+                    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                        label: Some("shadow out"),
+                        entries: &[storage_texture_entry(0, wgpu::TextureFormat::R32Float)],
+                    });
+                let out_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("shadow out"),
+                    layout: &out_layout,
+                    entries: &[wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: wgpu::BindingResource::TextureView(&shared.shadow_view),
+                    }],
+                });
+                let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                    label: Some("shadow"),
+                    bind_group_layouts: &[Some(&frame_layout), Some(&out_layout)],
+                    immediate_size: 0,
+                });
+                let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                    label: Some("shadow"),
+                    layout: Some(&layout),
+                    module: &module,
+                    entry_point: Some("cs_shadow"),
+                    compilation_options: Default::default(),
+                    cache: None,
+                });
+                ShadowPipeline::Compute {
+                    pipeline,
+                    out_group,
+                }
+            }
+            ShadowPassKind::Fragment => {
+                let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                    label: Some("shadow"),
+                    bind_group_layouts: &[Some(&frame_layout)],
+                    immediate_size: 0,
+                });
+                ShadowPipeline::Fragment(device.create_render_pipeline(
+                    &wgpu::RenderPipelineDescriptor {
+                        label: Some("shadow"),
+                        layout: Some(&layout),
+                        vertex: wgpu::VertexState {
+                            module: &module,
+                            entry_point: Some("vs_fullscreen"),
+                            compilation_options: Default::default(),
+                            buffers: &[],
+                        },
+                        primitive: Default::default(),
+                        depth_stencil: None,
+                        multisample: Default::default(),
+                        fragment: Some(wgpu::FragmentState {
+                            module: &module,
+                            entry_point: Some("fs_shadow"),
+                            compilation_options: Default::default(),
+                            targets: &[Some(wgpu::TextureFormat::R32Float.into())],
+                        }),
+                        multiview_mask: None,
+                        cache: None,
+                    },
+                ))
+            }
+        };
         Ok(ShadowPass {
             pipeline,
             frame_group,
-            out_group,
+            target: shared.shadow_view.clone(),
         })
     }
 
+    /// Which kind of pass fills the map on this adapter.
+    pub fn kind(&self) -> ShadowPassKind {
+        match self.pipeline {
+            ShadowPipeline::Compute { .. } => ShadowPassKind::Compute,
+            ShadowPipeline::Fragment(_) => ShadowPassKind::Fragment,
+        }
+    }
+
     pub fn record(&self, encoder: &mut wgpu::CommandEncoder, timer: &crate::timing::PassTimer) {
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("shadow map"),
-            timestamp_writes: timer.compute("shadow"),
-        });
-        pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &self.frame_group, &[]);
-        pass.set_bind_group(1, &self.out_group, &[]);
-        pass.dispatch_workgroups(SHADOW_SIZE.div_ceil(8), SHADOW_SIZE.div_ceil(8), 1);
+        match &self.pipeline {
+            ShadowPipeline::Compute {
+                pipeline,
+                out_group,
+            } => {
+                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("shadow map"),
+                    timestamp_writes: timer.compute("shadow"),
+                });
+                pass.set_pipeline(pipeline);
+                pass.set_bind_group(0, &self.frame_group, &[]);
+                pass.set_bind_group(1, out_group, &[]);
+                pass.dispatch_workgroups(SHADOW_SIZE.div_ceil(8), SHADOW_SIZE.div_ceil(8), 1);
+            }
+            ShadowPipeline::Fragment(pipeline) => {
+                let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("shadow map"),
+                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                        view: &self.target,
+                        depth_slice: None,
+                        resolve_target: None,
+                        ops: wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                            store: wgpu::StoreOp::Store,
+                        },
+                    })],
+                    depth_stencil_attachment: None,
+                    timestamp_writes: timer.render("shadow"),
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                });
+                pass.set_pipeline(pipeline);
+                pass.set_bind_group(0, &self.frame_group, &[]);
+                pass.draw(0..3, 0..1);
+            }
+        }
     }
 }

@@ -51,8 +51,10 @@ impl TerrainLayout {
         self.layer_rows.trailing_zeros()
     }
 
+    /// GPU bytes of the texture (one layer more than the map needs for
+    /// one-layer maps: see [`TerrainTexture::new`]).
     pub fn bytes(&self) -> u64 {
-        u64::from(self.map_width) * u64::from(self.map_height) * 2
+        u64::from(self.pairs) * u64::from(self.layer_rows) * u64::from(self.layers.max(2)) * 4
     }
 }
 
@@ -72,7 +74,11 @@ impl TerrainTexture {
             size: wgpu::Extent3d {
                 width: layout.pairs,
                 height: layout.layer_rows,
-                depth_or_array_layers: layout.layers,
+                // wgpu's GL backend makes a one-layer texture a GL_TEXTURE_2D,
+                // which a `texture_2d_array` binding then does not see (it
+                // read zeros): allocate a second, unused layer for maps of
+                // at most `MAX_LAYER_ROWS` rows.
+                depth_or_array_layers: layout.layers.max(2),
             },
             mip_level_count: 1,
             sample_count: 1,

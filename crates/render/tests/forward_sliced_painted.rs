@@ -28,49 +28,52 @@ fn worst_over(
 
 #[test]
 fn painted_matches_the_reference() {
-    let Some(gpu) = common::gpu() else { return };
-    let level = common::synthetic_level();
-    let m = worst_over(
-        &gpu,
-        &level,
-        &TerrainColors::test_ramps(),
-        &common::synthetic_views(),
-        "painted",
-        (W, H),
-    );
-    eprintln!("painted worst (synthetic): {m:?}");
-    // Measured: 0 % see-through and covers-sky, p95 <= 0.033 at every pitch
-    // (the issue asks <= 1 %): bars are the exact solid.
-    assert!(m.see_through <= 0.1 && m.covers_sky <= 0.1, "{m:?}");
-    assert!(m.depth_p95 <= 0.1, "{m:?}");
+    for gpu in common::gpus() {
+        let level = common::synthetic_level();
+        let m = worst_over(
+            &gpu,
+            &level,
+            &TerrainColors::test_ramps(),
+            &common::synthetic_views(),
+            "painted",
+            (W, H),
+        );
+        eprintln!("painted worst (synthetic): {m:?}");
+        // Measured: 0 % see-through and covers-sky, p95 <= 0.033 at every pitch
+        // (the issue asks <= 1 %): bars are the exact solid.
+        assert!(m.see_through <= 0.1 && m.covers_sky <= 0.1, "{m:?}");
+        assert!(m.depth_p95 <= 0.1, "{m:?}");
+    }
 }
 
 #[test]
 fn painted_matches_the_reference_on_a_generated_world() {
-    let Some(gpu) = common::gpu() else { return };
-    let w = common::generated_world();
-    let m = worst_over(
-        &gpu,
-        &w.level,
-        &TerrainColors::from_world(&w),
-        &w.views,
-        "painted",
-        (W, H),
-    );
-    eprintln!("painted worst (generated): {m:?}");
-    assert!(m.see_through <= 0.1 && m.covers_sky <= 0.1, "{m:?}");
-    assert!(m.depth_p95 <= 0.1, "{m:?}");
+    for gpu in common::gpus() {
+        let w = common::generated_world();
+        let m = worst_over(
+            &gpu,
+            &w.level,
+            &TerrainColors::from_world(&w),
+            &w.views,
+            "painted",
+            (W, H),
+        );
+        eprintln!("painted worst (generated): {m:?}");
+        assert!(m.see_through <= 0.1 && m.covers_sky <= 0.1, "{m:?}");
+        assert!(m.depth_p95 <= 0.1, "{m:?}");
+    }
 }
 
 /// The crater's first frame equals a fresh renderer's, and shows.
 fn assert_crater_like_fresh(method: &str) {
-    let Some(gpu) = common::gpu() else { return };
-    let (pct, p95, changed) = common::crater_against_fresh(&gpu, method);
-    assert!(
-        changed > 100,
-        "the crater left (almost) no trace: {changed}"
-    );
-    assert!(pct <= 0.01 && p95 <= 0.1, "mismatch {pct} %, p95 {p95}");
+    for gpu in common::gpus() {
+        let (pct, p95, changed) = common::crater_against_fresh(&gpu, method);
+        assert!(
+            changed > 100,
+            "the crater left (almost) no trace: {changed}"
+        );
+        assert!(pct <= 0.01 && p95 <= 0.1, "mismatch {pct} %, p95 {p95}");
+    }
 }
 
 #[test]
@@ -80,42 +83,44 @@ fn painted_shows_a_crater_in_the_next_frame() {
 
 #[test]
 fn sliced_matches_the_reference() {
-    let Some(gpu) = common::gpu() else { return };
-    let level = common::synthetic_level();
-    let colors = TerrainColors::test_ramps();
-    let (level_views, pitched): (Vec<_>, Vec<_>) = common::synthetic_views()
-        .into_iter()
-        .partition(|v| v.pitch == 0.0);
-    // Looking down, slices 0.5 apart leave nothing uncovered.
-    let m = worst_over(&gpu, &level, &colors, &pitched, "sliced", (W, H));
-    eprintln!("sliced worst (synthetic, pitched): {m:?}");
-    assert!(m.see_through <= 0.1 && m.covers_sky <= 0.2, "{m:?}");
-    assert!(m.depth_p95 <= 1.5, "{m:?}");
-    // At the horizon a 100 px image is all grazing rays (11 degrees of
-    // view): they cross slices 0.5/slope apart and slip through thin
-    // features — the method's bands. Measured: 13.1 % at horizon-b.
-    let m = worst_over(&gpu, &level, &colors, &level_views, "sliced", (W, H));
-    eprintln!("sliced worst (synthetic, level): {m:?}");
-    assert!(m.see_through <= 16.0 && m.covers_sky <= 0.2, "{m:?}");
+    for gpu in common::gpus() {
+        let level = common::synthetic_level();
+        let colors = TerrainColors::test_ramps();
+        let (level_views, pitched): (Vec<_>, Vec<_>) = common::synthetic_views()
+            .into_iter()
+            .partition(|v| v.pitch == 0.0);
+        // Looking down, slices 0.5 apart leave nothing uncovered.
+        let m = worst_over(&gpu, &level, &colors, &pitched, "sliced", (W, H));
+        eprintln!("sliced worst (synthetic, pitched): {m:?}");
+        assert!(m.see_through <= 0.1 && m.covers_sky <= 0.2, "{m:?}");
+        assert!(m.depth_p95 <= 1.5, "{m:?}");
+        // At the horizon a 100 px image is all grazing rays (11 degrees of
+        // view): they cross slices 0.5/slope apart and slip through thin
+        // features — the method's bands. Measured: 13.1 % at horizon-b.
+        let m = worst_over(&gpu, &level, &colors, &level_views, "sliced", (W, H));
+        eprintln!("sliced worst (synthetic, level): {m:?}");
+        assert!(m.see_through <= 16.0 && m.covers_sky <= 0.2, "{m:?}");
+    }
 }
 
 #[test]
 fn sliced_matches_the_reference_on_a_generated_world() {
-    let Some(gpu) = common::gpu() else { return };
-    let w = common::generated_world();
-    let m = worst_over(
-        &gpu,
-        &w.level,
-        &TerrainColors::from_world(&w),
-        &w.views,
-        "sliced",
-        (320, 200),
-    );
-    eprintln!("sliced worst (generated, 320x200): {m:?}");
-    // Measured: worst 0.94 % (hangar, pitch 0), 0 % looking down; the issue
-    // asks <= 3 %.
-    assert!(m.see_through <= 2.0, "{m:?}");
-    assert!(m.covers_sky <= 0.2, "{m:?}");
+    for gpu in common::gpus() {
+        let w = common::generated_world();
+        let m = worst_over(
+            &gpu,
+            &w.level,
+            &TerrainColors::from_world(&w),
+            &w.views,
+            "sliced",
+            (320, 200),
+        );
+        eprintln!("sliced worst (generated, 320x200): {m:?}");
+        // Measured: worst 0.94 % (hangar, pitch 0), 0 % looking down; the issue
+        // asks <= 3 %.
+        assert!(m.see_through <= 2.0, "{m:?}");
+        assert!(m.covers_sky <= 0.2, "{m:?}");
+    }
 }
 
 #[test]
@@ -125,36 +130,38 @@ fn sliced_shows_a_crater_in_the_next_frame() {
 
 #[test]
 fn bad_settings_fail_clearly() {
-    let Some(gpu) = common::gpu() else { return };
-    let level = Level::flat(64, 64, 10, 1).unwrap();
-    let colors = TerrainColors::test_ramps();
-    for slices in [0, 1 << 20] {
-        let settings = MethodSettings {
-            slices,
-            ..Default::default()
-        };
-        let err = Renderer::new(&gpu, &level, &colors, "sliced", &settings, 8, 8)
-            .err()
-            .expect("should fail");
-        assert!(format!("{err:#}").contains("slices"), "{err:#}");
-    }
-    // A far plane far beyond the map at a grazing view: painted clamps its
-    // footprint (a warning) and still draws; sliced draws its quads.
-    for method in ["painted", "sliced"] {
-        let mut r = Renderer::new(
-            &gpu,
-            &level,
-            &colors,
-            method,
-            &MethodSettings::default(),
-            16,
-            8,
-        )
-        .unwrap();
-        let mut camera = Camera::new(glam::Vec3::new(5.0, 5.0, 30.0), 45.0, -10.0, 16, 8).unwrap();
-        camera.far = 200_000.0;
-        r.render_frame(&camera).unwrap();
-        let depth = r.read_depth().unwrap();
-        assert!(depth.iter().any(|&d| d < 1.0), "{method}: nothing drawn");
+    for gpu in common::gpus() {
+        let level = Level::flat(64, 64, 10, 1).unwrap();
+        let colors = TerrainColors::test_ramps();
+        for slices in [0, 1 << 20] {
+            let settings = MethodSettings {
+                slices,
+                ..Default::default()
+            };
+            let err = Renderer::new(&gpu, &level, &colors, "sliced", &settings, 8, 8)
+                .err()
+                .expect("should fail");
+            assert!(format!("{err:#}").contains("slices"), "{err:#}");
+        }
+        // A far plane far beyond the map at a grazing view: painted clamps its
+        // footprint (a warning) and still draws; sliced draws its quads.
+        for method in ["painted", "sliced"] {
+            let mut r = Renderer::new(
+                &gpu,
+                &level,
+                &colors,
+                method,
+                &MethodSettings::default(),
+                16,
+                8,
+            )
+            .unwrap();
+            let mut camera =
+                Camera::new(glam::Vec3::new(5.0, 5.0, 30.0), 45.0, -10.0, 16, 8).unwrap();
+            camera.far = 200_000.0;
+            r.render_frame(&camera).unwrap();
+            let depth = r.read_depth().unwrap();
+            assert!(depth.iter().any(|&d| d < 1.0), "{method}: nothing drawn");
+        }
     }
 }

@@ -62,39 +62,41 @@ fn worst_over(
 
 #[test]
 fn mesh_matches_the_reference() {
-    let Some(gpu) = common::gpu() else { return };
-    let level = common::synthetic_level();
-    let m = worst_over(
-        &gpu,
-        &level,
-        &TerrainColors::test_ramps(),
-        &common::synthetic_views(),
-        (160, 100),
-    );
-    eprintln!("mesh worst (synthetic, 160x100): {m:?}");
-    // Measured: 0 % see-through at every view but `high` (pitch 0, 1.0 %):
-    // samples stand at texel centres, so the level's 20-unit terrace cliffs
-    // become ramps whose top edge sits half a texel inside the block
-    // silhouette. Covers-sky 0.57 % there: far chunks' coarser LODs.
-    assert!(m.see_through <= 1.5 && m.coherence <= 0.5, "{m:?}");
-    assert!(m.covers_sky <= 1.0, "{m:?}");
+    for gpu in common::gpus() {
+        let level = common::synthetic_level();
+        let m = worst_over(
+            &gpu,
+            &level,
+            &TerrainColors::test_ramps(),
+            &common::synthetic_views(),
+            (160, 100),
+        );
+        eprintln!("mesh worst (synthetic, 160x100): {m:?}");
+        // Measured: 0 % see-through at every view but `high` (pitch 0, 1.0 %):
+        // samples stand at texel centres, so the level's 20-unit terrace cliffs
+        // become ramps whose top edge sits half a texel inside the block
+        // silhouette. Covers-sky 0.57 % there: far chunks' coarser LODs.
+        assert!(m.see_through <= 1.5 && m.coherence <= 0.5, "{m:?}");
+        assert!(m.covers_sky <= 1.0, "{m:?}");
+    }
 }
 
 #[test]
 fn mesh_matches_the_reference_on_a_generated_world() {
-    let Some(gpu) = common::gpu() else { return };
-    let w = common::generated_world();
-    let m = worst_over(
-        &gpu,
-        &w.level,
-        &TerrainColors::from_world(&w),
-        &w.views,
-        (320, 200),
-    );
-    eprintln!("mesh worst (generated, 320x200): {m:?}");
-    // Measured: see-through 0 %, covers-sky 0 %, coherence <= 0.18 % (spiral).
-    assert!(m.see_through <= 0.5 && m.coherence <= 0.5, "{m:?}");
-    assert!(m.covers_sky <= 0.5, "{m:?}");
+    for gpu in common::gpus() {
+        let w = common::generated_world();
+        let m = worst_over(
+            &gpu,
+            &w.level,
+            &TerrainColors::from_world(&w),
+            &w.views,
+            (320, 200),
+        );
+        eprintln!("mesh worst (generated, 320x200): {m:?}");
+        // Measured: see-through 0 %, covers-sky 0 %, coherence <= 0.18 % (spiral).
+        assert!(m.see_through <= 0.5 && m.coherence <= 0.5, "{m:?}");
+        assert!(m.covers_sky <= 0.5, "{m:?}");
+    }
 }
 
 /// CPU ms of refitting the chunks `rects` dirty, one after another on this
@@ -125,101 +127,105 @@ fn sequential_refit_cpu_ms(
 
 #[test]
 fn a_crater_equals_a_fresh_fit_in_the_next_frame() {
-    let Some(gpu) = common::gpu() else { return };
-    // The fixture's camera: the crater is ~14 degrees down, in frame only in
-    // a tall image.
-    let (w_px, h_px) = (160, 400);
-    let w = common::generated_world();
-    let colors = TerrainColors::from_world(&w);
-    let site = w.edit.clone().expect("generated worlds carry an edit site");
-    let mut level = w.level.clone();
-    let camera = Camera::from_view(&level, &site.camera, w_px, h_px).unwrap();
-    let mut r = Renderer::new(&gpu, &level, &colors, "mesh", &settings(), w_px, h_px).unwrap();
-    r.render_frame(&camera).unwrap();
-    let before = r.read_depth().unwrap();
-    let retained = r.retained_bytes();
-    let rects = strata_level::edit::crater(&mut level, &site);
-    let (cpu_ms, chunks) = sequential_refit_cpu_ms(&level, &rects);
-    let t0 = std::time::Instant::now();
-    r.apply_edit(&level, &rects).unwrap();
-    let wall_ms = t0.elapsed().as_secs_f64() * 1e3;
-    eprintln!("mesh crater: {chunks} dirty chunks");
-    r.render_frame(&camera).unwrap();
-    let after = r.read_depth().unwrap();
-    let mut fresh = Renderer::new(&gpu, &level, &colors, "mesh", &settings(), w_px, h_px).unwrap();
-    fresh.render_frame(&camera).unwrap();
-    let want = fresh.read_depth().unwrap();
-    let changed = before.iter().zip(&after).filter(|(a, b)| a != b).count();
-    let class = after
-        .iter()
-        .zip(&want)
-        .filter(|(a, b)| (**a >= 1.0) != (**b >= 1.0))
-        .count();
-    let max_diff = after
-        .iter()
-        .zip(&want)
-        .map(|(a, b)| (a - b).abs())
-        .fold(0.0f32, f32::max);
-    eprintln!(
-        "mesh crater: {} rects, apply_edit (texture upload + refit + pool writes) wall {wall_ms:.2} ms, CPU {cpu_ms:?} ms; \
+    for gpu in common::gpus() {
+        // The fixture's camera: the crater is ~14 degrees down, in frame only in
+        // a tall image.
+        let (w_px, h_px) = (160, 400);
+        let w = common::generated_world();
+        let colors = TerrainColors::from_world(&w);
+        let site = w.edit.clone().expect("generated worlds carry an edit site");
+        let mut level = w.level.clone();
+        let camera = Camera::from_view(&level, &site.camera, w_px, h_px).unwrap();
+        let mut r = Renderer::new(&gpu, &level, &colors, "mesh", &settings(), w_px, h_px).unwrap();
+        r.render_frame(&camera).unwrap();
+        let before = r.read_depth().unwrap();
+        let retained = r.retained_bytes();
+        let rects = strata_level::edit::crater(&mut level, &site);
+        let (cpu_ms, chunks) = sequential_refit_cpu_ms(&level, &rects);
+        let t0 = std::time::Instant::now();
+        r.apply_edit(&level, &rects).unwrap();
+        let wall_ms = t0.elapsed().as_secs_f64() * 1e3;
+        eprintln!("mesh crater: {chunks} dirty chunks");
+        r.render_frame(&camera).unwrap();
+        let after = r.read_depth().unwrap();
+        let mut fresh =
+            Renderer::new(&gpu, &level, &colors, "mesh", &settings(), w_px, h_px).unwrap();
+        fresh.render_frame(&camera).unwrap();
+        let want = fresh.read_depth().unwrap();
+        let changed = before.iter().zip(&after).filter(|(a, b)| a != b).count();
+        let class = after
+            .iter()
+            .zip(&want)
+            .filter(|(a, b)| (**a >= 1.0) != (**b >= 1.0))
+            .count();
+        let max_diff = after
+            .iter()
+            .zip(&want)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0f32, f32::max);
+        eprintln!(
+            "mesh crater: {} rects, apply_edit (texture upload + refit + pool writes) wall {wall_ms:.2} ms, CPU {cpu_ms:?} ms; \
          {changed} pixels changed; vs fresh: class mismatch {class}, max depth difference {max_diff}; \
          retained before {retained:?}, after {:?}",
-        rects.len(),
-        r.retained_bytes()
-    );
-    assert!(
-        changed > 100,
-        "the crater left (almost) no trace: {changed}"
-    );
-    assert_eq!(class, 0, "hit/miss differs from a fresh renderer");
-    assert_eq!(max_diff, 0.0, "depth differs from a fresh renderer");
-    // The slot table does not grow with an edit; the pool is not reallocated
-    // for a crater (its tail has room).
-    assert_eq!(r.retained_bytes(), retained);
+            rects.len(),
+            r.retained_bytes()
+        );
+        assert!(
+            changed > 100,
+            "the crater left (almost) no trace: {changed}"
+        );
+        assert_eq!(class, 0, "hit/miss differs from a fresh renderer");
+        assert_eq!(max_diff, 0.0, "depth differs from a fresh renderer");
+        // The slot table does not grow with an edit; the pool is not reallocated
+        // for a crater (its tail has room).
+        assert_eq!(r.retained_bytes(), retained);
+    }
 }
 
 #[test]
 fn retained_bytes_cover_all_lods() {
-    let Some(gpu) = common::gpu() else { return };
-    let level = common::synthetic_level();
-    let r = Renderer::new(
-        &gpu,
-        &level,
-        &TerrainColors::test_ramps(),
-        "mesh",
-        &settings(),
-        64,
-        40,
-    )
-    .unwrap();
-    let mesh = strata_mesh::LevelMesh::fit(&level, 4.0);
-    let stats = mesh.stats();
-    let b = r.retained_bytes();
-    let finest = stats.lods[0].emitted;
-    eprintln!(
-        "mesh retained {b:?}; fit: {} indices ({} bytes) for all LODs, {finest} finest-LOD triangles",
-        stats.gpu_indices, stats.gpu_bytes
-    );
-    // All three LODs' indices, plus the tail kept for refits.
-    assert!(b.gpu >= stats.gpu_bytes, "{b:?} vs {stats:?}");
-    // The CPU keeps a slot table per chunk, not the triangulation.
-    assert!(b.cpu > 0 && b.cpu < 64 * 1024, "{b:?}");
+    for gpu in common::gpus() {
+        let level = common::synthetic_level();
+        let r = Renderer::new(
+            &gpu,
+            &level,
+            &TerrainColors::test_ramps(),
+            "mesh",
+            &settings(),
+            64,
+            40,
+        )
+        .unwrap();
+        let mesh = strata_mesh::LevelMesh::fit(&level, 4.0);
+        let stats = mesh.stats();
+        let b = r.retained_bytes();
+        let finest = stats.lods[0].emitted;
+        eprintln!(
+            "mesh retained {b:?}; fit: {} indices ({} bytes) for all LODs, {finest} finest-LOD triangles",
+            stats.gpu_indices, stats.gpu_bytes
+        );
+        // All three LODs' indices, plus the tail kept for refits.
+        assert!(b.gpu >= stats.gpu_bytes, "{b:?} vs {stats:?}");
+        // The CPU keeps a slot table per chunk, not the triangulation.
+        assert!(b.cpu > 0 && b.cpu < 64 * 1024, "{b:?}");
+    }
 }
 
 #[test]
 fn bad_quality_fails_clearly() {
-    let Some(gpu) = common::gpu() else { return };
-    let level = Level::flat(64, 64, 10, 1).unwrap();
-    for q in [-0.1, 1.5, f32::NAN] {
-        let s = MethodSettings {
-            mesh_quality: q,
-            ..Default::default()
-        };
-        let err = Renderer::new(&gpu, &level, &TerrainColors::test_ramps(), "mesh", &s, 8, 8)
-            .err()
-            .map(|e| format!("{e:#}"))
-            .expect("quality outside [0, 1] must fail");
-        assert!(err.contains("mesh quality"), "{err}");
+    for gpu in common::gpus() {
+        let level = Level::flat(64, 64, 10, 1).unwrap();
+        for q in [-0.1, 1.5, f32::NAN] {
+            let s = MethodSettings {
+                mesh_quality: q,
+                ..Default::default()
+            };
+            let err = Renderer::new(&gpu, &level, &TerrainColors::test_ramps(), "mesh", &s, 8, 8)
+                .err()
+                .map(|e| format!("{e:#}"))
+                .expect("quality outside [0, 1] must fail");
+            assert!(err.contains("mesh quality"), "{err}");
+        }
     }
 }
 
@@ -232,77 +238,79 @@ fn bad_quality_fails_clearly() {
 #[test]
 #[ignore]
 fn default_world_views_memory_and_crater() {
-    let Some(gpu) = common::gpu() else { return };
-    let (w_px, h_px) = (320, 200);
-    let world = generate(&Default::default()).unwrap();
-    let colors = TerrainColors::from_world(&world);
-    if std::env::var("MESH_SKIP_VIEWS").is_err() {
-        let m = worst_over(&gpu, &world.level, &colors, &world.views, (w_px, h_px));
-        eprintln!("mesh worst (default world, 320x200): {m:?}");
-        assert!(m.see_through <= 0.5 && m.coherence <= 0.5, "{m:?}");
+    for gpu in common::gpus() {
+        let (w_px, h_px) = (320, 200);
+        let world = generate(&Default::default()).unwrap();
+        let colors = TerrainColors::from_world(&world);
+        if std::env::var("MESH_SKIP_VIEWS").is_err() {
+            let m = worst_over(&gpu, &world.level, &colors, &world.views, (w_px, h_px));
+            eprintln!("mesh worst (default world, 320x200): {m:?}");
+            assert!(m.see_through <= 0.5 && m.coherence <= 0.5, "{m:?}");
+        }
+        let site = world
+            .edit
+            .clone()
+            .expect("the default world has an edit site");
+        let mut level = world.level.clone();
+        let camera = Camera::from_view(&level, &site.camera, w_px, h_px).unwrap();
+        let mut r = Renderer::new(&gpu, &level, &colors, "mesh", &settings(), w_px, h_px).unwrap();
+        let t = std::time::Instant::now();
+        let fitted = strata_mesh::LevelMesh::fit(&level, 4.0);
+        eprintln!(
+            "mesh default world: LevelMesh::fit alone {:.0} ms",
+            t.elapsed().as_secs_f64() * 1e3
+        );
+        let fit = fitted.stats();
+        drop(fitted);
+        let b = r.retained_bytes();
+        let tris = fit.lods[0].emitted as f64;
+        eprintln!(
+            "mesh default world: setup {:.0} ms; retained {b:?} = GPU {:.2} B, CPU {:.3} B per finest-LOD triangle ({} emitted)",
+            r.setup_ms(),
+            b.gpu as f64 / tris,
+            b.cpu as f64 / tris,
+            fit.lods[0].emitted
+        );
+        assert!(
+            (b.gpu as f64) < 16.0 * tris && (b.cpu as f64) < 4.0 * tris,
+            "{b:?}"
+        );
+        r.render_frame(&camera).unwrap();
+        let rects = strata_level::edit::crater(&mut level, &site);
+        let (refit_cpu_ms, chunks) = sequential_refit_cpu_ms(&level, &rects);
+        let t0 = std::time::Instant::now();
+        r.apply_edit(&level, &rects).unwrap();
+        let wall_ms = t0.elapsed().as_secs_f64() * 1e3;
+        r.render_frame(&camera).unwrap();
+        let after = r.read_depth().unwrap();
+        let mut fresh =
+            Renderer::new(&gpu, &level, &colors, "mesh", &settings(), w_px, h_px).unwrap();
+        fresh.render_frame(&camera).unwrap();
+        let want = fresh.read_depth().unwrap();
+        let cpu_ms = refit_cpu_ms;
+        eprintln!(
+            "mesh default-world crater: {chunks} dirty chunks, their refit on one thread: CPU {cpu_ms:?} ms"
+        );
+        let differ = after.iter().zip(&want).filter(|(a, b)| a != b).count();
+        eprintln!(
+            "mesh default-world crater: apply_edit wall {wall_ms:.2} ms; {differ} depth pixels differ from a fresh renderer"
+        );
+        assert_eq!(differ, 0);
+        assert!(cpu_ms.is_none_or(|ms| ms < 20.0), "{cpu_ms:?}");
+        // The paper's fixture spot, (1024, 8192) r 48, sits on a chunk corner:
+        // four chunks to refit. Measured 31.7 ms CPU (2-core machine, load ~8):
+        // over issue 7's 20 ms — the cost is the fitter's per chunk (~8 ms for
+        // these four, ~2 ms for the world's own site); bound it against regression.
+        let corner = strata_level::DirtyRect {
+            x: 976,
+            y: 8144,
+            width: 97,
+            height: 97,
+        };
+        let (corner_ms, corner_chunks) = sequential_refit_cpu_ms(&level, &[corner]);
+        eprintln!(
+            "mesh default-world refit of the paper's crater rect: {corner_chunks} chunks, CPU {corner_ms:?} ms"
+        );
+        assert!(corner_ms.is_none_or(|ms| ms < 50.0), "{corner_ms:?}");
     }
-    let site = world
-        .edit
-        .clone()
-        .expect("the default world has an edit site");
-    let mut level = world.level.clone();
-    let camera = Camera::from_view(&level, &site.camera, w_px, h_px).unwrap();
-    let mut r = Renderer::new(&gpu, &level, &colors, "mesh", &settings(), w_px, h_px).unwrap();
-    let t = std::time::Instant::now();
-    let fitted = strata_mesh::LevelMesh::fit(&level, 4.0);
-    eprintln!(
-        "mesh default world: LevelMesh::fit alone {:.0} ms",
-        t.elapsed().as_secs_f64() * 1e3
-    );
-    let fit = fitted.stats();
-    drop(fitted);
-    let b = r.retained_bytes();
-    let tris = fit.lods[0].emitted as f64;
-    eprintln!(
-        "mesh default world: setup {:.0} ms; retained {b:?} = GPU {:.2} B, CPU {:.3} B per finest-LOD triangle ({} emitted)",
-        r.setup_ms(),
-        b.gpu as f64 / tris,
-        b.cpu as f64 / tris,
-        fit.lods[0].emitted
-    );
-    assert!(
-        (b.gpu as f64) < 16.0 * tris && (b.cpu as f64) < 4.0 * tris,
-        "{b:?}"
-    );
-    r.render_frame(&camera).unwrap();
-    let rects = strata_level::edit::crater(&mut level, &site);
-    let (refit_cpu_ms, chunks) = sequential_refit_cpu_ms(&level, &rects);
-    let t0 = std::time::Instant::now();
-    r.apply_edit(&level, &rects).unwrap();
-    let wall_ms = t0.elapsed().as_secs_f64() * 1e3;
-    r.render_frame(&camera).unwrap();
-    let after = r.read_depth().unwrap();
-    let mut fresh = Renderer::new(&gpu, &level, &colors, "mesh", &settings(), w_px, h_px).unwrap();
-    fresh.render_frame(&camera).unwrap();
-    let want = fresh.read_depth().unwrap();
-    let cpu_ms = refit_cpu_ms;
-    eprintln!(
-        "mesh default-world crater: {chunks} dirty chunks, their refit on one thread: CPU {cpu_ms:?} ms"
-    );
-    let differ = after.iter().zip(&want).filter(|(a, b)| a != b).count();
-    eprintln!(
-        "mesh default-world crater: apply_edit wall {wall_ms:.2} ms; {differ} depth pixels differ from a fresh renderer"
-    );
-    assert_eq!(differ, 0);
-    assert!(cpu_ms.is_none_or(|ms| ms < 20.0), "{cpu_ms:?}");
-    // The paper's fixture spot, (1024, 8192) r 48, sits on a chunk corner:
-    // four chunks to refit. Measured 31.7 ms CPU (2-core machine, load ~8):
-    // over issue 7's 20 ms — the cost is the fitter's per chunk (~8 ms for
-    // these four, ~2 ms for the world's own site); bound it against regression.
-    let corner = strata_level::DirtyRect {
-        x: 976,
-        y: 8144,
-        width: 97,
-        height: 97,
-    };
-    let (corner_ms, corner_chunks) = sequential_refit_cpu_ms(&level, &[corner]);
-    eprintln!(
-        "mesh default-world refit of the paper's crater rect: {corner_chunks} chunks, CPU {corner_ms:?} ms"
-    );
-    assert!(corner_ms.is_none_or(|ms| ms < 50.0), "{corner_ms:?}");
 }

@@ -24,6 +24,61 @@ pub fn gpu() -> Option<Gpu> {
     }
 }
 
+/// The adapters the reference-comparing tests run on: one per backend
+/// found, Vulkan (lavapipe on a CPU machine) and GL (llvmpipe through EGL),
+/// so each method is held to the same limits on both, plus Metal or DX12
+/// where they exist. `STRATA_TEST_BACKENDS=vulkan` (a comma list) narrows
+/// it. A missing Vulkan or GL adapter is skipped loudly;
+/// `STRATA_REQUIRE_GPU=1` (CI) makes a missing Vulkan adapter a failure,
+/// `STRATA_REQUIRE_GL=1` (CI) a missing GL one.
+pub fn gpus() -> Vec<Gpu> {
+    use strata_render::{AdapterChoice, BackendChoice};
+    let wanted = std::env::var("STRATA_TEST_BACKENDS").ok();
+    let mut found = Vec::new();
+    for (backend, required_by) in [
+        (BackendChoice::Vulkan, Some("STRATA_REQUIRE_GPU")),
+        (BackendChoice::Gl, Some("STRATA_REQUIRE_GL")),
+        (BackendChoice::Metal, None),
+        (BackendChoice::Dx12, None),
+    ] {
+        if wanted
+            .as_deref()
+            .is_some_and(|w| !w.split(',').any(|b| b.trim() == backend.to_string()))
+        {
+            continue;
+        }
+        match Gpu::open(&AdapterChoice {
+            backend,
+            index: None,
+        }) {
+            Ok(gpu) => {
+                eprintln!(
+                    "adapter: {} ({}, {})",
+                    gpu.report.name, gpu.report.backend, gpu.report.driver
+                );
+                found.push(gpu);
+            }
+            Err(e) => {
+                if let Some(var) = required_by {
+                    skip_backend_loudly(var, &format!("no {backend} adapter ({e:#})"));
+                }
+            }
+        }
+    }
+    if found.is_empty() {
+        skip_loudly("no GPU adapter on any backend");
+    }
+    found
+}
+
+fn skip_backend_loudly(var: &str, why: &str) {
+    use std::io::Write;
+    if std::env::var_os(var).is_some_and(|v| v == "1") {
+        panic!("{var}=1 but {why}");
+    }
+    let _ = writeln!(std::io::stderr(), "\n*** SKIPPED GPU backend: {why} ***\n");
+}
+
 /// Report a skipped GPU test where the harness cannot swallow it: libtest
 /// captures `eprintln!` of passing tests, so this writes to the process's
 /// stderr directly. With `STRATA_REQUIRE_GPU=1` (CI, which installs lavapipe)
