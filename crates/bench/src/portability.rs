@@ -1582,7 +1582,7 @@ mod tests {
     #[test]
     fn written_report_has_side_by_side_pictures_and_round_trips() {
         let root = tmp("write");
-        let mut runs = vec![run_on("gpu", "vulkan"), run_on("gpu", "gl")];
+        let mut runs = [run_on("gpu", "vulkan"), run_on("gpu", "gl")];
         runs[1].rows[0].see_through = 3.0; // river/ray disagrees
         let mut paths = Vec::new();
         for (k, run) in runs.iter_mut().enumerate() {
