@@ -826,7 +826,10 @@ pub fn write(
     Ok((report, md_path, json_path))
 }
 
-/// `strata merge --portability`: read the results files and write the report.
+/// `strata merge --portability`: read the inputs and write the report. An
+/// input is a results file, or an earlier `portability.json` (a batch made
+/// on another machine), which stands for its runs (their results files
+/// found relative to it) and its skipped adapters.
 pub fn merge_files(
     paths: &[PathBuf],
     out: &Path,
@@ -834,8 +837,54 @@ pub fn merge_files(
     if paths.is_empty() {
         bail!("no results files to merge");
     }
-    let inputs = read_inputs(paths)?;
-    write(&inputs, Vec::new(), out)
+    let mut inputs = Vec::new();
+    let mut skipped = Vec::new();
+    for path in paths {
+        match read_batch(path)? {
+            Some(batch) => {
+                let dir = path.parent().unwrap_or(Path::new("."));
+                for run in &batch.runs {
+                    let results = dir.join(&run.results);
+                    let read = crate::merge::read_run(&results)
+                        .with_context(|| format!("a run of the batch {}", path.display()))?;
+                    inputs.push(Input {
+                        path: results,
+                        run: read,
+                    });
+                }
+                skipped.extend(batch.skipped);
+            }
+            None => inputs.push(Input {
+                path: path.clone(),
+                run: crate::merge::read_run(path)?,
+            }),
+        }
+    }
+    write(&inputs, skipped, out)
+}
+
+/// `Some` when `path` holds a portability report rather than a results file.
+fn read_batch(path: &Path) -> anyhow::Result<Option<Portability>> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    let value: serde_json::Value = match serde_json::from_str(&text) {
+        Ok(v) => v,
+        // Not JSON at all: let the results reader name the problem.
+        Err(_) => return Ok(None),
+    };
+    if value.get("groups").is_none() || value.get("format_version").is_none() {
+        return Ok(None);
+    }
+    let batch: Portability = serde_json::from_value(value)
+        .with_context(|| format!("{} is not a strata portability report", path.display()))?;
+    if batch.format_version != PORTABILITY_FORMAT {
+        bail!(
+            "{}: portability format {} (this strata reads {PORTABILITY_FORMAT})",
+            path.display(),
+            batch.format_version
+        );
+    }
+    Ok(Some(batch))
 }
 
 /// The subfolder of an adapter's run in a batch: name and backend, so one
@@ -1639,6 +1688,37 @@ mod tests {
         let back: Portability =
             serde_json::from_str(&std::fs::read_to_string(json_path).unwrap()).unwrap();
         assert_eq!(back, p);
+        std::fs::remove_dir_all(&root).unwrap();
+    }
+
+    #[test]
+    fn earlier_batches_merge_with_their_runs_and_skipped_adapters() {
+        let root = tmp("batches");
+        let gpu = root.join("gpu");
+        let run_dir = gpu.join("gpu-vulkan");
+        std::fs::create_dir_all(&run_dir).unwrap();
+        let results = run_on("gpu", "vulkan").write(&run_dir).unwrap();
+        let skipped = vec![SkippedAdapter {
+            adapter: "gpu".into(),
+            backend: "gl".into(),
+            error: "refused a device".into(),
+        }];
+        let inputs = read_inputs(&[results]).unwrap();
+        write(&inputs, skipped.clone(), &gpu).unwrap();
+        let cpu_dir = root.join("cpu");
+        std::fs::create_dir_all(&cpu_dir).unwrap();
+        let mut cpu = run_on("cpu", "gl");
+        cpu.settings.width = 16;
+        let cpu_results = cpu.write(&cpu_dir).unwrap();
+        let merged = root.join("merged");
+        let (p, _, _) = merge_files(&[gpu.join("portability.json"), cpu_results], &merged).unwrap();
+        assert_eq!(p.skipped, skipped);
+        let labels: Vec<&str> = p.runs.iter().map(|r| r.label.as_str()).collect();
+        assert_eq!(labels, vec!["gpu (vulkan)", "cpu (gl)"]);
+        assert_eq!(p.runs[0].results, "../gpu/gpu-vulkan/results-gpu.json");
+        assert_eq!(p.groups.len(), 2);
+        let md = render_markdown(&p);
+        assert!(md.contains("- gpu (gl): refused a device"), "{md}");
         std::fs::remove_dir_all(&root).unwrap();
     }
 

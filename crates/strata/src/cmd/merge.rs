@@ -12,6 +12,8 @@ use std::path::PathBuf;
 #[derive(clap::Args)]
 pub struct Args {
     /// `results-*.json` files written by `strata compare`; the first is the baseline.
+    /// With --portability also `portability.json` files of earlier batches (their runs
+    /// and skipped adapters are merged).
     #[arg(required = true, num_args = 1..)]
     pub runs: Vec<PathBuf>,
     /// Directory for the merged `report.md` (or the portability report).
