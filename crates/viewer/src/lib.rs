@@ -100,6 +100,7 @@ impl ApplicationHandler for App {
             self.display.clone(),
         ));
         desc.backends = options.adapter.backend.backends();
+        desc.flags = strata_render::gpu::instance_flags(desc.flags);
         let instance = wgpu::Instance::new(desc);
         match viewer::Viewer::new(event_loop, options, instance) {
             Ok(viewer) => {
