@@ -104,6 +104,17 @@ fn all_adapters_batch_and_portability_merge() {
         "no adapter ran: {:?}",
         report.skipped
     );
+    // CI installs llvmpipe's GL beside lavapipe: there the batch must cover both APIs.
+    if std::env::var_os("STRATA_REQUIRE_GL").is_some_and(|v| v == "1") {
+        for backend in ["vulkan", "gl"] {
+            assert!(
+                report.runs.iter().any(|r| r.adapter.backend == backend),
+                "STRATA_REQUIRE_GL=1 but no {backend} run: {:?} skipped {:?}",
+                report.runs,
+                report.skipped
+            );
+        }
+    }
     // One protocol (the size and frames were explicit): one group.
     assert_eq!(report.groups.len(), 1, "{report:#?}");
     let g = &report.groups[0];
