@@ -111,5 +111,6 @@ pub fn run(adapter: &str) -> RunResults {
         }],
         failures: Vec::new(),
         edit_skipped: None,
+        reference_images: Vec::new(),
     }
 }

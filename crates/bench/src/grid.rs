@@ -14,7 +14,13 @@ const MISSING: Rgba<u8> = Rgba([90, 30, 60, 255]);
 /// Box-filter an image down by the integer factor that brings it to at most
 /// [`THUMB_MAX_WIDTH`] wide.
 pub fn thumbnail(img: &RgbaImage) -> RgbaImage {
-    let k = img.width().div_ceil(THUMB_MAX_WIDTH).max(1);
+    thumbnail_to(img, THUMB_MAX_WIDTH)
+}
+
+/// Box-filter an image down by the integer factor that brings it to at most
+/// `max_width` wide.
+pub fn thumbnail_to(img: &RgbaImage, max_width: u32) -> RgbaImage {
+    let k = img.width().div_ceil(max_width.max(1)).max(1);
     if k == 1 {
         return img.clone();
     }

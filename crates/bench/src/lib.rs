@@ -7,6 +7,7 @@ pub mod grid;
 pub mod merge;
 pub mod methods;
 pub mod plan;
+pub mod portability;
 pub mod report;
 pub mod results;
 pub mod run;

@@ -82,14 +82,14 @@ pub fn check_compatible(base: &RunResults, other: &RunResults) -> anyhow::Result
 }
 
 /// An accuracy field: its name and how to read it from a row.
-type Field = (&'static str, fn(&Row) -> f64);
+pub(crate) type Field = (&'static str, fn(&Row) -> f64);
 
-const PERCENT_FIELDS: [Field; 3] = [
+pub(crate) const PERCENT_FIELDS: [Field; 3] = [
     ("see_through", |r| r.see_through),
     ("covers_sky", |r| r.covers_sky),
     ("coherence", |r| r.coherence),
 ];
-const DEPTH_FIELDS: [Field; 2] = [
+pub(crate) const DEPTH_FIELDS: [Field; 2] = [
     ("depth_p50", |r| r.depth_p50),
     ("depth_p95", |r| r.depth_p95),
 ];

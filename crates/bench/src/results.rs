@@ -37,6 +37,18 @@ pub struct RunResults {
     /// Why the edit protocol did not run, when it did not.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub edit_skipped: Option<String>,
+    /// Each view's reference picture, relative to the directory holding
+    /// this results file (absent in files written before it was recorded).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub reference_images: Vec<ViewImage>,
+}
+
+/// A picture of one view (the CPU reference's distance picture).
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct ViewImage {
+    pub view: String,
+    /// Relative to the directory holding the results file.
+    pub image: String,
 }
 
 /// A method that could not be measured at a view (or anywhere: view "*").
@@ -125,7 +137,9 @@ pub struct Row {
     /// Mean GPU ms of each timed pass (label order of the first frame); empty without timestamps.
     #[serde(default)]
     pub passes: Vec<PassTime>,
-    /// The cell picture, relative to the output directory.
+    /// The cell picture, relative to the output directory, which is the
+    /// directory holding the results file (`merge --portability` finds the
+    /// pictures there).
     pub image: String,
 }
 

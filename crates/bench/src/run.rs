@@ -164,6 +164,7 @@ impl Plan {
             edit_rows: Vec::new(),
             failures: Vec::new(),
             edit_skipped: self.edit_skipped.clone(),
+            reference_images: Vec::new(),
         }
     }
 
@@ -174,7 +175,20 @@ impl Plan {
         let json = session.save_json()?;
         let references = self.references(&mut session)?;
 
-        let n_methods = self.opts.methods.len();
+        // A method the adapter cannot run is refused here, before any GPU
+        // work, with the missing capability named: one failure for every view
+        // and no edit row.
+        let refused: Vec<Option<String>> = self
+            .opts
+            .methods
+            .iter()
+            .map(|m| {
+                strata_render::methods::check_support(&m.name, &gpu.caps)
+                    .err()
+                    .map(|e| format!("refused: {e:#}"))
+            })
+            .collect();
+        let n_methods = refused.iter().filter(|r| r.is_none()).count();
         let total =
             self.cameras.len() * n_methods + if self.edit.is_some() { n_methods } else { 0 };
         let bar = ProgressBar::new(total as u64);
@@ -185,6 +199,16 @@ impl Plan {
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
         );
         for (m, choice) in self.opts.methods.iter().enumerate() {
+            if let Some(why) = &refused[m] {
+                bar.println(why.clone());
+                session.results.failures.push(Failure {
+                    view: "*".into(),
+                    method: choice.label(),
+                    error: why.clone(),
+                });
+                session.save_json()?;
+                continue;
+            }
             if let Err(e) = self.method_column(gpu, &mut session, &references, m, &bar) {
                 bar.println(format!("{}: {e:#}", choice.label()));
                 session.results.failures.push(Failure {
@@ -199,7 +223,15 @@ impl Plan {
         if let Some((site, camera)) = &self.edit {
             let mut edited = self.world.level.clone();
             let rects = strata_level::edit::crater(&mut edited, site);
-            for (choice, settings) in self.opts.methods.iter().zip(&self.settings) {
+            let runnable = self
+                .opts
+                .methods
+                .iter()
+                .zip(&self.settings)
+                .zip(&refused)
+                .filter(|(_, why)| why.is_none())
+                .map(|(pair, _)| pair);
+            for (choice, settings) in runnable {
                 bar.set_message(format!("edit / {}", choice.label()));
                 let input = edits::EditInput {
                     gpu,
@@ -265,12 +297,16 @@ impl Plan {
                         .0
                 }
             };
-            session.save_picture(
+            let image = session.save_picture(
                 v,
                 0,
                 &format!("{}-reference", view.name),
                 reference_image(&r, camera.far),
             )?;
+            session.results.reference_images.push(ViewImage {
+                view: view.name.clone(),
+                image,
+            });
             out.push(r);
             bar.inc(1);
         }

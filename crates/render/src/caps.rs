@@ -73,8 +73,16 @@ impl Capabilities {
     pub fn of(adapter: &wgpu::Adapter, limits: &wgpu::Limits, features: wgpu::Features) -> Self {
         let flags = adapter.get_downlevel_capabilities().flags;
         use wgpu::DownlevelFlags as D;
-        let storage_buffers = limits.max_storage_buffers_per_shader_stage > 0;
+        let info = adapter.get_info();
+        // wgpu's GL backend reports compute on a desktop GL 3.3 context
+        // that has GL_ARB_compute_shader (NVIDIA's, through EGL), but writes
+        // GLSL 330, which has neither compute nor storage buffers.
+        let glsl_lacks_compute =
+            info.backend == wgpu::Backend::Gl && !gl_version_has_compute(&info.driver_info);
+        let storage_buffers =
+            limits.max_storage_buffers_per_shader_stage > 0 && !glsl_lacks_compute;
         let compute = flags.contains(D::COMPUTE_SHADERS)
+            && !glsl_lacks_compute
             && limits.max_compute_workgroup_size_x >= 64
             && limits.max_compute_invocations_per_workgroup >= 64;
         let r32 = adapter.get_texture_format_features(wgpu::TextureFormat::R32Float);
@@ -171,6 +179,29 @@ impl Capabilities {
     }
 }
 
+/// Whether a GL context of this version string (wgpu's `driver_info` on the
+/// GL backend: `4.5 (Core Profile) Mesa …`, `3.3.0 NVIDIA …`, `OpenGL ES 3.2
+/// …`) has compute shaders and storage buffers in its GLSL: desktop 4.3 or
+/// ES 3.1 and up. An unparsable string counts as having them (wgpu decides).
+pub fn gl_version_has_compute(version: &str) -> bool {
+    let (es, rest) = match version.find("OpenGL ES") {
+        Some(i) => (true, &version[i + "OpenGL ES".len()..]),
+        None => (false, version),
+    };
+    let Some(number) = rest.split_whitespace().next() else {
+        return true;
+    };
+    let mut parts = number.split('.').map(|p| p.parse::<u32>());
+    let (Some(Ok(major)), Some(Ok(minor))) = (parts.next(), parts.next()) else {
+        return true;
+    };
+    if es {
+        (major, minor) >= (3, 1)
+    } else {
+        (major, minor) >= (4, 3)
+    }
+}
+
 /// How the shadow map is drawn (see [`Capabilities::shadow_pass`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
@@ -220,6 +251,16 @@ mod tests {
             "mesh: needs storage buffers in vertex shaders, which this adapter lacks"
         );
         assert_eq!(caps.shadow_pass(), Some(ShadowPassKind::Fragment));
+    }
+
+    #[test]
+    fn gl_versions_with_and_without_compute() {
+        assert!(gl_version_has_compute("4.5 (Core Profile) Mesa 22.3.6"));
+        assert!(!gl_version_has_compute("3.3.0 NVIDIA 580.159.04"));
+        assert!(gl_version_has_compute("OpenGL ES 3.2 NVIDIA 580.159.04"));
+        assert!(!gl_version_has_compute("OpenGL ES 3.0 Mesa"));
+        assert!(gl_version_has_compute("4.3.0 NVIDIA"));
+        assert!(gl_version_has_compute(""));
     }
 
     #[test]

@@ -138,8 +138,18 @@ impl AdapterChoice {
     pub fn instance(&self) -> wgpu::Instance {
         let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
         desc.backends = self.backend.backends();
+        desc.flags = instance_flags(desc.flags);
         wgpu::Instance::new(desc)
     }
+}
+
+/// The instance flags Strata runs with: wgpu's defaults (or `WGPU_*`'s)
+/// without indirect-call validation. Strata issues no indirect draws or
+/// dispatches, and that validation builds a compute pipeline when the device
+/// is made, which fails on GL contexts that claim compute without GLSL for it
+/// (NVIDIA's desktop GL 3.3 through EGL refused every device for it).
+pub fn instance_flags(flags: wgpu::InstanceFlags) -> wgpu::InstanceFlags {
+    flags - wgpu::InstanceFlags::VALIDATION_INDIRECT_CALL
 }
 
 /// One adapter as `strata adapters` lists it.

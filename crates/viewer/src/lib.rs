@@ -98,6 +98,7 @@ impl App {
             self.display.clone(),
         ));
         desc.backends = options.adapter.backend.backends();
+        desc.flags = strata_render::gpu::instance_flags(desc.flags);
         let instance = wgpu::Instance::new(desc);
         let opened = viewer::Viewer::open_window(event_loop, &options, &instance).and_then(
             |(window, surface)| {

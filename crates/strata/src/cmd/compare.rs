@@ -2,13 +2,20 @@
 //! the publication configuration: every method at its tuned setting, the
 //! level's views, 1280x800, far 600, shadows on, per-method warm-up, 40 timed
 //! frames, and the edit protocol. Every input is checked before GPU work.
+//!
+//! `--all-adapters` runs the protocol once per adapter the machine offers
+//! (each into `<out>/<adapter>-<backend>/`), then writes one merged
+//! `portability.md` + `portability.json` into `<out>`.
 
 use crate::adapter_arg::AdapterArgs;
 use crate::world_arg::WorldArgs;
 use anyhow::Context;
 use std::path::PathBuf;
 use strata_bench::plan::{MethodChoice, parse_methods, parse_size, prepare_out_dir};
+use strata_bench::portability::{self, Input, SkippedAdapter, adapter_dir_name};
 use strata_bench::run::{EditMode, Options, Plan};
+use strata_level::{ViewSpec, World};
+use strata_render::gpu::{AdapterChoice, AdapterReport, Gpu, list_adapters};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -49,13 +56,43 @@ pub struct Args {
     pub warmup: Option<u32>,
     #[command(flatten)]
     pub adapter: AdapterArgs,
+    /// Run the protocol on every adapter of --backend (default: every backend), each into
+    /// `<out>/<adapter>-<backend>/`, then write the merged `portability.md` and
+    /// `portability.json` into `<out>`. A CPU rasteriser runs the --quick form unless
+    /// --size/--frames are given.
+    #[arg(long, conflicts_with = "adapter")]
+    pub all_adapters: bool,
     /// Reference cache directory (default: $STRATA_CACHE_DIR/reference or ~/.cache/strata/reference).
     #[arg(long, value_name = "DIR")]
     pub cache: Option<PathBuf>,
 }
 
+/// Everything checked before any adapter is opened.
+struct Prepared {
+    methods: Vec<MethodChoice>,
+    explicit_size: Option<(u32, u32)>,
+    views: Vec<ViewSpec>,
+    world: World,
+    edits: EditMode,
+}
+
 pub fn run(args: Args) -> anyhow::Result<()> {
-    // Cheap checks first, then the level, then the plan; the GPU last.
+    let prepared = prepare(&args)?;
+    if args.all_adapters {
+        return run_all_adapters(&args, prepared);
+    }
+    let gpu = Gpu::open(&args.adapter.choice())?;
+    announce(&gpu.report);
+    let options = options_for(&args, &prepared, &gpu.report, args.out.clone());
+    let plan = Plan::new(prepared.world, options)?;
+    let (json, report) = plan.run(&gpu)?;
+    println!("wrote {}", json.display());
+    println!("wrote {}", report.display());
+    Ok(())
+}
+
+/// Cheap checks first, then the level; the GPU comes later.
+fn prepare(args: &Args) -> anyhow::Result<Prepared> {
     let known = strata_render::methods::names();
     let methods = match &args.methods {
         Some(list) => parse_methods(list, &known)?,
@@ -80,6 +117,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         None => None,
     };
     prepare_out_dir(&args.out)?;
+    if args.all_adapters {
+        // The per-adapter subfolders hold the cells; the top level only the merged report.
+        let _ = std::fs::remove_dir(args.out.join("cells"));
+    }
     let world = args.world.load()?;
     let views = file_views.unwrap_or_else(|| world.views.clone());
     let edits = if args.no_edits {
@@ -89,50 +130,172 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     } else {
         EditMode::Auto
     };
-    let gpu = strata_render::Gpu::open(&args.adapter.choice())?;
+    Ok(Prepared {
+        methods,
+        explicit_size,
+        views,
+        world,
+        edits,
+    })
+}
+
+fn announce(report: &AdapterReport) {
     eprintln!(
         "adapter: {} ({}, {}); timestamps {}",
-        gpu.report.name,
-        gpu.report.backend,
-        gpu.report.driver,
-        if gpu.report.timestamps {
+        report.name,
+        report.backend,
+        report.driver,
+        if report.timestamps {
             "on"
         } else {
             "off: CPU submit-and-wait"
         }
     );
-    // The publication configuration takes hours on a CPU rasteriser
-    // (lavapipe/llvmpipe), so there the default is the quick smoke; an
-    // explicit --size or --frames still wins.
+}
+
+/// The run's options on one adapter: the publication configuration, or the
+/// quick smoke on a CPU rasteriser (lavapipe/llvmpipe), where the full one
+/// takes hours; an explicit --size or --frames still wins.
+fn options_for(args: &Args, p: &Prepared, adapter: &AdapterReport, out: PathBuf) -> Options {
     let quick = args.quick
-        || (gpu.report.device_type == "Cpu" && args.size.is_none() && args.frames.is_none());
+        || (adapter.device_type == "Cpu" && args.size.is_none() && args.frames.is_none());
     if quick && !args.quick {
         eprintln!(
             "note: {} is a CPU rasteriser: running the --quick smoke (320x200, 4 frames); \
              pass --size/--frames for the full configuration",
-            gpu.report.name
+            adapter.name
         );
     }
-    let (width, height) = explicit_size.unwrap_or(if quick { (320, 200) } else { (1280, 800) });
-    let frames = args.frames.unwrap_or(if quick { 4 } else { 40 });
-    let options = Options {
-        out: args.out.clone(),
-        methods,
-        views,
+    let (width, height) = p
+        .explicit_size
+        .unwrap_or(if quick { (320, 200) } else { (1280, 800) });
+    Options {
+        out,
+        methods: p.methods.clone(),
+        views: p.views.clone(),
         width,
         height,
-        frames,
+        frames: args.frames.unwrap_or(if quick { 4 } else { 40 }),
         min_warmup: args.warmup.unwrap_or(if quick { 1 } else { 3 }),
         shadows: !args.no_shadows,
-        edits,
+        edits: p.edits,
         cache_dir: args
             .cache
             .clone()
             .unwrap_or_else(strata_reference::default_cache_dir),
-    };
-    let plan = Plan::new(world, options)?;
-    let (json, report) = plan.run(&gpu)?;
+    }
+}
+
+/// `--all-adapters`: one run per adapter, then the merged portability report.
+/// An adapter that cannot be opened or whose run stops is recorded and the
+/// batch goes on; a method an adapter refuses is a failure in its run.
+fn run_all_adapters(args: &Args, prepared: Prepared) -> anyhow::Result<()> {
+    let backend = args.adapter.backend;
+    let adapters = list_adapters(backend);
+    if adapters.is_empty() {
+        anyhow::bail!(
+            "--all-adapters: no adapter found on backend `{backend}` (install mesa-vulkan-drivers \
+             for lavapipe, libegl1 + libgl1-mesa-dri for llvmpipe's GL)"
+        );
+    }
+    eprintln!(
+        "{} adapter(s): {}",
+        adapters.len(),
+        adapters
+            .iter()
+            .map(|a| format!("[{}] {} ({})", a.index, a.name, a.backend))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    let mut inputs: Vec<Input> = Vec::new();
+    let mut skipped: Vec<SkippedAdapter> = Vec::new();
+    let mut dirs: Vec<String> = Vec::new();
+    for listing in &adapters {
+        let mut dir_name = adapter_dir_name(&listing.name, &listing.backend);
+        if dirs.contains(&dir_name) {
+            dir_name = format!("{dir_name}-{}", listing.index);
+        }
+        dirs.push(dir_name.clone());
+        let out = args.out.join(&dir_name);
+        eprintln!(
+            "\n== [{}] {} ({}) -> {}",
+            listing.index,
+            listing.name,
+            listing.backend,
+            out.display()
+        );
+        let choice = AdapterChoice {
+            backend,
+            index: Some(listing.index),
+        };
+        let skip = |error: String| SkippedAdapter {
+            adapter: listing.name.clone(),
+            backend: listing.backend.clone(),
+            error,
+        };
+        let gpu = match Gpu::open(&choice) {
+            Ok(gpu) => gpu,
+            Err(e) => {
+                eprintln!("skipped: {e:#}");
+                skipped.push(skip(format!("{e:#}")));
+                continue;
+            }
+        };
+        announce(&gpu.report);
+        let options = options_for(args, &prepared, &gpu.report, out.clone());
+        let result = Plan::new(prepared.world.clone(), options).and_then(|plan| plan.run(&gpu));
+        drop(gpu);
+        match result {
+            Ok((json, report)) => {
+                println!("wrote {}", json.display());
+                println!("wrote {}", report.display());
+                inputs.push(Input {
+                    run: strata_bench::merge::read_run(&json)?,
+                    path: json,
+                });
+            }
+            Err(e) => {
+                eprintln!("stopped: {e:#}");
+                skipped.push(skip(format!("{e:#}")));
+                // A run that stopped part-way keeps its finished cells: merge them.
+                let partial = out.join(format!(
+                    "results-{}.json",
+                    strata_bench::results::slug(&listing.name)
+                ));
+                if let Ok(run) = strata_bench::merge::read_run(&partial) {
+                    inputs.push(Input { path: partial, run });
+                }
+            }
+        }
+    }
+    let (report, md, json) = portability::write(&inputs, skipped, &args.out)?;
+    println!("wrote {}", md.display());
     println!("wrote {}", json.display());
-    println!("wrote {}", report.display());
+    summarize(&report);
     Ok(())
+}
+
+/// The batch's findings in a few lines.
+pub fn summarize(report: &portability::Portability) {
+    for g in &report.groups {
+        println!(
+            "group {} ({}x{}, {} adapter(s)): {} of {} cells disagree, {} refusal(s) or failure(s)",
+            g.id,
+            g.protocol.width,
+            g.protocol.height,
+            g.adapters.len(),
+            g.disagreeing_cells,
+            g.cells.len(),
+            g.failures.len()
+        );
+        if let Some(why) = &g.separate_because {
+            println!("  not compared with group A: {why}");
+        }
+    }
+    for s in &report.skipped {
+        println!(
+            "adapter {} ({}) did not finish: {}",
+            s.adapter, s.backend, s.error
+        );
+    }
 }
