@@ -196,7 +196,7 @@ async fn open(client: &Client, url: &str) -> (Value, f64) {
 /// Score the drawn method; its metrics (see-through, covers-sky, coherence).
 async fn score(client: &Client, before: &Value, method: &str) -> (f64, f64, f64) {
     let scored = before["scored"].as_u64().unwrap_or(0);
-    let s = run(client, "score", 120).await;
+    let s = run(client, "score", 600).await;
     assert!(
         s["scored"].as_u64().unwrap_or(0) > scored,
         "no new score: {s}"
@@ -320,7 +320,7 @@ async fn drive(client: Client, url: String) {
     for (method, ..) in LIMITS {
         run(&client, &format!("method {method}"), 300).await;
         let start = Instant::now();
-        let s = run(&client, "frames 2", 120).await;
+        let s = run(&client, "frames 2", 600).await;
         let frame_ms = start.elapsed().as_secs_f64() * 1e3 / 2.0;
         check(method, score(&client, &s, method).await, &mut failures);
         eprintln!("{method:14} {frame_ms:.0} ms per frame (2 frames, wall clock)");
@@ -352,6 +352,18 @@ async fn drive(client: Client, url: String) {
     let undone = canvas_pixels(&client).await;
     let left = differing(&before, &undone);
     assert!(left < 20, "undo left {left} pixels different");
+    // The mouse: a click on the canvas digs (through winit's pointer events).
+    client
+        .find(fantoccini::Locator::Id("strata-canvas"))
+        .await
+        .expect("the canvas")
+        .click()
+        .await
+        .expect("clicking the canvas");
+    let s = wait_for(&client, "a dig by a click", 60, |s| s["undo_depth"] == 1).await;
+    eprintln!("a click dug: {}", s["log"]);
+    let s = run(&client, "undo\nframes 2", 60).await;
+    assert_eq!(s["undo_depth"], 0, "{s}");
 
     // WebGL2: ray.
     let (s, _) = open(&client, &format!("{url}/{PAGE}&backend=webgl2")).await;
