@@ -70,6 +70,9 @@ fn sample_and_bisect(o: vec3<f32>, d: vec3<f32>, ta: f32, tb: f32, n: u32, bisec
 
 // The paper's RAYMARCH: `steps` uniform samples over [t0, t1] until one is
 // solid, then four bisections between the last empty and first solid sample.
+// Twin of `methods::ray::MAX_RAY_STEPS`.
+const MAX_MARCH_STEPS: u32 = 16384u;
+
 fn march(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, steps: u32) -> MarchHit {
     var result: MarchHit;
     result.hit = false;
@@ -82,7 +85,9 @@ fn march(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, steps: u32) -> MarchHit {
         result.t = t0;
         return result;
     }
-    return sample_and_bisect(o, d, t0, t1, steps, BISECTIONS);
+    // A step count from a uniform bounds this loop: never trust it past
+    // MAX_MARCH_STEPS (the CPU side refuses more), so a bad read cannot hang the GPU.
+    return sample_and_bisect(o, d, t0, t1, min(steps, MAX_MARCH_STEPS), BISECTIONS);
 }
 
 // Depth-buffer value of a point at view depth `view_z`: the twin of

@@ -163,6 +163,9 @@ pub struct AdapterListing {
     pub driver_info: String,
     pub device_type: String,
     pub capabilities: Capabilities,
+    /// Why the adapter as a whole is refused (its device cannot be made,
+    /// or fails the GL self-check), if it is.
+    pub refused: Option<String>,
     /// Every method, and whether it runs here.
     pub methods: Vec<MethodSupport>,
 }
@@ -192,11 +195,17 @@ pub fn list_adapters(backend: BackendChoice) -> Vec<AdapterListing> {
             let info = adapter.get_info();
             let (features, limits) = device_request(&adapter);
             let capabilities = Capabilities::of(&adapter, &limits, features);
+            let refused = (info.backend == wgpu::Backend::Gl)
+                .then(|| check_gl_adapter(&adapter).err().map(|e| format!("{e:#}")))
+                .flatten();
             let methods = crate::methods::METHODS
                 .iter()
                 .map(|entry| MethodSupport {
                     name: entry.name.to_string(),
-                    refused: entry.check(&capabilities).err().map(|r| r.to_string()),
+                    refused: match &refused {
+                        Some(_) => Some(format!("{}: the adapter is refused (above)", entry.name)),
+                        None => entry.check(&capabilities).err().map(|r| r.to_string()),
+                    },
                 })
                 .collect();
             AdapterListing {
@@ -207,10 +216,30 @@ pub fn list_adapters(backend: BackendChoice) -> Vec<AdapterListing> {
                 driver_info: info.driver_info.clone(),
                 device_type: format!("{:?}", info.device_type),
                 capabilities,
+                refused,
                 methods,
             }
         })
         .collect()
+}
+
+/// Make a device on a GL adapter and run the self-check on it.
+#[cfg(not(target_arch = "wasm32"))]
+fn check_gl_adapter(adapter: &wgpu::Adapter) -> anyhow::Result<()> {
+    let (features, limits) = device_request(adapter);
+    let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+        label: Some("strata adapters"),
+        required_features: features,
+        required_limits: limits,
+        experimental_features: wgpu::ExperimentalFeatures::disabled(),
+        memory_hints: wgpu::MemoryHints::Performance,
+        trace: wgpu::Trace::Off,
+    }))
+    .map_err(|e| anyhow::anyhow!("it refused a device: {e}"))?;
+    let errors = ErrorSink::default();
+    let sink = errors.clone();
+    device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| sink.push(e.to_string())));
+    crate::self_check::uniforms_read_back(&device, &queue, &errors)
 }
 
 fn backend_name(backend: wgpu::Backend) -> String {
@@ -288,6 +317,15 @@ impl Gpu {
             }
         });
 
+        // wgpu maps bind groups to GL binding points itself: check, with a
+        // draw of known answer, that it worked, before any picture is trusted.
+        // (Not in a browser: its read-back cannot block; the browser test
+        // compares WebGL2's picture with WebGPU's instead.)
+        if !cfg!(target_arch = "wasm32") && info.backend == wgpu::Backend::Gl {
+            crate::self_check::uniforms_read_back(&device, &queue, &errors)
+                .map_err(|e| anyhow::anyhow!("adapter `{}` (gl): {e:#}", info.name))?;
+        }
+
         let report = AdapterReport {
             name: info.name.clone(),
             backend: backend_name(info.backend),
@@ -315,19 +353,33 @@ impl Gpu {
 
 /// Block until the device is idle, then report any collected error.
 pub fn wait_device(device: &wgpu::Device, errors: &ErrorSink) -> anyhow::Result<()> {
-    // A page cannot block: the browser finishes the work after it yields
-    // (read-backs are polled per frame there, see `TextureReadback`).
-    if cfg!(target_arch = "wasm32") {
-        let _ = device.poll(wgpu::PollType::Poll);
-        return errors.check();
-    }
-    let polled = device.poll(wgpu::PollType::Wait {
-        submission_index: None,
-        timeout: Some(GPU_WAIT_TIMEOUT),
-    });
+    let polled = wait_idle(device);
     errors.check()?;
     polled.map_err(|e| anyhow::anyhow!("waiting for the GPU failed: {e}"))?;
     Ok(())
+}
+
+/// Block until the device is idle, up to [`GPU_WAIT_TIMEOUT`]. wgpu's GL
+/// backend cuts one wait to about 2.1 s (a 32-bit nanosecond count), which a
+/// first frame on NVIDIA's GL outlasts while it compiles shaders: so wait
+/// again while our own limit has not passed.
+pub fn wait_idle(device: &wgpu::Device) -> Result<(), wgpu::PollError> {
+    // A page cannot block: the browser runs the queue in order after it
+    // yields (read-backs are polled per frame there, see `TextureReadback`).
+    if cfg!(target_arch = "wasm32") {
+        return device.poll(wgpu::PollType::Poll).map(|_| ());
+    }
+    let start = web_time::Instant::now();
+    loop {
+        match device.poll(wgpu::PollType::Wait {
+            submission_index: None,
+            timeout: Some(GPU_WAIT_TIMEOUT.saturating_sub(start.elapsed())),
+        }) {
+            Err(wgpu::PollError::Timeout) if start.elapsed() < GPU_WAIT_TIMEOUT => continue,
+            Err(e) => return Err(e),
+            Ok(_) => return Ok(()),
+        }
+    }
 }
 
 /// WebGPU default limits (so what runs here runs in a browser), except the

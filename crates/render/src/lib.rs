@@ -26,6 +26,7 @@ pub mod gpu;
 pub mod methods;
 pub mod renderer;
 pub mod report;
+pub mod self_check;
 pub mod shaders;
 pub mod shadow;
 pub mod terrain;

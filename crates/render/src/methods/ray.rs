@@ -12,10 +12,17 @@ pub struct Ray {
     group: wgpu::BindGroup,
 }
 
+/// Most forward samples a ray may take (`MAX_MARCH_STEPS` in `ray_core.wgsl`,
+/// which clamps to it, so a bad uniform read cannot hang the GPU).
+pub const MAX_RAY_STEPS: u32 = 16384;
+
 /// Check `--ray-steps`: the method's uniform (`RayParams`).
 fn ray_params_data(settings: &MethodSettings) -> anyhow::Result<[u32; 4]> {
-    if settings.ray_steps == 0 {
-        anyhow::bail!("ray steps must be at least 1 (got 0)");
+    if settings.ray_steps == 0 || settings.ray_steps > MAX_RAY_STEPS {
+        anyhow::bail!(
+            "ray steps must be 1..={MAX_RAY_STEPS} (got {})",
+            settings.ray_steps
+        );
     }
     Ok([settings.ray_steps, 0, 0, 0])
 }

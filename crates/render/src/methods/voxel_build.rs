@@ -377,16 +377,7 @@ const MIB: f64 = 1024.0 * 1024.0;
 /// Block until the GPU is idle (device errors surface through the
 /// renderer's own error sink on its next wait).
 fn wait(device: &wgpu::Device) -> anyhow::Result<()> {
-    // A page cannot block; its queue runs the build in order anyway.
-    if cfg!(target_arch = "wasm32") {
-        let _ = device.poll(wgpu::PollType::Poll);
-        return Ok(());
-    }
-    device
-        .poll(wgpu::PollType::Wait {
-            submission_index: None,
-            timeout: Some(crate::gpu::GPU_WAIT_TIMEOUT),
-        })
+    crate::gpu::wait_idle(device)
         .map_err(|e| anyhow::anyhow!("waiting for the voxel build failed: {e}"))?;
     Ok(())
 }

@@ -50,6 +50,9 @@ fn describe(a: &AdapterListing, backend: BackendChoice) -> String {
         a.index, a.name, a.backend, a.device_type, a.driver, a.driver_info
     );
     out += &format!("    select with: {flag}\n");
+    if let Some(why) = &a.refused {
+        out += &format!("    REFUSED: {why}\n");
+    }
     out += &format!(
         "    timestamps: {}   compute: {}   storage textures: {}   storage in vertex / fragment: {} / {}   depth copies: {}\n",
         yes_no(c.timestamps),

@@ -1,0 +1,213 @@
+//! A draw with a known answer, run once when a device is made on wgpu's GL
+//! backend: a uniform buffer's value written out by a fragment shader. wgpu
+//! translates bind groups into GL binding points itself, and on NVIDIA's
+//! desktop GL 3.3 context (through EGL) uniform blocks read wrong values:
+//! every method drew sky, and `ray`'s step count came back in the billions
+//! (the GPU hung). Such an adapter is refused by name instead of drawing
+//! wrong pictures.
+
+use crate::gpu::{ErrorSink, read_texture};
+
+const SHADER: &str = "
+struct Probe { value: vec4<u32> }
+@group(0) @binding(0) var<uniform> first: Probe;
+@group(0) @binding(1) var<uniform> second: Probe;
+@group(0) @binding(2) var texels: texture_2d_array<u32>;
+@group(1) @binding(0) var<uniform> method: Probe;
+
+@vertex
+fn vs(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
+    let x = f32((i << 1u) & 2u) * 2.0 - 1.0;
+    let y = f32(i & 2u) * 2.0 - 1.0;
+    return vec4<f32>(x, y, 0.0, 1.0);
+}
+
+@fragment
+fn fs() -> @location(0) vec4<u32> {
+    let t = textureLoad(texels, vec2<i32>(1, 0), 1, 0).x;
+    return vec4<u32>(first.value.x ^ (second.value.x * 3u) ^ (method.value.x * 7u) ^ (t * 11u), 0u, 0u, 0u);
+}
+";
+
+/// What each uniform holds (`x`), and the texel at (1, 0) of layer 1.
+const FIRST: u32 = 0x5eed_1234;
+const SECOND: u32 = 0x0bad_cafe;
+const METHOD: u32 = 0x1357_9bdf;
+const TEXEL: u32 = 0xa5;
+
+fn uniform(device: &wgpu::Device, queue: &wgpu::Queue, x: u32) -> wgpu::Buffer {
+    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("self check"),
+        size: 16,
+        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    queue.write_buffer(&buffer, 0, bytemuck::cast_slice(&[x, 0, 0, 0]));
+    buffer
+}
+
+/// `Err` when a fragment shader does not compute what the bindings hold: two
+/// uniforms and a `u32` array texture in group 0, a uniform in group 1, as
+/// every method binds the shared frame and its own parameters.
+pub fn uniforms_read_back(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    errors: &ErrorSink,
+) -> anyhow::Result<()> {
+    use crate::frame::{texture_entry, uniform_layout_entry};
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("self check"),
+        source: wgpu::ShaderSource::Wgsl(SHADER.into()),
+    });
+    let (first, second, method) = (
+        uniform(device, queue, FIRST),
+        uniform(device, queue, SECOND),
+        uniform(device, queue, METHOD),
+    );
+    // Two layers, as the terrain texture always has (see terrain.rs).
+    let texels = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("self check"),
+        size: wgpu::Extent3d {
+            width: 2,
+            height: 1,
+            depth_or_array_layers: 2,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::Rgba8Uint,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    let mut data = [0u8; 16];
+    data[12] = TEXEL as u8;
+    queue.write_texture(
+        texels.as_image_copy(),
+        &data,
+        wgpu::TexelCopyBufferLayout {
+            offset: 0,
+            bytes_per_row: Some(8),
+            rows_per_image: Some(1),
+        },
+        texels.size(),
+    );
+    let texels_view = texels.create_view(&wgpu::TextureViewDescriptor {
+        dimension: Some(wgpu::TextureViewDimension::D2Array),
+        ..Default::default()
+    });
+    let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("self check frame"),
+        entries: &[
+            uniform_layout_entry(0),
+            uniform_layout_entry(1),
+            texture_entry(
+                2,
+                wgpu::TextureSampleType::Uint,
+                wgpu::TextureViewDimension::D2Array,
+            ),
+        ],
+    });
+    let method_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("self check method"),
+        entries: &[uniform_layout_entry(0)],
+    });
+    let frame_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("self check frame"),
+        layout: &frame_layout,
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: first.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: second.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 2,
+                resource: wgpu::BindingResource::TextureView(&texels_view),
+            },
+        ],
+    });
+    let method_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("self check method"),
+        layout: &method_layout,
+        entries: &[wgpu::BindGroupEntry {
+            binding: 0,
+            resource: method.as_entire_binding(),
+        }],
+    });
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("self check"),
+        bind_group_layouts: &[Some(&frame_layout), Some(&method_layout)],
+        immediate_size: 0,
+    });
+    let format = wgpu::TextureFormat::R32Uint;
+    let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("self check"),
+        layout: Some(&pipeline_layout),
+        vertex: wgpu::VertexState {
+            module: &module,
+            entry_point: Some("vs"),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        primitive: Default::default(),
+        depth_stencil: None,
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module: &module,
+            entry_point: Some("fs"),
+            compilation_options: Default::default(),
+            targets: &[Some(format.into())],
+        }),
+        multiview_mask: None,
+        cache: None,
+    });
+    let (target, view) = crate::frame::texture_2d(
+        device,
+        "self check",
+        (1, 1),
+        format,
+        wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+    );
+    let mut encoder = device.create_command_encoder(&Default::default());
+    {
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("self check"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: None,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&pipeline);
+        pass.set_bind_group(0, &frame_group, &[]);
+        pass.set_bind_group(1, &method_group, &[]);
+        pass.draw(0..3, 0..1);
+    }
+    queue.submit([encoder.finish()]);
+    let raw = read_texture(device, queue, errors, &target, wgpu::TextureAspect::All)?;
+    let want = FIRST ^ SECOND.wrapping_mul(3) ^ METHOD.wrapping_mul(7) ^ TEXEL.wrapping_mul(11);
+    let got = raw
+        .first_chunk::<4>()
+        .map(|b| u32::from_le_bytes(*b))
+        .ok_or_else(|| anyhow::anyhow!("the self-check read back no pixel"))?;
+    if got != want {
+        anyhow::bail!(
+            "a fragment shader computed {got:#010x} from its bindings where {want:#010x} was \
+             due: bind groups (uniforms in two groups and an array texture, as every method \
+             binds them) do not reach shaders on this adapter through wgpu (seen on NVIDIA's \
+             desktop GL 3.3 context through EGL); use another backend (--backend vulkan)"
+        );
+    }
+    Ok(())
+}
