@@ -35,33 +35,15 @@ impl DepthReader {
                 count: None,
             }],
         });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("depth read"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
         let module = crate::shaders::create_module(device, "depth_read.wgsl")?;
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("depth read"),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_fullscreen"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: Default::default(),
-            depth_stencil: None,
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_depth_read"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::TextureFormat::R32Uint.into())],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let pipeline = crate::fullscreen::pipeline(
+            device,
+            "depth read",
+            &[&layout],
+            &module,
+            ("vs_fullscreen", "fs_depth_read"),
+            wgpu::TextureFormat::R32Uint,
+        );
         Ok(Some(DepthReader { layout, pipeline }))
     }
 
@@ -103,27 +85,14 @@ impl DepthReader {
             wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
         );
         let mut encoder = device.create_command_encoder(&Default::default());
-        {
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("depth read"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &target_view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                depth_stencil_attachment: None,
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(0, &group, &[]);
-            pass.draw(0..3, 0..1);
-        }
+        crate::fullscreen::draw(
+            &mut encoder,
+            "depth read",
+            &target_view,
+            &self.pipeline,
+            &[&group],
+            None,
+        );
         queue.submit([encoder.finish()]);
         crate::gpu::TextureReadback::start(device, queue, &target, wgpu::TextureAspect::All)
     }

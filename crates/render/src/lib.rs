@@ -22,6 +22,7 @@ extern crate self as strata_render;
 pub mod caps;
 pub mod depth_read;
 pub mod frame;
+pub(crate) mod fullscreen;
 pub mod gpu;
 pub mod methods;
 pub mod renderer;

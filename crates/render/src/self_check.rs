@@ -137,33 +137,15 @@ pub fn uniforms_read_back(
             resource: method.as_entire_binding(),
         }],
     });
-    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some("self check"),
-        bind_group_layouts: &[Some(&frame_layout), Some(&method_layout)],
-        immediate_size: 0,
-    });
     let format = wgpu::TextureFormat::R32Uint;
-    let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some("self check"),
-        layout: Some(&pipeline_layout),
-        vertex: wgpu::VertexState {
-            module: &module,
-            entry_point: Some("vs"),
-            compilation_options: Default::default(),
-            buffers: &[],
-        },
-        primitive: Default::default(),
-        depth_stencil: None,
-        multisample: Default::default(),
-        fragment: Some(wgpu::FragmentState {
-            module: &module,
-            entry_point: Some("fs"),
-            compilation_options: Default::default(),
-            targets: &[Some(format.into())],
-        }),
-        multiview_mask: None,
-        cache: None,
-    });
+    let pipeline = crate::fullscreen::pipeline(
+        device,
+        "self check",
+        &[&frame_layout, &method_layout],
+        &module,
+        ("vs", "fs"),
+        format,
+    );
     let (target, view) = crate::frame::texture_2d(
         device,
         "self check",
@@ -172,28 +154,14 @@ pub fn uniforms_read_back(
         wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
     );
     let mut encoder = device.create_command_encoder(&Default::default());
-    {
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("self check"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: None,
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        pass.set_pipeline(&pipeline);
-        pass.set_bind_group(0, &frame_group, &[]);
-        pass.set_bind_group(1, &method_group, &[]);
-        pass.draw(0..3, 0..1);
-    }
+    crate::fullscreen::draw(
+        &mut encoder,
+        "self check",
+        &view,
+        &pipeline,
+        &[&frame_group, &method_group],
+        None,
+    );
     queue.submit([encoder.finish()]);
     let raw = read_texture(device, queue, errors, &target, wgpu::TextureAspect::All)?;
     let want = FIRST ^ SECOND.wrapping_mul(3) ^ METHOD.wrapping_mul(7) ^ TEXEL.wrapping_mul(11);

@@ -175,36 +175,14 @@ impl ShadowPass {
                     out_group,
                 }
             }
-            ShadowPassKind::Fragment => {
-                let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                    label: Some("shadow"),
-                    bind_group_layouts: &[Some(&frame_layout)],
-                    immediate_size: 0,
-                });
-                ShadowPipeline::Fragment(device.create_render_pipeline(
-                    &wgpu::RenderPipelineDescriptor {
-                        label: Some("shadow"),
-                        layout: Some(&layout),
-                        vertex: wgpu::VertexState {
-                            module: &module,
-                            entry_point: Some("vs_fullscreen"),
-                            compilation_options: Default::default(),
-                            buffers: &[],
-                        },
-                        primitive: Default::default(),
-                        depth_stencil: None,
-                        multisample: Default::default(),
-                        fragment: Some(wgpu::FragmentState {
-                            module: &module,
-                            entry_point: Some("fs_shadow"),
-                            compilation_options: Default::default(),
-                            targets: &[Some(wgpu::TextureFormat::R32Float.into())],
-                        }),
-                        multiview_mask: None,
-                        cache: None,
-                    },
-                ))
-            }
+            ShadowPassKind::Fragment => ShadowPipeline::Fragment(crate::fullscreen::pipeline(
+                device,
+                "shadow",
+                &[&frame_layout],
+                &module,
+                ("vs_fullscreen", "fs_shadow"),
+                wgpu::TextureFormat::R32Float,
+            )),
         };
         Ok(ShadowPass {
             pipeline,
@@ -236,27 +214,14 @@ impl ShadowPass {
                 pass.set_bind_group(1, out_group, &[]);
                 pass.dispatch_workgroups(SHADOW_SIZE.div_ceil(8), SHADOW_SIZE.div_ceil(8), 1);
             }
-            ShadowPipeline::Fragment(pipeline) => {
-                let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some("shadow map"),
-                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                        view: &self.target,
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                            store: wgpu::StoreOp::Store,
-                        },
-                    })],
-                    depth_stencil_attachment: None,
-                    timestamp_writes: timer.render("shadow"),
-                    occlusion_query_set: None,
-                    multiview_mask: None,
-                });
-                pass.set_pipeline(pipeline);
-                pass.set_bind_group(0, &self.frame_group, &[]);
-                pass.draw(0..3, 0..1);
-            }
+            ShadowPipeline::Fragment(pipeline) => crate::fullscreen::draw(
+                encoder,
+                "shadow map",
+                &self.target,
+                pipeline,
+                &[&self.frame_group],
+                timer.render("shadow"),
+            ),
         }
     }
 }
