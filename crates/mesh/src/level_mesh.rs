@@ -66,6 +66,19 @@ impl LevelMesh {
         }
     }
 
+    /// Start a fit that runs a few chunks at a time on the calling thread
+    /// ([`FitInSteps::step`]): a browser page has one thread and must give
+    /// it back between frames. The finished mesh equals [`fit`](Self::fit)'s.
+    pub fn fit_in_steps(level: &Level, tolerance: f64) -> FitInSteps {
+        let layout = ChunkLayout::of(level);
+        FitInSteps {
+            layout,
+            tolerance: sanitize(tolerance),
+            fitter: ChunkFitter::default(),
+            chunks: Vec::with_capacity(layout.count()),
+        }
+    }
+
     /// Refit every chunk whose samples intersect `dirty` from scratch, so the
     /// result equals a fresh [`fit`](Self::fit) of the edited level. Returns
     /// the indices (ascending) of the chunks whose mesh actually changed.
@@ -133,6 +146,50 @@ impl LevelMesh {
         s.gpu_bytes = s.gpu_indices * 2;
         s.cpu_bytes = (self.chunks.len() * std::mem::size_of::<ChunkRange>()) as u64;
         s
+    }
+}
+
+/// A fit in progress, chunk by chunk in order (see
+/// [`LevelMesh::fit_in_steps`]).
+pub struct FitInSteps {
+    layout: ChunkLayout,
+    tolerance: f64,
+    fitter: ChunkFitter,
+    chunks: Vec<ChunkMesh>,
+}
+
+impl FitInSteps {
+    /// Fit chunks of `level` (the level the fit started on) until
+    /// `keep_going()` says stop (asked after each chunk) or none is left;
+    /// true once every chunk is fitted.
+    pub fn step(&mut self, level: &Level, mut keep_going: impl FnMut() -> bool) -> bool {
+        while self.chunks.len() < self.layout.count() {
+            let (cx, cy) = self.layout.coords(self.chunks.len());
+            let mesh = self.fitter.fit(level, &self.layout, cx, cy, self.tolerance);
+            self.chunks.push(mesh);
+            if !keep_going() {
+                break;
+            }
+        }
+        self.is_done()
+    }
+
+    pub fn is_done(&self) -> bool {
+        self.chunks.len() == self.layout.count()
+    }
+
+    /// Chunks fitted, of all.
+    pub fn progress(&self) -> f32 {
+        self.chunks.len() as f32 / self.layout.count().max(1) as f32
+    }
+
+    /// The mesh, once [`is_done`](Self::is_done) (`None` before).
+    pub fn finish(self) -> Option<LevelMesh> {
+        self.is_done().then(|| LevelMesh {
+            layout: self.layout,
+            tolerance_bits: self.tolerance.to_bits(),
+            chunks: self.chunks,
+        })
     }
 }
 

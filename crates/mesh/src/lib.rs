@@ -47,7 +47,7 @@ pub mod triangulation;
 pub use emit::{ChunkMesh, ChunkStats, LodStats, decode, encode};
 pub use fit::{CAUSES, Cause, ChunkFitter, LODS};
 pub use level_mesh::{
-    ChunkRange, FitTiming, LevelMesh, MeshStats, dirty_chunks, fit_on_threads, timed_fit,
-    tolerance_for_quality,
+    ChunkRange, FitInSteps, FitTiming, LevelMesh, MeshStats, dirty_chunks, fit_on_threads,
+    timed_fit, tolerance_for_quality,
 };
 pub use samples::{CHUNK, ChunkLayout};

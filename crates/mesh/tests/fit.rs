@@ -174,6 +174,33 @@ fn fit_is_deterministic_at_any_thread_count() {
 }
 
 #[test]
+fn fit_in_steps_equals_the_parallel_fit() {
+    let l = level();
+    let whole = LevelMesh::fit(&l, 4.0);
+    let mut steps = LevelMesh::fit_in_steps(&l, 4.0);
+    assert_eq!(
+        LevelMesh::fit_in_steps(&l, 4.0).finish(),
+        None,
+        "an unfinished fit"
+    );
+    let mut calls = 0;
+    // Two chunks per call: the fit must resume where it stopped.
+    while !steps.step(&l, {
+        let mut left = 2;
+        move || {
+            left -= 1;
+            left > 0
+        }
+    }) {
+        calls += 1;
+        assert!(steps.progress() < 1.0);
+    }
+    assert!(calls >= whole.chunks.len() / 2 - 1, "{calls} calls");
+    assert_eq!(steps.progress(), 1.0);
+    assert_eq!(steps.finish(), Some(whole));
+}
+
+#[test]
 fn refit_after_edit_equals_fresh_fit() {
     // One crater inside the map, one across the corner (wraps both ways).
     for (cx, cy) in [(130, 120), (3, 250)] {

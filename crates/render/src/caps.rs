@@ -56,7 +56,7 @@ pub struct Capabilities {
     pub vertex_storage: bool,
     pub float32_targets: bool,
     /// Depth textures copy to buffers; without it depth is read back
-    /// through a pass into an `R32Uint` target (`depth_read.rs`).
+    /// through a pass into an RGBA8 target (`depth_read.rs`).
     pub depth_copies: bool,
     /// Per-pass GPU timestamps; without them frames are timed on the CPU
     /// (submit until done).

@@ -1,8 +1,8 @@
 //! Depth read-back through a pass, for adapters without depth-texture copies
-//! (wgpu's GL backend, WebGL2): the depth target is drawn into an `R32Uint`
-//! colour target by `depth_read.wgsl` (the f32's bits, so nothing is rounded;
-//! 32-bit unsigned targets are renderable everywhere, `R32Float` is not on GL),
-//! and that target is copied out.
+//! (wgpu's GL backend, WebGL2): the depth target is drawn into an
+//! `Rgba8Unorm` colour target by `depth_read.wgsl` (the f32's four bytes, so
+//! nothing is rounded; RGBA8 is the format every GL reads back: Chromium's
+//! WebGL2 gave zeros for an `R32Uint` target), and that target is copied out.
 
 use crate::caps::Capabilities;
 use crate::frame::texture_2d;
@@ -11,6 +11,8 @@ use crate::gpu::ErrorSink;
 /// The read-back pipeline (built once per renderer, on adapters that need it).
 pub struct DepthReader {
     layout: wgpu::BindGroupLayout,
+    /// Nearest: WebGL2 reads an unfilterable depth texture only through one.
+    sampler: wgpu::Sampler,
     pipeline: wgpu::RenderPipeline,
 }
 
@@ -22,18 +24,30 @@ impl DepthReader {
         }
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("depth read"),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::FRAGMENT,
-                ty: wgpu::BindingType::Texture {
-                    // Depth bound as unfilterable float (WebGPU allows it):
-                    // naga's GLSL output cannot textureLoad a depth texture.
-                    sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                    view_dimension: wgpu::TextureViewDimension::D2,
-                    multisampled: false,
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        // Depth bound as unfilterable float (WebGPU allows it):
+                        // naga's GLSL output cannot textureLoad a depth texture.
+                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
                 },
-                count: None,
-            }],
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::NonFiltering),
+                    count: None,
+                },
+            ],
+        });
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("depth read"),
+            ..Default::default()
         });
         let module = crate::shaders::create_module(device, "depth_read.wgsl")?;
         let pipeline = crate::fullscreen::pipeline(
@@ -42,9 +56,13 @@ impl DepthReader {
             &[&layout],
             &module,
             ("vs_fullscreen", "fs_depth_read"),
-            wgpu::TextureFormat::R32Uint,
+            wgpu::TextureFormat::Rgba8Unorm,
         );
-        Ok(Some(DepthReader { layout, pipeline }))
+        Ok(Some(DepthReader {
+            layout,
+            sampler,
+            pipeline,
+        }))
     }
 
     /// Copy `depth` (a `Depth32Float` texture) to the CPU as its f32 values,
@@ -72,16 +90,22 @@ impl DepthReader {
         let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("depth read"),
             layout: &self.layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: wgpu::BindingResource::TextureView(&view),
-            }],
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::TextureView(&view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::Sampler(&self.sampler),
+                },
+            ],
         });
         let (target, target_view) = texture_2d(
             device,
             "depth read",
             (depth.width(), depth.height()),
-            wgpu::TextureFormat::R32Uint,
+            wgpu::TextureFormat::Rgba8Unorm,
             wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
         );
         let mut encoder = device.create_command_encoder(&Default::default());

@@ -182,6 +182,44 @@ fn a_crater_equals_a_fresh_fit_in_the_next_frame() {
     }
 }
 
+/// The browser's build (the fit a chunk or so per step, then the upload)
+/// draws exactly what the whole build draws.
+#[test]
+fn a_build_in_steps_draws_what_the_whole_build_draws() {
+    for gpu in common::gpus() {
+        let w = common::generated_world();
+        let colors = TerrainColors::from_world(&w);
+        let (w_px, h_px) = (160, 100);
+        let camera = Camera::from_view(&w.level, &w.views[0], w_px, h_px).unwrap();
+        let mut whole =
+            Renderer::new(&gpu, &w.level, &colors, "mesh", &settings(), w_px, h_px).unwrap();
+        whole.render_frame(&camera).unwrap();
+        let want = whole.read_depth().unwrap();
+
+        let mut r = Renderer::new(&gpu, &w.level, &colors, "ray", &settings(), w_px, h_px).unwrap();
+        let shared = r.shared_handle();
+        let mut build =
+            strata_render::methods::create_in_steps("mesh", &shared.caps, &settings()).unwrap();
+        let mut steps = 0;
+        let method = loop {
+            steps += 1;
+            // A zero budget: one chunk per step.
+            if let Some(m) = build.step(&shared, &w.level, 0.0).unwrap() {
+                break m;
+            }
+        };
+        let chunks = strata_mesh::ChunkLayout::of(&w.level).count();
+        assert_eq!(steps, chunks, "one chunk per step, then the upload");
+        r.insert_method(method, settings());
+        r.activate("mesh").unwrap();
+        r.render_frame(&camera).unwrap();
+        let got = r.read_depth().unwrap();
+        let differ = got.iter().zip(&want).filter(|(a, b)| a != b).count();
+        assert_eq!(differ, 0, "{differ} pixels differ from the whole build");
+        assert!(want.iter().any(|d| *d < 1.0), "the view shows terrain");
+    }
+}
+
 #[test]
 fn retained_bytes_cover_all_lods() {
     for gpu in common::gpus() {

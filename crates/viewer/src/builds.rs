@@ -1,4 +1,5 @@
-//! Methods built off the render thread. A method's first use (or a changed
+//! Methods built off the render thread (natively a thread per build; in a
+//! browser page a slice per frame). A method's first use (or a changed
 //! setting) can take seconds (the mesh fit, the voxel pyramid on a CPU
 //! adapter); the window keeps drawing the current method meanwhile and shows
 //! the build's progress. Edits made while a build runs are replayed on the
@@ -17,11 +18,19 @@ struct Job(std::thread::JoinHandle<Built>);
 
 #[cfg(not(target_arch = "wasm32"))]
 impl Job {
-    fn spawn(name: &str, build: impl FnOnce() -> Built + Send + 'static) -> anyhow::Result<Self> {
+    fn start(
+        renderer: &Renderer,
+        level: &Arc<Level>,
+        name: &str,
+        settings: &MethodSettings,
+    ) -> anyhow::Result<Self> {
         use anyhow::Context;
+        let shared = renderer.shared_handle();
+        let level = Arc::clone(level);
+        let (owned_name, owned_settings) = (name.to_string(), settings.clone());
         std::thread::Builder::new()
             .name(format!("build {name}"))
-            .spawn(build)
+            .spawn(move || methods::create(&owned_name, &shared, &level, &owned_settings))
             .map(Job)
             .with_context(|| format!("starting a thread to build {name}"))
     }
@@ -37,21 +46,37 @@ impl Job {
     }
 }
 
-/// A browser page has one thread: the build runs on it, in the second
-/// frame after it was asked for (so the frame between shows that it runs),
-/// and that frame waits for it.
+/// A browser page has one thread: the build runs on it a slice per frame
+/// ([`BuildSteps`]: the mesh fits a few chunks, other methods build whole),
+/// from the second frame after it was asked for (so the frame between shows
+/// that it runs); the current method keeps drawing meanwhile.
 #[cfg(target_arch = "wasm32")]
 struct Job {
-    build: Option<Box<dyn FnOnce() -> Built>>,
+    steps: Box<dyn strata_render::methods::BuildSteps>,
+    shared: Arc<strata_render::Shared>,
+    level: Arc<Level>,
     result: Option<Built>,
     polls: u32,
 }
 
+/// Milliseconds of building per frame in a page: the page keeps drawing at
+/// a few frames a second while the mesh fits.
+#[cfg(target_arch = "wasm32")]
+const STEP_BUDGET_MS: f64 = 80.0;
+
 #[cfg(target_arch = "wasm32")]
 impl Job {
-    fn spawn(_name: &str, build: impl FnOnce() -> Built + 'static) -> anyhow::Result<Self> {
+    fn start(
+        renderer: &Renderer,
+        level: &Arc<Level>,
+        name: &str,
+        settings: &MethodSettings,
+    ) -> anyhow::Result<Self> {
+        let shared = renderer.shared_handle();
         Ok(Job {
-            build: Some(Box::new(build)),
+            steps: methods::create_in_steps(name, &shared.caps, settings)?,
+            shared,
+            level: Arc::clone(level),
             result: None,
             polls: 0,
         })
@@ -59,17 +84,19 @@ impl Job {
 
     fn is_finished(&mut self) -> bool {
         self.polls += 1;
-        if self.polls >= 2
-            && let Some(build) = self.build.take()
-        {
-            self.result = Some(build());
+        if self.polls >= 2 && self.result.is_none() {
+            match self.steps.step(&self.shared, &self.level, STEP_BUDGET_MS) {
+                Ok(None) => {}
+                Ok(Some(method)) => self.result = Some(Ok(method)),
+                Err(error) => self.result = Some(Err(error)),
+            }
         }
         self.result.is_some()
     }
 
     fn join(self) -> Built {
         self.result
-            .unwrap_or_else(|| Err(anyhow::anyhow!("the build never ran")))
+            .unwrap_or_else(|| Err(anyhow::anyhow!("the build never finished")))
     }
 }
 
@@ -107,12 +134,7 @@ impl Builds {
         if self.is_building(name, settings) {
             return Ok(());
         }
-        let shared = renderer.shared_handle();
-        let level = Arc::clone(level);
-        let (owned_name, owned_settings) = (name.to_string(), settings.clone());
-        let thread = Job::spawn(name, move || {
-            methods::create(&owned_name, &shared, &level, &owned_settings)
-        })?;
+        let thread = Job::start(renderer, level, name, settings)?;
         self.pending.push(Pending {
             name: name.to_string(),
             settings: settings.clone(),

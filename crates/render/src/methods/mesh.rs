@@ -28,7 +28,7 @@ use strata_camera::Camera;
 use strata_level::model::decode_column;
 use strata_level::{DirtyRect, Level};
 use strata_mesh::{
-    ChunkFitter, ChunkLayout, ChunkMesh, LevelMesh, dirty_chunks, tolerance_for_quality,
+    ChunkFitter, ChunkLayout, ChunkMesh, FitInSteps, LevelMesh, dirty_chunks, tolerance_for_quality,
 };
 
 /// LOD 0 within the first distance, LOD 1 within the second, LOD 2 beyond
@@ -118,9 +118,9 @@ fn draws_binding(
     (buffer, group)
 }
 
-/// The chunks of `level`, fitted at `tolerance`, each with its altitude range
-/// (reporting the fit's progress to `shared`).
-fn fit_all(shared: &Shared, level: &Level, tolerance: f64) -> (ChunkLayout, Vec<Fitted>) {
+/// Fit `level` at `tolerance` on the rayon pool (reporting the fit's
+/// progress to `shared`).
+fn fit_all(shared: &Shared, level: &Level, tolerance: f64) -> LevelMesh {
     // Every 1/64th is enough for a progress bar and keeps the lock cold.
     let report = |done: usize, total: usize| {
         if done * 64 / total != (done - 1) * 64 / total {
@@ -129,6 +129,11 @@ fn fit_all(shared: &Shared, level: &Level, tolerance: f64) -> (ChunkLayout, Vec<
     };
     let mesh = LevelMesh::fit_with_progress(level, tolerance, &report);
     shared.progress.clear("mesh");
+    mesh
+}
+
+/// Each chunk of `mesh` with its altitude range.
+fn with_z_ranges(level: &Level, mesh: LevelMesh) -> (ChunkLayout, Vec<Fitted>) {
     let layout = mesh.layout;
     let chunks = mesh
         .chunks
@@ -142,16 +147,70 @@ fn fit_all(shared: &Shared, level: &Level, tolerance: f64) -> (ChunkLayout, Vec<
     (layout, chunks)
 }
 
+fn tolerance_of(settings: &MethodSettings) -> anyhow::Result<f64> {
+    let q = settings.mesh_quality;
+    tolerance_for_quality(f64::from(q))
+        .ok_or_else(|| anyhow::anyhow!("mesh quality {q} is outside [0, 1] (max error 2^(4(1-q)))"))
+}
+
+/// The fit a few chunks per step, then the upload (the browser's build).
+struct MeshSteps {
+    tolerance: f64,
+    fit: Option<FitInSteps>,
+}
+
+/// Start the mesh's build in slices: [`super::BuildSteps`].
+pub fn build_in_steps(settings: &MethodSettings) -> anyhow::Result<Box<dyn super::BuildSteps>> {
+    Ok(Box::new(MeshSteps {
+        tolerance: tolerance_of(settings)?,
+        fit: None,
+    }))
+}
+
+impl super::BuildSteps for MeshSteps {
+    fn step(
+        &mut self,
+        shared: &Shared,
+        level: &Level,
+        budget_ms: f64,
+    ) -> anyhow::Result<Option<Box<dyn Method>>> {
+        let start = web_time::Instant::now();
+        let fit = self
+            .fit
+            .get_or_insert_with(|| LevelMesh::fit_in_steps(level, self.tolerance));
+        let done = fit.step(level, || start.elapsed().as_secs_f64() * 1e3 < budget_ms);
+        shared.progress.report("mesh", fit.progress());
+        if !done {
+            return Ok(None);
+        }
+        shared.progress.clear("mesh");
+        let mesh = self
+            .fit
+            .take()
+            .and_then(FitInSteps::finish)
+            .ok_or_else(|| anyhow::anyhow!("the mesh fit stopped before its last chunk"))?;
+        from_fit(shared, level, self.tolerance, mesh).map(Some)
+    }
+}
+
 pub fn create(
     shared: &Shared,
     level: &Level,
     settings: &MethodSettings,
 ) -> anyhow::Result<Box<dyn Method>> {
-    let q = settings.mesh_quality;
-    let Some(tolerance) = tolerance_for_quality(f64::from(q)) else {
-        anyhow::bail!("mesh quality {q} is outside [0, 1] (max error 2^(4(1-q)))");
-    };
-    let (layout, chunks) = fit_all(shared, level, tolerance);
+    let tolerance = tolerance_of(settings)?;
+    let mesh = fit_all(shared, level, tolerance);
+    from_fit(shared, level, tolerance, mesh)
+}
+
+/// Upload a fitted mesh and make the method.
+fn from_fit(
+    shared: &Shared,
+    level: &Level,
+    tolerance: f64,
+    mesh: LevelMesh,
+) -> anyhow::Result<Box<dyn Method>> {
+    let (layout, chunks) = with_z_ranges(level, mesh);
     let headroom = pool_headroom(&chunks);
     let (pool, slots) = IndexPool::build(&shared.device, &shared.queue, &chunks, headroom)?;
     drop(chunks);
@@ -339,7 +398,7 @@ impl Method for Mesh {
         let layout = ChunkLayout::of(level);
         if layout != self.layout {
             // Another map size: nothing local survives.
-            let (layout, chunks) = fit_all(shared, level, self.tolerance);
+            let (layout, chunks) = with_z_ranges(level, fit_all(shared, level, self.tolerance));
             let headroom = pool_headroom(&chunks);
             let (pool, slots) = IndexPool::build(&shared.device, &shared.queue, &chunks, headroom)?;
             (self.layout, self.pool, self.slots) = (layout, pool, slots);

@@ -158,10 +158,47 @@ pub trait Method: Send {
 /// Builds a method.
 pub type Constructor = fn(&Shared, &Level, &MethodSettings) -> anyhow::Result<Box<dyn Method>>;
 
+/// Starts a method's build in slices ([`BuildSteps`]).
+pub type StepsConstructor = fn(&MethodSettings) -> anyhow::Result<Box<dyn BuildSteps>>;
+
+/// A method built a slice at a time on the calling thread: a browser page
+/// has one thread, so it builds between frames and keeps drawing. Natively
+/// a build runs whole on a thread of its own ([`create`]).
+pub trait BuildSteps {
+    /// Work for about `budget_ms` (at least one unit of work); the method
+    /// once built. `level` must be the level of the first call.
+    fn step(
+        &mut self,
+        shared: &Shared,
+        level: &Level,
+        budget_ms: f64,
+    ) -> anyhow::Result<Option<Box<dyn Method>>>;
+}
+
+/// A method without a sliced build: built whole in its first step.
+struct Whole {
+    create: Constructor,
+    settings: MethodSettings,
+}
+
+impl BuildSteps for Whole {
+    fn step(
+        &mut self,
+        shared: &Shared,
+        level: &Level,
+        _: f64,
+    ) -> anyhow::Result<Option<Box<dyn Method>>> {
+        (self.create)(shared, level, &self.settings).map(Some)
+    }
+}
+
 /// A method by name: how to build it and what it needs of the adapter.
 pub struct MethodEntry {
     pub name: &'static str,
     pub create: Constructor,
+    /// A build in slices, for methods whose CPU preparation takes long
+    /// (built whole in one step when `None`).
+    pub in_steps: Option<StepsConstructor>,
     /// Capabilities beyond WebGL2's baseline (a fragment pass reading the
     /// terrain texture) that its pipelines use.
     pub needs: &'static [Capability],
@@ -189,44 +226,52 @@ pub const METHODS: &[MethodEntry] = &[
     MethodEntry {
         name: "ray",
         create: ray::create,
+        in_steps: None,
         needs: &[],
     },
     MethodEntry {
         name: "ray-compute",
         create: ray_compute::create,
+        in_steps: None,
         needs: &[ComputeShaders, StorageTextures],
     },
     MethodEntry {
         name: "voxel",
         // The occupancy pyramid is built and edited by compute passes.
         create: voxel::create,
+        in_steps: None,
         needs: &[ComputeShaders, FragmentStorage],
     },
     MethodEntry {
         name: "voxel-compute",
         create: voxel::create_compute,
+        in_steps: None,
         needs: &[ComputeShaders, StorageTextures],
     },
     MethodEntry {
         name: "painted",
         create: painted::create,
+        in_steps: None,
         needs: &[],
     },
     MethodEntry {
         name: "sliced",
         create: sliced::create,
+        in_steps: None,
         needs: &[],
     },
     MethodEntry {
         name: "mesh",
         // Vertices fetch their chunk's placement from a storage buffer.
         create: mesh::create,
+        in_steps: Some(mesh::build_in_steps),
         needs: &[VertexStorage],
     },
     MethodEntry {
         name: "scattered",
         // Compute scatters into an atomic screen buffer; a fragment pass resolves it.
         create: scattered::create,
+        in_steps: None,
         needs: &[ComputeShaders, FragmentStorage],
     },
 ];
@@ -271,4 +316,22 @@ pub fn create(
     let entry = entry(name)?;
     entry.check(&shared.caps)?;
     (entry.create)(shared, level, settings)
+}
+
+/// Start building the method called `name` in slices ([`BuildSteps`]);
+/// refused at once, like [`create`], when the adapter lacks what it needs.
+pub fn create_in_steps(
+    name: &str,
+    caps: &Capabilities,
+    settings: &MethodSettings,
+) -> anyhow::Result<Box<dyn BuildSteps>> {
+    let entry = entry(name)?;
+    entry.check(caps)?;
+    match entry.in_steps {
+        Some(start) => start(settings),
+        None => Ok(Box::new(Whole {
+            create: entry.create,
+            settings: settings.clone(),
+        })),
+    }
 }
