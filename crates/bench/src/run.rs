@@ -67,6 +67,13 @@ impl Plan {
     /// method settings, edit site. Errors name the bad input.
     pub fn new(world: World, opts: Options) -> anyhow::Result<Plan> {
         prepare_out_dir(&opts.out)?;
+        Self::without_output(world, opts)
+    }
+
+    /// [`Plan::new`] for a runner that writes no files (the browser page's,
+    /// which offers the results file for download): `opts.out` and
+    /// `opts.cache_dir` are not touched.
+    pub fn without_output(world: World, opts: Options) -> anyhow::Result<Plan> {
         check_view_names(&opts.views)?;
         if opts.frames == 0 {
             anyhow::bail!("--frames must be at least 1");
@@ -117,7 +124,40 @@ impl Plan {
         })
     }
 
-    fn results_header(&self, gpu: &Gpu) -> RunResults {
+    pub fn world(&self) -> &World {
+        &self.world
+    }
+
+    pub fn options(&self) -> &Options {
+        &self.opts
+    }
+
+    /// Each view's camera, in view order.
+    pub fn cameras(&self) -> &[Camera] {
+        &self.cameras
+    }
+
+    /// Method `m`'s settings (the order of `options().methods`).
+    pub fn method_settings(&self, m: usize) -> &MethodSettings {
+        &self.settings[m]
+    }
+
+    pub fn colors(&self) -> &TerrainColors {
+        &self.colors
+    }
+
+    /// Pre-timing frames at view `v`: the first view adds enough for a
+    /// whole-level incremental build.
+    pub fn warmup_frames(&self, v: usize) -> u32 {
+        if v == 0 {
+            self.warmup_first
+        } else {
+            self.opts.min_warmup
+        }
+    }
+
+    /// The results file before any cell: protocol, level, adapter, settings.
+    pub fn results_header(&self, gpu: &Gpu) -> RunResults {
         let level = &self.world.level;
         RunResults {
             protocol_version: PROTOCOL_VERSION,
@@ -391,32 +431,9 @@ impl Plan {
             warmup,
             session.results.adapter.timestamps,
         )?;
-        let mut gpu = Vec::new();
-        let mut cpu = Vec::new();
-        let mut passes: Vec<PassTime> = Vec::new();
-        for _ in 0..self.opts.frames {
-            let t = renderer.render_frame(camera)?;
-            cpu.push(t.cpu_ms);
-            for (label, ms) in &t.passes {
-                match passes.iter_mut().find(|p| p.label == *label) {
-                    Some(p) => p.mean_ms += ms / f64::from(self.opts.frames),
-                    None => passes.push(PassTime {
-                        label: label.clone(),
-                        mean_ms: ms / f64::from(self.opts.frames),
-                    }),
-                }
-            }
-            if let Some(g) = t.gpu_ms {
-                gpu.push(g);
-            }
-        }
-        // Timestamps on some frames only would mix sources: keep GPU only when every frame has it.
-        let gpu_t = if gpu.len() == cpu.len() {
-            summarize(&gpu)
-        } else {
-            None
-        };
-        let cpu_t = summarize(&cpu).context("no timed frames")?;
+        let frames = (0..self.opts.frames)
+            .map(|_| renderer.render_frame(camera))
+            .collect::<anyhow::Result<Vec<_>>>()?;
         let depth = renderer.read_depth()?;
         let distance = strata_reference::distance_from_depth(camera, &depth);
         let metrics = strata_reference::metrics::try_compare(reference, &distance)?;
@@ -427,11 +444,60 @@ impl Plan {
             &format!("{}-{}", view.name, file_part(&label)),
             color,
         )?;
-        let retained = renderer.retained_bytes();
+        let measured = Measured {
+            metrics,
+            frames,
+            warm,
+            setup_ms,
+            retained: renderer.retained_bytes(),
+        };
+        self.row(v, m, measured, image)
+    }
+
+    /// The row of cell (view `v`, method `m`) from what was measured there
+    /// (the native runner's and the browser page's). `image` is the cell
+    /// picture relative to the results file ("" without one).
+    pub fn row(
+        &self,
+        v: usize,
+        m: usize,
+        measured: Measured,
+        image: String,
+    ) -> anyhow::Result<Row> {
+        let view = &self.opts.views[v];
+        let Measured {
+            metrics,
+            frames,
+            warm,
+            setup_ms,
+            retained,
+        } = measured;
+        let n = frames.len() as f64;
+        let mut passes: Vec<PassTime> = Vec::new();
+        for t in &frames {
+            for (label, ms) in &t.passes {
+                match passes.iter_mut().find(|p| p.label == *label) {
+                    Some(p) => p.mean_ms += ms / n,
+                    None => passes.push(PassTime {
+                        label: label.clone(),
+                        mean_ms: ms / n,
+                    }),
+                }
+            }
+        }
+        let cpu: Vec<f64> = frames.iter().map(|t| t.cpu_ms).collect();
+        let gpu: Vec<f64> = frames.iter().filter_map(|t| t.gpu_ms).collect();
+        // Timestamps on some frames only would mix sources: keep GPU only when every frame has it.
+        let gpu_t = if gpu.len() == cpu.len() {
+            summarize(&gpu)
+        } else {
+            None
+        };
+        let cpu_t = summarize(&cpu).context("no timed frames")?;
         Ok(Row {
             view: view.name.clone(),
             pitch: view.pitch,
-            method: label,
+            method: self.opts.methods[m].label(),
             see_through: metrics.see_through,
             covers_sky: metrics.covers_sky,
             depth_p50: f64::from(metrics.depth_p50),
@@ -455,6 +521,17 @@ impl Plan {
             image,
         })
     }
+}
+
+/// What one cell measured, before it becomes a [`Row`].
+pub struct Measured {
+    pub metrics: strata_reference::Metrics,
+    /// The timed frames.
+    pub frames: Vec<strata_render::FrameTimings>,
+    pub warm: WarmUp,
+    /// The renderer's setup (paid once per method, recorded on each row).
+    pub setup_ms: f64,
+    pub retained: strata_render::RetainedBytes,
 }
 
 /// What warming a renderer up at one view cost.

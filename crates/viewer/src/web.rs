@@ -27,7 +27,8 @@ pub enum Backend {
 }
 
 impl Backend {
-    fn backends(self) -> wgpu::Backends {
+    /// The wgpu backends an instance for this API uses.
+    pub fn backends(self) -> wgpu::Backends {
         match self {
             Backend::WebGpu => wgpu::Backends::BROWSER_WEBGPU,
             Backend::WebGl2 => wgpu::Backends::GL,
@@ -46,6 +47,14 @@ thread_local! {
     /// What the page measured before the viewer started (world generation
     /// or download time), carried in every published state.
     static PAGE_INFO: RefCell<serde_json::Map<String, serde_json::Value>> = RefCell::new(serde_json::Map::new());
+    /// A world the page loaded (a picked folder) for the viewer to show next.
+    static NEXT_WORLD: RefCell<Option<strata_level::World>> = const { RefCell::new(None) };
+}
+
+/// Show `world` in the viewer from its next frame on (the window, device,
+/// method and settings stay; the camera goes to the world's first view).
+pub fn open_world(world: strata_level::World) {
+    NEXT_WORLD.with(|w| *w.borrow_mut() = Some(world));
 }
 
 /// Remember a page measurement (shown in every published state).
@@ -117,6 +126,14 @@ pub fn show_error(message: &str) {
         state["error"] = message.into();
         *s.borrow_mut() = state.to_string();
     });
+}
+
+/// Hide the page's error box (a new attempt is under way).
+pub fn clear_error() {
+    if let Some(element) = document().and_then(|d| d.get_element_by_id(ERROR_ID)) {
+        element.set_text_content(None);
+        let _ = element.set_attribute("style", "display: none");
+    }
 }
 
 fn document() -> Option<web_sys::Document> {
@@ -216,8 +233,34 @@ impl App {
         });
     }
 
-    /// Build the viewer once the device has come.
+    /// Build the viewer once the device has come; swap in a world the page
+    /// loaded since.
     pub(crate) fn poll_opening(&mut self, event_loop: &ActiveEventLoop) {
+        self.poll_device(event_loop);
+        if self.viewer.is_some()
+            && let Some(world) = NEXT_WORLD.with(|w| w.borrow_mut().take())
+            && let Some(viewer) = self.viewer.take()
+        {
+            let parts = viewer.hand_over();
+            let inner = parts.window.inner_size();
+            let options = Options {
+                world,
+                method: parts.method,
+                settings: parts.settings,
+                size: (inner.width.max(1), inner.height.max(1)),
+                render_scale: Some(parts.render_scale),
+                view: None,
+                script: None,
+                vsync: parts.vsync,
+                adapter: Default::default(),
+                out: parts.out,
+            };
+            let opened = Viewer::new(parts.window, parts.surface, parts.gpu, options);
+            self.opened(event_loop, opened);
+        }
+    }
+
+    fn poll_device(&mut self, event_loop: &ActiveEventLoop) {
         let ready = self
             .opening
             .as_ref()

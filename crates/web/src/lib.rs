@@ -4,11 +4,14 @@
 //! `?level=URL`), then hand [`strata_viewer`] to the browser's event loop.
 //! Errors and panics are shown in the page.
 //!
-//! URL parameters: `backend=webgl2`, `method=NAME`, `view=NAME`,
+//! URL parameters: `backend=webgl2`, `method=NAME`, `view=NAME`, `voxel=X,Y,Z`,
 //! `size=WxH` (canvas), `scale=F` (picture / canvas), `world=WxH` and
-//! `seed=N` (the generated world), `level=URL` (a world directory).
+//! `seed=N` (the generated world), `level=URL` (a world directory),
+//! `compare` (the quick protocol instead of the viewer; `views=A,B` to
+//! narrow it; see `compare.rs`).
 #![cfg(target_arch = "wasm32")]
 
+mod compare;
 mod page;
 
 use wasm_bindgen::prelude::*;
@@ -37,4 +40,11 @@ pub fn strata_run(text: &str) -> Result<u32, JsValue> {
 #[wasm_bindgen(js_name = strataState)]
 pub fn strata_state() -> String {
     strata_viewer::web::state()
+}
+
+/// The results file (`results-<adapter>.json`) of a finished `?compare`
+/// run; `undefined` before it finishes.
+#[wasm_bindgen(js_name = strataResults)]
+pub fn strata_results() -> Option<String> {
+    compare::results_json()
 }

@@ -1,4 +1,5 @@
-//! URL parameters, the world in the page, the progress bar.
+//! URL parameters, the world in the page (generated, fetched or picked),
+//! the progress bar.
 
 use anyhow::{Context, bail};
 use strata_level::World;
@@ -17,6 +18,12 @@ pub struct Params {
     pub scale: Option<f32>,
     pub world: GenerateParams,
     pub level: Option<String>,
+    /// `?voxel=X,Y,Z`: the voxel methods' grid (default the tuned one).
+    pub settings: MethodSettings,
+    /// `?compare`: run the quick protocol instead of the viewer.
+    pub compare: bool,
+    /// `&views=A,B`: the protocol's views (default: the level's).
+    pub views: Option<Vec<String>>,
 }
 
 impl Params {
@@ -61,14 +68,29 @@ impl Params {
                 .ok()
                 .with_context(|| format!("?seed={text}: a whole number"))?;
         }
+        let mut settings = MethodSettings::default();
+        if let Some(text) = get("voxel") {
+            let sizes: Vec<u32> = text
+                .split(',')
+                .map(|v| v.trim().parse::<u32>().ok().filter(|v| *v > 0))
+                .collect::<Option<_>>()
+                .with_context(|| format!("?voxel={text}: three positive whole numbers X,Y,Z"))?;
+            let [x, y, z] = sizes[..] else {
+                bail!("?voxel={text}: three sizes X,Y,Z");
+            };
+            settings.voxel_size = [x, y, z];
+        }
         Ok(Params {
             backend,
+            settings,
             method: get("method").unwrap_or_else(|| "ray".into()),
             view: get("view"),
             size,
             scale,
             world,
             level: get("level"),
+            compare: query.has("compare"),
+            views: get("views").map(|v| v.split(',').map(|n| n.trim().to_string()).collect()),
         })
     }
 }
@@ -80,12 +102,16 @@ pub async fn run() -> anyhow::Result<()> {
         Some(url) => fetch_world(url).await?,
         None => generate(&params.world).await?,
     };
+    if params.compare {
+        return crate::compare::run(world, params.backend, params.views).await;
+    }
+    watch_folder_picker();
     progress(None, "");
     strata_viewer::web::start(
         strata_viewer::Options {
             world,
             method: params.method,
-            settings: MethodSettings::default(),
+            settings: params.settings,
             size: params.size,
             render_scale: params.scale,
             view: params.view,
@@ -202,45 +228,122 @@ async fn fetch(url: &str) -> anyhow::Result<Option<Vec<u8>>> {
     Ok(Some(js_sys::Uint8Array::new(&buffer).to_vec()))
 }
 
-async fn fetch_required(url: &str) -> anyhow::Result<Vec<u8>> {
-    fetch(url)
-        .await?
-        .with_context(|| format!("GET {url}: 404 Not Found (a world directory needs this file)"))
+/// Where a world directory's files come from: a URL served over HTTP, or
+/// a folder the person picked.
+enum Folder {
+    Http(String),
+    Picked {
+        name: String,
+        files: Vec<web_sys::File>,
+    },
+}
+
+impl Folder {
+    /// How messages name the folder.
+    fn label(&self) -> String {
+        match self {
+            Folder::Http(base) => base.clone(),
+            Folder::Picked { name, .. } => format!("the picked folder `{name}`"),
+        }
+    }
+
+    /// The file `name` of the folder, `None` when it has none.
+    async fn get(&self, name: &str) -> anyhow::Result<Option<Vec<u8>>> {
+        match self {
+            Folder::Http(base) => fetch(&format!("{base}{name}")).await,
+            Folder::Picked { files, .. } => {
+                // Top-level files first (a folder's subfolders come along too).
+                let depth = |f: &web_sys::File| relative_path(f).matches('/').count();
+                let Some(file) = files
+                    .iter()
+                    .filter(|f| f.name() == name)
+                    .min_by_key(|f| depth(f))
+                else {
+                    return Ok(None);
+                };
+                let buffer = JsFuture::from(file.array_buffer())
+                    .await
+                    .map_err(|e| anyhow::anyhow!("reading {name}: {e:?}"))?;
+                Ok(Some(js_sys::Uint8Array::new(&buffer).to_vec()))
+            }
+        }
+    }
+
+    async fn required(&self, name: &str) -> anyhow::Result<Vec<u8>> {
+        self.get(name).await?.with_context(|| match self {
+            Folder::Http(base) => {
+                format!("GET {base}{name}: 404 Not Found (a world directory needs this file)")
+            }
+            Folder::Picked { name: folder, .. } => {
+                format!("the picked folder `{folder}` has no {name} (a world directory needs it)")
+            }
+        })
+    }
+}
+
+/// A picked file's path under the picked folder's parent (`fostral/world.ini`;
+/// web-sys does not bind `webkitRelativePath`).
+fn relative_path(file: &web_sys::File) -> String {
+    js_sys::Reflect::get(file, &"webkitRelativePath".into())
+        .ok()
+        .and_then(|v| v.as_string())
+        .unwrap_or_default()
 }
 
 /// A world directory served over HTTP (`world.ini`, the map, the palette,
 /// optionally `.vpr`, `views.txt`, `edit.txt`), through the native readers.
 async fn fetch_world(url: &str) -> anyhow::Result<World> {
-    use std::path::Path;
-    use strata_level::config::WorldConfig;
-    use strata_level::{MidRule, io};
     let base = if url.ends_with('/') {
         url.to_string()
     } else {
         format!("{url}/")
     };
-    let dir = Path::new(base.trim_end_matches('/'));
-    progress(Some(0.0), &format!("loading the world at {base}"));
-    let ini = fetch_required(&format!("{base}{}", io::WORLD_INI)).await?;
+    load_world(&Folder::Http(base)).await
+}
+
+/// A world folder from the page's file picker.
+pub async fn picked_world(files: Vec<web_sys::File>) -> anyhow::Result<World> {
+    let name = files
+        .first()
+        .map(relative_path)
+        .and_then(|p| p.split('/').next().map(str::to_string))
+        .filter(|n| !n.is_empty())
+        .unwrap_or_else(|| "world".into());
+    let world = load_world(&Folder::Picked { name, files }).await?;
+    progress(None, "");
+    Ok(world)
+}
+
+async fn load_world(folder: &Folder) -> anyhow::Result<World> {
+    use std::path::Path;
+    use strata_level::config::WorldConfig;
+    use strata_level::{MidRule, io};
+    let label = folder.label();
+    let dir = Path::new(label.trim_end_matches('/'));
+    progress(Some(0.0), &format!("loading the world at {label}"));
+    let ini = folder.required(io::WORLD_INI).await?;
     let config = WorldConfig::parse(&String::from_utf8_lossy(&ini), &dir.join(io::WORLD_INI))?;
     let map_path = io::map_path(dir, &config);
     let map_name = map_path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
-    progress(Some(0.1), &format!("loading {base}{map_name}"));
-    let map = fetch_required(&format!("{base}{map_name}")).await?;
-    let palette = fetch_required(&format!("{base}{}", config.palette_file)).await?;
-    let vpr = fetch(&format!("{base}{}.vpr", config.file_name)).await?;
-    let views = fetch(&format!("{base}{}", io::VIEWS_TXT)).await?;
-    let edit = fetch(&format!("{base}{}", io::EDIT_TXT)).await?;
-    progress(Some(0.5), &format!("decoding {base}{map_name}"));
+    progress(Some(0.1), &format!("loading {map_name} from {label}"));
+    let map = folder.required(&map_name).await?;
+    let palette = folder.required(&config.palette_file).await?;
+    let vpr = folder.get(&format!("{}.vpr", config.file_name)).await?;
+    let views = folder.get(io::VIEWS_TXT).await?;
+    let edit = folder.get(io::EDIT_TXT).await?;
+    progress(Some(0.5), &format!("decoding {map_name} from {label}"));
     yield_to_browser().await;
     let level = io::decode_map(&map, &config, MidRule::Original, &map_path)?;
     drop(map);
-    let name = dir
-        .file_name()
-        .map_or_else(|| "world".into(), |n| n.to_string_lossy().into_owned());
+    let name = match folder {
+        Folder::Picked { name, .. } => name.clone(),
+        Folder::Http(_) => dir
+            .file_name()
+            .map_or_else(|| "world".into(), |n| n.to_string_lossy().into_owned()),
+    };
     Ok(io::world_from_parts(
         name,
         dir,
@@ -253,4 +356,40 @@ async fn fetch_world(url: &str) -> anyhow::Result<World> {
             edit: edit.as_deref(),
         },
     )?)
+}
+
+/// The page's folder picker: a picked world folder replaces the world the
+/// viewer shows; a bad one gets the same clear error as natively.
+pub fn watch_folder_picker() {
+    let Some(input) = web_sys::window()
+        .and_then(|w| w.document())
+        .and_then(|d| d.get_element_by_id("strata-open"))
+        .and_then(|e| e.dyn_into::<web_sys::HtmlInputElement>().ok())
+    else {
+        return;
+    };
+    let picker = input.clone();
+    let on_change = wasm_bindgen::closure::Closure::<dyn FnMut()>::new(move || {
+        let Some(list) = picker.files() else { return };
+        let files: Vec<web_sys::File> = (0..list.length()).filter_map(|i| list.get(i)).collect();
+        if files.is_empty() {
+            return;
+        }
+        strata_viewer::web::clear_error();
+        wasm_bindgen_futures::spawn_local(async move {
+            match picked_world(files).await {
+                Ok(world) => {
+                    web_sys::console::log_1(&format!("strata: opened {}", world.name).into());
+                    strata_viewer::web::open_world(world);
+                }
+                Err(error) => {
+                    progress(None, "");
+                    strata_viewer::web::show_error(&format!("{error:#}"));
+                }
+            }
+        });
+    });
+    input.set_onchange(Some(on_change.as_ref().unchecked_ref()));
+    // The page lives as long as the picker: keep the handler.
+    on_change.forget();
 }

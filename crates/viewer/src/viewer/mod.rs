@@ -117,6 +117,19 @@ pub struct Viewer {
     quit: bool,
 }
 
+/// What a viewer leaves to the viewer of the next world ([`Viewer::hand_over`]).
+#[cfg(target_arch = "wasm32")]
+pub struct Handover {
+    pub window: Arc<Window>,
+    pub surface: wgpu::Surface<'static>,
+    pub gpu: Gpu,
+    pub method: String,
+    pub settings: MethodSettings,
+    pub render_scale: f32,
+    pub vsync: bool,
+    pub out: PathBuf,
+}
+
 fn surface_config(
     surface: &wgpu::Surface<'_>,
     gpu: &Gpu,
@@ -323,6 +336,23 @@ impl Viewer {
         ));
         viewer.request_method(&method)?;
         Ok(viewer)
+    }
+
+    /// Give up the window, its surface and the device, with the method and
+    /// settings drawn, so a viewer of another world can take them (the page
+    /// cannot open a second window or event loop).
+    #[cfg(target_arch = "wasm32")]
+    pub fn hand_over(self) -> Handover {
+        Handover {
+            method: self.renderer.method_name().to_string(),
+            settings: self.settings.clone(),
+            render_scale: self.render_scale,
+            vsync: self.config.present_mode != wgpu::PresentMode::AutoNoVsync,
+            out: self.out.clone(),
+            window: self.window,
+            surface: self.surface,
+            gpu: self.gpu,
+        }
     }
 
     /// The picture's size: the renderer's targets.
@@ -742,6 +772,7 @@ impl Viewer {
             "timings": self.timings.iter().map(|(m, t)| serde_json::json!({
                 "method": m, "cpu_ms": t.cpu_ms, "gpu_ms": t.gpu_ms, "record_ms": t.record_ms,
             })).collect::<Vec<_>>(),
+            "level_size": [self.level.width(), self.level.height()],
             "render_size": self.render_size(),
             "window_size": self.compositor.window_size(),
             "undo_depth": self.digger.can_undo(),
