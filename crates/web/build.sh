@@ -9,8 +9,14 @@ version=$(grep -A1 '^name = "wasm-bindgen"$' Cargo.lock | sed -n 's/^version = "
 rustup target list --installed 2>/dev/null | grep -qx wasm32-unknown-unknown ||
     rustup target add wasm32-unknown-unknown
 if [ "$(wasm-bindgen --version 2>/dev/null | cut -d' ' -f2)" != "$version" ]; then
-    cargo install wasm-bindgen-cli --locked --version "$version"
+    # --locked pins the CLI's own lock file, whose versions a crates.io
+    # mirror may not have yet; resolving afresh is the fallback.
+    cargo install wasm-bindgen-cli --locked --version "$version" ||
+        cargo install wasm-bindgen-cli --version "$version"
 fi
+# The page's ?compare results name the revision they were built from, as
+# native results do (only strata-web reads it, so only it rebuilds).
+export STRATA_SOURCE_REVISION="${STRATA_SOURCE_REVISION:-$(git describe --always --dirty --tags 2>/dev/null || echo unknown)}"
 # Line tables (the native release profile's) would double the .wasm.
 CARGO_PROFILE_RELEASE_DEBUG=false \
     cargo build --release --target wasm32-unknown-unknown -p strata-web

@@ -1,5 +1,5 @@
-//! `?compare`: the quick protocol in the page — every method at the level's
-//! views (or `&views=A,B`) at 320x200, 4 timed frames, shadows on, no edit
+//! `?compare`: the quick protocol in the page — every method (or
+//! `&methods=A,B`, as `--methods`) at the level's views (or `&views=A,B`) at 320x200, 4 timed frames, shadows on, no edit
 //! protocol — scored against the CPU reference traced in the page. The
 //! results file is `strata compare`'s own (`strata_bench::results`), built by
 //! the same [`Plan`]; the page offers it for download, and `strata merge`
@@ -17,7 +17,7 @@ use std::cell::RefCell;
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
-use strata_bench::plan::{MethodChoice, file_part};
+use strata_bench::plan::{MethodChoice, file_part, parse_methods};
 use strata_bench::results::{Failure, RunResults};
 use strata_bench::run::{EditMode, Measured, Options, Plan, WarmUp};
 use strata_camera::Camera;
@@ -44,8 +44,14 @@ pub fn results_json() -> Option<String> {
     RESULTS.with(|r| r.borrow().clone())
 }
 
-/// Run the protocol on `world`; `views` keeps only the named views.
-pub async fn run(world: World, backend: Backend, views: Option<Vec<String>>) -> anyhow::Result<()> {
+/// Run the protocol on `world`; `views` keeps only the named views, and
+/// `methods` (`compare --methods`' syntax) chooses the methods.
+pub async fn run(
+    world: World,
+    backend: Backend,
+    views: Option<Vec<String>>,
+    methods: Option<&str>,
+) -> anyhow::Result<()> {
     let views = match views {
         None => world.views.clone(),
         Some(names) => names
@@ -70,13 +76,16 @@ pub async fn run(world: World, backend: Backend, views: Option<Vec<String>>) -> 
             })
             .collect::<anyhow::Result<_>>()?,
     };
-    let methods = methods::names()
-        .into_iter()
-        .map(|name| MethodChoice {
-            name: name.to_string(),
-            setting: None,
-        })
-        .collect();
+    let methods = match methods {
+        Some(list) => parse_methods(list, &methods::names()).context("?methods")?,
+        None => methods::names()
+            .into_iter()
+            .map(|name| MethodChoice {
+                name: name.to_string(),
+                setting: None,
+            })
+            .collect(),
+    };
     let options = Options {
         out: PathBuf::new(),
         methods,

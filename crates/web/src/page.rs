@@ -24,6 +24,8 @@ pub struct Params {
     pub compare: bool,
     /// `&views=A,B`: the protocol's views (default: the level's).
     pub views: Option<Vec<String>>,
+    /// `&methods=A,B:setting`: the protocol's methods (default: every one).
+    pub methods: Option<String>,
 }
 
 impl Params {
@@ -91,6 +93,7 @@ impl Params {
             level: get("level"),
             compare: query.has("compare"),
             views: get("views").map(|v| v.split(',').map(|n| n.trim().to_string()).collect()),
+            methods: get("methods"),
         })
     }
 }
@@ -103,7 +106,13 @@ pub async fn run() -> anyhow::Result<()> {
         None => generate(&params.world).await?,
     };
     if params.compare {
-        return crate::compare::run(world, params.backend, params.views).await;
+        return crate::compare::run(
+            world,
+            params.backend,
+            params.views,
+            params.methods.as_deref(),
+        )
+        .await;
     }
     watch_folder_picker();
     progress(None, "");
