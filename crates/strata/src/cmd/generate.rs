@@ -66,7 +66,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     if world.config.map_power_x != 11 {
         outln!(
             out_notes,
-            "note: the original game opens only 2048-wide maps (Map Power X=11); vange-rs opens any size"
+            "note: the original game's loader accepts only 2048-wide maps (Map Power X=11); vange-rs takes the size from world.ini"
         );
     }
     let stats = LevelStats::compute(&world.level);
