@@ -1,60 +1,102 @@
 //! `world.ini`: the world's configuration.
 //!
-//! Parsing keeps every section and key (also the ones we do not interpret) in
-//! [`WorldConfig::ini`], so writing a parsed file preserves them; values we
-//! do interpret are written back in their original text when unchanged.
+//! [`Ini`] keeps the file as written: every line (comments, blank lines,
+//! spacing, line endings) is kept, and setting a value rewrites only its own
+//! line, so a file read and written back unchanged is byte-identical, and
+//! an edited one differs only in the edited lines. A file that is not UTF-8
+//! (the game's own files are from a DOS/Windows era) is read as Latin-1 and
+//! written back in it, byte for byte.
 
 use crate::error::LevelError;
 use std::path::Path;
 
-/// One `[Section]` of an ini file: its `Key=Value` lines in file order.
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
-pub struct IniSection {
-    pub name: String,
-    pub entries: Vec<(String, String)>,
+/// One line of an ini file, kept as written (its terminator included).
+#[derive(Clone, Debug, PartialEq, Eq)]
+struct IniLine {
+    text: String,
+    /// `Key=Value`, trimmed; `None` for a comment or blank line.
+    entry: Option<(String, String)>,
 }
 
-/// An ini file as sections of key/value pairs, in file order. Comments and
-/// blank lines are not kept.
+/// One `[Section]` of an ini file: its header line and the lines after it.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+struct IniSection {
+    name: String,
+    /// The header line as written; `None` for the lines before the first header.
+    header: Option<String>,
+    lines: Vec<IniLine>,
+}
+
+/// An ini file, line for line. `;` and `#` start comment lines.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Ini {
-    pub sections: Vec<IniSection>,
+    sections: Vec<IniSection>,
+    /// The file was not UTF-8 and was read as Latin-1 (written back the same way).
+    latin1: bool,
+}
+
+/// A line's terminator: `\r\n`, `\n`, or none (the file's last line).
+fn line_ending(line: &str) -> &str {
+    if line.ends_with("\r\n") {
+        "\r\n"
+    } else if line.ends_with('\n') {
+        "\n"
+    } else {
+        ""
+    }
 }
 
 impl Ini {
     /// Parse ini text. Lines before the first section go to a section named "".
-    /// `;` and `#` start comment lines. A line that is neither a section, a
-    /// key, a comment nor blank is an error (reported with its line number).
+    /// A line that is neither a section, a key, a comment nor blank is an
+    /// error (reported with its line number).
     pub fn parse(text: &str) -> Result<Self, (usize, String)> {
         let mut ini = Ini::default();
-        for (i, raw) in text.lines().enumerate() {
+        for (i, raw) in text.split_inclusive('\n').enumerate() {
             let line = raw.trim();
-            if line.is_empty() || line.starts_with(';') || line.starts_with('#') {
-                continue;
-            }
+            let mut entry = None;
             if let Some(rest) = line.strip_prefix('[') {
                 let name = rest
                     .strip_suffix(']')
                     .ok_or((i + 1, format!("section header `{line}` lacks `]`")))?;
                 ini.sections.push(IniSection {
                     name: name.trim().to_string(),
-                    entries: Vec::new(),
+                    header: Some(raw.to_string()),
+                    lines: Vec::new(),
                 });
                 continue;
             }
-            let (key, value) = line
-                .split_once('=')
-                .ok_or((i + 1, format!("`{line}` is not `Key=Value`")))?;
+            if !(line.is_empty() || line.starts_with(';') || line.starts_with('#')) {
+                let (key, value) = line
+                    .split_once('=')
+                    .ok_or((i + 1, format!("`{line}` is not `Key=Value`")))?;
+                entry = Some((key.trim().to_string(), value.trim().to_string()));
+            }
             if ini.sections.is_empty() {
                 ini.sections.push(IniSection::default());
             }
             if let Some(section) = ini.sections.last_mut() {
-                section
-                    .entries
-                    .push((key.trim().to_string(), value.trim().to_string()));
+                section.lines.push(IniLine {
+                    text: raw.to_string(),
+                    entry,
+                });
             }
         }
         Ok(ini)
+    }
+
+    /// Parse a file's bytes: UTF-8, else Latin-1 (so no byte is lost).
+    pub fn parse_bytes(bytes: &[u8]) -> Result<Self, (usize, String)> {
+        match std::str::from_utf8(bytes) {
+            Ok(text) => Self::parse(text),
+            Err(_) => {
+                let text: String = bytes.iter().map(|&b| char::from(b)).collect();
+                Ok(Ini {
+                    latin1: true,
+                    ..Self::parse(&text)?
+                })
+            }
+        }
     }
 
     /// The value of `key` in `section` (first occurrence).
@@ -62,54 +104,131 @@ impl Ini {
         self.sections
             .iter()
             .filter(|s| s.name == section)
-            .flat_map(|s| s.entries.iter())
+            .flat_map(|s| s.lines.iter())
+            .filter_map(|l| l.entry.as_ref())
             .find(|(k, _)| k == key)
             .map(|(_, v)| v.as_str())
     }
 
-    /// Set `key` in `section`, in place when present, else appended
-    /// (creating the section at the end when needed).
+    /// The line ending most of the file uses (`\n` for an empty file).
+    fn newline(&self) -> &'static str {
+        let crlf = self
+            .sections
+            .iter()
+            .flat_map(|s| s.header.iter().chain(s.lines.iter().map(|l| &l.text)))
+            .find(|t| t.ends_with('\n'))
+            .is_some_and(|t| t.ends_with("\r\n"));
+        if crlf { "\r\n" } else { "\n" }
+    }
+
+    /// Set `key` in `section`: its line rewritten in place when present
+    /// (the key as written and the line ending kept), else a line appended
+    /// after the section's last key (creating the section at the end when
+    /// needed). No other line changes.
     pub fn set(&mut self, section: &str, key: &str, value: String) {
-        if let Some(entry) = self
+        let newline = self.newline();
+        if let Some(line) = self
             .sections
             .iter_mut()
             .filter(|s| s.name == section)
-            .flat_map(|s| s.entries.iter_mut())
-            .find(|(k, _)| k == key)
+            .flat_map(|s| s.lines.iter_mut())
+            .find(|l| l.entry.as_ref().is_some_and(|(k, _)| k == key))
         {
-            entry.1 = value;
+            let key_as_written = line.text.split_once('=').map_or(key, |(k, _)| k);
+            line.text = format!("{key_as_written}={value}{}", line_ending(&line.text));
+            line.entry = Some((key.to_string(), value));
             return;
         }
-        match self.sections.iter_mut().find(|s| s.name == section) {
-            Some(s) => s.entries.push((key.to_string(), value)),
-            None => self.sections.push(IniSection {
-                name: section.to_string(),
-                entries: vec![(key.to_string(), value)],
-            }),
+        let new_line = IniLine {
+            text: format!("{key}={value}{newline}"),
+            entry: Some((key.to_string(), value)),
+        };
+        // Only the file's last line may lack a terminator; the line before
+        // the new one gets one so that the new line stands on its own.
+        let end_line = |text: Option<&mut String>| {
+            if let Some(text) = text
+                && !text.ends_with('\n')
+            {
+                text.push_str(newline);
+            }
+        };
+        if let Some(section) = self.sections.iter_mut().find(|s| s.name == section) {
+            let at = section
+                .lines
+                .iter()
+                .rposition(|l| l.entry.is_some())
+                .map_or(0, |p| p + 1);
+            let before = match at {
+                0 => section.header.as_mut(),
+                _ => Some(&mut section.lines[at - 1].text),
+            };
+            end_line(before);
+            section.lines.insert(at, new_line);
+            return;
         }
+        let last = self.sections.last_mut();
+        let ends_blank = last
+            .as_ref()
+            .is_none_or(|s| s.lines.last().is_some_and(|l| l.text.trim().is_empty()));
+        if let Some(s) = last {
+            end_line(
+                s.lines
+                    .last_mut()
+                    .map(|l| &mut l.text)
+                    .or(s.header.as_mut()),
+            );
+            if !ends_blank {
+                s.lines.push(IniLine {
+                    text: newline.to_string(),
+                    entry: None,
+                });
+            }
+        }
+        self.sections.push(IniSection {
+            name: section.to_string(),
+            header: Some(format!("[{section}]{newline}")),
+            lines: vec![new_line],
+        });
     }
 
-    /// The file text: `[Section]` then `Key=Value` lines, a blank line between sections.
+    /// The file text, line for line as read, with the lines [`Self::set`] changed.
     pub fn to_text(&self) -> String {
         let mut out = String::new();
-        for (i, section) in self.sections.iter().enumerate() {
-            if i > 0 {
-                out.push('\n');
+        for section in &self.sections {
+            if let Some(header) = &section.header {
+                out.push_str(header);
             }
-            if !(section.name.is_empty() && i == 0) {
-                out.push_str(&format!("[{}]\n", section.name));
-            }
-            for (k, v) in &section.entries {
-                out.push_str(&format!("{k}={v}\n"));
+            for line in &section.lines {
+                out.push_str(&line.text);
             }
         }
         out
+    }
+
+    /// The file bytes: the text in the encoding it was read in.
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let text = self.to_text();
+        if self.latin1 {
+            // Every char came from one byte, or is ASCII that `set` wrote.
+            text.chars()
+                .map(|c| u8::try_from(c).unwrap_or(b'?'))
+                .collect()
+        } else {
+            text.into_bytes()
+        }
     }
 }
 
 const GLOBAL: &str = "Global Parameters";
 const STORAGE: &str = "Storage";
 const RENDERING: &str = "Rendering Parameters";
+const SECTION_SIZE_POWER: &str = "Section Size Power";
+const GEONET_POWER: &str = "GeoNet Power";
+
+/// A `[Global Parameters]` power that may be absent.
+fn optional_power(ini: &Ini, key: &str) -> Option<u32> {
+    ini.get(GLOBAL, key)?.parse().ok()
+}
 
 /// The parts of `world.ini` the renderer and the file formats need.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -163,19 +282,34 @@ impl WorldConfig {
     }
 
     /// `[Global Parameters] Section Size Power` (rows per `.vpr` water
-    /// section = 2^this); 7 when absent, as in Fostral.
+    /// section = 2^this). When absent: 7 as in Fostral, but at most `Map
+    /// Power Y`, so that a small map still has one section. [`Self::parse`]
+    /// has checked a present value.
     pub fn section_size_power(&self) -> u32 {
-        self.ini
-            .get(GLOBAL, "Section Size Power")
-            .and_then(|v| v.parse().ok())
-            .filter(|p| *p <= MAX_POWER)
-            .unwrap_or(7)
+        optional_power(&self.ini, SECTION_SIZE_POWER).unwrap_or(7.min(self.map_power_y))
+    }
+
+    /// `[Global Parameters] GeoNet Power` (the original generator's net,
+    /// which sizes the `.vpr`); 5 when absent, as in Fostral.
+    pub fn geo_net_power(&self) -> u32 {
+        optional_power(&self.ini, GEONET_POWER).unwrap_or(5)
     }
 
     /// Parse `world.ini` text; `path` only names the file in errors.
     pub fn parse(text: &str, path: &Path) -> Result<Self, LevelError> {
         let ini = Ini::parse(text)
             .map_err(|(line, msg)| LevelError::format(path, format!("line {line}: {msg}")))?;
+        Self::from_ini(ini, path)
+    }
+
+    /// Parse `world.ini` bytes (UTF-8, else Latin-1, kept for write-back).
+    pub fn parse_bytes(bytes: &[u8], path: &Path) -> Result<Self, LevelError> {
+        let ini = Ini::parse_bytes(bytes)
+            .map_err(|(line, msg)| LevelError::format(path, format!("line {line}: {msg}")))?;
+        Self::from_ini(ini, path)
+    }
+
+    fn from_ini(ini: Ini, path: &Path) -> Result<Self, LevelError> {
         let err = |section: &str, key: &str, msg: String| LevelError::Ini {
             path: path.to_path_buf(),
             section: section.to_string(),
@@ -251,24 +385,52 @@ impl WorldConfig {
             end_colors: colors("End Colors")?,
             ini: Ini::default(),
         };
+        // Optional powers the `.vpr` layout depends on: checked here so the
+        // accessors need not fail.
+        for key in [SECTION_SIZE_POWER, GEONET_POWER] {
+            if let Some(v) = ini.get(GLOBAL, key) {
+                match v.parse::<u32>() {
+                    Ok(p) if p <= MAX_POWER => {}
+                    Ok(p) => {
+                        return Err(err(GLOBAL, key, format!("{p} is outside 0..={MAX_POWER}")));
+                    }
+                    Err(_) => {
+                        return Err(err(GLOBAL, key, format!("`{v}` is not a whole number")));
+                    }
+                }
+            }
+        }
         Ok(WorldConfig { ini, ..config })
     }
 
     /// Read and parse a `world.ini` file.
     pub fn read(path: &Path) -> Result<Self, LevelError> {
-        let bytes = crate::error::read_file(path)?;
-        let text = String::from_utf8_lossy(&bytes);
-        Self::parse(&text, path)
+        Self::parse_bytes(&crate::error::read_file(path)?, path)
     }
 
-    /// The file text. Keys of [`Self::ini`] are preserved; interpreted keys
-    /// keep their original text when their value is unchanged.
+    /// The file text: [`Self::ini`] line for line, with only the lines of
+    /// interpreted keys whose value changed rewritten (an unchanged value
+    /// keeps its original text).
     pub fn to_ini_text(&self) -> String {
-        let mut ini = if self.ini.sections.is_empty() {
-            fostral_like_ini()
-        } else {
-            self.ini.clone()
-        };
+        self.updated_ini().to_text()
+    }
+
+    /// The file bytes (in the encoding the file was read in).
+    pub fn to_ini_bytes(&self) -> Vec<u8> {
+        self.updated_ini().to_bytes()
+    }
+
+    fn updated_ini(&self) -> Ini {
+        let mut ini = self.ini.clone();
+        if ini == Ini::default() {
+            ini = fostral_like_ini();
+            // A new world's own values for the keys Fostral's text has.
+            ini.set(
+                GLOBAL,
+                SECTION_SIZE_POWER,
+                self.section_size_power().to_string(),
+            );
+        }
         let mut set = |section: &str, key: &str, value: String, same: &dyn Fn(&str) -> bool| {
             if !ini.get(section, key).is_some_and(same) {
                 ini.set(section, key, value);
@@ -305,24 +467,30 @@ impl WorldConfig {
             };
             set(RENDERING, key, text, &same);
         }
-        ini.to_text()
+        ini
     }
 
     /// Write `world.ini`.
     pub fn write(&self, path: &Path) -> Result<(), LevelError> {
-        crate::error::write_file(path, self.to_ini_text().as_bytes())
+        crate::error::write_file(path, &self.to_ini_bytes())
     }
 }
 
-/// The keys the original game reads besides those [`WorldConfig`]
-/// interprets, with Fostral's values: a world we write from scratch carries
-/// them so the game's own loader finds them.
+/// The keys the original game (`vrtMap::analyzeINI`) and vange-rs
+/// (`LevelConfig::from_ini`) read, with Fostral's values, in Fostral's
+/// order: a world written from scratch carries them so both loaders find
+/// every key they require (the game aborts on a missing `Wave Terrain` or a
+/// `Version` other than 1.4; vange-rs panics on any missing
+/// `[Global Parameters]` power). `[Creation Parameters]` is read only by the
+/// original map editor and is left out.
 fn fostral_like_ini() -> Ini {
     let text = "[Global Parameters]\nMap Power X=11\nMap Power Y=14\nGeoNet Power=5\n\
-        Section Size Power=7\nMinimal Square Power=4\n\
-        [Storage]\nVersion=1.4\nCompressed Format Using=1\nFile Name=output\nPalette File=harmony.pal\n\
+        Section Size Power=7\nMinimal Square Power=4\n\n\
+        [Storage]\nVersion=1.4\nCompressed Format Using=1\nFile Name=output\nPalette File=harmony.pal\n\n\
         [Rendering Parameters]\nShadow Offsets=10 12 4 9 6 4 4 4\nHeight Shifts=2 4 8 8 5 6 6 6\n\
-        Begin Colors=1 32 64 72 88 104 112 120\nEnd Colors=31 63 71 87 103 111 119 127\n";
+        Begin Colors=1 32 64 72 88 104 112 120\nEnd Colors=31 63 71 87 103 111 119 127\n\n\
+        [Dynamic Palette]\nWave Terrain=0\nTerrain Number=3\nTerrains=5 4 6\nSpeeds=128 128 256\n\
+        Amplitudes=32 8 32\nRed=1 1 1\nGreen=0 1 1\nBlue=0 0 0\n";
     Ini::parse(text).unwrap_or_default()
 }
 
@@ -354,17 +522,34 @@ mod tests {
     fn writing_preserves_unknown_keys_and_changes() {
         let mut config = WorldConfig::read(&fostral_path()).unwrap();
         let text = config.to_ini_text();
-        // Unchanged values keep their original spacing.
+        // Unchanged, the file comes back byte for byte (spacing, blank lines, order).
         assert!(
-            text.contains("Begin Colors=1 32 64 72  88 104 112 120"),
+            text.as_bytes() == std::fs::read(fostral_path()).unwrap(),
             "{text}"
         );
-        assert!(text.contains("[Creation Parameters]") && text.contains("Mesh Value=256"));
         assert_eq!(WorldConfig::parse(&text, Path::new("x")).unwrap(), config);
         config.map_power_y = 10;
         config.compressed = false;
         config.end_colors[7] = 200;
-        let again = WorldConfig::parse(&config.to_ini_text(), Path::new("x")).unwrap();
+        let changed = config.to_ini_text();
+        // Only the three changed lines differ.
+        let differ: Vec<(&str, &str)> = text
+            .lines()
+            .zip(changed.lines())
+            .filter(|(a, b)| a != b)
+            .collect();
+        assert_eq!(
+            differ,
+            [
+                ("Map Power Y=14", "Map Power Y=10"),
+                ("Compressed Format Using=1", "Compressed Format Using=0"),
+                (
+                    "End Colors=    31 63 71 87 103 111 119 127",
+                    "End Colors=31 63 71 87 103 111 119 200"
+                ),
+            ]
+        );
+        let again = WorldConfig::parse(&changed, Path::new("x")).unwrap();
         assert_eq!(
             (again.height(), again.compressed, again.end_colors[7]),
             (1024, false, 200)

@@ -117,6 +117,41 @@ impl Code {
         Self::canonical(&code_lengths(freq, MAX_CODE_LEN))
     }
 
+    /// The code a (checked) decode tree decodes: per symbol the shortest
+    /// path to one of its leaves. Symbols without a leaf, or whose code is
+    /// longer than [`MAX_CODE_LEN`] (more than the encoder's bit writer
+    /// takes), get length 0: encoding with this code is possible only for
+    /// the symbols it has.
+    pub fn from_tree(decoder: &Decoder) -> Self {
+        let tree = &decoder.tree;
+        let mut code = Code {
+            codes: [0; 256],
+            lengths: [0; 256],
+        };
+        // (node, code so far, its length); the checked tree has no cycles.
+        let mut stack = vec![(1usize, 0u32, 0u32)];
+        while let Some((node, bits, len)) = stack.pop() {
+            if len >= MAX_CODE_LEN {
+                continue;
+            }
+            for bit in 0..2u32 {
+                let v = tree[2 * node + bit as usize];
+                let (bits, len) = ((bits << 1) | bit, len + 1);
+                if v > 0 {
+                    stack.push((v as usize, bits, len));
+                    continue;
+                }
+                let s = usize::from(v.wrapping_neg() as u8);
+                let known = u32::from(code.lengths[s]);
+                if known == 0 || len < known {
+                    code.codes[s] = bits;
+                    code.lengths[s] = len as u8;
+                }
+            }
+        }
+        code
+    }
+
     /// The decode tree of this code in the file's 512-slot form.
     /// Unreachable slots hold 0.
     pub fn tree(&self) -> Tree {
@@ -452,6 +487,22 @@ mod tests {
         let decoded: Vec<u8> = symbols.iter().map(|_| decoder.symbol(&mut r)).collect();
         assert!(decoded == symbols, "decoded symbols differ");
         assert_eq!(r.position(), bits);
+    }
+
+    #[test]
+    fn code_from_a_tree_is_the_code_it_was_built_from() {
+        let code = Code::from_frequencies(&skewed());
+        let decoder = Decoder::new(&code.tree()).unwrap();
+        assert_eq!(Code::from_tree(&decoder), code);
+        // A code over a few symbols: the others get no code.
+        let mut freq = [0u64; 256];
+        freq[3] = 10;
+        freq[200] = 5;
+        freq[9] = 1;
+        let sparse = Code::from_frequencies(&freq);
+        let back = Code::from_tree(&Decoder::new(&sparse.tree()).unwrap());
+        assert_eq!(back, sparse);
+        assert_eq!(back.lengths.iter().filter(|&&l| l > 0).count(), 3);
     }
 
     #[test]

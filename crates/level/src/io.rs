@@ -7,8 +7,9 @@ use crate::error::{LevelError, read_file, write_file};
 use crate::model::{Level, MidRule};
 use crate::palette::Palette;
 use crate::views::{EditSite, ViewSpec, format_views, parse_views};
-use crate::{World, vmc, vmp, vpr};
+use crate::{SourceFiles, World, vmc, vmp, vpr};
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use web_time::Instant;
 
 pub const WORLD_INI: &str = "world.ini";
@@ -24,11 +25,6 @@ pub fn map_path(dir: &Path, config: &WorldConfig) -> PathBuf {
 /// The `.vpr` file a config names inside `dir`.
 pub fn vpr_path(dir: &Path, config: &WorldConfig) -> PathBuf {
     dir.join(format!("{}.vpr", config.file_name))
-}
-
-/// Number of `.vpr` water sections of a config's map.
-pub fn water_sections(config: &WorldConfig) -> usize {
-    (config.height() >> config.section_size_power().min(config.map_power_y)).max(1) as usize
 }
 
 /// Decode a map from bytes in the format the config names.
@@ -78,7 +74,9 @@ pub fn load_world_timed(dir: &Path, mid_rule: MidRule) -> Result<(World, MapLoad
         read_ms: (t1 - t0).as_secs_f64() * 1e3,
         decode_ms: (t2 - t1).as_secs_f64() * 1e3,
     };
-    drop(bytes);
+    // A `.vmc` is kept so that rows left unedited are written back as they
+    // were; a `.vmp` is the planes themselves and is rewritten identically.
+    let map_source = config.compressed.then(|| Arc::<[u8]>::from(bytes));
 
     let optional = |path: PathBuf| -> Result<Option<Vec<u8>>, LevelError> {
         if path.exists() {
@@ -88,10 +86,15 @@ pub fn load_world_timed(dir: &Path, mid_rule: MidRule) -> Result<(World, MapLoad
         }
     };
     let palette = read_file(&dir.join(&config.palette_file))?;
-    let vpr = optional(vpr_path(dir, &config))?;
+    let vpr_file = vpr_path(dir, &config);
+    // Its size is fixed by the map: a wrong one is refused before reading.
+    if let Ok(meta) = std::fs::metadata(&vpr_file) {
+        vpr::VprLayout::of(&config).check_len(meta.len(), &vpr_file)?;
+    }
+    let vpr = optional(vpr_file)?;
     let views = optional(dir.join(VIEWS_TXT))?;
     let edit = optional(dir.join(EDIT_TXT))?;
-    let world = world_from_parts(
+    let mut world = world_from_parts(
         dir_name(dir),
         dir,
         config,
@@ -103,6 +106,7 @@ pub fn load_world_timed(dir: &Path, mid_rule: MidRule) -> Result<(World, MapLoad
             edit: edit.as_deref(),
         },
     )?;
+    world.source.vmc = map_source;
     Ok((world, load))
 }
 
@@ -125,12 +129,16 @@ pub fn world_from_parts(
     files: WorldFiles<'_>,
 ) -> Result<World, LevelError> {
     let palette = Palette::from_bytes(files.palette, &dir.join(&config.palette_file))?;
+    let mut source = SourceFiles::default();
     let water = match files.vpr {
-        Some(bytes) => Some(vpr::parse_vpr(
-            bytes,
-            water_sections(&config),
-            &vpr_path(dir, &config),
-        )?),
+        Some(bytes) => {
+            let layout = vpr::VprLayout::of(&config);
+            let (levels, format) = vpr::parse_vpr(bytes, &layout, &vpr_path(dir, &config))?;
+            if format == vpr::VprFormat::Game {
+                source.vpr = Some(Arc::from(bytes));
+            }
+            Some(levels)
+        }
         None => None,
     };
     let fostral = is_fostral(&config);
@@ -162,6 +170,7 @@ pub fn world_from_parts(
         water,
         views,
         edit,
+        source,
     })
 }
 
@@ -179,8 +188,10 @@ fn dir_name(dir: &Path) -> String {
 
 /// Write a world directory (created if needed): `world.ini`, the map
 /// (`.vmc` when `config.compressed`, else `.vmp`), the palette, the `.vpr`
-/// when `water` is set, `views.txt` when there are views, `edit.txt` when
-/// there is an edit site.
+/// (the game's layout) when `water` is set, `views.txt` when there are
+/// views, `edit.txt` when there is an edit site. What `world.source` holds
+/// is reused, so a world read and written back unchanged gives the same
+/// `world.ini`, `.vpr` and `.vmc` bytes.
 pub fn write_world(dir: &Path, world: &World) -> Result<(), LevelError> {
     let config = &world.config;
     let ini_path = dir.join(WORLD_INI);
@@ -195,17 +206,30 @@ pub fn write_world(dir: &Path, world: &World) -> Result<(), LevelError> {
             ),
         ));
     }
+    // Built first: a wrong number of water levels fails before any file is written.
+    let vpr_file = match &world.water {
+        Some(water) => {
+            let path = vpr_path(dir, config);
+            let layout = vpr::VprLayout::of(config);
+            let bytes = vpr::vpr_bytes(water, &layout, world.source.vpr.as_deref(), &path)?;
+            Some((path, bytes))
+        }
+        None => None,
+    };
     std::fs::create_dir_all(dir).map_err(|e| LevelError::io(dir, e))?;
     let map = map_path(dir, config);
     if config.compressed {
-        vmc::write_vmc(&map, &world.level)?;
+        let bytes = match &world.source.vmc {
+            Some(source) => vmc::encode_vmc_reusing(&world.level, source, &map)?.0,
+            None => vmc::encode_vmc(&world.level, &map)?,
+        };
+        write_file(&map, &bytes)?;
     } else {
         vmp::write_vmp(&map, &world.level)?;
     }
     world.palette.write(&dir.join(&config.palette_file))?;
-    if let Some(water) = &world.water {
-        let rows = 1u32 << config.section_size_power().min(config.map_power_y);
-        vpr::write_vpr(&vpr_path(dir, config), water, rows)?;
+    if let Some((path, bytes)) = &vpr_file {
+        write_file(path, bytes)?;
     }
     if !world.views.is_empty() {
         write_file(&dir.join(VIEWS_TXT), format_views(&world.views).as_bytes())?;

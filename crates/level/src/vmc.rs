@@ -9,6 +9,11 @@
 //!
 //! Rows are independent: both directions run in parallel over rows, and
 //! decoding writes straight into the two final planes.
+//!
+//! Writing back a map that was read from a `.vmc` ([`encode_vmc_reusing`])
+//! keeps the file's trees and the bytes of every row that was not edited
+//! where the format allows, so an unedited map is written back byte for
+//! byte and an edit changes only the edited rows (and the row table).
 
 use crate::error::LevelError;
 use crate::huffman::{BitReader, BitWriter, Code, Decoder, TREE_SLOTS, Tree};
@@ -32,14 +37,18 @@ fn read_tree(bytes: &[u8]) -> Tree {
     tree
 }
 
-/// Decode `.vmc` bytes of a `width` x `height` map. `path` names the file in errors.
-pub fn decode_vmc(
-    bytes: &[u8],
-    width: u32,
-    height: u32,
-    mid_rule: MidRule,
-    path: &Path,
-) -> Result<Level, LevelError> {
+/// A `.vmc` file's row table and decoders, checked against the map size.
+struct Header {
+    /// Each row's bytes in the file.
+    rows: Vec<std::ops::Range<usize>>,
+    heights: Decoder,
+    metas: Decoder,
+}
+
+/// Read and check the row table and trees of `.vmc` bytes of a `width` x
+/// `height` map. Checks every row's place before anything map-sized is
+/// allocated, so a world.ini naming a huge map over a small file fails here.
+fn read_header(bytes: &[u8], width: u32, height: u32, path: &Path) -> Result<Header, LevelError> {
     let err = |msg: String| LevelError::format(path, msg);
     let header = header_bytes(height);
     if bytes.len() < header {
@@ -61,8 +70,6 @@ pub fn decode_vmc(
         }
         let (start, len) = (offset as usize, size as usize);
         // Codes are at least one bit: each stream takes at least W/8 bytes.
-        // Checked before the planes are allocated, so a world.ini naming a
-        // huge map over a small file fails here, not in the allocator.
         if len < min_row {
             return Err(err(format!(
                 "row {y}: {len} bytes cannot hold {width} heights and {width} metas (at least \
@@ -86,11 +93,27 @@ pub fn decode_vmc(
         rows.push(start..start + len);
     }
     let tree_err = |which: &str, e| err(format!("{which} Huffman tree: {e}"));
-    let heights_dec = Decoder::new(&read_tree(&bytes[table_end..table_end + TREES_BYTES / 2]))
+    let heights = Decoder::new(&read_tree(&bytes[table_end..table_end + TREES_BYTES / 2]))
         .map_err(|e| tree_err("height", e))?;
-    let metas_dec = Decoder::new(&read_tree(&bytes[table_end + TREES_BYTES / 2..header]))
+    let metas = Decoder::new(&read_tree(&bytes[table_end + TREES_BYTES / 2..header]))
         .map_err(|e| tree_err("meta", e))?;
+    Ok(Header {
+        rows,
+        heights,
+        metas,
+    })
+}
 
+/// Decode `.vmc` bytes of a `width` x `height` map. `path` names the file in errors.
+pub fn decode_vmc(
+    bytes: &[u8],
+    width: u32,
+    height: u32,
+    mid_rule: MidRule,
+    path: &Path,
+) -> Result<Level, LevelError> {
+    let err = |msg: String| LevelError::format(path, msg);
+    let header = read_header(bytes, width, height, path)?;
     let w = width as usize;
     let n = w * height as usize;
     let mut heights = vec![0u8; n];
@@ -98,13 +121,13 @@ pub fn decode_vmc(
     heights
         .par_chunks_mut(w)
         .zip(metas.par_chunks_mut(w))
-        .zip(rows.par_iter())
+        .zip(header.rows.par_iter())
         .enumerate()
         .try_for_each(|(y, ((h_row, m_row), range))| {
             decode_row(
                 &bytes[range.clone()],
-                &heights_dec,
-                &metas_dec,
+                &header.heights,
+                &header.metas,
                 h_row,
                 m_row,
             )
@@ -187,11 +210,16 @@ fn symbol_frequencies(level: &Level) -> ([u64; 256], [u64; 256]) {
         )
 }
 
-fn encode_row(hr: &[u8], mr: &[u8], hc: &Code, mc: &Code) -> Vec<u8> {
+/// A row's bytes under the given codes; `None` when a symbol it needs has
+/// no code (possible only for a code read from a file's trees).
+fn encode_row(hr: &[u8], mr: &[u8], hc: &Code, mc: &Code) -> Option<Vec<u8>> {
     let mut w = BitWriter::with_capacity(hr.len());
     let mut p = 0u8;
     for &h in hr {
         let s = usize::from(h.wrapping_sub(p));
+        if hc.lengths[s] == 0 {
+            return None;
+        }
         w.put(hc.codes[s], hc.lengths[s]);
         p = h;
     }
@@ -199,27 +227,21 @@ fn encode_row(hr: &[u8], mr: &[u8], hc: &Code, mc: &Code) -> Vec<u8> {
     let mut p = 0u8;
     for &m in mr {
         let s = usize::from(m ^ p);
+        if mc.lengths[s] == 0 {
+            return None;
+        }
         w.put(mc.codes[s], mc.lengths[s]);
         p = m;
     }
     w.align();
-    w.bytes
+    Some(w.bytes)
 }
 
-/// Encode a level as `.vmc` bytes with Huffman codes built from its own
-/// symbol statistics (one code for heights, one for meta).
-pub fn encode_vmc(level: &Level, path: &Path) -> Result<Vec<u8>, LevelError> {
-    let (fh, fm) = symbol_frequencies(level);
-    let (hc, mc) = (Code::from_frequencies(&fh), Code::from_frequencies(&fm));
-    let w = level.width() as usize;
-    let rows: Vec<Vec<u8>> = level
-        .heights()
-        .par_chunks(w)
-        .zip(level.metas().par_chunks(w))
-        .map(|(hr, mr)| encode_row(hr, mr, &hc, &mc))
-        .collect();
-    let header = header_bytes(level.height());
-    let total = header + rows.iter().map(Vec::len).sum::<usize>();
+/// The file: row table (rows in order, one after another), the two trees
+/// (`trees`: their 2 x 512 i32 LE as they go in the file), the rows.
+fn assemble<R: AsRef<[u8]>>(rows: &[R], trees: &[u8], path: &Path) -> Result<Vec<u8>, LevelError> {
+    let header = rows.len() * ENTRY_BYTES + TREES_BYTES;
+    let total = header + rows.iter().map(|r| r.as_ref().len()).sum::<usize>();
     if total > i32::MAX as usize {
         return Err(LevelError::format(
             path,
@@ -229,28 +251,122 @@ pub fn encode_vmc(level: &Level, path: &Path) -> Result<Vec<u8>, LevelError> {
     let mut out = Vec::with_capacity(total);
     let mut offset = header;
     for (y, row) in rows.iter().enumerate() {
-        let size = i16::try_from(row.len()).map_err(|_| {
+        let len = row.as_ref().len();
+        let size = i16::try_from(len).map_err(|_| {
             LevelError::format(
                 path,
-                format!(
-                    "row {y} encodes to {} bytes, over the format's i16 row size",
-                    row.len()
-                ),
+                format!("row {y} encodes to {len} bytes, over the format's i16 row size"),
             )
         })?;
         out.extend_from_slice(&(offset as i32).to_le_bytes());
         out.extend_from_slice(&size.to_le_bytes());
-        offset += row.len();
+        offset += len;
     }
-    for tree in [hc.tree(), mc.tree()] {
-        for v in tree {
-            out.extend_from_slice(&v.to_le_bytes());
-        }
-    }
-    for row in &rows {
-        out.extend_from_slice(row);
+    out.extend_from_slice(trees);
+    for row in rows {
+        out.extend_from_slice(row.as_ref());
     }
     Ok(out)
+}
+
+/// Encode a level as `.vmc` bytes with Huffman codes built from its own
+/// symbol statistics (one code for heights, one for meta).
+pub fn encode_vmc(level: &Level, path: &Path) -> Result<Vec<u8>, LevelError> {
+    let (fh, fm) = symbol_frequencies(level);
+    let (hc, mc) = (Code::from_frequencies(&fh), Code::from_frequencies(&fm));
+    let w = level.width() as usize;
+    // Codes built from the level's own symbols cover every row.
+    let rows: Option<Vec<Vec<u8>>> = level
+        .heights()
+        .par_chunks(w)
+        .zip(level.metas().par_chunks(w))
+        .map(|(hr, mr)| encode_row(hr, mr, &hc, &mc))
+        .collect();
+    let rows = rows.ok_or_else(|| {
+        LevelError::format(path, "internal: a symbol of the map has no Huffman code")
+    })?;
+    let trees: Vec<u8> = [hc.tree(), mc.tree()]
+        .iter()
+        .flatten()
+        .flat_map(|v| v.to_le_bytes())
+        .collect();
+    assemble(&rows, &trees, path)
+}
+
+/// How [`encode_vmc_reusing`] made the file.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VmcReuse {
+    /// No row changed: the source file, byte for byte.
+    Whole,
+    /// The source's trees and its unchanged rows' bytes; `changed` rows
+    /// encoded with the source's codes.
+    Rows { changed: usize },
+    /// A fresh [`encode_vmc`]: the source does not fit the map, or a changed
+    /// row needs a symbol its trees lack a code for.
+    Fresh,
+}
+
+/// Encode `level` keeping what it can of `source` (the `.vmc` bytes it was
+/// read from): a row whose decoded content is unchanged keeps its bytes, and
+/// the file keeps its trees, as long as the trees' codes cover the changed
+/// rows (else every row is re-encoded with new codes, since the trees are
+/// shared by all rows). `path` names the file in errors.
+pub fn encode_vmc_reusing(
+    level: &Level,
+    source: &[u8],
+    path: &Path,
+) -> Result<(Vec<u8>, VmcReuse), LevelError> {
+    let (width, height) = (level.width(), level.height());
+    let fresh = || encode_vmc(level, path).map(|b| (b, VmcReuse::Fresh));
+    let Ok(header) = read_header(source, width, height, path) else {
+        return fresh();
+    };
+    let w = width as usize;
+    // Per row: unchanged (decodes to the level's row) or not.
+    let unchanged: Vec<bool> = level
+        .heights()
+        .par_chunks(w)
+        .zip(level.metas().par_chunks(w))
+        .zip(header.rows.par_iter())
+        .map_init(
+            || (vec![0u8; w], vec![0u8; w]),
+            |(h, m), ((hr, mr), range)| {
+                decode_row(&source[range.clone()], &header.heights, &header.metas, h, m).is_ok()
+                    && h.as_slice() == hr
+                    && m.as_slice() == mr
+            },
+        )
+        .collect();
+    let changed = unchanged.iter().filter(|u| !**u).count();
+    if changed == 0 {
+        return Ok((source.to_vec(), VmcReuse::Whole));
+    }
+    let (hc, mc) = (
+        Code::from_tree(&header.heights),
+        Code::from_tree(&header.metas),
+    );
+    let rows: Option<Vec<std::borrow::Cow<'_, [u8]>>> = level
+        .heights()
+        .par_chunks(w)
+        .zip(level.metas().par_chunks(w))
+        .zip(header.rows.par_iter().zip(unchanged.par_iter()))
+        .map(|((hr, mr), (range, &same))| {
+            if same {
+                Some(std::borrow::Cow::Borrowed(&source[range.clone()]))
+            } else {
+                encode_row(hr, mr, &hc, &mc).map(std::borrow::Cow::Owned)
+            }
+        })
+        .collect();
+    let Some(rows) = rows else {
+        return fresh();
+    };
+    let table_end = height as usize * ENTRY_BYTES;
+    match assemble(&rows, &source[table_end..table_end + TREES_BYTES], path) {
+        Ok(bytes) => Ok((bytes, VmcReuse::Rows { changed })),
+        // A row the source's codes make too long for the table: new codes.
+        Err(_) => fresh(),
+    }
 }
 
 pub fn read_vmc(

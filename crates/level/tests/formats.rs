@@ -205,6 +205,7 @@ fn world_directory_round_trip() {
             water: Some(vec![80, 81]),
             views: strata_level::io::fostral_views(),
             edit: Some(EditSite::fostral()),
+            source: Default::default(),
         };
         write_world(&dir, &world).unwrap();
         let back = load_world(&dir, MidRule::Original).unwrap();
@@ -268,6 +269,7 @@ fn world_directory_errors_name_the_file() {
         water: None,
         views: Vec::new(),
         edit: None,
+        source: Default::default(),
     };
     write_world(&dir, &world).unwrap();
     assert!(!dir.join("views.txt").exists() && !dir.join("output.vpr").exists());

@@ -260,14 +260,17 @@ impl Generation {
             height,
         } = self.params;
         let level = Level::from_planes(width, height, self.heights, self.metas, MidRule::Original)?;
+        let config = world_config(width, height)?;
+        let sections = crate::vpr::VprLayout::of(&config).sections();
         Ok(World {
             name: format!("generated-{seed}"),
-            config: world_config(width, height)?,
+            config,
             palette: palette(),
-            water: Some(vec![SEA; (height as usize).div_ceil(128)]),
+            water: Some(vec![SEA; sections]),
             views: self.layout.views(&self.terrain),
             edit: Some(self.layout.edit_site()),
             level,
+            source: Default::default(),
         })
     }
 }

@@ -62,6 +62,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     io::write_world(&args.out, &world)
         .with_context(|| format!("writing {}", args.out.display()))?;
     let write_s = t1.elapsed().as_secs_f64();
+    let mut out_notes = String::new();
+    if world.config.map_power_x != 11 {
+        outln!(
+            out_notes,
+            "note: the original game's loader accepts only 2048-wide maps (Map Power X=11); vange-rs takes the size from world.ini"
+        );
+    }
     let stats = LevelStats::compute(&world.level);
     // Collected and written once: a closed pipe (`| head`) is not an error worth a panic.
     let mut out = String::new();
@@ -114,6 +121,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             png.display()
         );
     }
+    out.push_str(&out_notes);
     let _ = std::io::Write::write_all(&mut std::io::stdout(), out.as_bytes());
     Ok(())
 }

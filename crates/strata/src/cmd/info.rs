@@ -57,11 +57,55 @@ struct VmcRoundTrip {
     decode_ms: f64,
 }
 
+/// The water levels (`.vpr`) as the game reads them.
+#[derive(Serialize)]
+struct Water {
+    /// The world's `.vpr` on disk, when it has one.
+    file: Option<String>,
+    bytes: Option<u64>,
+    /// The size the game's and vange-rs's readers require for this map.
+    expected_bytes: u64,
+    /// `game`, `older Strata` (read, not yet rewritten), `generated` (not
+    /// on disk), or `absent` (level 0 everywhere).
+    layout: &'static str,
+    sections: usize,
+    min: i32,
+    max: i32,
+}
+
+fn water(world: &World, dir: Option<&Path>) -> Water {
+    let layout = strata_level::vpr::VprLayout::of(&world.config);
+    let file = dir
+        .map(|d| io::vpr_path(d, &world.config))
+        .filter(|p| p.exists());
+    let bytes = file
+        .as_ref()
+        .and_then(|p| std::fs::metadata(p).ok())
+        .map(|m| m.len());
+    let levels = world.water_levels();
+    Water {
+        // Loading accepted only these two sizes.
+        layout: match (&world.water, bytes) {
+            (None, _) => "absent",
+            (Some(_), Some(b)) if b == layout.file_size() => "game",
+            (Some(_), Some(_)) => "older Strata",
+            (Some(_), None) => "generated",
+        },
+        file: file.map(|p| p.display().to_string()),
+        bytes,
+        expected_bytes: layout.file_size(),
+        sections: levels.len(),
+        min: levels.iter().copied().min().unwrap_or(0),
+        max: levels.iter().copied().max().unwrap_or(0),
+    }
+}
+
 #[derive(Serialize)]
 struct Info {
     world: String,
     mid_rule: MidRule,
     map_file: Option<MapFile>,
+    water: Water,
     vmc_round_trip: Option<VmcRoundTrip>,
     stats_ms: f64,
     stats: LevelStats,
@@ -154,6 +198,7 @@ fn map_file(
 
 pub fn run(args: Args) -> anyhow::Result<()> {
     let mid_rule = args.world.mid_rule();
+    let mut world_dir = args.world.level.clone();
     let (world, load) = match &args.world.level {
         Some(dir) => io::load_world_timed(dir, mid_rule)
             .map(|(world, load)| (world, Some(load)))
@@ -165,10 +210,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             let cached = world_arg::cache_root()
                 .map(|root| world_arg::cache_dir(&root, &GenerateParams::default()))
                 .filter(|dir| dir.join(io::WORLD_INI).exists());
-            let load = match cached {
-                Some(dir) => Some(time_map(&dir, &world, mid_rule)?),
+            let load = match &cached {
+                Some(dir) => Some(time_map(dir, &world, mid_rule)?),
                 None => None,
             };
+            world_dir = cached;
             (world, load)
         }
     };
@@ -188,6 +234,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         world: world.name.clone(),
         mid_rule,
         map_file,
+        water: water(&world, world_dir.as_deref()),
         vmc_round_trip,
         stats_ms: ms_since(t),
         stats,
@@ -223,6 +270,15 @@ fn print_text(info: &Info) {
             );
         }
     }
+    let w = &info.water;
+    let file = match (&w.file, w.bytes) {
+        (Some(f), Some(b)) => format!("{f} ({b} bytes, {} layout)", w.layout),
+        _ => format!("{} (no .vpr file)", w.layout),
+    };
+    println!(
+        "water        {} sections, levels {} .. {}: {file}; the game reads {} bytes",
+        w.sections, w.min, w.max, w.expected_bytes
+    );
     if let Some(r) = &info.vmc_round_trip {
         println!(
             "as .vmc      {:.2} MB: encode {:.0} ms, decode {:.0} ms",
