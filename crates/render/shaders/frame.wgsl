@@ -42,3 +42,12 @@ struct ShadingParams {
 @group(0) @binding(2) var terrain: texture_2d_array<u32>;
 // Distance along the light from the shadow plane to the first solid point.
 @group(0) @binding(3) var shadow_map: texture_2d<f32>;
+
+// Unnormalised ray through the image point (px, py) in pixels from the top-left
+// (a pixel centre is i + 0.5): the twin of `Camera::image_direction`. Its
+// component along the view axis is the focal length, so view depth = t * focal.
+fn camera_ray(px: f32, py: f32) -> vec3<f32> {
+    let sx = px - globals.screen.x * 0.5;
+    let sy = globals.screen.y * 0.5 - py;
+    return globals.forward.xyz * globals.eye.w - globals.right.xyz * sx + globals.up.xyz * sy;
+}

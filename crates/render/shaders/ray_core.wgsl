@@ -11,15 +11,6 @@ struct MarchHit {
     t: f32,
 }
 
-// Unnormalised ray through the image point (px, py) in pixels from the top-left
-// (a pixel centre is i + 0.5): the twin of `Camera::image_direction`. Its
-// component along the view axis is the focal length, so view depth = t * focal.
-fn camera_ray(px: f32, py: f32) -> vec3<f32> {
-    let sx = px - globals.screen.x * 0.5;
-    let sy = globals.screen.y * 0.5 - py;
-    return globals.forward.xyz * globals.eye.w - globals.right.xyz * sx + globals.up.xyz * sy;
-}
-
 // Clip [t0, t1] of o + t d to the altitude slab [0, 255]; nothing is solid
 // above 255 and everything is solid at and below 0. Empty when x > y.
 fn clip_to_altitudes(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32) -> vec2<f32> {

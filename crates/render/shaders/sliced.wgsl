@@ -15,6 +15,7 @@ const SLICE_TOP: f32 = 256.0;
 struct VertexOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) world: vec3<f32>,
+    @location(1) @interpolate(flat) altitude: f32,
 }
 
 @vertex
@@ -36,13 +37,28 @@ fn vs_sliced(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) -> 
     let xy = vec2<f32>(footprint.origin.xy) + corners[v] * extent;
     var out: VertexOut;
     out.world = vec3<f32>(xy, z);
+    out.altitude = z;
     out.clip = globals.view_proj * vec4<f32>(out.world, 1.0);
     return out;
 }
 
+// The point of the slice seen through this pixel: the pixel's ray meets the
+// slice's plane. A quad spans the whole footprint, hundreds of units, so a
+// world position interpolated across it is imprecise on some rasterisers
+// (SwiftShader's showed sky for a whole horizon view); the plane hit is exact.
+// Edge-on (the ray parallel to the slice) keeps the interpolated point.
+fn slice_point(in: VertexOut) -> vec3<f32> {
+    let d = camera_ray(in.clip.x, in.clip.y);
+    let e = globals.eye.xyz;
+    if (abs(d.z) < 1e-6 * length(d)) {
+        return in.world;
+    }
+    return e + d * ((in.altitude - e.z) / d.z);
+}
+
 @fragment
 fn fs_sliced(in: VertexOut) -> @location(0) vec4<f32> {
-    let p = in.world;
+    let p = slice_point(in);
     if (!is_solid(p)) {
         discard;
     }
