@@ -278,18 +278,20 @@ impl Renderer {
             .create_command_encoder(&Default::default());
         self.timer.reset();
         let current = self.shadow_reuse && self.shadow_drawn == Some(shadow);
-        if shadows && !current {
-            self.shadow.record(&mut encoder, &self.timer);
-            self.shadow_drawn = Some(shadow);
-        }
         let frame = Frame {
             camera,
             timer: &self.timer,
             index: self.frames,
         };
-        self.methods[self.active]
-            .method
-            .record(&self.shared, &frame, &mut encoder);
+        let method = &self.methods[self.active].method;
+        if shadows && !current {
+            // The method may fill the map itself (the exact march does).
+            if !method.record_shadow_map(&self.shared, &frame, &mut encoder) {
+                self.shadow.record(&mut encoder, &self.timer);
+            }
+            self.shadow_drawn = Some(shadow);
+        }
+        method.record(&self.shared, &frame, &mut encoder);
         self.timer.resolve(&mut encoder);
         let commands = encoder.finish();
         let record_ms = ms(record_start);

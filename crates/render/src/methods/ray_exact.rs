@@ -1,0 +1,554 @@
+//! `ray-exact` and `ray-exact-fragment`: the exact march (issue 15). A
+//! hierarchical 2D traversal over the max-height pyramid of column tops
+//! ([`ray_exact_build`], the twin of `strata_maxmip`), descending where the
+//! ray dips to a tile's maximum, and at the finest level the exact
+//! segment–interval test of the CPU reference: no step budget, only a
+//! safety cap on iterations ([`ITERATION_CAP`]) whose hits are counted
+//! ([`RayExact::stats`]). f32 throughout, relative to the 256-texel tile
+//! holding the ray's start (`ray_exact_core.wgsl`), so depth on a
+//! 16384-long wrapping map agrees with the f64 reference.
+//!
+//! `ray-exact` is a compute dispatch (colour into the shared target, depth
+//! into an R32Float image) plus a depth pass: by default one point per pixel
+//! through a depth-only pipeline (`ray_exact_depth.wgsl`), or the shared
+//! full-screen blit. `ray-exact-fragment` is one full-screen fragment pass.
+//! Both fill the shared shadow map with the same march along the light
+//! ([`Method::record_shadow_map`]) instead of the renderer's 128-step march.
+//!
+//! Measuring switches (environment, read at creation): `STRATA_EXACT_SHADOW=shared`
+//! keeps the renderer's shadow pass; `STRATA_EXACT_DEPTH=blit` uses the
+//! full-screen depth blit; `STRATA_EXACT_STATS=1` prints the iteration
+//! statistics and the build's GPU time to stderr when the method is dropped.
+//!
+//! [`ray_exact_build`]: super::ray_exact_build
+
+use super::common::{DepthCopy, compute_pipeline, dispatch_per_pixel, fullscreen_pipeline};
+use super::ray_exact_build::{GpuMaxMip, read_buffer};
+use super::{Frame, Method, MethodSettings, RetainedBytes};
+use crate::frame::{SHADOW_SIZE, Shared, storage_texture_entry};
+use serde::Serialize;
+use std::cell::Cell;
+use strata_camera::Camera;
+use strata_level::{DirtyRect, Level};
+
+/// Most traversal iterations of one ray: a guard against a hang, never
+/// reached on the protocol's views (counted in [`ExactStats`]).
+pub const ITERATION_CAP: u32 = 4096;
+
+/// Twin of `ExactParams` in `ray_exact_core.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct ExactParams {
+    config: [u32; 4],
+    levels: [[u32; 4]; 9],
+}
+
+/// What the march counted since creation (or the last [`RayExact::reset_stats`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct ExactStats {
+    /// Camera rays stopped by [`ITERATION_CAP`] (must be 0).
+    pub cap_hits: u32,
+    /// Most iterations any camera ray took (compute variant only).
+    pub most_iterations: u32,
+    /// Shadow-map rays stopped by the cap (must be 0).
+    pub shadow_cap_hits: u32,
+    /// Most iterations any shadow-map ray took.
+    pub shadow_most_iterations: u32,
+}
+
+enum Variant {
+    Compute {
+        march: wgpu::ComputePipeline,
+        depth: DepthCopy,
+        points: bool,
+    },
+    Fragment(wgpu::RenderPipeline),
+}
+
+/// The exact shadow-map pass.
+struct ExactShadow {
+    pipeline: wgpu::ComputePipeline,
+    frame_group: wgpu::BindGroup,
+    group: wgpu::BindGroup,
+}
+
+pub struct RayExact {
+    name: &'static str,
+    pyramid: GpuMaxMip,
+    params: wgpu::Buffer,
+    stats: wgpu::Buffer,
+    layout: wgpu::BindGroupLayout,
+    group: wgpu::BindGroup,
+    variant: Variant,
+    shadow: Option<ExactShadow>,
+    /// The pyramid update was recorded this frame (before the shadow map).
+    updated: Cell<bool>,
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    print_stats: bool,
+}
+
+/// How the method is put together (the measuring switches).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ExactOptions {
+    /// A compute dispatch (`ray-exact`), else a fragment pass.
+    pub compute: bool,
+    /// Depth by one point per pixel, else by the full-screen blit.
+    pub points: bool,
+    /// The shadow map by the exact march, else by the renderer's pass.
+    pub exact_shadow: bool,
+}
+
+impl ExactOptions {
+    /// The defaults, with the environment's measuring switches applied.
+    pub fn from_env(compute: bool) -> Self {
+        ExactOptions {
+            compute,
+            points: !env_is("STRATA_EXACT_DEPTH", "blit"),
+            exact_shadow: !env_is("STRATA_EXACT_SHADOW", "shared"),
+        }
+    }
+}
+
+pub fn create(
+    shared: &Shared,
+    level: &Level,
+    _settings: &MethodSettings,
+) -> anyhow::Result<Box<dyn Method>> {
+    Ok(Box::new(build(
+        shared,
+        level,
+        ExactOptions::from_env(true),
+    )?))
+}
+
+pub fn create_fragment(
+    shared: &Shared,
+    level: &Level,
+    _settings: &MethodSettings,
+) -> anyhow::Result<Box<dyn Method>> {
+    Ok(Box::new(build(
+        shared,
+        level,
+        ExactOptions::from_env(false),
+    )?))
+}
+
+fn env_is(name: &str, value: &str) -> bool {
+    #[cfg(not(target_arch = "wasm32"))]
+    {
+        std::env::var(name).is_ok_and(|v| v == value)
+    }
+    #[cfg(target_arch = "wasm32")]
+    {
+        let _ = (name, value);
+        false
+    }
+}
+
+fn buffer_entry(
+    binding: u32,
+    stages: wgpu::ShaderStages,
+    ty: wgpu::BufferBindingType,
+) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: stages,
+        ty: wgpu::BindingType::Buffer {
+            ty,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+/// Layout entries 0..=2 of group 1: parameters, pyramid, statistics.
+fn core_entries(stages: wgpu::ShaderStages) -> Vec<wgpu::BindGroupLayoutEntry> {
+    vec![
+        buffer_entry(0, stages, wgpu::BufferBindingType::Uniform),
+        buffer_entry(
+            1,
+            stages,
+            wgpu::BufferBindingType::Storage { read_only: true },
+        ),
+        buffer_entry(
+            2,
+            stages,
+            wgpu::BufferBindingType::Storage { read_only: false },
+        ),
+    ]
+}
+
+fn core_bindings<'a>(
+    params: &'a wgpu::Buffer,
+    pyramid: &'a GpuMaxMip,
+    stats: &'a wgpu::Buffer,
+) -> Vec<wgpu::BindGroupEntry<'a>> {
+    vec![
+        wgpu::BindGroupEntry {
+            binding: 0,
+            resource: params.as_entire_binding(),
+        },
+        wgpu::BindGroupEntry {
+            binding: 1,
+            resource: pyramid.buffer.as_entire_binding(),
+        },
+        wgpu::BindGroupEntry {
+            binding: 2,
+            resource: stats.as_entire_binding(),
+        },
+    ]
+}
+
+fn march_group(
+    shared: &Shared,
+    layout: &wgpu::BindGroupLayout,
+    params: &wgpu::Buffer,
+    pyramid: &GpuMaxMip,
+    stats: &wgpu::Buffer,
+    depth: Option<&DepthCopy>,
+) -> wgpu::BindGroup {
+    let mut entries = core_bindings(params, pyramid, stats);
+    if let Some(depth) = depth {
+        entries.extend(depth.bindings(shared, 3));
+    }
+    shared.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("ray-exact"),
+        layout,
+        entries: &entries,
+    })
+}
+
+/// The traversal's level table for `layout`.
+fn exact_params(layout: &strata_maxmip::Layout) -> ExactParams {
+    let mut table = ExactParams {
+        config: [layout.top(), ITERATION_CAP, 0, 0],
+        levels: [[0; 4]; 9],
+    };
+    for info in &layout.levels {
+        table.levels[info.log2_tile as usize] = [
+            info.offset,
+            info.width.trailing_zeros(),
+            info.width - 1,
+            info.height - 1,
+        ];
+    }
+    table
+}
+
+/// Build the method with explicit options.
+pub fn build(shared: &Shared, level: &Level, options: ExactOptions) -> anyhow::Result<RayExact> {
+    let compute = options.compute;
+    let device = &shared.device;
+    let pyramid = GpuMaxMip::new(shared, level)?;
+    let table = exact_params(&pyramid.layout);
+    let params = shared.uniform_buffer("ray-exact params", bytemuck::bytes_of(&table));
+    let stats = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("ray-exact stats"),
+        size: 16,
+        usage: wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_SRC
+            | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let name = if compute {
+        "ray-exact"
+    } else {
+        "ray-exact-fragment"
+    };
+    let stages = if compute {
+        wgpu::ShaderStages::COMPUTE
+    } else {
+        wgpu::ShaderStages::FRAGMENT
+    };
+    let mut entries = core_entries(stages);
+    let depth = if compute {
+        let depth = DepthCopy::new(shared, name, "ray-exact depth")?;
+        Some(if options.points {
+            depth.with_points(shared)?
+        } else {
+            depth
+        })
+    } else {
+        None
+    };
+    if compute {
+        entries.extend(DepthCopy::layout_entries(3));
+    }
+    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some(name),
+        entries: &entries,
+    });
+    let group = march_group(shared, &layout, &params, &pyramid, &stats, depth.as_ref());
+    let pipeline_layout = shared.pipeline_layout(name, &[&layout]);
+    let variant = match depth {
+        Some(depth) => Variant::Compute {
+            march: compute_pipeline(
+                shared,
+                name,
+                "ray_exact.wgsl",
+                &pipeline_layout,
+                "cs_ray_exact",
+            )?,
+            points: options.points,
+            depth,
+        },
+        None => Variant::Fragment(fullscreen_pipeline(
+            shared,
+            name,
+            "ray_exact_fragment.wgsl",
+            &pipeline_layout,
+            "fs_ray_exact",
+        )?),
+    };
+    let shadow = if shared.caps.compute && options.exact_shadow {
+        Some(exact_shadow(shared, &params, &pyramid, &stats)?)
+    } else {
+        None
+    };
+    Ok(RayExact {
+        name,
+        pyramid,
+        params,
+        stats,
+        layout,
+        group,
+        variant,
+        shadow,
+        updated: Cell::new(false),
+        device: device.clone(),
+        queue: shared.queue.clone(),
+        print_stats: env_is("STRATA_EXACT_STATS", "1"),
+    })
+}
+
+/// The shadow map by the exact march: group 0 without the shadow map (it is
+/// written here), group 1 the core's bindings and the map as storage.
+fn exact_shadow(
+    shared: &Shared,
+    params: &wgpu::Buffer,
+    pyramid: &GpuMaxMip,
+    stats: &wgpu::Buffer,
+) -> anyhow::Result<ExactShadow> {
+    let device = &shared.device;
+    let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("ray-exact shadow frame"),
+        entries: &[
+            crate::frame::uniform_layout_entry(0),
+            crate::frame::texture_entry(
+                2,
+                wgpu::TextureSampleType::Uint,
+                wgpu::TextureViewDimension::D2Array,
+            ),
+        ],
+    });
+    let frame_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("ray-exact shadow frame"),
+        layout: &frame_layout,
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: shared.globals.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 2,
+                resource: wgpu::BindingResource::TextureView(&shared.terrain.view),
+            },
+        ],
+    });
+    let mut entries = core_entries(wgpu::ShaderStages::COMPUTE);
+    entries.push(storage_texture_entry(3, wgpu::TextureFormat::R32Float));
+    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("ray-exact shadow"),
+        entries: &entries,
+    });
+    let mut bindings = core_bindings(params, pyramid, stats);
+    bindings.push(wgpu::BindGroupEntry {
+        binding: 3,
+        resource: wgpu::BindingResource::TextureView(&shared.shadow_view),
+    });
+    let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("ray-exact shadow"),
+        layout: &layout,
+        entries: &bindings,
+    });
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("ray-exact shadow"),
+        bind_group_layouts: &[Some(&frame_layout), Some(&layout)],
+        immediate_size: 0,
+    });
+    let pipeline = compute_pipeline(
+        shared,
+        "ray-exact shadow",
+        "ray_exact_shadow.wgsl",
+        &pipeline_layout,
+        "cs_exact_shadow",
+    )?;
+    Ok(ExactShadow {
+        pipeline,
+        frame_group,
+        group,
+    })
+}
+
+impl RayExact {
+    /// The GPU pyramid (tests compare it with `strata_maxmip`).
+    pub fn pyramid(&self) -> &GpuMaxMip {
+        &self.pyramid
+    }
+
+    /// The march's counters since creation or the last reset.
+    pub fn stats(&self) -> anyhow::Result<ExactStats> {
+        let w = read_buffer(&self.device, &self.queue, &self.stats)?;
+        Ok(ExactStats {
+            cap_hits: w[0],
+            most_iterations: w[1],
+            shadow_cap_hits: w[2],
+            shadow_most_iterations: w[3],
+        })
+    }
+
+    /// Zero the counters.
+    pub fn reset_stats(&self) {
+        self.queue.write_buffer(&self.stats, 0, &[0u8; 16]);
+    }
+
+    /// Record the queued pyramid update once per frame, before anything reads it.
+    fn record_update(&self, frame: &Frame<'_>, encoder: &mut wgpu::CommandEncoder) {
+        if !self.updated.get() && self.pyramid.has_work() {
+            self.pyramid
+                .record(encoder, frame.timer.compute("ray-exact pyramid update"));
+        }
+        self.updated.set(true);
+    }
+}
+
+impl Method for RayExact {
+    fn name(&self) -> &'static str {
+        self.name
+    }
+
+    fn apply_edit(
+        &mut self,
+        _shared: &Shared,
+        _level: &Level,
+        rects: &[DirtyRect],
+    ) -> anyhow::Result<()> {
+        self.pyramid.enqueue(rects);
+        Ok(())
+    }
+
+    fn update_settings(&mut self, _: &Shared, _: &MethodSettings) -> anyhow::Result<bool> {
+        // No knob: nothing to change.
+        Ok(true)
+    }
+
+    fn resize(&mut self, shared: &Shared) -> anyhow::Result<()> {
+        if let Variant::Compute { depth, .. } = &mut self.variant {
+            depth.resize(shared);
+            self.group = march_group(
+                shared,
+                &self.layout,
+                &self.params,
+                &self.pyramid,
+                &self.stats,
+                Some(depth),
+            );
+        }
+        Ok(())
+    }
+
+    fn prepare(&mut self, shared: &Shared, _camera: &Camera) -> anyhow::Result<()> {
+        self.pyramid.prepare(shared);
+        self.updated.set(false);
+        Ok(())
+    }
+
+    fn record_shadow_map(
+        &self,
+        shared: &Shared,
+        frame: &Frame<'_>,
+        encoder: &mut wgpu::CommandEncoder,
+    ) -> bool {
+        let Some(shadow) = &self.shadow else {
+            return false;
+        };
+        let _ = shared;
+        self.record_update(frame, encoder);
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("ray-exact shadow"),
+            timestamp_writes: frame.timer.compute("shadow"),
+        });
+        pass.set_pipeline(&shadow.pipeline);
+        pass.set_bind_group(0, &shadow.frame_group, &[]);
+        pass.set_bind_group(1, &shadow.group, &[]);
+        pass.dispatch_workgroups(SHADOW_SIZE.div_ceil(8), SHADOW_SIZE.div_ceil(8), 1);
+        true
+    }
+
+    fn record(&self, shared: &Shared, frame: &Frame<'_>, encoder: &mut wgpu::CommandEncoder) {
+        self.record_update(frame, encoder);
+        match &self.variant {
+            Variant::Compute {
+                march,
+                depth,
+                points,
+            } => {
+                dispatch_per_pixel(
+                    shared,
+                    frame,
+                    encoder,
+                    "ray-exact march",
+                    march,
+                    &self.group,
+                );
+                depth.record_with(shared, frame, encoder, "ray-exact depth", *points);
+            }
+            Variant::Fragment(pipeline) => super::common::draw_fullscreen(
+                shared,
+                frame,
+                encoder,
+                "ray-exact-fragment",
+                pipeline,
+                &self.group,
+            ),
+        }
+    }
+
+    fn retained_bytes(&self) -> RetainedBytes {
+        let depth = match &self.variant {
+            Variant::Compute { depth, .. } => depth.bytes(),
+            Variant::Fragment(_) => 0,
+        };
+        RetainedBytes {
+            gpu: self.pyramid.gpu_bytes()
+                + std::mem::size_of::<ExactParams>() as u64
+                + self.stats.size()
+                + depth,
+            cpu: 0,
+        }
+    }
+}
+
+impl Drop for RayExact {
+    fn drop(&mut self) {
+        if !self.print_stats {
+            return;
+        }
+        match self.stats() {
+            Ok(s) => eprintln!(
+                "{} stats: {} build_gpu_ms {:?} pyramid_bytes {}",
+                self.name,
+                serde_json::to_string(&s).unwrap_or_default(),
+                self.pyramid.build_gpu_ms,
+                self.pyramid.layout.bytes
+            ),
+            Err(e) => eprintln!("{} stats: {e}", self.name),
+        }
+    }
+}
+
+#[cfg(test)]
+#[path = "ray_exact_tests.rs"]
+mod tests;
