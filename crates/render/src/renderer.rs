@@ -95,7 +95,9 @@ impl Renderer {
             frames: 0,
             adapter: gpu.report.clone(),
             setup_ms: 0.0,
-            shadow_reuse: false,
+            // Off by default (the protocol pays for every frame's map);
+            // `STRATA_SHADOW_REUSE=1` turns it on to measure a cached map.
+            shadow_reuse: shadow_reuse_from_env(),
             shadow_drawn: None,
             depth_reader,
         };
@@ -411,6 +413,19 @@ impl Renderer {
             texture,
             aspect,
         )
+    }
+}
+
+/// `STRATA_SHADOW_REUSE=1`: start with [`Renderer::set_shadow_reuse`] on
+/// (a measuring switch; never on in a browser).
+fn shadow_reuse_from_env() -> bool {
+    #[cfg(not(target_arch = "wasm32"))]
+    {
+        std::env::var("STRATA_SHADOW_REUSE").is_ok_and(|v| v == "1")
+    }
+    #[cfg(target_arch = "wasm32")]
+    {
+        false
     }
 }
 

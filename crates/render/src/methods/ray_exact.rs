@@ -22,7 +22,7 @@
 //!
 //! [`ray_exact_build`]: super::ray_exact_build
 
-use super::common::{DepthCopy, compute_pipeline, dispatch_per_pixel, fullscreen_pipeline};
+use super::common::{DepthCopy, dispatch_per_pixel, fullscreen_pipeline};
 use super::ray_exact_build::{GpuMaxMip, read_buffer};
 use super::{Frame, Method, MethodSettings, RetainedBytes};
 use crate::frame::{SHADOW_SIZE, Shared, storage_texture_entry};
@@ -97,6 +97,8 @@ pub struct ExactOptions {
     pub points: bool,
     /// The shadow map by the exact march, else by the renderer's pass.
     pub exact_shadow: bool,
+    /// Most levels the compute traversals climb per step (`EXACT_CLIMB`).
+    pub climb: u32,
 }
 
 impl ExactOptions {
@@ -106,6 +108,11 @@ impl ExactOptions {
             compute,
             points: !env_is("STRATA_EXACT_DEPTH", "blit"),
             exact_shadow: !env_is("STRATA_EXACT_SHADOW", "shared"),
+            climb: if env_is("STRATA_EXACT_CLIMB", "all") {
+                8
+            } else {
+                1
+            },
         }
     }
 }
@@ -220,6 +227,31 @@ fn march_group(
     })
 }
 
+/// A compute pipeline of the exact core with its `EXACT_CLIMB` constant.
+fn exact_pipeline(
+    shared: &Shared,
+    label: &str,
+    shader: &str,
+    layout: &wgpu::PipelineLayout,
+    entry: &str,
+    climb: u32,
+) -> anyhow::Result<wgpu::ComputePipeline> {
+    let module = shared.shader(shader)?;
+    Ok(shared
+        .device
+        .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(label),
+            layout: Some(layout),
+            module: &module,
+            entry_point: Some(entry),
+            compilation_options: wgpu::PipelineCompilationOptions {
+                constants: &[("EXACT_CLIMB", f64::from(climb))],
+                ..Default::default()
+            },
+            cache: None,
+        }))
+}
+
 /// The traversal's level table for `layout`.
 fn exact_params(layout: &strata_maxmip::Layout) -> ExactParams {
     let mut table = ExactParams {
@@ -284,12 +316,13 @@ pub fn build(shared: &Shared, level: &Level, options: ExactOptions) -> anyhow::R
     let pipeline_layout = shared.pipeline_layout(name, &[&layout]);
     let variant = match depth {
         Some(depth) => Variant::Compute {
-            march: compute_pipeline(
+            march: exact_pipeline(
                 shared,
                 name,
                 "ray_exact.wgsl",
                 &pipeline_layout,
                 "cs_ray_exact",
+                options.climb,
             )?,
             points: options.points,
             depth,
@@ -303,7 +336,13 @@ pub fn build(shared: &Shared, level: &Level, options: ExactOptions) -> anyhow::R
         )?),
     };
     let shadow = if shared.caps.compute && options.exact_shadow {
-        Some(exact_shadow(shared, &params, &pyramid, &stats)?)
+        Some(exact_shadow(
+            shared,
+            &params,
+            &pyramid,
+            &stats,
+            options.climb,
+        )?)
     } else {
         None
     };
@@ -330,6 +369,7 @@ fn exact_shadow(
     params: &wgpu::Buffer,
     pyramid: &GpuMaxMip,
     stats: &wgpu::Buffer,
+    climb: u32,
 ) -> anyhow::Result<ExactShadow> {
     let device = &shared.device;
     let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -378,12 +418,13 @@ fn exact_shadow(
         bind_group_layouts: &[Some(&frame_layout), Some(&layout)],
         immediate_size: 0,
     });
-    let pipeline = compute_pipeline(
+    let pipeline = exact_pipeline(
         shared,
         "ray-exact shadow",
         "ray_exact_shadow.wgsl",
         &pipeline_layout,
         "cs_exact_shadow",
+        climb,
     )?;
     Ok(ExactShadow {
         pipeline,
