@@ -86,6 +86,11 @@ pub struct RayExact {
     device: wgpu::Device,
     queue: wgpu::Queue,
     print_stats: bool,
+    /// With `STRATA_EXACT_STATS=1` and timestamps: the pyramid updates are
+    /// timed here (not in the frame's sum) and their GPU ms kept.
+    update_timer: Option<crate::timing::PassTimer>,
+    update_timed: Cell<bool>,
+    update_ms: Vec<f64>,
 }
 
 /// How the method is put together (the measuring switches).
@@ -359,6 +364,10 @@ pub fn build(shared: &Shared, level: &Level, options: ExactOptions) -> anyhow::R
         device: device.clone(),
         queue: shared.queue.clone(),
         print_stats: env_is("STRATA_EXACT_STATS", "1"),
+        update_timer: (env_is("STRATA_EXACT_STATS", "1") && shared.caps.timestamps)
+            .then(|| crate::timing::PassTimer::new(device, &shared.queue, true)),
+        update_timed: Cell::new(false),
+        update_ms: Vec::new(),
     })
 }
 
@@ -455,11 +464,33 @@ impl RayExact {
         self.queue.write_buffer(&self.stats, 0, &[0u8; 16]);
     }
 
+    /// Keep the last frame's update time (statistics mode only).
+    fn read_update_time(&mut self) -> anyhow::Result<()> {
+        if let (Some(timer), true) = (&self.update_timer, self.update_timed.get()) {
+            self.update_timed.set(false);
+            #[cfg(not(target_arch = "wasm32"))]
+            if let (Some(ms), _) = timer.read(&self.device, &crate::gpu::ErrorSink::default())? {
+                self.update_ms.push(ms);
+            }
+            #[cfg(target_arch = "wasm32")]
+            let _ = timer;
+        }
+        Ok(())
+    }
+
     /// Record the queued pyramid update once per frame, before anything reads it.
     fn record_update(&self, frame: &Frame<'_>, encoder: &mut wgpu::CommandEncoder) {
         if !self.updated.get() && self.pyramid.has_work() {
-            self.pyramid
-                .record(encoder, frame.timer.compute("ray-exact pyramid update"));
+            if let Some(timer) = &self.update_timer {
+                timer.reset();
+                self.pyramid
+                    .record(encoder, timer.compute("ray-exact pyramid update"));
+                timer.resolve(encoder);
+                self.update_timed.set(true);
+            } else {
+                self.pyramid
+                    .record(encoder, frame.timer.compute("ray-exact pyramid update"));
+            }
         }
         self.updated.set(true);
     }
@@ -501,6 +532,7 @@ impl Method for RayExact {
     }
 
     fn prepare(&mut self, shared: &Shared, _camera: &Camera) -> anyhow::Result<()> {
+        self.read_update_time()?;
         self.pyramid.prepare(shared);
         self.updated.set(false);
         Ok(())
@@ -577,12 +609,14 @@ impl Drop for RayExact {
         if !self.print_stats {
             return;
         }
+        let _ = self.read_update_time();
         match self.stats() {
             Ok(s) => eprintln!(
-                "{} stats: {} build_gpu_ms {:?} pyramid_bytes {}",
+                "{} stats: {} build_gpu_ms {:?} update_gpu_ms {:?} pyramid_bytes {}",
                 self.name,
                 serde_json::to_string(&s).unwrap_or_default(),
                 self.pyramid.build_gpu_ms,
+                self.update_ms,
                 self.pyramid.layout.bytes
             ),
             Err(e) => eprintln!("{} stats: {e}", self.name),
