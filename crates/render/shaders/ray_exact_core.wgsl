@@ -33,6 +33,11 @@ struct ExactParams {
 // constant, for measuring: 1 as the reference, 8 = as far as the step allows).
 override EXACT_CLIMB: u32 = 1u;
 
+// log2 of the tile ratio between the levels the traversal visits (a pipeline
+// constant, for measuring): 1 visits every level (tiles 2, 4, .., 256), 2 every
+// other one (4, 16, 64, 256, as the CPU reference does).
+override EXACT_LOG_RATIO: u32 = 1u;
+
 // The coarsest tile: `base` is a multiple of it.
 const EXACT_BASE_TILE: f32 = 256.0;
 const EXACT_BIG: f32 = 3.0e38;
@@ -121,28 +126,32 @@ fn exact_march(o: vec3<f32>, base: vec2<i32>, d: vec3<f32>, t0: f32, t1: f32) ->
     let far_side = select(vec2<i32>(0), vec2<i32>(1), pos);
     let still = d.xy == vec2<f32>(0.0);
     let inv = select(vec2<f32>(1.0) / d.xy, vec2<f32>(0.0), still);
-    var lvl = top;
+    let ratio = EXACT_LOG_RATIO;
+    // Visited levels are lvl * ratio (pyramid level 0 = the texels).
+    var lvl = top / ratio;
     var t = t0;
-    var cell = texel_after(o.xy + d.xy * t, d.xy) >> vec2<u32>(lvl);
+    var cell = texel_after(o.xy + d.xy * t, d.xy) >> vec2<u32>(lvl * ratio);
     loop {
         if (r.iterations >= cap) {
             r.capped = true;
             return r;
         }
         r.iterations = r.iterations + 1u;
-        let size = f32(1u << lvl);
+        let shift = lvl * ratio;
+        let size = f32(1u << shift);
         let edge = vec2<f32>(cell + far_side) * size;
         let tb = select((edge - o.xy) * inv, vec2<f32>(EXACT_BIG), still);
         let t_exit = min(tb.x, tb.y);
         let t_out = min(t_exit, t1);
         if (lvl > 0u) {
             let z_min = min(o.z + d.z * t, o.z + d.z * t_out);
-            let tile = (base >> vec2<u32>(lvl)) + cell;
-            if (z_min <= maxmip_get(lvl, tile.x, tile.y)) {
+            let tile = (base >> vec2<u32>(shift)) + cell;
+            if (z_min <= maxmip_get(shift, tile.x, tile.y)) {
                 // The ray may touch something here: the child it is in at t.
                 lvl = lvl - 1u;
-                let child = texel_after(o.xy + d.xy * t, d.xy) >> vec2<u32>(lvl);
-                cell = clamp(child, cell * 2, cell * 2 + vec2<i32>(1));
+                let child = texel_after(o.xy + d.xy * t, d.xy) >> vec2<u32>(shift - ratio);
+                let first = cell << vec2<u32>(ratio);
+                cell = clamp(child, first, first + vec2<i32>((1 << ratio) - 1));
                 continue;
             }
         } else {
@@ -179,11 +188,11 @@ fn exact_march(o: vec3<f32>, base: vec2<i32>, d: vec3<f32>, t0: f32, t1: f32) ->
         // back down at every crossing).
         var was = old;
         for (var n = 0u; n < EXACT_CLIMB; n = n + 1u) {
-            if (lvl >= top || all((was >> vec2<u32>(1u)) == (cell >> vec2<u32>(1u)))) {
+            if (lvl >= top / ratio || all((was >> vec2<u32>(ratio)) == (cell >> vec2<u32>(ratio)))) {
                 break;
             }
-            was = was >> vec2<u32>(1u);
-            cell = cell >> vec2<u32>(1u);
+            was = was >> vec2<u32>(ratio);
+            cell = cell >> vec2<u32>(ratio);
             lvl = lvl + 1u;
         }
     }

@@ -391,6 +391,28 @@ impl DepthCopy {
         self.record_with(shared, frame, encoder, label, false);
     }
 
+    /// Diagnostic: the copy pass with its draw limited to a 16x16 scissor.
+    pub(crate) fn record_scissor(
+        &self,
+        shared: &Shared,
+        frame: &Frame<'_>,
+        encoder: &mut wgpu::CommandEncoder,
+        label: &str,
+    ) {
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some(label),
+            color_attachments: &[],
+            depth_stencil_attachment: Some(depth_attachment(shared)),
+            timestamp_writes: frame.timer.render(label),
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_scissor_rect(0, 0, shared.width.min(16), shared.height.min(16));
+        pass.set_pipeline(&self.blit);
+        pass.set_bind_group(0, &self.blit_group, &[]);
+        pass.draw(0..3, 0..1);
+    }
+
     /// [`DepthCopy::record`], by points where `points` and they were built.
     pub(crate) fn record_with(
         &self,

@@ -60,7 +60,7 @@ enum Variant {
     Compute {
         march: wgpu::ComputePipeline,
         depth: DepthCopy,
-        points: bool,
+        mode: DepthMode,
     },
     Fragment(wgpu::RenderPipeline),
 }
@@ -98,25 +98,72 @@ pub struct RayExact {
 pub struct ExactOptions {
     /// A compute dispatch (`ray-exact`), else a fragment pass.
     pub compute: bool,
-    /// Depth by one point per pixel, else by the full-screen blit.
-    pub points: bool,
+    /// How depth reaches the shared depth target.
+    pub depth: DepthMode,
     /// The shadow map by the exact march, else by the renderer's pass.
     pub exact_shadow: bool,
     /// Most levels the compute traversals climb per step (`EXACT_CLIMB`).
     pub climb: u32,
+    /// log2 of the tile ratio between visited levels (`EXACT_LOG_RATIO`).
+    pub log_ratio: u32,
+}
+
+/// How the compute variant moves its depth image into the shared depth target.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DepthMode {
+    /// The full-screen blit (`depth_blit.wgsl`, frag_depth), clearing first.
+    Blit,
+    /// One point per pixel through a depth-only pipeline (no fragment shader).
+    Points,
+    /// Diagnostic: the blit limited to a 16x16 scissor (wrong image; measures
+    /// what a render pass costs before its fragments).
+    Scissor,
+}
+
+impl ExactOptions {
+    /// The chosen configuration (H100 measurements in `bench/ray-exact.md`).
+    pub const DEFAULT: ExactOptions = ExactOptions {
+        compute: true,
+        depth: DepthMode::Blit,
+        exact_shadow: true,
+        climb: 1,
+        log_ratio: 1,
+    };
 }
 
 impl ExactOptions {
     /// The defaults, with the environment's measuring switches applied.
     pub fn from_env(compute: bool) -> Self {
+        let d = ExactOptions::DEFAULT;
         ExactOptions {
             compute,
-            points: !env_is("STRATA_EXACT_DEPTH", "blit"),
-            exact_shadow: !env_is("STRATA_EXACT_SHADOW", "shared"),
+            depth: if env_is("STRATA_EXACT_DEPTH", "points") {
+                DepthMode::Points
+            } else if env_is("STRATA_EXACT_DEPTH", "scissor") {
+                DepthMode::Scissor
+            } else if env_is("STRATA_EXACT_DEPTH", "blit") {
+                DepthMode::Blit
+            } else {
+                d.depth
+            },
+            exact_shadow: if env_is("STRATA_EXACT_SHADOW", "shared") {
+                false
+            } else if env_is("STRATA_EXACT_SHADOW", "exact") {
+                true
+            } else {
+                d.exact_shadow
+            },
             climb: if env_is("STRATA_EXACT_CLIMB", "all") {
                 8
             } else {
+                d.climb
+            },
+            log_ratio: if env_is("STRATA_EXACT_RATIO", "4") {
+                2
+            } else if env_is("STRATA_EXACT_RATIO", "2") {
                 1
+            } else {
+                d.log_ratio
             },
         }
     }
@@ -232,14 +279,14 @@ fn march_group(
     })
 }
 
-/// A compute pipeline of the exact core with its `EXACT_CLIMB` constant.
+/// A compute pipeline of the exact core with its traversal constants.
 fn exact_pipeline(
     shared: &Shared,
     label: &str,
     shader: &str,
     layout: &wgpu::PipelineLayout,
     entry: &str,
-    climb: u32,
+    options: ExactOptions,
 ) -> anyhow::Result<wgpu::ComputePipeline> {
     let module = shared.shader(shader)?;
     Ok(shared
@@ -250,7 +297,10 @@ fn exact_pipeline(
             module: &module,
             entry_point: Some(entry),
             compilation_options: wgpu::PipelineCompilationOptions {
-                constants: &[("EXACT_CLIMB", f64::from(climb))],
+                constants: &[
+                    ("EXACT_CLIMB", f64::from(options.climb)),
+                    ("EXACT_LOG_RATIO", f64::from(options.log_ratio)),
+                ],
                 ..Default::default()
             },
             cache: None,
@@ -302,7 +352,7 @@ pub fn build(shared: &Shared, level: &Level, options: ExactOptions) -> anyhow::R
     let mut entries = core_entries(stages);
     let depth = if compute {
         let depth = DepthCopy::new(shared, name, "ray-exact depth")?;
-        Some(if options.points {
+        Some(if options.depth == DepthMode::Points {
             depth.with_points(shared)?
         } else {
             depth
@@ -327,9 +377,9 @@ pub fn build(shared: &Shared, level: &Level, options: ExactOptions) -> anyhow::R
                 "ray_exact.wgsl",
                 &pipeline_layout,
                 "cs_ray_exact",
-                options.climb,
+                options,
             )?,
-            points: options.points,
+            mode: options.depth,
             depth,
         },
         None => Variant::Fragment(fullscreen_pipeline(
@@ -341,13 +391,7 @@ pub fn build(shared: &Shared, level: &Level, options: ExactOptions) -> anyhow::R
         )?),
     };
     let shadow = if shared.caps.compute && options.exact_shadow {
-        Some(exact_shadow(
-            shared,
-            &params,
-            &pyramid,
-            &stats,
-            options.climb,
-        )?)
+        Some(exact_shadow(shared, &params, &pyramid, &stats, options)?)
     } else {
         None
     };
@@ -378,7 +422,7 @@ fn exact_shadow(
     params: &wgpu::Buffer,
     pyramid: &GpuMaxMip,
     stats: &wgpu::Buffer,
-    climb: u32,
+    options: ExactOptions,
 ) -> anyhow::Result<ExactShadow> {
     let device = &shared.device;
     let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -433,7 +477,7 @@ fn exact_shadow(
         "ray_exact_shadow.wgsl",
         &pipeline_layout,
         "cs_exact_shadow",
-        climb,
+        options,
     )?;
     Ok(ExactShadow {
         pipeline,
@@ -563,11 +607,7 @@ impl Method for RayExact {
     fn record(&self, shared: &Shared, frame: &Frame<'_>, encoder: &mut wgpu::CommandEncoder) {
         self.record_update(frame, encoder);
         match &self.variant {
-            Variant::Compute {
-                march,
-                depth,
-                points,
-            } => {
+            Variant::Compute { march, depth, mode } => {
                 dispatch_per_pixel(
                     shared,
                     frame,
@@ -576,7 +616,12 @@ impl Method for RayExact {
                     march,
                     &self.group,
                 );
-                depth.record_with(shared, frame, encoder, "ray-exact depth", *points);
+                let label = "ray-exact depth";
+                match mode {
+                    DepthMode::Blit => depth.record(shared, frame, encoder, label),
+                    DepthMode::Points => depth.record_with(shared, frame, encoder, label, true),
+                    DepthMode::Scissor => depth.record_scissor(shared, frame, encoder, label),
+                }
             }
             Variant::Fragment(pipeline) => super::common::draw_fullscreen(
                 shared,
