@@ -391,23 +391,37 @@ impl DepthCopy {
         self.record_with(shared, frame, encoder, label, false);
     }
 
-    /// Diagnostic: the copy pass with its draw limited to a 16x16 scissor.
-    pub(crate) fn record_scissor(
+    /// The blit with its choices open (for measuring): `scissor` limits the
+    /// draw to 16x16 pixels (a wrong image: what the pass costs before its
+    /// fragments); `clear` false loads the old depth instead of clearing it
+    /// (the same image: the blit writes every pixel, compare `Always`).
+    pub(crate) fn record_blit(
         &self,
         shared: &Shared,
         frame: &Frame<'_>,
         encoder: &mut wgpu::CommandEncoder,
         label: &str,
+        scissor: bool,
+        clear: bool,
     ) {
+        let mut attachment = depth_attachment(shared);
+        if !clear {
+            attachment.depth_ops = Some(wgpu::Operations {
+                load: wgpu::LoadOp::Load,
+                store: wgpu::StoreOp::Store,
+            });
+        }
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some(label),
             color_attachments: &[],
-            depth_stencil_attachment: Some(depth_attachment(shared)),
+            depth_stencil_attachment: Some(attachment),
             timestamp_writes: frame.timer.render(label),
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_scissor_rect(0, 0, shared.width.min(16), shared.height.min(16));
+        if scissor {
+            pass.set_scissor_rect(0, 0, shared.width.min(16), shared.height.min(16));
+        }
         pass.set_pipeline(&self.blit);
         pass.set_bind_group(0, &self.blit_group, &[]);
         pass.draw(0..3, 0..1);

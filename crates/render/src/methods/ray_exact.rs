@@ -115,9 +115,14 @@ pub enum DepthMode {
     Blit,
     /// One point per pixel through a depth-only pipeline (no fragment shader).
     Points,
+    /// The blit loading the old depth instead of clearing it first (the same
+    /// image: it writes every pixel).
+    BlitLoad,
     /// Diagnostic: the blit limited to a 16x16 scissor (wrong image; measures
     /// what a render pass costs before its fragments).
     Scissor,
+    /// Diagnostic: [`DepthMode::Scissor`] without the clear.
+    ScissorLoad,
 }
 
 impl ExactOptions {
@@ -141,6 +146,10 @@ impl ExactOptions {
                 DepthMode::Points
             } else if env_is("STRATA_EXACT_DEPTH", "scissor") {
                 DepthMode::Scissor
+            } else if env_is("STRATA_EXACT_DEPTH", "load") {
+                DepthMode::BlitLoad
+            } else if env_is("STRATA_EXACT_DEPTH", "scissor-load") {
+                DepthMode::ScissorLoad
             } else if env_is("STRATA_EXACT_DEPTH", "blit") {
                 DepthMode::Blit
             } else {
@@ -620,7 +629,15 @@ impl Method for RayExact {
                 match mode {
                     DepthMode::Blit => depth.record(shared, frame, encoder, label),
                     DepthMode::Points => depth.record_with(shared, frame, encoder, label, true),
-                    DepthMode::Scissor => depth.record_scissor(shared, frame, encoder, label),
+                    DepthMode::BlitLoad => {
+                        depth.record_blit(shared, frame, encoder, label, false, false)
+                    }
+                    DepthMode::Scissor => {
+                        depth.record_blit(shared, frame, encoder, label, true, true)
+                    }
+                    DepthMode::ScissorLoad => {
+                        depth.record_blit(shared, frame, encoder, label, true, false)
+                    }
                 }
             }
             Variant::Fragment(pipeline) => super::common::draw_fullscreen(

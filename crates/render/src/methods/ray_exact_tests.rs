@@ -540,6 +540,10 @@ fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
             },
             ExactOptions { climb: 8, ..d },
             ExactOptions { log_ratio: 2, ..d },
+            ExactOptions {
+                depth: DepthMode::BlitLoad,
+                ..d
+            },
         ];
         let mut images = Vec::new();
         for options in variants {
@@ -561,9 +565,9 @@ fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
             );
             assert!(a.1 == b.1, "view {v}: colour differs");
         }
-        // Climbing as far as a step allows, or visiting every other level,
-        // changes nothing but the work.
-        for other in [3, 4] {
+        // Climbing as far as a step allows, visiting every other level, or
+        // loading depth instead of clearing it changes nothing but the work.
+        for other in [3, 4, 5] {
             for (v, (a, b)) in images[1].iter().zip(&images[other]).enumerate() {
                 assert!(
                     a.0 == b.0 && a.1 == b.1,
