@@ -541,7 +541,7 @@ fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
             ExactOptions { climb: 8, ..d },
             ExactOptions { log_ratio: 2, ..d },
             ExactOptions {
-                depth: DepthMode::BlitLoad,
+                depth: DepthMode::Blit,
                 ..d
             },
         ];
