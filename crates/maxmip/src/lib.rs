@@ -239,7 +239,7 @@ mod tests {
             .collect();
         let metas: Vec<u8> = (0..n as u32)
             .map(|i| {
-                if ((i / 2).wrapping_mul(40503) ^ seed) % 3 == 0 {
+                if ((i / 2).wrapping_mul(40503) ^ seed).is_multiple_of(3) {
                     META_DOUBLE_LEVEL | (i as u8 & 3)
                 } else {
                     0

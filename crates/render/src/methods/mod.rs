@@ -52,6 +52,13 @@ pub mod sliced;
 pub mod voxel;
 pub mod voxel_build;
 
+/// The integration tests' helpers (adapter skip, metric loops, distance
+/// comparisons), shared by the methods' unit tests; `strata_render::` paths
+/// there resolve through the `extern crate self` alias in lib.rs.
+#[cfg(test)]
+#[path = "../../tests/common/mod.rs"]
+pub(crate) mod test_common;
+
 use crate::caps::{Capabilities, Capability, Refusal};
 use crate::frame::Shared;
 use crate::timing::PassTimer;

@@ -17,8 +17,7 @@ use strata_level::{DirtyRect, Level, World};
 use strata_reference::metrics::distance_from_depth;
 use strata_reference::{HitClass, ReferenceSettings, Tracer, metrics, render_reference};
 
-#[path = "../../tests/common/mod.rs"]
-mod common;
+use super::super::test_common as common;
 
 fn world(width: u32, height: u32, seed: u64) -> World {
     generate(&GenerateParams {
