@@ -127,8 +127,13 @@ fn shade_with_normal(p: vec3<f32>, c: Column, kind: u32, n: vec3<f32>) -> vec3<f
 // Shade with the height-field normal (every method but the mesh, which passes
 // its geometric normal to `shade_with_normal`).
 fn shade(p: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
-    let x = i32(floor(p.x));
-    let y = i32(floor(p.y));
+    return shade_column(p, i32(floor(p.x)), i32(floor(p.y)), dir);
+}
+
+// `shade` at a point of column (x, y) named by the caller: an exact march hit
+// on a column's side lies on the texel line, where `floor(p)` may name the
+// neighbour the ray came from.
+fn shade_column(p: vec3<f32>, x: i32, y: i32, dir: vec3<f32>) -> vec3<f32> {
     let c = decode_column(x, y);
     let kind = surface_kind(c, p.z, dir.z);
     let here = select(c.high, c.mid, kind == SURFACE_CEILING);

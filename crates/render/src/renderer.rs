@@ -95,7 +95,9 @@ impl Renderer {
             frames: 0,
             adapter: gpu.report.clone(),
             setup_ms: 0.0,
-            shadow_reuse: false,
+            // Off by default (the protocol pays for every frame's map);
+            // `STRATA_SHADOW_REUSE=1` turns it on to measure a cached map.
+            shadow_reuse: shadow_reuse_from_env(),
             shadow_drawn: None,
             depth_reader,
         };
@@ -278,18 +280,20 @@ impl Renderer {
             .create_command_encoder(&Default::default());
         self.timer.reset();
         let current = self.shadow_reuse && self.shadow_drawn == Some(shadow);
-        if shadows && !current {
-            self.shadow.record(&mut encoder, &self.timer);
-            self.shadow_drawn = Some(shadow);
-        }
         let frame = Frame {
             camera,
             timer: &self.timer,
             index: self.frames,
         };
-        self.methods[self.active]
-            .method
-            .record(&self.shared, &frame, &mut encoder);
+        let method = &self.methods[self.active].method;
+        if shadows && !current {
+            // The method may fill the map itself (the exact march does).
+            if !method.record_shadow_map(&self.shared, &frame, &mut encoder) {
+                self.shadow.record(&mut encoder, &self.timer);
+            }
+            self.shadow_drawn = Some(shadow);
+        }
+        method.record(&self.shared, &frame, &mut encoder);
         self.timer.resolve(&mut encoder);
         let commands = encoder.finish();
         let record_ms = ms(record_start);
@@ -409,6 +413,19 @@ impl Renderer {
             texture,
             aspect,
         )
+    }
+}
+
+/// `STRATA_SHADOW_REUSE=1`: start with [`Renderer::set_shadow_reuse`] on
+/// (a measuring switch; never on in a browser).
+fn shadow_reuse_from_env() -> bool {
+    #[cfg(not(target_arch = "wasm32"))]
+    {
+        std::env::var("STRATA_SHADOW_REUSE").is_ok_and(|v| v == "1")
+    }
+    #[cfg(target_arch = "wasm32")]
+    {
+        false
     }
 }
 

@@ -60,6 +60,35 @@ pub const SOURCES: &[(&str, &str)] = &[
         "scattered_resolve.wgsl",
         include_str!("../shaders/scattered_resolve.wgsl"),
     ),
+    (
+        "ray_exact_core.wgsl",
+        include_str!("../shaders/ray_exact_core.wgsl"),
+    ),
+    (
+        "ray_exact_pixel.wgsl",
+        include_str!("../shaders/ray_exact_pixel.wgsl"),
+    ),
+    ("ray_exact.wgsl", include_str!("../shaders/ray_exact.wgsl")),
+    (
+        "ray_exact_fragment.wgsl",
+        include_str!("../shaders/ray_exact_fragment.wgsl"),
+    ),
+    (
+        "ray_exact_shadow.wgsl",
+        include_str!("../shaders/ray_exact_shadow.wgsl"),
+    ),
+    (
+        "ray_exact_depth.wgsl",
+        include_str!("../shaders/ray_exact_depth.wgsl"),
+    ),
+    (
+        "ray_exact_build.wgsl",
+        include_str!("../shaders/ray_exact_build.wgsl"),
+    ),
+    (
+        "ray_exact_test.wgsl",
+        include_str!("../shaders/ray_exact_test.wgsl"),
+    ),
 ];
 
 /// Shaders with entry points (the rest are modules); the naga test validates these.
@@ -78,6 +107,12 @@ pub const ENTRY_SHADERS: &[&str] = &[
     "mesh.wgsl",
     "scattered.wgsl",
     "scattered_resolve.wgsl",
+    "ray_exact.wgsl",
+    "ray_exact_fragment.wgsl",
+    "ray_exact_shadow.wgsl",
+    "ray_exact_depth.wgsl",
+    "ray_exact_build.wgsl",
+    "ray_exact_test.wgsl",
 ];
 
 #[derive(Debug, thiserror::Error, PartialEq, Eq)]

@@ -224,6 +224,9 @@ pub(crate) struct DepthCopy {
     view: wgpu::TextureView,
     bytes: u64,
     blit: wgpu::RenderPipeline,
+    /// The depth-only alternative to `blit`: one point per pixel
+    /// (`ray_exact_depth.wgsl`), built on request ([`DepthCopy::with_points`]).
+    points: Option<wgpu::RenderPipeline>,
     layout: wgpu::BindGroupLayout,
     blit_group: wgpu::BindGroup,
 }
@@ -298,9 +301,44 @@ impl DepthCopy {
             view,
             bytes: u64::from(shared.width) * u64::from(shared.height) * 4,
             blit,
+            points: None,
             layout,
             blit_group,
         })
+    }
+
+    /// Also build the point-per-pixel depth pass ([`DepthCopy::record_points`]):
+    /// a depth-only pipeline, no fragment shader.
+    pub(crate) fn with_points(mut self, shared: &Shared) -> anyhow::Result<Self> {
+        let device = &shared.device;
+        let module = shared.shader("ray_exact_depth.wgsl")?;
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("depth points"),
+            bind_group_layouts: &[Some(&self.layout)],
+            immediate_size: 0,
+        });
+        self.points = Some(
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some("depth points"),
+                layout: Some(&pipeline_layout),
+                vertex: wgpu::VertexState {
+                    module: &module,
+                    entry_point: Some("vs_depth_point"),
+                    compilation_options: Default::default(),
+                    buffers: &[],
+                },
+                primitive: wgpu::PrimitiveState {
+                    topology: wgpu::PrimitiveTopology::PointList,
+                    ..Default::default()
+                },
+                depth_stencil: Some(depth_write(wgpu::CompareFunction::Always)),
+                multisample: Default::default(),
+                fragment: None,
+                multiview_mask: None,
+                cache: None,
+            }),
+        );
+        Ok(self)
     }
 
     /// A new storage image at the shared targets' new size; the caller
@@ -350,6 +388,54 @@ impl DepthCopy {
         encoder: &mut wgpu::CommandEncoder,
         label: &str,
     ) {
+        self.record_with(shared, frame, encoder, label, false);
+    }
+
+    /// The blit with its choices open (for measuring): `scissor` limits the
+    /// draw to 16x16 pixels (a wrong image: what the pass costs before its
+    /// fragments); `clear` false loads the old depth instead of clearing it
+    /// (the same image: the blit writes every pixel, compare `Always`).
+    pub(crate) fn record_blit(
+        &self,
+        shared: &Shared,
+        frame: &Frame<'_>,
+        encoder: &mut wgpu::CommandEncoder,
+        label: &str,
+        scissor: bool,
+        clear: bool,
+    ) {
+        let mut attachment = depth_attachment(shared);
+        if !clear {
+            attachment.depth_ops = Some(wgpu::Operations {
+                load: wgpu::LoadOp::Load,
+                store: wgpu::StoreOp::Store,
+            });
+        }
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some(label),
+            color_attachments: &[],
+            depth_stencil_attachment: Some(attachment),
+            timestamp_writes: frame.timer.render(label),
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        if scissor {
+            pass.set_scissor_rect(0, 0, shared.width.min(16), shared.height.min(16));
+        }
+        pass.set_pipeline(&self.blit);
+        pass.set_bind_group(0, &self.blit_group, &[]);
+        pass.draw(0..3, 0..1);
+    }
+
+    /// [`DepthCopy::record`], by points where `points` and they were built.
+    pub(crate) fn record_with(
+        &self,
+        shared: &Shared,
+        frame: &Frame<'_>,
+        encoder: &mut wgpu::CommandEncoder,
+        label: &str,
+        points: bool,
+    ) {
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some(label),
             color_attachments: &[],
@@ -358,8 +444,17 @@ impl DepthCopy {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_pipeline(&self.blit);
-        pass.set_bind_group(0, &self.blit_group, &[]);
-        pass.draw(0..3, 0..1);
+        match (&self.points, points) {
+            (Some(pipeline), true) => {
+                pass.set_pipeline(pipeline);
+                pass.set_bind_group(0, &self.blit_group, &[]);
+                pass.draw(0..shared.width * shared.height, 0..1);
+            }
+            _ => {
+                pass.set_pipeline(&self.blit);
+                pass.set_bind_group(0, &self.blit_group, &[]);
+                pass.draw(0..3, 0..1);
+            }
+        }
     }
 }

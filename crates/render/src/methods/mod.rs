@@ -44,11 +44,20 @@ mod mesh_pool;
 pub mod painted;
 pub mod ray;
 pub mod ray_compute;
+pub mod ray_exact;
+pub mod ray_exact_build;
 pub mod scattered;
 mod scattered_grid;
 pub mod sliced;
 pub mod voxel;
 pub mod voxel_build;
+
+/// The integration tests' helpers (adapter skip, metric loops, distance
+/// comparisons), shared by the methods' unit tests; `strata_render::` paths
+/// there resolve through the `extern crate self` alias in lib.rs.
+#[cfg(test)]
+#[path = "../../tests/common/mod.rs"]
+pub(crate) mod test_common;
 
 use crate::caps::{Capabilities, Capability, Refusal};
 use crate::frame::Shared;
@@ -148,6 +157,19 @@ pub trait Method: Send {
         Ok(())
     }
 
+    /// Fill the shared shadow map (`Shared::shadow_view`) this frame, in
+    /// place of the renderer's own pass, and say so with `true`. Called before
+    /// `record` on frames that need a new map; the default leaves it to the
+    /// renderer (`shadow.wgsl`).
+    fn record_shadow_map(
+        &self,
+        _shared: &Shared,
+        _frame: &Frame<'_>,
+        _encoder: &mut wgpu::CommandEncoder,
+    ) -> bool {
+        false
+    }
+
     /// Record this frame's passes.
     fn record(&self, shared: &Shared, frame: &Frame<'_>, encoder: &mut wgpu::CommandEncoder);
 
@@ -234,6 +256,20 @@ pub const METHODS: &[MethodEntry] = &[
         create: ray_compute::create,
         in_steps: None,
         needs: &[ComputeShaders, StorageTextures],
+    },
+    MethodEntry {
+        name: "ray-exact",
+        // The pyramid is built and edited by compute passes; the march is a
+        // compute dispatch writing storage images.
+        create: ray_exact::create,
+        in_steps: None,
+        needs: &[ComputeShaders, StorageTextures],
+    },
+    MethodEntry {
+        name: "ray-exact-fragment",
+        create: ray_exact::create_fragment,
+        in_steps: None,
+        needs: &[ComputeShaders, FragmentStorage],
     },
     MethodEntry {
         name: "voxel",

@@ -384,7 +384,7 @@ fn wait(device: &wgpu::Device) -> anyhow::Result<()> {
 
 /// A frame bind group whose globals carry the level's shape (all the
 /// build's `decode_column` reads) over the shared terrain texture.
-fn build_frame_group(shared: &Shared, level: &Level) -> anyhow::Result<wgpu::BindGroup> {
+pub(crate) fn build_frame_group(shared: &Shared, level: &Level) -> anyhow::Result<wgpu::BindGroup> {
     // Any camera will do: only `Globals::level` is read by the build.
     let camera = Camera::new(glam::Vec3::new(0.0, 0.0, 300.0), 0.0, 0.0, 1, 1)?;
     let shadow = crate::shadow::ShadowFrame::fit(&camera, false);

@@ -12,11 +12,7 @@ use strata_level::{DirtyRect, Level, World};
 use strata_occupancy::{Pyramid, VoxelSize};
 use strata_reference::metrics::distance_from_depth;
 
-// The integration tests' helpers (adapter skip, metric loops, distance
-// comparisons); `strata_render::` paths there resolve through the
-// `extern crate self` alias in lib.rs.
-#[path = "../../tests/common/mod.rs"]
-mod common;
+use super::super::test_common as common;
 
 const W: u32 = 160;
 const H: u32 = 100;

@@ -1,0 +1,35 @@
+// `ray-exact`: the exact march (`ray_exact_core.wgsl`), one invocation per
+// pixel, colour straight into the shared colour target and depth into an
+// R32Float image that a depth pass moves into the shared depth target.
+#include "frame.wgsl"
+#include "surface.wgsl"
+#include "shading.wgsl"
+#include "ray_core.wgsl"
+#include "ray_exact_core.wgsl"
+#include "ray_exact_pixel.wgsl"
+
+@group(1) @binding(3) var color_out: texture_storage_2d<rgba8unorm, write>;
+@group(1) @binding(4) var depth_out: texture_storage_2d<r32float, write>;
+
+var<workgroup> group_most: atomic<u32>;
+
+@compute @workgroup_size(8, 8, 1)
+fn cs_ray_exact(
+    @builtin(global_invocation_id) id: vec3<u32>,
+    @builtin(local_invocation_index) li: u32,
+) {
+    let size = vec2<u32>(globals.screen.xy);
+    if (all(id.xy < size)) {
+        let s = exact_pixel(f32(id.x) + 0.5, f32(id.y) + 0.5);
+        textureStore(color_out, id.xy, s.color);
+        textureStore(depth_out, id.xy, vec4<f32>(s.depth, 0.0, 0.0, 0.0));
+        if (s.capped) {
+            atomicAdd(&xstats[0], 1u);
+        }
+        atomicMax(&group_most, s.iterations);
+    }
+    workgroupBarrier();
+    if (li == 0u) {
+        atomicMax(&xstats[1], atomicLoad(&group_most));
+    }
+}

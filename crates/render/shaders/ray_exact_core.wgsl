@@ -1,0 +1,220 @@
+// The exact march shared by `ray-exact`, `ray-exact-fragment` and their shadow
+// map: a hierarchical 2D grid traversal over the max-height pyramid of column
+// tops (`strata_maxmip`: level k holds the highest top of each 2^k-texel tile),
+// descending where the ray dips to a tile's maximum and climbing when it leaves
+// its parent, and at the finest level the exact segment-interval test of the
+// CPU reference (`raycast.rs::column_hit`) against [0, low] and [mid, high].
+// No step budget: a safety cap on iterations (`xparams.config.y`), counted.
+//
+// Precision: the map is up to 16384 long, where f32 keeps ~0.002 of a unit.
+// The traversal runs relative to `base`, a point whose x and y are multiples of
+// the coarsest tile (256) near the ray's start, so every cell index is small,
+// every boundary parameter is computed from its own integer coordinate (never
+// accumulated), and tile indices are `(base >> k) + cell` exactly.
+#include "frame.wgsl"
+#include "surface.wgsl"
+
+// Twin of `methods::ray_exact::ExactParams`.
+struct ExactParams {
+    // x coarsest level, y iteration cap, z/w unused
+    config: vec4<u32>,
+    // level k at index k (index 0 unused): x first byte, y log2 tiles across,
+    // z tiles across - 1, w tiles down - 1
+    levels: array<vec4<u32>, 9>,
+}
+
+@group(1) @binding(0) var<uniform> xparams: ExactParams;
+@group(1) @binding(1) var<storage, read> maxmip: array<u32>;
+// [0] camera rays that hit the cap, [1] most iterations of a camera ray,
+// [2] shadow rays that hit the cap, [3] most iterations of a shadow ray
+@group(1) @binding(2) var<storage, read_write> xstats: array<atomic<u32>, 4>;
+
+// Most levels climbed after a step leaves its parent tile (a pipeline
+// constant, for measuring: 1 as the reference, 8 = as far as the step allows).
+override EXACT_CLIMB: u32 = 1u;
+
+// log2 of the tile ratio between the levels the traversal visits (a pipeline
+// constant, for measuring): 1 visits every level (tiles 2, 4, .., 256), 2 every
+// other one (4, 16, 64, 256, as the CPU reference does).
+override EXACT_LOG_RATIO: u32 = 1u;
+
+// The coarsest tile: `base` is a multiple of it.
+const EXACT_BASE_TILE: f32 = 256.0;
+const EXACT_BIG: f32 = 3.0e38;
+
+struct ExactHit {
+    hit: bool,
+    // ray parameter of the first solid point (t1 at a miss)
+    t: f32,
+    // the hit column, absolute (unwrapped) texel coordinates
+    column: vec2<i32>,
+    // what was hit, as `strata_reference::HitClass` codes: 1 floor, 2 slab
+    // top, 3 cave ceiling, 4 wall (a column entered through its side)
+    hit_class: u32,
+    iterations: u32,
+    capped: bool,
+}
+
+// Max top of tile (tx, ty) of level k, wrapping around the map.
+fn maxmip_get(k: u32, tx: i32, ty: i32) -> f32 {
+    let l = xparams.levels[k];
+    let i = l.x + (u32(tx) & l.z) + ((u32(ty) & l.w) << l.y);
+    return f32((maxmip[i >> 2u] >> ((i & 3u) << 3u)) & 0xffu);
+}
+
+// The texel holding p + eps d: a point exactly on a texel line belongs to the
+// side the ray moves into (twin of `raycast.rs::texel_after`).
+fn texel_after(p: vec2<f32>, d: vec2<f32>) -> vec2<i32> {
+    let f = floor(p);
+    let on_line = (f == p) & (d < vec2<f32>(0.0));
+    return vec2<i32>(f) - select(vec2<i32>(0), vec2<i32>(1), on_line);
+}
+
+// The first t in [t0, t1] at which o + t d is solid in column `c` (x; -1 when
+// none) and whether it is in the slab (y = 1): the earlier entry wins, on a
+// tie the floor.
+fn column_entry(c: Column, oz: f32, dz: f32, t0: f32, t1: f32) -> vec2<f32> {
+    var best = -1.0;
+    var slab = 0.0;
+    // The floor [.., low].
+    if (dz < 0.0) {
+        let e = max(t0, (c.low - oz) / dz);
+        if (e <= t1) {
+            best = e;
+        }
+    } else if (oz + dz * t0 <= c.low) {
+        best = t0;
+    }
+    if (c.dual) {
+        var lo = t0;
+        var hi = t1;
+        if (dz == 0.0) {
+            if (oz < c.mid || oz > c.high) {
+                lo = 1.0;
+                hi = 0.0;
+            }
+        } else {
+            let ta = (c.mid - oz) / dz;
+            let tb = (c.high - oz) / dz;
+            lo = max(t0, min(ta, tb));
+            hi = min(t1, max(ta, tb));
+        }
+        if (lo <= hi && (best < 0.0 || lo < best)) {
+            best = lo;
+            slab = 1.0;
+        }
+    }
+    return vec2<f32>(best, slab);
+}
+
+// The first solid point of o + t d, t in [t0, t1], with o relative to `base`
+// (see the top). t0 must be at or below the altitude 255 along the ray.
+fn exact_march(o: vec3<f32>, base: vec2<i32>, d: vec3<f32>, t0: f32, t1: f32) -> ExactHit {
+    var r: ExactHit;
+    r.hit = false;
+    r.t = t1;
+    r.hit_class = 0u;
+    r.iterations = 0u;
+    r.capped = false;
+    if (t1 < t0) {
+        return r;
+    }
+    let top = xparams.config.x;
+    let cap = xparams.config.y;
+    let pos = d.xy > vec2<f32>(0.0);
+    let step = select(vec2<i32>(-1), vec2<i32>(1), pos);
+    let far_side = select(vec2<i32>(0), vec2<i32>(1), pos);
+    let still = d.xy == vec2<f32>(0.0);
+    let inv = select(vec2<f32>(1.0) / d.xy, vec2<f32>(0.0), still);
+    let ratio = EXACT_LOG_RATIO;
+    // Visited levels are lvl * ratio (pyramid level 0 = the texels).
+    var lvl = top / ratio;
+    var t = t0;
+    var cell = texel_after(o.xy + d.xy * t, d.xy) >> vec2<u32>(lvl * ratio);
+    loop {
+        if (r.iterations >= cap) {
+            r.capped = true;
+            return r;
+        }
+        r.iterations = r.iterations + 1u;
+        let shift = lvl * ratio;
+        let size = f32(1u << shift);
+        let edge = vec2<f32>(cell + far_side) * size;
+        let tb = select((edge - o.xy) * inv, vec2<f32>(EXACT_BIG), still);
+        let t_exit = min(tb.x, tb.y);
+        let t_out = min(t_exit, t1);
+        if (lvl > 0u) {
+            let z_min = min(o.z + d.z * t, o.z + d.z * t_out);
+            let tile = (base >> vec2<u32>(shift)) + cell;
+            if (z_min <= maxmip_get(shift, tile.x, tile.y)) {
+                // The ray may touch something here: the child it is in at t.
+                lvl = lvl - 1u;
+                let child = texel_after(o.xy + d.xy * t, d.xy) >> vec2<u32>(shift - ratio);
+                let first = cell << vec2<u32>(ratio);
+                cell = clamp(child, first, first + vec2<i32>((1 << ratio) - 1));
+                continue;
+            }
+        } else {
+            let column = base + cell;
+            let c = decode_column(column.x, column.y);
+            let e = column_entry(c, o.z, d.z, t, t_out);
+            if (e.x >= 0.0) {
+                r.hit = true;
+                r.t = e.x;
+                r.column = column;
+                if (t > t0 && e.x <= t) {
+                    r.hit_class = 4u;
+                } else if (e.y == 0.0) {
+                    r.hit_class = 1u;
+                } else {
+                    r.hit_class = select(3u, 2u, d.z < 0.0);
+                }
+                return r;
+            }
+        }
+        if (t_exit >= t1) {
+            return r;
+        }
+        t = t_exit;
+        let old = cell;
+        if (tb.x <= tb.y) {
+            cell.x = cell.x + step.x;
+        }
+        if (tb.y <= tb.x) {
+            cell.y = cell.y + step.y;
+        }
+        // Left the parent tile: climb (one level by default, as the reference
+        // does, so a ray skimming rough ground does not climb high and come
+        // back down at every crossing).
+        var was = old;
+        for (var n = 0u; n < EXACT_CLIMB; n = n + 1u) {
+            if (lvl >= top / ratio || all((was >> vec2<u32>(ratio)) == (cell >> vec2<u32>(ratio)))) {
+                break;
+            }
+            was = was >> vec2<u32>(ratio);
+            cell = cell >> vec2<u32>(ratio);
+            lvl = lvl + 1u;
+        }
+    }
+    return r;
+}
+
+// The base (multiple of the coarsest tile) for a ray starting near world `p`.
+fn exact_base(p: vec2<f32>) -> vec2<i32> {
+    return vec2<i32>(floor(p / EXACT_BASE_TILE)) * i32(EXACT_BASE_TILE);
+}
+
+// Clip [t0, t1] of world o + t d to altitudes <= 255 (nothing is solid above).
+// Empty (x > y) when the segment stays above.
+fn exact_clip(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32) -> vec2<f32> {
+    var a = t0;
+    var b = t1;
+    if (d.z < 0.0) {
+        a = max(a, (MAX_ALTITUDE - o.z) / d.z);
+    } else if (o.z > MAX_ALTITUDE) {
+        return vec2<f32>(1.0, 0.0);
+    } else if (d.z > 0.0) {
+        b = min(b, (MAX_ALTITUDE - o.z) / d.z);
+    }
+    return vec2<f32>(a, b);
+}

@@ -1,0 +1,700 @@
+//! `ray-exact` and `ray-exact-fragment`: the exact march (issue 15). A
+//! hierarchical 2D traversal over the max-height pyramid of column tops
+//! ([`ray_exact_build`], the twin of `strata_maxmip`), descending where the
+//! ray dips to a tile's maximum, and at the finest level the exact
+//! segment–interval test of the CPU reference: no step budget, only a
+//! safety cap on iterations ([`ITERATION_CAP`]) whose hits are counted
+//! ([`RayExact::stats`]). f32 throughout, relative to the 256-texel tile
+//! holding the ray's start (`ray_exact_core.wgsl`), so depth on a
+//! 16384-long wrapping map agrees with the f64 reference.
+//!
+//! `ray-exact` is a compute dispatch (colour into the shared target, depth
+//! into an R32Float image) plus the shared full-screen depth blit, which here
+//! *loads* the depth target instead of clearing it first: the blit writes
+//! every pixel (compare `Always`, sky = 1.0), so the image is the same, and on
+//! the H100 the clear alone cost 0.073 ms of the blit's 0.149. (The method
+//! contract asks the first pass to clear; this is the one deliberate
+//! exception, and `STRATA_EXACT_DEPTH=blit` restores the clear.)
+//! `ray-exact-fragment` is one full-screen fragment pass. Both fill the shared
+//! shadow map with the same march along the light
+//! ([`Method::record_shadow_map`]) instead of the renderer's 128-step march.
+//!
+//! Measuring switches (environment, read at creation; H100 numbers in
+//! `bench/ray-exact.md`): `STRATA_EXACT_SHADOW=shared` keeps the renderer's
+//! shadow pass; `STRATA_EXACT_DEPTH=blit|points|scissor|scissor-load` picks
+//! the depth pass (the last two are diagnostics that draw a wrong image);
+//! `STRATA_EXACT_CLIMB=all`, `STRATA_EXACT_RATIO=4` change the traversal's
+//! climbing and level ratio (same image); `STRATA_EXACT_STATS=1` prints the
+//! iteration statistics, the build's and each update's GPU time to stderr
+//! when the method is dropped. `STRATA_SHADOW_REUSE=1` (the renderer's) keeps
+//! the shadow map while its frame and the terrain are unchanged.
+//!
+//! [`ray_exact_build`]: super::ray_exact_build
+
+use super::common::{DepthCopy, dispatch_per_pixel, fullscreen_pipeline};
+use super::ray_exact_build::{GpuMaxMip, read_buffer};
+use super::{Frame, Method, MethodSettings, RetainedBytes};
+use crate::frame::{SHADOW_SIZE, Shared, storage_texture_entry};
+use serde::Serialize;
+use std::cell::Cell;
+use strata_camera::Camera;
+use strata_level::{DirtyRect, Level};
+
+/// Most traversal iterations of one ray: a guard against a hang, never
+/// reached on the protocol's views (counted in [`ExactStats`]).
+pub const ITERATION_CAP: u32 = 4096;
+
+/// Twin of `ExactParams` in `ray_exact_core.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct ExactParams {
+    config: [u32; 4],
+    levels: [[u32; 4]; 9],
+}
+
+/// What the march counted since creation (or the last [`RayExact::reset_stats`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct ExactStats {
+    /// Camera rays stopped by [`ITERATION_CAP`] (must be 0).
+    pub cap_hits: u32,
+    /// Most iterations any camera ray took (compute variant only).
+    pub most_iterations: u32,
+    /// Shadow-map rays stopped by the cap (must be 0).
+    pub shadow_cap_hits: u32,
+    /// Most iterations any shadow-map ray took.
+    pub shadow_most_iterations: u32,
+}
+
+enum Variant {
+    Compute {
+        march: wgpu::ComputePipeline,
+        depth: DepthCopy,
+        mode: DepthMode,
+    },
+    Fragment(wgpu::RenderPipeline),
+}
+
+/// The exact shadow-map pass.
+struct ExactShadow {
+    pipeline: wgpu::ComputePipeline,
+    frame_group: wgpu::BindGroup,
+    group: wgpu::BindGroup,
+}
+
+pub struct RayExact {
+    name: &'static str,
+    pyramid: GpuMaxMip,
+    params: wgpu::Buffer,
+    stats: wgpu::Buffer,
+    layout: wgpu::BindGroupLayout,
+    group: wgpu::BindGroup,
+    variant: Variant,
+    shadow: Option<ExactShadow>,
+    /// The pyramid update was recorded this frame (before the shadow map).
+    updated: Cell<bool>,
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    print_stats: bool,
+    /// With `STRATA_EXACT_STATS=1` and timestamps: the pyramid updates are
+    /// timed here (not in the frame's sum) and their GPU ms kept.
+    update_timer: Option<crate::timing::PassTimer>,
+    update_timed: Cell<bool>,
+    update_ms: Vec<f64>,
+}
+
+/// How the method is put together (the measuring switches).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ExactOptions {
+    /// A compute dispatch (`ray-exact`), else a fragment pass.
+    pub compute: bool,
+    /// How depth reaches the shared depth target.
+    pub depth: DepthMode,
+    /// The shadow map by the exact march, else by the renderer's pass.
+    pub exact_shadow: bool,
+    /// Most levels the compute traversals climb per step (`EXACT_CLIMB`).
+    pub climb: u32,
+    /// log2 of the tile ratio between visited levels (`EXACT_LOG_RATIO`).
+    pub log_ratio: u32,
+}
+
+/// How the compute variant moves its depth image into the shared depth target.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DepthMode {
+    /// The full-screen blit (`depth_blit.wgsl`, frag_depth), clearing first.
+    Blit,
+    /// One point per pixel through a depth-only pipeline (no fragment shader).
+    Points,
+    /// The blit loading the old depth instead of clearing it first (the same
+    /// image: it writes every pixel).
+    BlitLoad,
+    /// Diagnostic: the blit limited to a 16x16 scissor (wrong image; measures
+    /// what a render pass costs before its fragments).
+    Scissor,
+    /// Diagnostic: [`DepthMode::Scissor`] without the clear.
+    ScissorLoad,
+}
+
+impl ExactOptions {
+    /// The chosen configuration (H100 measurements in `bench/ray-exact.md`).
+    pub const DEFAULT: ExactOptions = ExactOptions {
+        compute: true,
+        depth: DepthMode::BlitLoad,
+        exact_shadow: true,
+        climb: 1,
+        log_ratio: 1,
+    };
+}
+
+impl ExactOptions {
+    /// The defaults, with the environment's measuring switches applied.
+    pub fn from_env(compute: bool) -> Self {
+        let d = ExactOptions::DEFAULT;
+        ExactOptions {
+            compute,
+            depth: if env_is("STRATA_EXACT_DEPTH", "points") {
+                DepthMode::Points
+            } else if env_is("STRATA_EXACT_DEPTH", "scissor") {
+                DepthMode::Scissor
+            } else if env_is("STRATA_EXACT_DEPTH", "load") {
+                DepthMode::BlitLoad
+            } else if env_is("STRATA_EXACT_DEPTH", "scissor-load") {
+                DepthMode::ScissorLoad
+            } else if env_is("STRATA_EXACT_DEPTH", "blit") {
+                DepthMode::Blit
+            } else {
+                d.depth
+            },
+            exact_shadow: if env_is("STRATA_EXACT_SHADOW", "shared") {
+                false
+            } else if env_is("STRATA_EXACT_SHADOW", "exact") {
+                true
+            } else {
+                d.exact_shadow
+            },
+            climb: if env_is("STRATA_EXACT_CLIMB", "all") {
+                8
+            } else {
+                d.climb
+            },
+            log_ratio: if env_is("STRATA_EXACT_RATIO", "4") {
+                2
+            } else if env_is("STRATA_EXACT_RATIO", "2") {
+                1
+            } else {
+                d.log_ratio
+            },
+        }
+    }
+}
+
+pub fn create(
+    shared: &Shared,
+    level: &Level,
+    _settings: &MethodSettings,
+) -> anyhow::Result<Box<dyn Method>> {
+    Ok(Box::new(build(
+        shared,
+        level,
+        ExactOptions::from_env(true),
+    )?))
+}
+
+pub fn create_fragment(
+    shared: &Shared,
+    level: &Level,
+    _settings: &MethodSettings,
+) -> anyhow::Result<Box<dyn Method>> {
+    Ok(Box::new(build(
+        shared,
+        level,
+        ExactOptions::from_env(false),
+    )?))
+}
+
+fn env_is(name: &str, value: &str) -> bool {
+    #[cfg(not(target_arch = "wasm32"))]
+    {
+        std::env::var(name).is_ok_and(|v| v == value)
+    }
+    #[cfg(target_arch = "wasm32")]
+    {
+        let _ = (name, value);
+        false
+    }
+}
+
+fn buffer_entry(
+    binding: u32,
+    stages: wgpu::ShaderStages,
+    ty: wgpu::BufferBindingType,
+) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: stages,
+        ty: wgpu::BindingType::Buffer {
+            ty,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+/// Layout entries 0..=2 of group 1: parameters, pyramid, statistics.
+fn core_entries(stages: wgpu::ShaderStages) -> Vec<wgpu::BindGroupLayoutEntry> {
+    vec![
+        buffer_entry(0, stages, wgpu::BufferBindingType::Uniform),
+        buffer_entry(
+            1,
+            stages,
+            wgpu::BufferBindingType::Storage { read_only: true },
+        ),
+        buffer_entry(
+            2,
+            stages,
+            wgpu::BufferBindingType::Storage { read_only: false },
+        ),
+    ]
+}
+
+fn core_bindings<'a>(
+    params: &'a wgpu::Buffer,
+    pyramid: &'a GpuMaxMip,
+    stats: &'a wgpu::Buffer,
+) -> Vec<wgpu::BindGroupEntry<'a>> {
+    vec![
+        wgpu::BindGroupEntry {
+            binding: 0,
+            resource: params.as_entire_binding(),
+        },
+        wgpu::BindGroupEntry {
+            binding: 1,
+            resource: pyramid.buffer.as_entire_binding(),
+        },
+        wgpu::BindGroupEntry {
+            binding: 2,
+            resource: stats.as_entire_binding(),
+        },
+    ]
+}
+
+fn march_group(
+    shared: &Shared,
+    layout: &wgpu::BindGroupLayout,
+    params: &wgpu::Buffer,
+    pyramid: &GpuMaxMip,
+    stats: &wgpu::Buffer,
+    depth: Option<&DepthCopy>,
+) -> wgpu::BindGroup {
+    let mut entries = core_bindings(params, pyramid, stats);
+    if let Some(depth) = depth {
+        entries.extend(depth.bindings(shared, 3));
+    }
+    shared.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("ray-exact"),
+        layout,
+        entries: &entries,
+    })
+}
+
+/// A compute pipeline of the exact core with its traversal constants.
+fn exact_pipeline(
+    shared: &Shared,
+    label: &str,
+    shader: &str,
+    layout: &wgpu::PipelineLayout,
+    entry: &str,
+    options: ExactOptions,
+) -> anyhow::Result<wgpu::ComputePipeline> {
+    let module = shared.shader(shader)?;
+    Ok(shared
+        .device
+        .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(label),
+            layout: Some(layout),
+            module: &module,
+            entry_point: Some(entry),
+            compilation_options: wgpu::PipelineCompilationOptions {
+                constants: &[
+                    ("EXACT_CLIMB", f64::from(options.climb)),
+                    ("EXACT_LOG_RATIO", f64::from(options.log_ratio)),
+                ],
+                ..Default::default()
+            },
+            cache: None,
+        }))
+}
+
+/// The traversal's level table for `layout`.
+fn exact_params(layout: &strata_maxmip::Layout) -> ExactParams {
+    let mut table = ExactParams {
+        config: [layout.top(), ITERATION_CAP, 0, 0],
+        levels: [[0; 4]; 9],
+    };
+    for info in &layout.levels {
+        table.levels[info.log2_tile as usize] = [
+            info.offset,
+            info.width.trailing_zeros(),
+            info.width - 1,
+            info.height - 1,
+        ];
+    }
+    table
+}
+
+/// Build the method with explicit options.
+pub fn build(shared: &Shared, level: &Level, options: ExactOptions) -> anyhow::Result<RayExact> {
+    let compute = options.compute;
+    let device = &shared.device;
+    let pyramid = GpuMaxMip::new(shared, level)?;
+    let table = exact_params(&pyramid.layout);
+    let params = shared.uniform_buffer("ray-exact params", bytemuck::bytes_of(&table));
+    let stats = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("ray-exact stats"),
+        size: 16,
+        usage: wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_SRC
+            | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let name = if compute {
+        "ray-exact"
+    } else {
+        "ray-exact-fragment"
+    };
+    let stages = if compute {
+        wgpu::ShaderStages::COMPUTE
+    } else {
+        wgpu::ShaderStages::FRAGMENT
+    };
+    let mut entries = core_entries(stages);
+    let depth = if compute {
+        let depth = DepthCopy::new(shared, name, "ray-exact depth")?;
+        Some(if options.depth == DepthMode::Points {
+            depth.with_points(shared)?
+        } else {
+            depth
+        })
+    } else {
+        None
+    };
+    if compute {
+        entries.extend(DepthCopy::layout_entries(3));
+    }
+    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some(name),
+        entries: &entries,
+    });
+    let group = march_group(shared, &layout, &params, &pyramid, &stats, depth.as_ref());
+    let pipeline_layout = shared.pipeline_layout(name, &[&layout]);
+    let variant = match depth {
+        Some(depth) => Variant::Compute {
+            march: exact_pipeline(
+                shared,
+                name,
+                "ray_exact.wgsl",
+                &pipeline_layout,
+                "cs_ray_exact",
+                options,
+            )?,
+            mode: options.depth,
+            depth,
+        },
+        None => Variant::Fragment(fullscreen_pipeline(
+            shared,
+            name,
+            "ray_exact_fragment.wgsl",
+            &pipeline_layout,
+            "fs_ray_exact",
+        )?),
+    };
+    let shadow = if shared.caps.compute && options.exact_shadow {
+        Some(exact_shadow(shared, &params, &pyramid, &stats, options)?)
+    } else {
+        None
+    };
+    Ok(RayExact {
+        name,
+        pyramid,
+        params,
+        stats,
+        layout,
+        group,
+        variant,
+        shadow,
+        updated: Cell::new(false),
+        device: device.clone(),
+        queue: shared.queue.clone(),
+        print_stats: env_is("STRATA_EXACT_STATS", "1"),
+        update_timer: (env_is("STRATA_EXACT_STATS", "1") && shared.caps.timestamps)
+            .then(|| crate::timing::PassTimer::new(device, &shared.queue, true)),
+        update_timed: Cell::new(false),
+        update_ms: Vec::new(),
+    })
+}
+
+/// The shadow map by the exact march: group 0 without the shadow map (it is
+/// written here), group 1 the core's bindings and the map as storage.
+fn exact_shadow(
+    shared: &Shared,
+    params: &wgpu::Buffer,
+    pyramid: &GpuMaxMip,
+    stats: &wgpu::Buffer,
+    options: ExactOptions,
+) -> anyhow::Result<ExactShadow> {
+    let device = &shared.device;
+    let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("ray-exact shadow frame"),
+        entries: &[
+            crate::frame::uniform_layout_entry(0),
+            crate::frame::texture_entry(
+                2,
+                wgpu::TextureSampleType::Uint,
+                wgpu::TextureViewDimension::D2Array,
+            ),
+        ],
+    });
+    let frame_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("ray-exact shadow frame"),
+        layout: &frame_layout,
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: shared.globals.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 2,
+                resource: wgpu::BindingResource::TextureView(&shared.terrain.view),
+            },
+        ],
+    });
+    let mut entries = core_entries(wgpu::ShaderStages::COMPUTE);
+    entries.push(storage_texture_entry(3, wgpu::TextureFormat::R32Float));
+    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("ray-exact shadow"),
+        entries: &entries,
+    });
+    let mut bindings = core_bindings(params, pyramid, stats);
+    bindings.push(wgpu::BindGroupEntry {
+        binding: 3,
+        resource: wgpu::BindingResource::TextureView(&shared.shadow_view),
+    });
+    let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("ray-exact shadow"),
+        layout: &layout,
+        entries: &bindings,
+    });
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("ray-exact shadow"),
+        bind_group_layouts: &[Some(&frame_layout), Some(&layout)],
+        immediate_size: 0,
+    });
+    let pipeline = exact_pipeline(
+        shared,
+        "ray-exact shadow",
+        "ray_exact_shadow.wgsl",
+        &pipeline_layout,
+        "cs_exact_shadow",
+        options,
+    )?;
+    Ok(ExactShadow {
+        pipeline,
+        frame_group,
+        group,
+    })
+}
+
+impl RayExact {
+    /// The GPU pyramid (tests compare it with `strata_maxmip`).
+    pub fn pyramid(&self) -> &GpuMaxMip {
+        &self.pyramid
+    }
+
+    /// The march's counters since creation or the last reset.
+    pub fn stats(&self) -> anyhow::Result<ExactStats> {
+        let w = read_buffer(&self.device, &self.queue, &self.stats)?;
+        Ok(ExactStats {
+            cap_hits: w[0],
+            most_iterations: w[1],
+            shadow_cap_hits: w[2],
+            shadow_most_iterations: w[3],
+        })
+    }
+
+    /// Zero the counters.
+    pub fn reset_stats(&self) {
+        self.queue.write_buffer(&self.stats, 0, &[0u8; 16]);
+    }
+
+    /// Keep the last frame's update time (statistics mode only).
+    fn read_update_time(&mut self) -> anyhow::Result<()> {
+        if let (Some(timer), true) = (&self.update_timer, self.update_timed.get()) {
+            self.update_timed.set(false);
+            #[cfg(not(target_arch = "wasm32"))]
+            if let (Some(ms), _) = timer.read(&self.device, &crate::gpu::ErrorSink::default())? {
+                self.update_ms.push(ms);
+            }
+            #[cfg(target_arch = "wasm32")]
+            let _ = timer;
+        }
+        Ok(())
+    }
+
+    /// Record the queued pyramid update once per frame, before anything reads it.
+    fn record_update(&self, frame: &Frame<'_>, encoder: &mut wgpu::CommandEncoder) {
+        if !self.updated.get() && self.pyramid.has_work() {
+            if let Some(timer) = &self.update_timer {
+                timer.reset();
+                self.pyramid
+                    .record(encoder, timer.compute("ray-exact pyramid update"));
+                timer.resolve(encoder);
+                self.update_timed.set(true);
+            } else {
+                self.pyramid
+                    .record(encoder, frame.timer.compute("ray-exact pyramid update"));
+            }
+        }
+        self.updated.set(true);
+    }
+}
+
+impl Method for RayExact {
+    fn name(&self) -> &'static str {
+        self.name
+    }
+
+    fn apply_edit(
+        &mut self,
+        _shared: &Shared,
+        _level: &Level,
+        rects: &[DirtyRect],
+    ) -> anyhow::Result<()> {
+        self.pyramid.enqueue(rects);
+        Ok(())
+    }
+
+    fn update_settings(&mut self, _: &Shared, _: &MethodSettings) -> anyhow::Result<bool> {
+        // No knob: nothing to change.
+        Ok(true)
+    }
+
+    fn resize(&mut self, shared: &Shared) -> anyhow::Result<()> {
+        if let Variant::Compute { depth, .. } = &mut self.variant {
+            depth.resize(shared);
+            self.group = march_group(
+                shared,
+                &self.layout,
+                &self.params,
+                &self.pyramid,
+                &self.stats,
+                Some(depth),
+            );
+        }
+        Ok(())
+    }
+
+    fn prepare(&mut self, shared: &Shared, _camera: &Camera) -> anyhow::Result<()> {
+        self.read_update_time()?;
+        self.pyramid.prepare(shared);
+        self.updated.set(false);
+        Ok(())
+    }
+
+    fn record_shadow_map(
+        &self,
+        shared: &Shared,
+        frame: &Frame<'_>,
+        encoder: &mut wgpu::CommandEncoder,
+    ) -> bool {
+        let Some(shadow) = &self.shadow else {
+            return false;
+        };
+        let _ = shared;
+        self.record_update(frame, encoder);
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("ray-exact shadow"),
+            timestamp_writes: frame.timer.compute("shadow"),
+        });
+        pass.set_pipeline(&shadow.pipeline);
+        pass.set_bind_group(0, &shadow.frame_group, &[]);
+        pass.set_bind_group(1, &shadow.group, &[]);
+        pass.dispatch_workgroups(SHADOW_SIZE.div_ceil(8), SHADOW_SIZE.div_ceil(8), 1);
+        true
+    }
+
+    fn record(&self, shared: &Shared, frame: &Frame<'_>, encoder: &mut wgpu::CommandEncoder) {
+        self.record_update(frame, encoder);
+        match &self.variant {
+            Variant::Compute { march, depth, mode } => {
+                dispatch_per_pixel(
+                    shared,
+                    frame,
+                    encoder,
+                    "ray-exact march",
+                    march,
+                    &self.group,
+                );
+                let label = "ray-exact depth";
+                match mode {
+                    DepthMode::Blit => depth.record(shared, frame, encoder, label),
+                    DepthMode::Points => depth.record_with(shared, frame, encoder, label, true),
+                    DepthMode::BlitLoad => {
+                        depth.record_blit(shared, frame, encoder, label, false, false)
+                    }
+                    DepthMode::Scissor => {
+                        depth.record_blit(shared, frame, encoder, label, true, true)
+                    }
+                    DepthMode::ScissorLoad => {
+                        depth.record_blit(shared, frame, encoder, label, true, false)
+                    }
+                }
+            }
+            Variant::Fragment(pipeline) => super::common::draw_fullscreen(
+                shared,
+                frame,
+                encoder,
+                "ray-exact-fragment",
+                pipeline,
+                &self.group,
+            ),
+        }
+    }
+
+    fn retained_bytes(&self) -> RetainedBytes {
+        let depth = match &self.variant {
+            Variant::Compute { depth, .. } => depth.bytes(),
+            Variant::Fragment(_) => 0,
+        };
+        RetainedBytes {
+            gpu: self.pyramid.gpu_bytes()
+                + std::mem::size_of::<ExactParams>() as u64
+                + self.stats.size()
+                + depth,
+            cpu: 0,
+        }
+    }
+}
+
+impl Drop for RayExact {
+    fn drop(&mut self) {
+        if !self.print_stats {
+            return;
+        }
+        let _ = self.read_update_time();
+        match self.stats() {
+            Ok(s) => eprintln!(
+                "{} stats: {} build_gpu_ms {:?} update_gpu_ms {:?} pyramid_bytes {}",
+                self.name,
+                serde_json::to_string(&s).unwrap_or_default(),
+                self.pyramid.build_gpu_ms,
+                self.update_ms,
+                self.pyramid.layout.bytes
+            ),
+            Err(e) => eprintln!("{} stats: {e}", self.name),
+        }
+    }
+}
+
+#[cfg(test)]
+#[path = "ray_exact_tests.rs"]
+mod tests;

@@ -1,0 +1,303 @@
+//! The max-height pyramid on the GPU (`ray_exact_build.wgsl`): one storage
+//! buffer laid out by `strata_maxmip::Layout`, filled by one compute dispatch
+//! per level (level 1 from the terrain texture, each coarser one from the
+//! level below), the twin of `strata_maxmip::Pyramid` bit for bit.
+//!
+//! Creation builds every level in one submission. An edit queues its dirty
+//! rectangles; the next frame's first pass rebuilds exactly the tiles over
+//! them and their ancestors (one dispatch per level and rectangle), before
+//! the shadow map and the march read the pyramid, so the first post-edit
+//! frame equals a fresh build.
+
+use crate::frame::Shared;
+use crate::timing::PassTimer;
+use strata_level::{DirtyRect, Level};
+use strata_maxmip::{Layout, LevelInfo};
+
+/// Dispatches one submission can hold (uniform slots).
+const MAX_SLOTS: usize = 256;
+
+/// Twin of `BuildParams` in `ray_exact_build.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+struct BuildParams {
+    level: [u32; 4],
+    child: [u32; 4],
+    rect: [u32; 4],
+}
+
+pub struct GpuMaxMip {
+    pub layout: Layout,
+    pub buffer: wgpu::Buffer,
+    pipeline: wgpu::ComputePipeline,
+    frame_group: wgpu::BindGroup,
+    group: wgpu::BindGroup,
+    slots: wgpu::Buffer,
+    slot_stride: u64,
+    pending: Vec<DirtyRect>,
+    /// Dispatches chosen by the last `prepare`: params and workgroup counts.
+    scheduled: Vec<[u32; 2]>,
+    /// GPU time of the full build at creation (timestamps), milliseconds.
+    pub build_gpu_ms: Option<f64>,
+}
+
+impl GpuMaxMip {
+    /// Create the buffer and build every level.
+    pub fn new(shared: &Shared, level: &Level) -> anyhow::Result<Self> {
+        let layout = Layout::new(level.width(), level.height());
+        let device = &shared.device;
+        let limits = device.limits();
+        // At least one word, so that a map without tiles still binds a buffer.
+        let bytes = u64::from(layout.bytes.max(4));
+        if bytes
+            > limits
+                .max_storage_buffer_binding_size
+                .min(limits.max_buffer_size)
+        {
+            anyhow::bail!(
+                "the max pyramid of a {}x{} map needs {bytes} bytes of storage buffer, more than this adapter binds",
+                level.width(),
+                level.height()
+            );
+        }
+        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("ray-exact pyramid"),
+            size: bytes,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let slot_stride = (std::mem::size_of::<BuildParams>() as u64)
+            .next_multiple_of(u64::from(limits.min_uniform_buffer_offset_alignment));
+        let slots = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("ray-exact build params"),
+            size: slot_stride * MAX_SLOTS as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let group_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("ray-exact build"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: true,
+                        min_binding_size: wgpu::BufferSize::new(
+                            std::mem::size_of::<BuildParams>() as u64
+                        ),
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Storage { read_only: false },
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+            ],
+        });
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("ray-exact build"),
+            layout: &group_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &slots,
+                        offset: 0,
+                        size: wgpu::BufferSize::new(std::mem::size_of::<BuildParams>() as u64),
+                    }),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: buffer.as_entire_binding(),
+                },
+            ],
+        });
+        let frame_group = super::voxel_build::build_frame_group(shared, level)?;
+        let module = shared.shader("ray_exact_build.wgsl")?;
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("ray-exact build"),
+            layout: Some(&shared.pipeline_layout("ray-exact build", &[&group_layout])),
+            module: &module,
+            entry_point: Some("cs_maxmip"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        let mut pyramid = GpuMaxMip {
+            pending: vec![whole(level)],
+            layout,
+            buffer,
+            pipeline,
+            frame_group,
+            group,
+            slots,
+            slot_stride,
+            scheduled: Vec::new(),
+            build_gpu_ms: None,
+        };
+        let timer = PassTimer::new(device, &shared.queue, shared.caps.timestamps);
+        timer.reset();
+        pyramid.prepare(shared);
+        let mut encoder = device.create_command_encoder(&Default::default());
+        pyramid.record(&mut encoder, timer.compute("ray-exact pyramid build"));
+        timer.resolve(&mut encoder);
+        shared.queue.submit([encoder.finish()]);
+        crate::gpu::wait_idle(device)
+            .map_err(|e| anyhow::anyhow!("waiting for the pyramid build failed: {e}"))?;
+        #[cfg(not(target_arch = "wasm32"))]
+        if shared.caps.timestamps {
+            let errors = crate::gpu::ErrorSink::default();
+            pyramid.build_gpu_ms = timer.read(device, &errors)?.0;
+        }
+        Ok(pyramid)
+    }
+
+    /// Queue the rectangles an edit changed (applied by the next frame).
+    pub fn enqueue(&mut self, rects: &[DirtyRect]) {
+        self.pending.extend_from_slice(rects);
+    }
+
+    /// Turn the queue into this frame's dispatches and write their parameters.
+    pub fn prepare(&mut self, shared: &Shared) {
+        self.scheduled.clear();
+        if self.pending.is_empty() {
+            return;
+        }
+        let levels = self.layout.levels.len().max(1);
+        if self.pending.len() * levels > MAX_SLOTS {
+            // More rectangles than slots: rebuild everything (exact, rare).
+            self.pending = vec![DirtyRect {
+                x: 0,
+                y: 0,
+                width: self.layout.map_width,
+                height: self.layout.map_height,
+            }];
+        }
+        let mut data = Vec::new();
+        for info in self.layout.levels.clone() {
+            for rect in &self.pending {
+                let p = params(&self.layout, &info, rect);
+                self.scheduled.push([p.rect[2].div_ceil(64), p.rect[3]]);
+                let at = data.len();
+                data.resize(at + self.slot_stride as usize, 0);
+                data[at..at + std::mem::size_of::<BuildParams>()]
+                    .copy_from_slice(bytemuck::bytes_of(&p));
+            }
+        }
+        self.pending.clear();
+        if !data.is_empty() {
+            shared.queue.write_buffer(&self.slots, 0, &data);
+        }
+    }
+
+    /// Are dispatches scheduled for the coming `record`?
+    pub fn has_work(&self) -> bool {
+        !self.scheduled.is_empty()
+    }
+
+    /// Record the scheduled dispatches in one compute pass, finest level
+    /// first (wgpu orders dispatches that write and read the buffer).
+    pub fn record(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        timestamps: Option<wgpu::ComputePassTimestampWrites<'_>>,
+    ) {
+        if self.scheduled.is_empty() {
+            return;
+        }
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("ray-exact pyramid"),
+            timestamp_writes: timestamps,
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &self.frame_group, &[]);
+        for (i, [x, y]) in self.scheduled.iter().enumerate() {
+            pass.set_bind_group(1, &self.group, &[(i as u64 * self.slot_stride) as u32]);
+            pass.dispatch_workgroups(*x, *y, 1);
+        }
+    }
+
+    /// Copy the whole buffer back (tests).
+    pub fn read_back(&self, shared: &Shared) -> anyhow::Result<Vec<u32>> {
+        let words = read_buffer(&shared.device, &shared.queue, &self.buffer)?;
+        Ok(words[..self.layout.bytes as usize / 4].to_vec())
+    }
+
+    /// GPU bytes: the pyramid plus the dispatch parameter slots.
+    pub fn gpu_bytes(&self) -> u64 {
+        self.buffer.size() + self.slots.size()
+    }
+}
+
+fn whole(level: &Level) -> DirtyRect {
+    DirtyRect {
+        x: 0,
+        y: 0,
+        width: level.width(),
+        height: level.height(),
+    }
+}
+
+/// The dispatch over the words of level `info` holding tiles over `rect`.
+fn params(layout: &Layout, info: &LevelInfo, rect: &DirtyRect) -> BuildParams {
+    let k = info.log2_tile;
+    let child = if k > 1 {
+        let c = layout.level(k - 1);
+        [c.offset, c.width.trailing_zeros(), 0, 0]
+    } else {
+        [0; 4]
+    };
+    let r = layout.dirty_tiles(k, rect);
+    let rect = if info.width >= 4 {
+        // Word columns holding tiles x0..=x1, rows y0..=y1.
+        [r.x0 / 4, r.y0, r.x1 / 4 - r.x0 / 4 + 1, r.y1 - r.y0 + 1]
+    } else {
+        // A level narrower than a word: all of it, as one row of words.
+        [0, 0, info.bytes().div_ceil(4), 1]
+    };
+    BuildParams {
+        level: [info.offset, info.width.trailing_zeros(), info.height, k],
+        child,
+        rect,
+    }
+}
+
+/// Copy a storage buffer back as words (tests and statistics).
+pub(crate) fn read_buffer(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    buffer: &wgpu::Buffer,
+) -> anyhow::Result<Vec<u32>> {
+    let size = buffer.size();
+    let staging = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("ray-exact readback"),
+        size,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut encoder = device.create_command_encoder(&Default::default());
+    encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, size);
+    queue.submit([encoder.finish()]);
+    let slice = staging.slice(..);
+    let (tx, rx) = std::sync::mpsc::channel();
+    slice.map_async(wgpu::MapMode::Read, move |r| {
+        let _ = tx.send(r);
+    });
+    crate::gpu::wait_idle(device).map_err(|e| anyhow::anyhow!("ray-exact readback: {e}"))?;
+    rx.recv()
+        .map_err(|_| anyhow::anyhow!("ray-exact readback: map callback never ran"))?
+        .map_err(|e| anyhow::anyhow!("ray-exact readback: mapping failed: {e}"))?;
+    let words: Vec<u32> = bytemuck::pod_collect_to_vec(
+        &slice
+            .get_mapped_range()
+            .map_err(|e| anyhow::anyhow!("ray-exact readback: {e}"))?,
+    );
+    staging.unmap();
+    Ok(words)
+}
