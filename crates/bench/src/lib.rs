@@ -13,6 +13,7 @@ pub mod results;
 pub mod run;
 pub mod session;
 pub mod stats;
+pub mod video;
 
 #[cfg(test)]
 mod fixtures;
