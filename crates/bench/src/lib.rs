@@ -2,6 +2,7 @@
 //! results, statistics, the report and picture grid, and the protocol runner.
 
 pub mod edits;
+pub mod figures;
 pub mod font;
 pub mod grid;
 pub mod merge;

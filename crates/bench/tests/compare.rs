@@ -38,6 +38,7 @@ fn options(world: &World, out: PathBuf) -> Options {
         min_warmup: 1,
         shadows: true,
         edits: EditMode::Auto,
+        temporal: false,
         cache_dir: out.join("cache"),
     }
 }
