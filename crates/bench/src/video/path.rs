@@ -31,6 +31,7 @@ impl fmt::Display for PathError {
                 f,
                 "a camera path needs at least two keyframes; this one has {n}"
             ),
+            PathError::Keyframe { line: 0, msg } => write!(f, "the built-in path: {msg}"),
             PathError::Keyframe { line, msg } => write!(f, "line {line}: {msg}"),
         }
     }
@@ -322,7 +323,7 @@ fn free_altitude(level: &Level, x: f32, y: f32, z: f32) -> f32 {
 /// it. Without an edit site: a flight between the level's first two views.
 pub fn default_path(world: &World) -> CameraPath {
     match &world.edit {
-        Some(site) => around_edit_site(site),
+        Some(site) => fit_under_slabs(around_edit_site(site), &world.level),
         None => {
             let keys = world
                 .views
@@ -338,6 +339,24 @@ pub fn default_path(world: &World) -> CameraPath {
             CameraPath { keys, dig_at: None }
         }
     }
+}
+
+/// Put each `under` keyframe's eye halfway between floor and slab (the
+/// headroom differs from level to level); drop one with no slab above it.
+fn fit_under_slabs(mut path: CameraPath, level: &Level) -> CameraPath {
+    path.keys.retain_mut(|k| {
+        if !k.view.under {
+            return true;
+        }
+        let c = level.column_at(
+            k.view.x.rem_euclid(level.width() as f32),
+            k.view.y.rem_euclid(level.height() as f32),
+        );
+        let headroom = f32::from(c.mid) - f32::from(c.low);
+        k.view.eye = headroom / 2.0;
+        c.dual && headroom >= 4.0
+    });
+    path
 }
 
 /// The keyframes of [`default_path`], relative to the crater centre. The
