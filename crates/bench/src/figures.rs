@@ -136,7 +136,8 @@ fn frame_time_by_pitch<DB: DrawingBackend>(
     }
     let ys = series.iter().flat_map(|(_, s)| s.iter().map(|p| p.1));
     let (lo, hi) = ys.fold((f64::MAX, f64::MIN), |(a, b), y| (a.min(y), b.max(y)));
-    let (lo, hi) = if lo <= hi { (lo / 1.5, hi * 1.5) } else { (0.1, 10.0) };
+    // Headroom above the lines for the legend (a log axis: a factor).
+    let (lo, hi) = if lo <= hi { (lo / 1.5, hi * 8.0) } else { (0.1, 10.0) };
     let mut chart = ChartBuilder::on(area)
         .caption("frame time by pitch (ms)", ("sans-serif", 18))
         .margin(10)
@@ -165,7 +166,7 @@ fn frame_time_by_pitch<DB: DrawingBackend>(
         .configure_series_labels()
         .background_style(WHITE.mix(0.8))
         .border_style(BLACK)
-        .position(SeriesLabelPosition::UpperLeft)
+        .position(SeriesLabelPosition::UpperRight)
         .draw()
         .map_err(plot_error)?;
     Ok(())
@@ -181,7 +182,9 @@ fn bars<DB: DrawingBackend>(
     log: bool,
 ) -> anyhow::Result<()> {
     let k = names.len().max(1) as f64;
-    let hi = values.iter().flatten().copied().fold(0.0f64, f64::max).max(1e-3) * 1.3;
+    // Headroom above the bars for the legend.
+    let top = values.iter().flatten().copied().fold(0.0f64, f64::max).max(1e-3);
+    let hi = if log { top * 20.0 } else { top * 1.5 };
     let lo = values
         .iter()
         .flatten()
@@ -190,16 +193,16 @@ fn bars<DB: DrawingBackend>(
         .fold(f64::MAX, f64::min)
         .min(hi)
         / 2.0;
-    let n = methods.len() as f64;
+    // Group i is centred on x = i, so the axis's whole-number ticks name them.
+    let n = methods.len() as f64 - 0.5;
     let label = |x: &f64| {
-        let i = x.floor() as usize;
-        if (x - x.floor() - 0.5).abs() < 1e-6 {
-            methods.get(i).cloned().unwrap_or_default()
+        if (x - x.round()).abs() < 1e-6 && *x >= 0.0 {
+            methods.get(x.round() as usize).cloned().unwrap_or_default()
         } else {
             String::new()
         }
     };
-    let x_labels = (methods.len() * 2).max(2);
+    let x_labels = methods.len().max(1);
     macro_rules! draw_bars {
         ($chart:expr, $floor:expr) => {{
             let mut chart = $chart;
@@ -213,7 +216,7 @@ fn bars<DB: DrawingBackend>(
             for (j, name) in names.iter().enumerate() {
                 let c = colour(j);
                 let rects = values.iter().enumerate().map(|(i, v)| {
-                    let x0 = i as f64 + 0.1 + 0.8 * j as f64 / k;
+                    let x0 = i as f64 - 0.4 + 0.8 * j as f64 / k;
                     let y = v.get(j).copied().unwrap_or(0.0).max($floor);
                     Rectangle::new([(x0, $floor), (x0 + 0.8 / k, y)], c.filled())
                 });
@@ -227,6 +230,7 @@ fn bars<DB: DrawingBackend>(
                 .configure_series_labels()
                 .background_style(WHITE.mix(0.8))
                 .border_style(BLACK)
+                .position(SeriesLabelPosition::UpperRight)
                 .draw()
                 .map_err(plot_error)?;
         }};
@@ -241,12 +245,12 @@ fn bars<DB: DrawingBackend>(
     };
     if log {
         let chart = builder(area)
-            .build_cartesian_2d(0.0..n, (lo.max(1e-3)..hi).log_scale())
+            .build_cartesian_2d(-0.5..n, (lo.max(1e-3)..hi).log_scale())
             .map_err(plot_error)?;
         draw_bars!(chart, lo.max(1e-3));
     } else {
         let chart = builder(area)
-            .build_cartesian_2d(0.0..n, 0.0..hi)
+            .build_cartesian_2d(-0.5..n, 0.0..hi)
             .map_err(plot_error)?;
         draw_bars!(chart, 0.0);
     }
