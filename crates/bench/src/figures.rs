@@ -12,10 +12,10 @@ use crate::results::{Row, RunResults};
 use crate::{font, grid, report, stats};
 use anyhow::Context;
 use image::{Rgba, RgbaImage};
-use plotters_backend::{BackendColor, BackendCoord, BackendTextStyle, DrawingErrorKind};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters_backend::text_anchor::{HPos, VPos};
+use plotters_backend::{BackendColor, BackendCoord, BackendTextStyle, DrawingErrorKind};
 use std::path::{Path, PathBuf};
 
 const SIZE: (u32, u32) = (720, 420);
@@ -34,8 +34,7 @@ pub fn write_all(runs: &[RunResults], dir: &Path) -> anyhow::Result<Vec<Figure>>
         return Ok(Vec::new());
     };
     let fig_dir = dir.join("figures");
-    std::fs::create_dir_all(&fig_dir)
-        .with_context(|| format!("creating {}", fig_dir.display()))?;
+    std::fs::create_dir_all(&fig_dir).with_context(|| format!("creating {}", fig_dir.display()))?;
     let mut out = Vec::new();
     if runs.iter().any(|r| !r.rows.is_empty()) {
         out.push(plot(
@@ -137,7 +136,11 @@ fn frame_time_by_pitch<DB: DrawingBackend>(
     let ys = series.iter().flat_map(|(_, s)| s.iter().map(|p| p.1));
     let (lo, hi) = ys.fold((f64::MAX, f64::MIN), |(a, b), y| (a.min(y), b.max(y)));
     // Headroom above the lines for the legend (a log axis: a factor).
-    let (lo, hi) = if lo <= hi { (lo / 1.5, hi * 8.0) } else { (0.1, 10.0) };
+    let (lo, hi) = if lo <= hi {
+        (lo / 1.5, hi * 8.0)
+    } else {
+        (0.1, 10.0)
+    };
     let mut chart = ChartBuilder::on(area)
         .caption("frame time by pitch (ms)", ("sans-serif", 18))
         .margin(10)
@@ -183,7 +186,12 @@ fn bars<DB: DrawingBackend>(
 ) -> anyhow::Result<()> {
     let k = names.len().max(1) as f64;
     // Headroom above the bars for the legend.
-    let top = values.iter().flatten().copied().fold(0.0f64, f64::max).max(1e-3);
+    let top = values
+        .iter()
+        .flatten()
+        .copied()
+        .fold(0.0f64, f64::max)
+        .max(1e-3);
     let hi = if log { top * 20.0 } else { top * 1.5 };
     let lo = values
         .iter()
@@ -224,7 +232,9 @@ fn bars<DB: DrawingBackend>(
                     .draw_series(rects)
                     .map_err(plot_error)?
                     .label(*name)
-                    .legend(move |(x, y)| Rectangle::new([(x, y - 4), (x + 10, y + 4)], c.filled()));
+                    .legend(move |(x, y)| {
+                        Rectangle::new([(x, y - 4), (x + 10, y + 4)], c.filled())
+                    });
             }
             chart
                 .configure_series_labels()
@@ -301,7 +311,14 @@ fn memory<DB: DrawingBackend>(
             ]
         })
         .collect();
-    bars(area, "retained memory (MiB)", &methods, &values, &["GPU", "CPU"], false)
+    bars(
+        area,
+        "retained memory (MiB)",
+        &methods,
+        &values,
+        &["GPU", "CPU"],
+        false,
+    )
 }
 
 fn methods_with_rows(run: &RunResults) -> Vec<String> {
@@ -337,7 +354,11 @@ pub fn edit_figure(run: &RunResults, dir: &Path) -> anyhow::Result<Option<(Strin
         }) else {
             continue;
         };
-        let load = |rel: &str| image::open(dir.join(rel)).ok().map(|i| grid::thumbnail(&i.to_rgba8()));
+        let load = |rel: &str| {
+            image::open(dir.join(rel))
+                .ok()
+                .map(|i| grid::thumbnail(&i.to_rgba8()))
+        };
         rows.push(format!("{} ({class})", pics.method));
         cells.push(vec![load(&pics.before), load(&pics.after)]);
     }
@@ -347,8 +368,7 @@ pub fn edit_figure(run: &RunResults, dir: &Path) -> anyhow::Result<Option<(Strin
     let columns = vec!["before".to_string(), "first post-edit frame".to_string()];
     let img = grid::compose(&rows, &columns, &cells);
     let fig_dir = dir.join("figures");
-    std::fs::create_dir_all(&fig_dir)
-        .with_context(|| format!("creating {}", fig_dir.display()))?;
+    std::fs::create_dir_all(&fig_dir).with_context(|| format!("creating {}", fig_dir.display()))?;
     let path = fig_dir.join("edit.png");
     img.save(&path)
         .with_context(|| format!("writing {}", path.display()))?;

@@ -132,7 +132,11 @@ fn figures(md: &mut String, pictures: &Pictures) {
     }
     md.push_str("## Figures\n\n");
     for f in &pictures.figures {
-        let _ = writeln!(md, "![{}]({})\n\n{} ([SVG]({}))\n", f.title, f.png, f.title, f.svg);
+        let _ = writeln!(
+            md,
+            "![{}]({})\n\n{} ([SVG]({}))\n",
+            f.title, f.png, f.title, f.svg
+        );
     }
     if let Some((png, rows)) = &pictures.edit_figure {
         let _ = writeln!(

@@ -298,7 +298,9 @@ impl Plan {
                     Ok((mut row, pictures)) => {
                         row.method = choice.label();
                         session.results.edit_rows.push(row);
-                        if let Err(e) = save_edit_pictures(&mut session, camera, &choice.label(), pictures) {
+                        if let Err(e) =
+                            save_edit_pictures(&mut session, camera, &choice.label(), pictures)
+                        {
                             bar.println(format!("edit / {}: pictures: {e:#}", choice.label()));
                         }
                     }

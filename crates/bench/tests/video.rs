@@ -62,7 +62,16 @@ fn still_camera_does_not_flicker_and_a_slow_pan_little() {
         assert_eq!(flicker(&gpu, &w, &still, method), (0.0, 0.0), "{method}");
     }
     // Two degrees over two seconds: a quarter degree per frame.
-    let pan = format!("{} {} 0\n{} {} 2\n", at(v.yaw), v.pitch, at(v.yaw + 2.0), v.pitch);
+    let pan = format!(
+        "{} {} 0\n{} {} 2\n",
+        at(v.yaw),
+        v.pitch,
+        at(v.yaw + 2.0),
+        v.pitch
+    );
     let (mean, worst) = flicker(&gpu, &w, &pan, "ray");
-    assert!(mean < 5.0 && worst < 10.0, "ray on a slow pan: {mean} / {worst}");
+    assert!(
+        mean < 5.0 && worst < 10.0,
+        "ray on a slow pan: {mean} / {worst}"
+    );
 }

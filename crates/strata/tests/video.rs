@@ -99,7 +99,11 @@ fn missing_ffmpeg_is_a_clear_error() {
     );
     assert_clean_error(
         &out,
-        &["`ffmpeg` is not on the PATH", "apt-get install ffmpeg", "--frames-dir"],
+        &[
+            "`ffmpeg` is not on the PATH",
+            "apt-get install ffmpeg",
+            "--frames-dir",
+        ],
     );
 }
 
@@ -111,7 +115,15 @@ fn small_world(d: &Path) -> Option<PathBuf> {
     }
     let world = d.join("world");
     let out = strata(
-        &["generate", "--size", "256x1024", "--seed", "7", "--out", p(&world)],
+        &[
+            "generate",
+            "--size",
+            "256x1024",
+            "--seed",
+            "7",
+            "--out",
+            p(&world),
+        ],
         None,
     );
     assert!(out.status.success(), "generate: {}", stderr(&out));
@@ -120,7 +132,14 @@ fn small_world(d: &Path) -> Option<PathBuf> {
 
 /// Tiny: two methods in 48x28 tiles, 2 s at 4 fps (9 frames), the crater dug midway.
 const TINY: [&str; 8] = [
-    "--methods", "ray,mesh", "--size", "96x28", "--fps", "4", "--duration", "2",
+    "--methods",
+    "ray,mesh",
+    "--size",
+    "96x28",
+    "--fps",
+    "4",
+    "--duration",
+    "2",
 ];
 
 #[test]
@@ -141,8 +160,7 @@ fn tiny_video_to_frames_with_flicker_in_range() {
     }
     assert!(!frames.join("frame-00009.png").exists());
     let json: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(frames.join("video.json")).unwrap())
-            .unwrap();
+        serde_json::from_str(&std::fs::read_to_string(frames.join("video.json")).unwrap()).unwrap();
     assert_eq!(json["frames"], 9);
     assert_eq!(json["tile_width"], 48);
     // 2 s path, dig at 11/20 of it: frame ceil(1.1 * 4) = 5.
@@ -155,8 +173,16 @@ fn tiny_video_to_frames_with_flicker_in_range() {
         let worst = f["max_percent"].as_f64().unwrap();
         // Coarse frames of a fast flight: some flicker against the reference,
         // never most of the picture on average.
-        assert!((0.0..40.0).contains(&mean), "{}: mean flicker {mean}", m["method"]);
-        assert!(worst >= mean && worst <= 100.0, "{}: worst {worst}", m["method"]);
+        assert!(
+            (0.0..40.0).contains(&mean),
+            "{}: mean flicker {mean}",
+            m["method"]
+        );
+        assert!(
+            worst >= mean && worst <= 100.0,
+            "{}: worst {worst}",
+            m["method"]
+        );
         assert_eq!(f["pairs"], 8);
         assert!(m["first_post_edit_ms"].as_f64().unwrap() > 0.0);
     }
@@ -179,11 +205,9 @@ fn ffmpeg_failing_half_way_shows_its_stderr() {
     )
     .unwrap();
     std::fs::set_permissions(&fake, std::fs::Permissions::from_mode(0o755)).unwrap();
-    let path_env = std::env::join_paths(
-        std::iter::once(bin.clone()).chain(std::env::split_paths(
-            &std::env::var_os("PATH").unwrap_or_default(),
-        )),
-    )
+    let path_env = std::env::join_paths(std::iter::once(bin.clone()).chain(std::env::split_paths(
+        &std::env::var_os("PATH").unwrap_or_default(),
+    )))
     .unwrap();
     let mut args = vec!["video", "--level", p(&world), "--out"];
     let mp4 = d.join("v.mp4");
@@ -192,7 +216,11 @@ fn ffmpeg_failing_half_way_shows_its_stderr() {
     let out = strata(&args, Some(Path::new(&path_env)));
     assert_clean_error(
         &out,
-        &["ffmpeg stopped after", "fake ffmpeg: no space left on device", "kept in"],
+        &[
+            "ffmpeg stopped after",
+            "fake ffmpeg: no space left on device",
+            "kept in",
+        ],
     );
 }
 
@@ -210,7 +238,14 @@ fn real_ffmpeg_writes_an_mp4() {
         return;
     };
     let mp4 = d.join("v.mp4");
-    let mut args = vec!["video", "--level", p(&world), "--out", p(&mp4), "--no-temporal"];
+    let mut args = vec![
+        "video",
+        "--level",
+        p(&world),
+        "--out",
+        p(&mp4),
+        "--no-temporal",
+    ];
     args.extend(TINY);
     let out = strata(&args, None);
     assert!(out.status.success(), "{}", stderr(&out));

@@ -52,7 +52,7 @@ pub struct Ffmpeg {
 
 impl Ffmpeg {
     pub fn start(out: &Path, width: u32, height: u32, fps: u32) -> anyhow::Result<Ffmpeg> {
-        if width % 2 != 0 || height % 2 != 0 {
+        if !width.is_multiple_of(2) || !height.is_multiple_of(2) {
             bail!("H.264 needs an even frame size; {width}x{height} is not");
         }
         let mut child = Command::new("ffmpeg")
@@ -60,7 +60,9 @@ impl Ffmpeg {
             .args(["-f", "rawvideo", "-pix_fmt", "rgba"])
             .args(["-s", &format!("{width}x{height}"), "-r", &fps.to_string()])
             .args(["-i", "-"])
-            .args(["-c:v", "libx264", "-pix_fmt", "yuv420p", "-preset", "veryfast"])
+            .args([
+                "-c:v", "libx264", "-pix_fmt", "yuv420p", "-preset", "veryfast",
+            ])
             .args(["-crf", "23", "-g", &fps.to_string()])
             .args(["-movflags", "frag_keyframe+empty_moov+default_base_moof"])
             .arg(out)

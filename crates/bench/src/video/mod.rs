@@ -162,9 +162,8 @@ pub fn record(
     let start = Instant::now();
     for f in 0..frames {
         let t = flight.start() + f as f32 / opts.fps as f32;
-        let dig_now = dig_frame.is_none()
-            && edited.is_some()
-            && path.dig_at.is_some_and(|d| t >= d);
+        let dig_now =
+            dig_frame.is_none() && edited.is_some() && path.dig_at.is_some_and(|d| t >= d);
         let current: &Level = match (&edited, dig_frame.is_some() || dig_now) {
             (Some((l, _)), true) => l,
             _ => level,

@@ -14,10 +14,16 @@ use strata_level::{EditSite, Level, ViewSpec, World};
 /// What a path file line can be wrong about; every message names the line.
 #[derive(Debug, PartialEq)]
 pub enum PathError {
-    Malformed { line: usize, msg: String },
+    Malformed {
+        line: usize,
+        msg: String,
+    },
     TooFewKeyframes(usize),
     /// A keyframe's eye is inside solid terrain (or its view is otherwise unusable).
-    Keyframe { line: usize, msg: String },
+    Keyframe {
+        line: usize,
+        msg: String,
+    },
 }
 
 impl fmt::Display for PathError {
@@ -281,13 +287,7 @@ impl Flight {
 
     /// The camera at time `t` for a `width` x `height` image: wrapped onto
     /// the map, and lifted out of terrain where the curve cut through it.
-    pub fn camera(
-        &self,
-        level: &Level,
-        t: f32,
-        width: u32,
-        height: u32,
-    ) -> anyhow::Result<Camera> {
+    pub fn camera(&self, level: &Level, t: f32, width: u32, height: u32) -> anyhow::Result<Camera> {
         let pose = self.pose(t);
         let x = pose.position.x.rem_euclid(level.width() as f32);
         let y = pose.position.y.rem_euclid(level.height() as f32);
@@ -367,20 +367,18 @@ fn fit_under_slabs(mut path: CameraPath, level: &Level) -> CameraPath {
 fn around_edit_site(site: &EditSite) -> CameraPath {
     let (cx, cy) = (site.centre_x as f32, site.centre_y as f32);
     let e = &site.camera;
-    let key = |dx: f32, dy: f32, yaw: f32, eye: f32, under: bool, pitch: f32, time: f32| {
-        Keyframe {
-            view: ViewSpec {
-                name: format!("t{time}"),
-                x: cx + dx,
-                y: cy + dy,
-                yaw,
-                eye,
-                under,
-                pitch,
-            },
-            time,
-            line: 0,
-        }
+    let key = |dx: f32, dy: f32, yaw: f32, eye: f32, under: bool, pitch: f32, time: f32| Keyframe {
+        view: ViewSpec {
+            name: format!("t{time}"),
+            x: cx + dx,
+            y: cy + dy,
+            yaw,
+            eye,
+            under,
+            pitch,
+        },
+        time,
+        line: 0,
     };
     let edit_cam = |time: f32| Keyframe {
         view: ViewSpec {
@@ -429,7 +427,10 @@ mod tests {
         // The text form reads back as the same path.
         let again = CameraPath::parse(&p.to_text()).unwrap();
         assert_eq!(again.dig_at, p.dig_at);
-        assert_eq!(again.keys[1].view.spec_string(), p.keys[1].view.spec_string());
+        assert_eq!(
+            again.keys[1].view.spec_string(),
+            p.keys[1].view.spec_string()
+        );
     }
 
     #[test]
@@ -462,15 +463,18 @@ mod tests {
 
     #[test]
     fn flight_passes_through_keys_smoothly() {
-        let p = CameraPath::parse("0,0:0:10 0 0\n100,0:90:20 -30 1\n100,100:180:10 -60 3\n")
-            .unwrap();
+        let p =
+            CameraPath::parse("0,0:0:10 0 0\n100,0:90:20 -30 1\n100,100:180:10 -60 3\n").unwrap();
         let f = p.resolve(&flat()).unwrap();
         // Keys are hit exactly (z = ground 20 + eye).
         let at1 = f.pose(1.0);
         assert!(at1.position.abs_diff_eq(Vec3::new(100.0, 0.0, 40.0), 1e-4));
         assert_eq!((at1.yaw, at1.pitch), (90.0, -30.0));
         let end = f.pose(3.0);
-        assert!(end.position.abs_diff_eq(Vec3::new(100.0, 100.0, 30.0), 1e-4));
+        assert!(
+            end.position
+                .abs_diff_eq(Vec3::new(100.0, 100.0, 30.0), 1e-4)
+        );
         // Zero velocity at the ends, continuous velocity at the inner key.
         let v = |t: f32| (f.pose(t + 1e-3).position - f.pose(t - 1e-3).position) / 2e-3;
         assert!(v(1e-3).length() < 1.0, "{}", v(1e-3));
@@ -506,7 +510,10 @@ mod tests {
     fn keyframe_inside_terrain_names_its_line() {
         let p = CameraPath::parse("1,1:0:10 0 0\n1,1:0:-15 0 1\n").unwrap();
         let e = p.resolve(&flat()).unwrap_err().to_string();
-        assert!(e.starts_with("line 2:") && e.contains("inside solid"), "{e}");
+        assert!(
+            e.starts_with("line 2:") && e.contains("inside solid"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -43,12 +43,7 @@ pub fn flicker_percent(method: (&[f32], &[f32]), reference: (&[f32], &[f32])) ->
         return 0.0;
     }
     let count = (0..n)
-        .filter(|&i| {
-            flickers(
-                (method.0[i], method.1[i]),
-                (reference.0[i], reference.1[i]),
-            )
-        })
+        .filter(|&i| flickers((method.0[i], method.1[i]), (reference.0[i], reference.1[i])))
         .count();
     100.0 * count as f64 / n as f64
 }
@@ -136,6 +131,9 @@ mod tests {
             t.add(f, p);
         }
         let r = t.result();
-        assert_eq!((r.mean_percent, r.max_percent, r.max_at_frame, r.pairs), (2.0, 5.0, 2, 3));
+        assert_eq!(
+            (r.mean_percent, r.max_percent, r.max_at_frame, r.pairs),
+            (2.0, 5.0, 2, 3)
+        );
     }
 }

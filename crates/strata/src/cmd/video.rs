@@ -10,7 +10,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 use strata_bench::plan::{MethodChoice, parse_methods, parse_size};
-use strata_bench::video::encode::{self, FrameSink, Ffmpeg, PngDir};
+use strata_bench::video::encode::{self, Ffmpeg, FrameSink, PngDir};
 use strata_bench::video::path::{CameraPath, default_path};
 use strata_bench::video::{self, VideoOptions, tiles};
 use strata_render::Gpu;
@@ -71,6 +71,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         None => None,
     };
     if args.out.is_some() && !args.print_path {
+        if !width.is_multiple_of(2) || !height.is_multiple_of(2) {
+            anyhow::bail!(
+                "--size {width}x{height}: H.264 needs even sides (or use --frames-dir for PNGs)"
+            );
+        }
         encode::check_ffmpeg()?;
     }
     let world = args.world.load()?;
