@@ -20,7 +20,7 @@ use path::CameraPath;
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
 use strata_camera::Camera;
-use strata_level::{Level, World};
+use strata_level::{DirtyRect, Level, World};
 use strata_reference::{ReferenceSettings, Tracer};
 use strata_render::{Gpu, Renderer, TerrainColors};
 use temporal::{Flicker, FlickerTracker, flicker_percent};
@@ -120,37 +120,11 @@ pub fn record(
     let first = flight.camera(level, flight.start(), tw, th)?;
 
     bar.set_length(u64::from(frames));
-    let (mut lanes, mut tracks_failed) = (Vec::new(), Vec::new());
-    for choice in &opts.methods {
-        bar.set_message(format!("{}: setup", choice.label()));
-        match build_lane(gpu, level, &colors, choice, opts, &first) {
-            Ok(lane) => lanes.push(lane),
-            Err(e) => {
-                bar.println(format!("{}: left out: {e:#}", choice.label()));
-                tracks_failed.push(failed_track(choice, &e));
-            }
-        }
-    }
+    let (mut lanes, tracks_failed) = build_lanes(gpu, level, &colors, opts, &first, bar);
     if lanes.is_empty() {
         anyhow::bail!("no method could be built (see the messages above)");
     }
-
-    // The edit, prepared up front so the dig frame pays only the upload.
-    let edited = match (path.dig_at, &world.edit) {
-        (Some(_), Some(site)) => {
-            let mut l = level.clone();
-            let rects = strata_level::edit::crater(&mut l, site);
-            Some((l, rects))
-        }
-        (Some(_), None) => {
-            bar.println(format!(
-                "note: the path digs, but level `{}` has no edit site: no dig",
-                world.name
-            ));
-            None
-        }
-        _ => None,
-    };
+    let edited = prepare_edit(world, path, bar);
     let before = opts.temporal.then(|| Tracer::new(level));
     let after = match (&edited, opts.temporal) {
         (Some((l, _)), true) => Some(Tracer::new(l)),
@@ -169,6 +143,10 @@ pub fn record(
             _ => level,
         };
         let camera = flight.camera(current, t, tw, th)?;
+        bar.set_message(format!(
+            "path {t:.1} s{}",
+            if dig_now { ", digging" } else { "" }
+        ));
         for lane in &mut lanes {
             let start = Instant::now();
             if dig_now && let Some((l, rects)) = &edited {
@@ -242,6 +220,49 @@ pub fn record(
         reference_ms_mean: mean(&reference_ms),
         output: String::new(),
     })
+}
+
+/// Every method's lane; the tracks of those that could not be built.
+fn build_lanes(
+    gpu: &Gpu,
+    level: &Level,
+    colors: &TerrainColors,
+    opts: &VideoOptions,
+    first: &Camera,
+    bar: &ProgressBar,
+) -> (Vec<Lane>, Vec<MethodTrack>) {
+    let (mut lanes, mut failed) = (Vec::new(), Vec::new());
+    for choice in &opts.methods {
+        bar.set_message(format!("{}: setup", choice.label()));
+        match build_lane(gpu, level, colors, choice, opts, first) {
+            Ok(lane) => lanes.push(lane),
+            Err(e) => {
+                bar.println(format!("{}: left out: {e:#}", choice.label()));
+                failed.push(failed_track(choice, &e));
+            }
+        }
+    }
+    (lanes, failed)
+}
+
+/// The edited level and its dirty rectangles, made up front so the dig
+/// frame pays only the upload; `None` when the path does not dig.
+fn prepare_edit(
+    world: &World,
+    path: &CameraPath,
+    bar: &ProgressBar,
+) -> Option<(Level, Vec<DirtyRect>)> {
+    path.dig_at?;
+    let Some(site) = &world.edit else {
+        bar.println(format!(
+            "note: the path digs, but level `{}` has no edit site: no dig",
+            world.name
+        ));
+        return None;
+    };
+    let mut level = world.level.clone();
+    let rects = strata_level::edit::crater(&mut level, site);
+    Some((level, rects))
 }
 
 /// Frames in `seconds` at `fps`, the last keyframe included.
