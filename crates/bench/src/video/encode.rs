@@ -178,42 +178,104 @@ impl Drop for Ffmpeg {
     }
 }
 
-/// Numbered PNGs (`frame-00000.png`, ...) in a directory.
+/// Numbered PNGs (`frame-00000.png`, ...) in a directory, encoded on a
+/// thread of their own so compressing one frame overlaps rendering the next.
 pub struct PngDir {
     dir: PathBuf,
     frames: u32,
+    queue: Option<std::sync::mpsc::SyncSender<(PathBuf, RgbaImage)>>,
+    writer: Option<JoinHandle<anyhow::Result<()>>>,
 }
+
+/// Frames waiting for the PNG writer before `write` blocks.
+const PNG_QUEUE: usize = 4;
 
 impl PngDir {
     pub fn create(dir: &Path) -> anyhow::Result<PngDir> {
         std::fs::create_dir_all(dir)
             .with_context(|| format!("creating the frames directory {}", dir.display()))?;
+        let (queue, frames) = std::sync::mpsc::sync_channel::<(PathBuf, RgbaImage)>(PNG_QUEUE);
+        let writer = std::thread::spawn(move || {
+            for (path, frame) in frames {
+                frame
+                    .save(&path)
+                    .with_context(|| format!("writing {}", path.display()))?;
+            }
+            Ok(())
+        });
         Ok(PngDir {
             dir: dir.to_path_buf(),
             frames: 0,
+            queue: Some(queue),
+            writer: Some(writer),
         })
     }
 
     pub fn frame_path(dir: &Path, index: u32) -> PathBuf {
         dir.join(format!("frame-{index:05}.png"))
     }
+
+    /// Stop the writer and return its first error, if any.
+    fn join(&mut self) -> anyhow::Result<()> {
+        drop(self.queue.take());
+        match self.writer.take().map(JoinHandle::join) {
+            Some(Ok(result)) => result,
+            Some(Err(_)) => Err(anyhow::anyhow!("the PNG writer thread panicked")),
+            None => Ok(()),
+        }
+    }
 }
 
 impl FrameSink for PngDir {
     fn write(&mut self, frame: &RgbaImage) -> anyhow::Result<()> {
         let path = Self::frame_path(&self.dir, self.frames);
-        frame
-            .save(&path)
-            .with_context(|| format!("writing {}", path.display()))?;
+        let sent = self
+            .queue
+            .as_ref()
+            .is_some_and(|q| q.send((path, frame.clone())).is_ok());
+        if !sent {
+            // The writer stopped: its error says why.
+            self.join()?;
+            anyhow::bail!("the PNG writer stopped");
+        }
         self.frames += 1;
         Ok(())
     }
 
-    fn finish(self: Box<Self>) -> anyhow::Result<String> {
+    fn finish(mut self: Box<Self>) -> anyhow::Result<String> {
+        self.join()?;
         Ok(format!(
             "{} frames written to {} (frame-00000.png ...)",
             self.frames,
             self.dir.display()
         ))
+    }
+}
+
+impl Drop for PngDir {
+    fn drop(&mut self) {
+        // Stopped by an error elsewhere: the queued frames are still written.
+        let _ = self.join();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn png_frames_are_numbered_and_all_written() {
+        let dir = std::env::temp_dir().join(format!("strata-pngdir-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let mut sink: Box<dyn FrameSink> = Box::new(PngDir::create(&dir).unwrap());
+        for i in 0..10u8 {
+            sink.write(&RgbaImage::from_pixel(4, 2, image::Rgba([i, 0, 0, 255])))
+                .unwrap();
+        }
+        assert!(sink.finish().unwrap().starts_with("10 frames"));
+        let last = image::open(PngDir::frame_path(&dir, 9)).unwrap().to_rgba8();
+        assert_eq!(last.get_pixel(0, 0).0, [9, 0, 0, 255]);
+        assert!(!PngDir::frame_path(&dir, 10).exists());
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }
