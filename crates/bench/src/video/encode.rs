@@ -97,7 +97,8 @@ impl Ffmpeg {
 
     /// Close stdin, wait for ffmpeg, and return its status and stderr.
     fn close(&mut self) -> (Option<std::process::ExitStatus>, String) {
-        drop(self.stdin.take());
+        // Closing stdin tells ffmpeg the video is over.
+        self.stdin = None;
         let status = self.child.wait().ok();
         let text = self
             .stderr
