@@ -317,13 +317,21 @@ fn free_altitude(level: &Level, x: f32, y: f32, z: f32) -> f32 {
     f32::from(c.top()) + CLEARANCE
 }
 
-/// The default fly-through around the level's edit site (the generated
-/// world's roofed depot): a high approach, the edit camera, in under the
-/// depot's roof and out, the crater dug at the middle, then around and above
-/// it. Without an edit site: a flight between the level's first two views.
+/// The default fly-through: from the level's nearest landmark view (the
+/// generated world's hangar entrance) high over to its edit site (the
+/// roofed depot), the edit camera, in under the depot's roof and out, the
+/// crater dug, then around and above it. Without an edit site: a flight
+/// between the level's first two views.
 pub fn default_path(world: &World) -> CameraPath {
     match &world.edit {
-        Some(site) => fit_under_slabs(around_edit_site(site), &world.level),
+        Some(site) => {
+            let path = around_edit_site(site);
+            let path = match nearest_landmark(world, site) {
+                Some(view) => lead_in(&view, path),
+                None => path,
+            };
+            fit_under_slabs(path, &world.level)
+        }
         None => {
             let keys = world
                 .views
@@ -339,6 +347,74 @@ pub fn default_path(world: &World) -> CameraPath {
             CameraPath { keys, dig_at: None }
         }
     }
+}
+
+/// Landmark views this far from the crater (map units) make the lead-in.
+const LEAD_IN_RANGE: std::ops::Range<f32> = 300.0..3000.0;
+/// Seconds from the landmark to the first keyframe around the edit site.
+const LEAD_IN_SECONDS: f32 = 5.0;
+
+/// The level's view nearest the crater within [`LEAD_IN_RANGE`], moved to
+/// the copy of the map (it wraps) nearest the crater, so the flight is short.
+fn nearest_landmark(world: &World, site: &EditSite) -> Option<ViewSpec> {
+    let (w, h) = (world.level.width() as f32, world.level.height() as f32);
+    let (cx, cy) = (site.centre_x as f32, site.centre_y as f32);
+    let near = |v: &ViewSpec| {
+        let dx = (v.x - cx + w / 2.0).rem_euclid(w) - w / 2.0;
+        let dy = (v.y - cy + h / 2.0).rem_euclid(h) - h / 2.0;
+        ViewSpec {
+            x: cx + dx,
+            y: cy + dy,
+            ..v.clone()
+        }
+    };
+    let dist = |v: &ViewSpec| (v.x - cx).hypot(v.y - cy);
+    world
+        .views
+        .iter()
+        .map(near)
+        .filter(|v| LEAD_IN_RANGE.contains(&dist(v)) && v.pitch > -89.0)
+        .min_by(|a, b| dist(a).total_cmp(&dist(b)))
+}
+
+/// Start `path` at `landmark`, rise over the way to its first keyframe, and
+/// shift the rest (and the dig) by [`LEAD_IN_SECONDS`].
+fn lead_in(landmark: &ViewSpec, mut path: CameraPath) -> CameraPath {
+    let Some(first) = path.keys.first().map(|k| k.view.clone()) else {
+        return path;
+    };
+    let (mx, my) = (0.5 * (landmark.x + first.x), 0.5 * (landmark.y + first.y));
+    // Yaw 0 looks along +y, 90 along +x.
+    let yaw = (first.x - landmark.x)
+        .atan2(first.y - landmark.y)
+        .to_degrees()
+        .rem_euclid(360.0);
+    let transit = ViewSpec {
+        name: "transit".into(),
+        x: mx,
+        y: my,
+        yaw,
+        eye: 180.0,
+        under: false,
+        pitch: -20.0,
+    };
+    for k in &mut path.keys {
+        k.time += LEAD_IN_SECONDS;
+    }
+    path.dig_at = path.dig_at.map(|t| t + LEAD_IN_SECONDS);
+    let key = |view: ViewSpec, time: f32| Keyframe {
+        view,
+        time,
+        line: 0,
+    };
+    path.keys.splice(
+        0..0,
+        [
+            key(landmark.clone(), 0.0),
+            key(transit, 0.5 * LEAD_IN_SECONDS),
+        ],
+    );
+    path
 }
 
 /// Put each `under` keyframe's eye halfway between floor and slab (the
@@ -514,6 +590,41 @@ mod tests {
             e.starts_with("line 2:") && e.contains("inside solid"),
             "{e}"
         );
+    }
+
+    #[test]
+    fn default_path_leads_in_from_a_landmark_digs_and_dips_under_a_slab() {
+        use strata_level::generate::{GenerateParams, generate};
+        let world = generate(&GenerateParams {
+            seed: 7,
+            width: 256,
+            height: 1024,
+        })
+        .unwrap();
+        let p = default_path(&world);
+        let first = &p.keys[0].view;
+        assert!(
+            world
+                .views
+                .iter()
+                .any(|v| (v.yaw, v.eye, v.pitch) == (first.yaw, first.eye, first.pitch)),
+            "starts at a landmark view: {first:?}"
+        );
+        let dig = p.dig_at.expect("digs");
+        assert!(
+            dig > 0.4 * p.end() && dig < p.end(),
+            "dig at {dig} of {}",
+            p.end()
+        );
+        // Under a slab: the generated depot's roof is over the `under` keys.
+        let flight = p.resolve(&world.level).unwrap();
+        let under: Vec<&Keyframe> = p.keys.iter().filter(|k| k.view.under).collect();
+        assert!(!under.is_empty());
+        for k in under {
+            let cam = flight.camera(&world.level, k.time, 8, 8).unwrap();
+            let c = world.level.column_at(cam.position.x, cam.position.y);
+            assert!(c.dual && cam.position.z < f32::from(c.mid), "{k:?} {c:?}");
+        }
     }
 
     #[test]
