@@ -352,6 +352,7 @@ impl Plan {
             fps: TEMPORAL_FPS,
             shadows: self.opts.shadows,
             temporal: true,
+            overlap: None,
         };
         let (pos, len) = (bar.position(), bar.length());
         let recording = video::record(gpu, &self.world, &path, &opts, None, bar);

@@ -40,6 +40,9 @@ pub struct VideoOptions {
     pub shadows: bool,
     /// Trace the CPU reference every frame and measure flicker.
     pub temporal: bool,
+    /// Trace the reference while the methods render (`None`: when the
+    /// adapter is not a CPU rasteriser, whose frame times it would inflate).
+    pub overlap: Option<bool>,
 }
 
 /// The video's JSON sidecar (`<out>.json`).
@@ -130,6 +133,7 @@ pub fn record(
         (Some((l, _)), true) => Some(Tracer::new(l)),
         _ => None,
     };
+    let overlap = opts.overlap.unwrap_or(gpu.report.device_type != "Cpu");
     let mut dig_frame = None;
     let mut reference_ms = Vec::new();
     let mut previous_reference: Option<Vec<f32>> = None;
@@ -147,31 +151,35 @@ pub fn record(
             "path {t:.1} s{}",
             if dig_now { ", digging" } else { "" }
         ));
-        for lane in &mut lanes {
-            let start = Instant::now();
-            if dig_now && let Some((l, rects)) = &edited {
-                lane.renderer.apply_edit(l, rects)?;
-            }
-            let timing = lane.renderer.render_frame(&camera)?;
-            if dig_now {
-                lane.first_post_edit_ms = Some(ms(start));
-            }
-            lane.gpu_timed = timing.gpu_ms.is_some();
-            lane.frame_ms.push(timing.gpu_ms.unwrap_or(timing.cpu_ms));
-        }
-        if dig_now {
-            dig_frame = Some(f);
-        }
-        let tracer = if dig_frame.is_some() {
+        let edit = if dig_now { edited.as_ref() } else { None };
+        let tracer = if dig_frame.is_some() || dig_now {
             after.as_ref()
         } else {
             before.as_ref()
         };
-        let reference = tracer.map(|tr| {
-            let start = Instant::now();
-            let r = tr.render(&camera, &ReferenceSettings::default());
-            reference_ms.push(ms(start));
-            r.distance
+        let trace = || {
+            tracer.map(|tr| {
+                let start = Instant::now();
+                let r = tr.render(&camera, &ReferenceSettings::default());
+                (r.distance, ms(start))
+            })
+        };
+        // A GPU leaves the CPU free: trace the reference while the methods
+        // render. A CPU rasteriser would share its cores with the trace and
+        // time its frames slower, so there the two take turns.
+        let (reference, rendered) = if overlap {
+            rayon::join(trace, || render_lanes(&mut lanes, &camera, edit))
+        } else {
+            let rendered = render_lanes(&mut lanes, &camera, edit);
+            (trace(), rendered)
+        };
+        rendered?;
+        if dig_now {
+            dig_frame = Some(f);
+        }
+        let reference = reference.map(|(distance, ms)| {
+            reference_ms.push(ms);
+            distance
         });
         for lane in &mut lanes {
             if let Some(reference) = &reference {
@@ -220,6 +228,28 @@ pub fn record(
         reference_ms_mean: mean(&reference_ms),
         output: String::new(),
     })
+}
+
+/// Draw one frame with every method, applying `edit` first when given (the
+/// dig frame: the edit and that frame are timed together).
+fn render_lanes(
+    lanes: &mut [Lane],
+    camera: &Camera,
+    edit: Option<&(Level, Vec<DirtyRect>)>,
+) -> anyhow::Result<()> {
+    for lane in lanes {
+        let start = Instant::now();
+        if let Some((level, rects)) = edit {
+            lane.renderer.apply_edit(level, rects)?;
+        }
+        let timing = lane.renderer.render_frame(camera)?;
+        if edit.is_some() {
+            lane.first_post_edit_ms = Some(ms(start));
+        }
+        lane.gpu_timed = timing.gpu_ms.is_some();
+        lane.frame_ms.push(timing.gpu_ms.unwrap_or(timing.cpu_ms));
+    }
+    Ok(())
 }
 
 /// Every method's lane; the tracks of those that could not be built.

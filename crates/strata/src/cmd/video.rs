@@ -98,6 +98,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         fps: args.fps,
         shadows: !args.no_shadows,
         temporal: !args.no_temporal,
+        overlap: None,
     };
     let gpu = Gpu::open(&args.adapter.choice())?;
     eprintln!(
