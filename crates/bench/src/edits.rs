@@ -82,12 +82,19 @@ fn distance(r: &Renderer, camera: &Camera) -> anyhow::Result<Vec<f32>> {
     ))
 }
 
+/// The edit camera's colour (RGBA8) just before the edit and on the first
+/// post-edit frame, from the protocol's first sample: the edit figure.
+pub struct EditPictures {
+    pub before: Vec<u8>,
+    pub after: Vec<u8>,
+}
+
 /// Run the protocol for one method.
 pub fn edit_row(
     input: &EditInput<'_>,
     name: &str,
     settings: &MethodSettings,
-) -> anyhow::Result<EditRow> {
+) -> anyhow::Result<(EditRow, EditPictures)> {
     let cam = input.camera;
     // The fresh build of the already-edited level: steady time and the target image.
     let mut fresh = build(input, input.edited, name, settings)?;
@@ -102,8 +109,16 @@ pub fn edit_row(
 
     let (mut first_cpu, mut first_gpu) = (Vec::new(), Vec::new());
     let mut checks = Vec::new();
+    let mut pictures = EditPictures {
+        before: Vec::new(),
+        after: Vec::new(),
+    };
     for sample in 0..FIRST_FRAME_SAMPLES {
         let mut r = build(input, input.original, name, settings)?;
+        if sample == 0 {
+            // Read before the clock starts: the picture costs the edit nothing.
+            pictures.before = r.read_color()?;
+        }
         // The latency a player waits: upload + any rebuild + the frame + round trip.
         let start = Instant::now();
         r.apply_edit(input.edited, input.rects)?;
@@ -111,6 +126,7 @@ pub fn edit_row(
         first_cpu.push(ms(start));
         first_gpu.extend(t.gpu_ms);
         if sample == 0 {
+            pictures.after = r.read_color()?;
             let mut done = 1;
             for frames in EDIT_CHECK_FRAMES {
                 while done < frames {
@@ -134,7 +150,7 @@ pub fn edit_row(
         }
     }
     let all_timed = |g: &Vec<f64>, c: &Vec<f64>| if g.len() == c.len() { median(g) } else { None };
-    Ok(EditRow {
+    let row = EditRow {
         method: name.to_string(),
         first_frame_cpu_ms: median(&first_cpu).unwrap_or(f64::NAN),
         first_frame_gpu_ms: all_timed(&first_gpu, &first_cpu),
@@ -144,7 +160,8 @@ pub fn edit_row(
         first_frame_gpu_samples: first_gpu,
         consistent_after_frames: consistent_after(&checks),
         checks,
-    })
+    };
+    Ok((row, pictures))
 }
 
 #[cfg(test)]

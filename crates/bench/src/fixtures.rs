@@ -58,6 +58,8 @@ pub fn row(view: &str, pitch: f32, method: &str, see: f64, coh: f64, gpu: &[f64]
 pub fn run(adapter: &str) -> RunResults {
     let views = vec![view("river", 0.0), view("spiral", -90.0)];
     RunResults {
+        temporal: Vec::new(),
+        edit_images: Vec::new(),
         protocol_version: PROTOCOL_VERSION,
         level: LevelInfo {
             name: "test".into(),

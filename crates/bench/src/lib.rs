@@ -2,6 +2,7 @@
 //! results, statistics, the report and picture grid, and the protocol runner.
 
 pub mod edits;
+pub mod figures;
 pub mod font;
 pub mod grid;
 pub mod merge;
@@ -13,6 +14,7 @@ pub mod results;
 pub mod run;
 pub mod session;
 pub mod stats;
+pub mod video;
 
 #[cfg(test)]
 mod fixtures;

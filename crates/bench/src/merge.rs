@@ -186,8 +186,11 @@ pub fn merge_files(paths: &[PathBuf], out: &Path) -> anyhow::Result<(PathBuf, Ve
         .iter()
         .map(|p| read_run(p))
         .collect::<anyhow::Result<Vec<_>>>()?;
-    let (report, flags) = merge(&runs)?;
+    let (_, flags) = merge(&runs)?;
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    // The figures need a directory to live in, so they come with the files.
+    let pictures = crate::report::Pictures::default().with_figures(&runs, out);
+    let report = crate::report::render(&runs, &pictures, &flags);
     let path = out.join("report.md");
     std::fs::write(&path, report).with_context(|| format!("writing {}", path.display()))?;
     Ok((path, flags))

@@ -14,6 +14,28 @@ pub struct Pictures {
     pub grid: Option<String>,
     /// Column titles of the grid, left to right.
     pub grid_columns: Vec<String>,
+    /// The plotted figures (PNG and SVG), relative paths.
+    pub figures: Vec<crate::figures::Figure>,
+    /// The edit figure and its row titles.
+    pub edit_figure: Option<(String, Vec<String>)>,
+}
+
+impl Pictures {
+    /// Draw the figures of `runs` into `dir` (a failure costs the figures,
+    /// with a warning, never the report).
+    pub fn with_figures(mut self, runs: &[RunResults], dir: &std::path::Path) -> Self {
+        match crate::figures::write_all(runs, dir) {
+            Ok(f) => self.figures = f,
+            Err(e) => eprintln!("warning: figures not drawn: {e:#}"),
+        }
+        if let Some(base) = runs.first() {
+            match crate::figures::edit_figure(base, dir) {
+                Ok(f) => self.edit_figure = f,
+                Err(e) => eprintln!("warning: edit figure not drawn: {e:#}"),
+            }
+        }
+        self
+    }
 }
 
 /// Render the report. `runs` must be non-empty; the first is the baseline.
@@ -98,8 +120,65 @@ pub fn render(runs: &[RunResults], pictures: &Pictures, disagreements: &[Disagre
     preparation_table(&mut md, runs);
     memory_table(&mut md, base);
     edit_tables(&mut md, runs);
+    temporal_table(&mut md, runs);
+    figures(&mut md, pictures);
     per_view_table(&mut md, base);
     md
+}
+
+fn figures(md: &mut String, pictures: &Pictures) {
+    if pictures.figures.is_empty() && pictures.edit_figure.is_none() {
+        return;
+    }
+    md.push_str("## Figures\n\n");
+    for f in &pictures.figures {
+        let _ = writeln!(
+            md,
+            "![{}]({})\n\n{} ([SVG]({}))\n",
+            f.title, f.png, f.title, f.svg
+        );
+    }
+    if let Some((png, rows)) = &pictures.edit_figure {
+        let _ = writeln!(
+            md,
+            "![the edit camera before the crater and on the first post-edit frame]({png})\n\n\
+             The edit camera before the crater and on the first post-edit frame, one method per \
+             update class: {}.\n",
+            rows.join("; ")
+        );
+    }
+}
+
+/// `compare --temporal`: each method's flicker along the short path.
+fn temporal_table(md: &mut String, runs: &[RunResults]) {
+    if runs.iter().all(|r| r.temporal.is_empty()) {
+        return;
+    }
+    md.push_str("## Temporal flicker\n\n");
+    md.push_str(
+        "Percent of pixels whose depth changes between consecutive frames by more than the CPU \
+         reference's own change (4 % of the distance), or that switch between terrain and sky \
+         when the reference does not: mean over frame pairs / worst pair, along the video's \
+         default path played short (the crater dug midway).\n\n",
+    );
+    md.push_str("| adapter | method | flicker % mean / worst | frames | dug | frame ms |\n|---|---|---:|---:|---|---:|\n");
+    for run in runs {
+        for t in &run.temporal {
+            let _ = writeln!(
+                md,
+                "| {} | {} | {:.2} / {:.2} | {} at {} fps | {} | {:.2} |",
+                cell_text(&run.adapter.name),
+                t.method,
+                t.flicker_mean,
+                t.flicker_max,
+                t.frames,
+                t.fps,
+                if t.dug { "yes" } else { "no" },
+                t.frame_ms_mean
+            );
+        }
+    }
+    md.push('\n');
 }
 
 fn short_hash(h: &str) -> &str {
@@ -513,6 +592,7 @@ mod tests {
             &Pictures {
                 grid: Some("grid.png".into()),
                 grid_columns: vec!["reference".into()],
+                ..Pictures::default()
             },
             &[],
         );

@@ -41,6 +41,35 @@ pub struct RunResults {
     /// this results file (absent in files written before it was recorded).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub reference_images: Vec<ViewImage>,
+    /// `compare --temporal`: each method's flicker along a short path.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub temporal: Vec<TemporalRow>,
+    /// Before/after pictures of the edit camera for the edit figure.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub edit_images: Vec<EditImages>,
+}
+
+/// One method's temporal flicker along `compare --temporal`'s short path.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TemporalRow {
+    pub method: String,
+    /// Percent of pixels flickering beyond the reference, mean over frame pairs.
+    pub flicker_mean: f64,
+    pub flicker_max: f64,
+    pub frames: u32,
+    pub fps: u32,
+    /// The crater was dug part-way along the path.
+    pub dug: bool,
+    pub frame_ms_mean: f64,
+}
+
+/// The edit camera before the crater and on the first post-edit frame.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct EditImages {
+    pub method: String,
+    /// Relative to the directory holding the results file.
+    pub before: String,
+    pub after: String,
 }
 
 /// A picture of one view (the CPU reference's distance picture).

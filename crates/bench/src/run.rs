@@ -9,6 +9,7 @@ use crate::plan::{MethodChoice, check_view_names, file_part, prepare_out_dir, so
 use crate::results::*;
 use crate::session::{Session, color_image, reference_image};
 use crate::stats::summarize;
+use crate::video;
 use anyhow::Context;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
@@ -22,6 +23,11 @@ use strata_render::{Gpu, MethodSettings, Renderer, TerrainColors};
 /// (`voxel_build::DEFAULT_BUDGET_TEXELS`): the first view's warm-up covers a
 /// whole-level build at this budget, so no method is timed mid-build.
 pub const INCREMENTAL_BUDGET_TEXELS: u64 = 1 << 20;
+
+/// `--temporal`: the default path played in this many seconds ...
+pub const TEMPORAL_SECONDS: f32 = 2.0;
+/// ... at this many frames per second (21 frames; the crater dug midway).
+pub const TEMPORAL_FPS: u32 = 10;
 
 /// Whether to run the edit protocol.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -47,6 +53,8 @@ pub struct Options {
     pub min_warmup: u32,
     pub shadows: bool,
     pub edits: EditMode,
+    /// Fly a short path with every method and measure flicker (`--temporal`).
+    pub temporal: bool,
     pub cache_dir: PathBuf,
 }
 
@@ -205,6 +213,8 @@ impl Plan {
             failures: Vec::new(),
             edit_skipped: self.edit_skipped.clone(),
             reference_images: Vec::new(),
+            temporal: Vec::new(),
+            edit_images: Vec::new(),
         }
     }
 
@@ -285,9 +295,14 @@ impl Plan {
                     steady_frames: self.opts.frames.min(10),
                 };
                 match edits::edit_row(&input, &choice.name, settings) {
-                    Ok(mut row) => {
+                    Ok((mut row, pictures)) => {
                         row.method = choice.label();
                         session.results.edit_rows.push(row);
+                        if let Err(e) =
+                            save_edit_pictures(&mut session, camera, &choice.label(), pictures)
+                        {
+                            bar.println(format!("edit / {}: pictures: {e:#}", choice.label()));
+                        }
                     }
                     Err(e) => {
                         bar.println(format!("edit / {}: {e:#}", choice.label()));
@@ -302,11 +317,80 @@ impl Plan {
                 bar.inc(1);
             }
         }
+        if self.opts.temporal {
+            self.temporal(gpu, &mut session, &refused, &bar)?;
+        }
         bar.finish_and_clear();
         session.results.complete = true;
         session.save_json()?;
         let report = session.save_report()?;
         Ok((json, report))
+    }
+
+    /// `--temporal`: every runnable method along the video's default path,
+    /// played in [`TEMPORAL_SECONDS`] at [`TEMPORAL_FPS`] at the run's size.
+    fn temporal(
+        &self,
+        gpu: &Gpu,
+        session: &mut Session,
+        refused: &[Option<String>],
+        bar: &ProgressBar,
+    ) -> anyhow::Result<()> {
+        let methods: Vec<MethodChoice> = self
+            .opts
+            .methods
+            .iter()
+            .zip(refused)
+            .filter(|(_, why)| why.is_none())
+            .map(|(m, _)| m.clone())
+            .collect();
+        let path = video::path::default_path(&self.world).retimed(TEMPORAL_SECONDS);
+        let opts = video::VideoOptions {
+            methods,
+            tile: (self.opts.width, self.opts.height),
+            frame: None,
+            fps: TEMPORAL_FPS,
+            shadows: self.opts.shadows,
+            temporal: true,
+            overlap: None,
+        };
+        let (pos, len) = (bar.position(), bar.length());
+        let recording = video::record(gpu, &self.world, &path, &opts, None, bar);
+        bar.set_length(len.unwrap_or(0));
+        bar.set_position(pos);
+        match recording {
+            Ok(r) => {
+                let dug = r.dig_frame.is_some();
+                for m in r.methods {
+                    match (m.error, m.flicker) {
+                        (None, Some(f)) => session.results.temporal.push(TemporalRow {
+                            method: m.method,
+                            flicker_mean: f.mean_percent,
+                            flicker_max: f.max_percent,
+                            frames: r.frames,
+                            fps: r.fps,
+                            dug,
+                            frame_ms_mean: m.frame_ms_mean,
+                        }),
+                        (error, _) => session.results.failures.push(Failure {
+                            view: "temporal".into(),
+                            method: m.method,
+                            error: error.unwrap_or_else(|| "no flicker measured".into()),
+                        }),
+                    }
+                }
+            }
+            Err(e) => {
+                bar.println(format!("temporal: {e:#}"));
+                session.results.failures.push(Failure {
+                    view: "temporal".into(),
+                    method: "*".into(),
+                    error: format!("{e:#}"),
+                });
+            }
+        }
+        session.save_json()?;
+        Ok(())
     }
 
     /// The reference of every view (from the cache when present) and its picture.
@@ -578,6 +662,31 @@ pub fn warm_up(
         total_ms: ms(start),
         frames,
     })
+}
+
+/// Save the edit camera's before and first-post-edit pictures and record them.
+fn save_edit_pictures(
+    session: &mut Session,
+    camera: &Camera,
+    label: &str,
+    pictures: edits::EditPictures,
+) -> anyhow::Result<()> {
+    let save = |when: &str, rgba: Vec<u8>| -> anyhow::Result<String> {
+        let rel = format!("cells/edit-{}-{when}.png", file_part(label));
+        let path = session.out.join(&rel);
+        color_image(camera.width, camera.height, rgba)?
+            .save(&path)
+            .with_context(|| format!("writing {}", path.display()))?;
+        Ok(rel)
+    };
+    let before = save("before", pictures.before)?;
+    let after = save("after", pictures.after)?;
+    session.results.edit_images.push(EditImages {
+        method: label.to_string(),
+        before,
+        after,
+    });
+    Ok(())
 }
 
 pub fn ms(since: Instant) -> f64 {

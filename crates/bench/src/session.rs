@@ -72,7 +72,9 @@ impl Session {
         let pictures = Pictures {
             grid: Some("grid.png".into()),
             grid_columns: self.columns.clone(),
-        };
+            ..Pictures::default()
+        }
+        .with_figures(std::slice::from_ref(&self.results), &self.out);
         let md = report::render(std::slice::from_ref(&self.results), &pictures, &[]);
         let path = self.out.join("report.md");
         std::fs::write(&path, md).with_context(|| format!("writing {}", path.display()))?;

@@ -38,6 +38,7 @@ fn options(world: &World, out: PathBuf) -> Options {
         min_warmup: 1,
         shadows: true,
         edits: EditMode::Auto,
+        temporal: false,
         cache_dir: out.join("cache"),
     }
 }
@@ -102,7 +103,9 @@ fn tiny_run_writes_sane_results() {
     };
     let w = world();
     let out = temp("tiny");
-    let plan = Plan::new(w.clone(), options(&w, out.clone())).expect("plan");
+    let mut opts = options(&w, out.clone());
+    opts.temporal = true;
+    let plan = Plan::new(w.clone(), opts).expect("plan");
     let (json, report) = plan.run(&gpu).expect("run");
     let run = RunResults::from_json(&std::fs::read_to_string(&json).unwrap()).unwrap();
     assert!(
@@ -136,5 +139,26 @@ fn tiny_run_writes_sane_results() {
     let md = std::fs::read_to_string(report).unwrap();
     assert!(md.contains("![views down, methods across](grid.png)") && md.contains("| ray | "));
     assert!(out.join("grid.png").is_file());
+    // --temporal: the default path in 2 s at 10 fps, the crater dug on the
+    // way. Played this fast, frames are far apart, and under the depot's roof
+    // the march steps through its thin walls in some frames and not others:
+    // flicker, but never most of the picture on average.
+    assert_eq!(run.temporal.len(), 1);
+    let t = &run.temporal[0];
+    assert_eq!((t.frames, t.fps, t.dug), (21, 10, true));
+    assert!(
+        (0.5..40.0).contains(&t.flicker_mean) && t.flicker_max >= t.flicker_mean,
+        "{t:?}"
+    );
+    assert!(md.contains("## Temporal flicker") && md.contains("| ray | "));
+    // The figures, and the edit figure from the edit protocol's pictures.
+    for f in ["frame-time-by-pitch", "preparation", "memory"] {
+        assert!(md.contains(&format!("figures/{f}.png")), "{f}");
+        assert!(out.join(format!("figures/{f}.png")).is_file(), "{f}");
+        assert!(out.join(format!("figures/{f}.svg")).is_file(), "{f}");
+    }
+    assert_eq!(run.edit_images.len(), 1);
+    assert!(out.join(&run.edit_images[0].before).is_file());
+    assert!(md.contains("figures/edit.png") && out.join("figures/edit.png").is_file());
     std::fs::remove_dir_all(&out).unwrap();
 }

@@ -52,6 +52,7 @@ fn a_method_the_adapter_cannot_run_is_one_failure_and_no_edit_row() {
         min_warmup: 1,
         shadows: true,
         edits: EditMode::Required,
+        temporal: false,
         cache_dir: out.join("cache"),
     };
     let (json, _) = Plan::new(world, opts).unwrap().run(&gpu).unwrap();

@@ -37,6 +37,8 @@ enum Command {
     Merge(cmd::merge::Args),
     /// List every GPU adapter: backend, driver, capabilities, limits, the methods it runs.
     Adapters(cmd::adapters::Args),
+    /// Fly a camera path with one method or several side by side; H.264 MP4 via ffmpeg, or PNGs.
+    Video(cmd::video::Args),
     /// Open a window: fly over the level, switch methods live, dig craters.
     View(cmd::view::Args),
     /// Serve the browser build of the viewer (and a world directory) on localhost.
@@ -55,6 +57,7 @@ fn main() -> std::process::ExitCode {
         Command::Compare(args) => cmd::compare::run(args),
         Command::Merge(args) => cmd::merge::run(args),
         Command::View(args) => cmd::view::run(args),
+        Command::Video(args) => cmd::video::run(args),
         Command::Serve(args) => cmd::serve::run(args),
         Command::Adapters(args) => cmd::adapters::run(args),
     };

@@ -96,6 +96,7 @@ pub async fn run(
         min_warmup: MIN_WARMUP,
         shadows: true,
         edits: EditMode::Off,
+        temporal: false,
         cache_dir: PathBuf::new(),
     };
     let plan = Plan::without_output(world, options)?;

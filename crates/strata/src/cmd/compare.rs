@@ -44,6 +44,10 @@ pub struct Args {
     /// Skip the edit protocol.
     #[arg(long)]
     pub no_edits: bool,
+    /// Also fly a short path (the video's default, in 2 s at 10 fps, crater dug midway) with
+    /// every method and report each one's depth flicker beyond the CPU reference's.
+    #[arg(long)]
+    pub temporal: bool,
     /// Image size WxH (default 1280x800; 320x200 with --quick).
     #[arg(long, value_name = "WxH")]
     pub size: Option<String>,
@@ -179,6 +183,7 @@ fn options_for(args: &Args, p: &Prepared, adapter: &AdapterReport, out: PathBuf)
         min_warmup: args.warmup.unwrap_or(if quick { 1 } else { 3 }),
         shadows: !args.no_shadows,
         edits: p.edits,
+        temporal: args.temporal,
         cache_dir: args
             .cache
             .clone()

@@ -10,4 +10,5 @@ pub mod metrics;
 pub mod reference;
 pub mod render;
 pub mod serve;
+pub mod video;
 pub mod view;

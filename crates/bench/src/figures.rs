@@ -1,0 +1,495 @@
+//! The paper's figures for `report.md`, drawn with plotters as SVG and PNG:
+//! frame time by pitch (one line per method, per adapter when merged),
+//! preparation costs, retained memory, and the edit figure (the edit
+//! camera before the crater and on the first post-edit frame for one
+//! method of each update class).
+//!
+//! The PNGs go through [`ImageBackend`], which writes text with the grid's
+//! bitmap font: plotters' own PNG text needs a system font (fontconfig and
+//! FreeType), which a fresh CI machine does not have.
+
+use crate::results::{Row, RunResults};
+use crate::{font, grid, report, stats};
+use anyhow::Context;
+use image::{Rgba, RgbaImage};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters_backend::text_anchor::{HPos, VPos};
+use plotters_backend::{BackendColor, BackendCoord, BackendTextStyle, DrawingErrorKind};
+use std::path::{Path, PathBuf};
+
+const SIZE: (u32, u32) = (720, 420);
+
+/// A figure written as `<name>.png` and `<name>.svg`: relative paths.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Figure {
+    pub title: String,
+    pub png: String,
+    pub svg: String,
+}
+
+/// Draw every figure the runs support into `dir/figures/`.
+pub fn write_all(runs: &[RunResults], dir: &Path) -> anyhow::Result<Vec<Figure>> {
+    let Some(base) = runs.first() else {
+        return Ok(Vec::new());
+    };
+    let fig_dir = dir.join("figures");
+    std::fs::create_dir_all(&fig_dir).with_context(|| format!("creating {}", fig_dir.display()))?;
+    let mut out = Vec::new();
+    if runs.iter().any(|r| !r.rows.is_empty()) {
+        out.push(plot(
+            &fig_dir,
+            "frame-time-by-pitch",
+            "Frame time by pitch (ms, log scale)",
+            Chart::FrameTime(runs),
+        )?);
+    }
+    if !base.rows.is_empty() {
+        out.push(plot(
+            &fig_dir,
+            "preparation",
+            "Preparation costs (ms, log scale): setup, first frame, warm-up",
+            Chart::Preparation(base),
+        )?);
+        out.push(plot(
+            &fig_dir,
+            "memory",
+            "Retained memory (MiB): GPU, CPU",
+            Chart::Memory(base),
+        )?);
+    }
+    Ok(out)
+}
+
+/// The charts: one generic `draw` serves both backends.
+enum Chart<'a> {
+    FrameTime(&'a [RunResults]),
+    Preparation(&'a RunResults),
+    Memory(&'a RunResults),
+}
+
+impl Chart<'_> {
+    fn draw<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> anyhow::Result<()> {
+        area.fill(&WHITE).map_err(plot_error)?;
+        match self {
+            Chart::FrameTime(runs) => frame_time_by_pitch(area, runs)?,
+            Chart::Preparation(run) => preparation(area, run)?,
+            Chart::Memory(run) => memory(area, run)?,
+        }
+        area.present().map_err(plot_error)
+    }
+}
+
+/// Draw one chart as SVG and PNG.
+fn plot(dir: &Path, name: &str, title: &str, chart: Chart<'_>) -> anyhow::Result<Figure> {
+    let svg_path = dir.join(format!("{name}.svg"));
+    chart.draw(&SVGBackend::new(&svg_path, SIZE).into_drawing_area())?;
+    let png_path = dir.join(format!("{name}.png"));
+    chart.draw(&ImageBackend::new(SIZE, &png_path).into_drawing_area())?;
+    Ok(Figure {
+        title: title.to_string(),
+        png: format!("figures/{name}.png"),
+        svg: format!("figures/{name}.svg"),
+    })
+}
+
+fn plot_error<E: std::fmt::Debug>(e: E) -> anyhow::Error {
+    anyhow::anyhow!("drawing a figure: {e:?}")
+}
+
+fn colour(i: usize) -> RGBColor {
+    let c = Palette99::pick(i).to_rgba();
+    RGBColor(c.0, c.1, c.2)
+}
+
+/// Mean frame time of `method` at each pitch of `run`.
+fn pitch_series(run: &RunResults, method: &str) -> Vec<(f64, f64)> {
+    report::pitches(run)
+        .into_iter()
+        .filter_map(|p| {
+            let xs: Vec<f64> = run
+                .rows
+                .iter()
+                .filter(|r| r.method == method && r.pitch == p)
+                .map(Row::frame_ms)
+                .collect();
+            stats::mean(&xs).map(|m| (f64::from(p), m.max(1e-3)))
+        })
+        .collect()
+}
+
+fn frame_time_by_pitch<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    runs: &[RunResults],
+) -> anyhow::Result<()> {
+    let mut series = Vec::new();
+    for run in runs {
+        for m in &run.settings.methods {
+            let label = if runs.len() > 1 {
+                format!("{m} ({})", run.adapter.name)
+            } else {
+                m.clone()
+            };
+            series.push((label, pitch_series(run, m)));
+        }
+    }
+    let ys = series.iter().flat_map(|(_, s)| s.iter().map(|p| p.1));
+    let (lo, hi) = ys.fold((f64::MAX, f64::MIN), |(a, b), y| (a.min(y), b.max(y)));
+    // Headroom above the lines for the legend (a log axis: a factor).
+    let (lo, hi) = if lo <= hi {
+        (lo / 1.5, hi * 8.0)
+    } else {
+        (0.1, 10.0)
+    };
+    let mut chart = ChartBuilder::on(area)
+        .caption("frame time by pitch (ms)", ("sans-serif", 18))
+        .margin(10)
+        .x_label_area_size(30)
+        .y_label_area_size(50)
+        .build_cartesian_2d(-95.0f64..5.0f64, (lo..hi).log_scale())
+        .map_err(plot_error)?;
+    chart
+        .configure_mesh()
+        .x_desc("pitch (degrees)")
+        .x_labels(5)
+        .draw()
+        .map_err(plot_error)?;
+    for (i, (label, points)) in series.into_iter().enumerate() {
+        let c = colour(i);
+        chart
+            .draw_series(LineSeries::new(points.clone(), c.stroke_width(2)))
+            .map_err(plot_error)?
+            .label(label)
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], c.stroke_width(2)));
+        chart
+            .draw_series(points.into_iter().map(|p| Circle::new(p, 3, c.filled())))
+            .map_err(plot_error)?;
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .position(SeriesLabelPosition::UpperRight)
+        .draw()
+        .map_err(plot_error)?;
+    Ok(())
+}
+
+/// Grouped bars: one group per method, one bar per value.
+fn bars<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    caption: &str,
+    methods: &[String],
+    values: &[Vec<f64>],
+    names: &[&str],
+    log: bool,
+) -> anyhow::Result<()> {
+    let k = names.len().max(1) as f64;
+    // Headroom above the bars for the legend.
+    let top = values
+        .iter()
+        .flatten()
+        .copied()
+        .fold(0.0f64, f64::max)
+        .max(1e-3);
+    let hi = if log { top * 20.0 } else { top * 1.5 };
+    let lo = values
+        .iter()
+        .flatten()
+        .copied()
+        .filter(|v| *v > 0.0)
+        .fold(f64::MAX, f64::min)
+        .min(hi)
+        / 2.0;
+    // Group i is centred on x = i, so the axis's whole-number ticks name them.
+    let n = methods.len() as f64 - 0.5;
+    let label = |x: &f64| {
+        if (x - x.round()).abs() < 1e-6 && *x >= 0.0 {
+            methods.get(x.round() as usize).cloned().unwrap_or_default()
+        } else {
+            String::new()
+        }
+    };
+    let x_labels = methods.len().max(1);
+    macro_rules! draw_bars {
+        ($chart:expr, $floor:expr) => {{
+            let mut chart = $chart;
+            chart
+                .configure_mesh()
+                .disable_x_mesh()
+                .x_labels(x_labels)
+                .x_label_formatter(&label)
+                .draw()
+                .map_err(plot_error)?;
+            for (j, name) in names.iter().enumerate() {
+                let c = colour(j);
+                let rects = values.iter().enumerate().map(|(i, v)| {
+                    let x0 = i as f64 - 0.4 + 0.8 * j as f64 / k;
+                    let y = v.get(j).copied().unwrap_or(0.0).max($floor);
+                    Rectangle::new([(x0, $floor), (x0 + 0.8 / k, y)], c.filled())
+                });
+                chart
+                    .draw_series(rects)
+                    .map_err(plot_error)?
+                    .label(*name)
+                    .legend(move |(x, y)| {
+                        Rectangle::new([(x, y - 4), (x + 10, y + 4)], c.filled())
+                    });
+            }
+            chart
+                .configure_series_labels()
+                .background_style(WHITE.mix(0.8))
+                .border_style(BLACK)
+                .position(SeriesLabelPosition::UpperRight)
+                .draw()
+                .map_err(plot_error)?;
+        }};
+    }
+    let builder = |area| {
+        let mut b = ChartBuilder::on(area);
+        b.caption(caption, ("sans-serif", 18))
+            .margin(10)
+            .x_label_area_size(30)
+            .y_label_area_size(60);
+        b
+    };
+    if log {
+        let chart = builder(area)
+            .build_cartesian_2d(-0.5..n, (lo.max(1e-3)..hi).log_scale())
+            .map_err(plot_error)?;
+        draw_bars!(chart, lo.max(1e-3));
+    } else {
+        let chart = builder(area)
+            .build_cartesian_2d(-0.5..n, 0.0..hi)
+            .map_err(plot_error)?;
+        draw_bars!(chart, 0.0);
+    }
+    Ok(())
+}
+
+/// Per method: the largest setup, first-frame and warm-up cost over its rows.
+fn preparation<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    run: &RunResults,
+) -> anyhow::Result<()> {
+    let methods = methods_with_rows(run);
+    let values: Vec<Vec<f64>> = methods
+        .iter()
+        .map(|m| {
+            let rows: Vec<&Row> = run.rows.iter().filter(|r| &r.method == m).collect();
+            let max = |f: fn(&Row) -> f64| rows.iter().map(|r| f(r)).fold(0.0, f64::max);
+            vec![
+                max(|r| r.prep_setup_ms),
+                max(|r| r.prep_first_frame_ms),
+                max(|r| r.prep_warmup_ms),
+            ]
+        })
+        .collect();
+    bars(
+        area,
+        "preparation (ms)",
+        &methods,
+        &values,
+        &["setup", "first frame", "warm-up"],
+        true,
+    )
+}
+
+fn memory<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    run: &RunResults,
+) -> anyhow::Result<()> {
+    let methods = methods_with_rows(run);
+    let mib = |b: u64| b as f64 / (1024.0 * 1024.0);
+    let values: Vec<Vec<f64>> = methods
+        .iter()
+        .map(|m| {
+            let r = run.rows.iter().find(|r| &r.method == m);
+            vec![
+                r.map_or(0.0, |r| mib(r.gpu_bytes)),
+                r.map_or(0.0, |r| mib(r.cpu_bytes)),
+            ]
+        })
+        .collect();
+    bars(
+        area,
+        "retained memory (MiB)",
+        &methods,
+        &values,
+        &["GPU", "CPU"],
+        false,
+    )
+}
+
+fn methods_with_rows(run: &RunResults) -> Vec<String> {
+    run.settings
+        .methods
+        .iter()
+        .filter(|m| run.rows.iter().any(|r| &r.method == *m))
+        .cloned()
+        .collect()
+}
+
+/// The method names of each update class, in the order the figure shows them.
+pub const UPDATE_CLASSES: [(&str, &[&str]); 3] = [
+    (
+        "direct read",
+        &["ray", "ray-compute", "painted", "sliced", "scattered"],
+    ),
+    ("incremental rebuild", &["voxel", "voxel-compute"]),
+    ("mesh refit", &["mesh"]),
+];
+
+/// The edit figure: rows = one method per update class (the first the run
+/// has pictures of), columns = before the crater, first post-edit frame.
+/// Written as `figures/edit.png`; `None` without edit pictures.
+pub fn edit_figure(run: &RunResults, dir: &Path) -> anyhow::Result<Option<(String, Vec<String>)>> {
+    let mut rows = Vec::new();
+    let mut cells = Vec::new();
+    for (class, names) in UPDATE_CLASSES {
+        let Some(pics) = names.iter().find_map(|n| {
+            run.edit_images
+                .iter()
+                .find(|e| e.method.split(':').next() == Some(*n))
+        }) else {
+            continue;
+        };
+        let load = |rel: &str| {
+            image::open(dir.join(rel))
+                .ok()
+                .map(|i| grid::thumbnail(&i.to_rgba8()))
+        };
+        rows.push(format!("{} ({class})", pics.method));
+        cells.push(vec![load(&pics.before), load(&pics.after)]);
+    }
+    if rows.is_empty() {
+        return Ok(None);
+    }
+    let columns = vec!["before".to_string(), "first post-edit frame".to_string()];
+    let img = grid::compose(&rows, &columns, &cells);
+    let fig_dir = dir.join("figures");
+    std::fs::create_dir_all(&fig_dir).with_context(|| format!("creating {}", fig_dir.display()))?;
+    let path = fig_dir.join("edit.png");
+    img.save(&path)
+        .with_context(|| format!("writing {}", path.display()))?;
+    Ok(Some(("figures/edit.png".into(), rows)))
+}
+
+/// A plotters backend over an RGBA image, with the bitmap font for text;
+/// `present` writes it as a PNG.
+pub struct ImageBackend {
+    image: RgbaImage,
+    path: PathBuf,
+}
+
+impl ImageBackend {
+    pub fn new((w, h): (u32, u32), path: &Path) -> Self {
+        ImageBackend {
+            image: RgbaImage::from_pixel(w, h, Rgba([255, 255, 255, 255])),
+            path: path.to_path_buf(),
+        }
+    }
+}
+
+impl DrawingBackend for ImageBackend {
+    type ErrorType = std::io::Error;
+
+    fn get_size(&self) -> (u32, u32) {
+        self.image.dimensions()
+    }
+
+    fn ensure_prepared(&mut self) -> Result<(), DrawingErrorKind<Self::ErrorType>> {
+        Ok(())
+    }
+
+    fn present(&mut self) -> Result<(), DrawingErrorKind<Self::ErrorType>> {
+        self.image
+            .save(&self.path)
+            .map_err(|e| DrawingErrorKind::DrawingError(std::io::Error::other(e)))
+    }
+
+    fn draw_pixel(
+        &mut self,
+        (x, y): BackendCoord,
+        color: BackendColor,
+    ) -> Result<(), DrawingErrorKind<Self::ErrorType>> {
+        let (w, h) = self.image.dimensions();
+        if x < 0 || y < 0 || x as u32 >= w || y as u32 >= h {
+            return Ok(());
+        }
+        let a = color.alpha.clamp(0.0, 1.0);
+        let px = self.image.get_pixel_mut(x as u32, y as u32);
+        let (r, g, b) = color.rgb;
+        for (c, v) in px.0.iter_mut().zip([r, g, b]) {
+            *c = (f64::from(*c) * (1.0 - a) + f64::from(v) * a).round() as u8;
+        }
+        Ok(())
+    }
+
+    fn estimate_text_size<S: BackendTextStyle>(
+        &self,
+        text: &str,
+        _style: &S,
+    ) -> Result<(u32, u32), DrawingErrorKind<Self::ErrorType>> {
+        Ok((font::text_width(text), font::LINE))
+    }
+
+    fn draw_text<S: BackendTextStyle>(
+        &mut self,
+        text: &str,
+        style: &S,
+        (x, y): BackendCoord,
+    ) -> Result<(), DrawingErrorKind<Self::ErrorType>> {
+        let (w, h) = (font::text_width(text) as i32, font::LINE as i32);
+        let anchor = style.anchor();
+        let dx = match anchor.h_pos {
+            HPos::Left => 0,
+            HPos::Center => w / 2,
+            HPos::Right => w,
+        };
+        let dy = match anchor.v_pos {
+            VPos::Top => 0,
+            VPos::Center => h / 2,
+            VPos::Bottom => h,
+        };
+        let (r, g, b) = style.color().rgb;
+        let (px, py) = ((x - dx).max(0) as u32, (y - dy).max(0) as u32);
+        font::draw_text(&mut self.image, px, py, text, Rgba([r, g, b, 255]));
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fixtures;
+
+    #[test]
+    fn figures_are_written_as_png_and_svg() {
+        let dir = std::env::temp_dir().join(format!("strata-figures-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let runs = [fixtures::run("GPU A"), fixtures::run("GPU B")];
+        let figs = write_all(&runs, &dir).unwrap();
+        let names: Vec<&str> = figs.iter().map(|f| f.png.as_str()).collect();
+        assert_eq!(
+            names,
+            [
+                "figures/frame-time-by-pitch.png",
+                "figures/preparation.png",
+                "figures/memory.png"
+            ]
+        );
+        for f in &figs {
+            let png = image::open(dir.join(&f.png)).unwrap().to_rgba8();
+            assert_eq!(png.dimensions(), SIZE);
+            // Something besides the white background was drawn.
+            assert!(png.pixels().any(|p| p.0 != [255, 255, 255, 255]));
+            let svg = std::fs::read_to_string(dir.join(&f.svg)).unwrap();
+            assert!(svg.starts_with("<svg"), "{}", &svg[..40.min(svg.len())]);
+        }
+        // Merged runs name their adapter in the legend.
+        let svg = std::fs::read_to_string(dir.join("figures/frame-time-by-pitch.svg")).unwrap();
+        assert!(svg.contains("ray (GPU B)"), "legend per adapter");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

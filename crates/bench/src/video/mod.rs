@@ -1,0 +1,392 @@
+//! `strata video`: a camera path rendered by one or more methods side by
+//! side, each frame's tiles labelled with the method and its frame time,
+//! with the temporal metric measured on the way (the same loop serves
+//! `compare --temporal`, which writes no frames).
+
+pub mod encode;
+pub mod path;
+pub mod temporal;
+pub mod tiles;
+
+use crate::methods::{describe, settings_for};
+use crate::plan::MethodChoice;
+use crate::run::{INCREMENTAL_BUDGET_TEXELS, ms, warm_up};
+use crate::session::color_image;
+use crate::stats::mean;
+use anyhow::Context;
+use encode::FrameSink;
+use indicatif::ProgressBar;
+use path::CameraPath;
+use serde::{Deserialize, Serialize};
+use std::time::Instant;
+use strata_camera::Camera;
+use strata_level::{DirtyRect, Level, World};
+use strata_reference::{ReferenceSettings, Tracer};
+use strata_render::{Gpu, Renderer, TerrainColors};
+use temporal::{Flicker, FlickerTracker, flicker_percent};
+
+/// Seconds the "crater dug" note stays on screen after the dig.
+const DIG_NOTE_SECONDS: f32 = 1.5;
+
+#[derive(Clone, Debug)]
+pub struct VideoOptions {
+    pub methods: Vec<MethodChoice>,
+    /// Each method renders at this size.
+    pub tile: (u32, u32),
+    /// The composed frame's size; `None` renders without composing (the
+    /// temporal metric alone).
+    pub frame: Option<(u32, u32)>,
+    pub fps: u32,
+    pub shadows: bool,
+    /// Trace the CPU reference every frame and measure flicker.
+    pub temporal: bool,
+    /// Trace the reference while the methods render (`None`: when the
+    /// adapter is not a CPU rasteriser, whose frame times it would inflate).
+    pub overlap: Option<bool>,
+}
+
+/// The video's JSON sidecar (`<out>.json`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Recording {
+    pub level: String,
+    pub adapter: String,
+    pub backend: String,
+    pub timestamps: bool,
+    pub frame_width: u32,
+    pub frame_height: u32,
+    pub tile_width: u32,
+    pub tile_height: u32,
+    pub fps: u32,
+    pub frames: u32,
+    /// The path as played, in the path-file format.
+    pub path: String,
+    /// The first frame drawn after the crater was dug.
+    pub dig_frame: Option<u32>,
+    pub methods: Vec<MethodTrack>,
+    /// Wall-clock seconds of the frame loop (render, read back, reference,
+    /// compose, encode), and frames per second of output it achieved.
+    pub wall_seconds: f64,
+    pub output_fps: f64,
+    /// Mean ms to trace one reference frame (with `temporal`).
+    pub reference_ms_mean: Option<f64>,
+    /// Where the frames went.
+    pub output: String,
+}
+
+/// One method along the path.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct MethodTrack {
+    pub method: String,
+    pub settings: String,
+    pub setup_ms: f64,
+    /// Frame time (GPU when timed, else CPU submit-and-wait), ms.
+    pub frame_ms_mean: f64,
+    pub frame_ms_max: f64,
+    pub gpu_timed: bool,
+    /// Applying the edit plus the first frame after it (wall clock), ms.
+    pub first_post_edit_ms: Option<f64>,
+    /// Flicker beyond the reference's; `None` without `temporal`.
+    pub flicker: Option<Flicker>,
+    /// Why the method is missing from the video, when it is.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub error: Option<String>,
+}
+
+/// A method's renderer and what it measured so far.
+struct Lane {
+    choice: MethodChoice,
+    renderer: Renderer,
+    frame_ms: Vec<f64>,
+    gpu_timed: bool,
+    first_post_edit_ms: Option<f64>,
+    flicker: FlickerTracker,
+    previous: Option<Vec<f32>>,
+    setup_ms: f64,
+    settings: String,
+}
+
+/// Render `path` with every method, feeding composed frames to `sink` when
+/// given. A method that cannot be built is left out (its track says why).
+pub fn record(
+    gpu: &Gpu,
+    world: &World,
+    path: &CameraPath,
+    opts: &VideoOptions,
+    mut sink: Option<&mut dyn FrameSink>,
+    bar: &ProgressBar,
+) -> anyhow::Result<Recording> {
+    let level = &world.level;
+    let flight = path.resolve(level).context("the camera path")?;
+    let frames = frame_count(flight.duration(), opts.fps);
+    let (tw, th) = opts.tile;
+    let colors = TerrainColors::from_world(world);
+    let first = flight.camera(level, flight.start(), tw, th)?;
+
+    bar.set_length(u64::from(frames));
+    let (mut lanes, tracks_failed) = build_lanes(gpu, level, &colors, opts, &first, bar);
+    if lanes.is_empty() {
+        anyhow::bail!("no method could be built (see the messages above)");
+    }
+    let edited = prepare_edit(world, path, bar);
+    let before = opts.temporal.then(|| Tracer::new(level));
+    let after = match (&edited, opts.temporal) {
+        (Some((l, _)), true) => Some(Tracer::new(l)),
+        _ => None,
+    };
+    let overlap = opts.overlap.unwrap_or(gpu.report.device_type != "Cpu");
+    let mut dig_frame = None;
+    let mut reference_ms = Vec::new();
+    let mut previous_reference: Option<Vec<f32>> = None;
+    let start = Instant::now();
+    for f in 0..frames {
+        let t = flight.start() + f as f32 / opts.fps as f32;
+        let dig_now =
+            dig_frame.is_none() && edited.is_some() && path.dig_at.is_some_and(|d| t >= d);
+        let current: &Level = match (&edited, dig_frame.is_some() || dig_now) {
+            (Some((l, _)), true) => l,
+            _ => level,
+        };
+        let camera = flight.camera(current, t, tw, th)?;
+        bar.set_message(format!(
+            "path {t:.1} s{}",
+            if dig_now { ", digging" } else { "" }
+        ));
+        let edit = if dig_now { edited.as_ref() } else { None };
+        let tracer = if dig_frame.is_some() || dig_now {
+            after.as_ref()
+        } else {
+            before.as_ref()
+        };
+        let trace = || {
+            tracer.map(|tr| {
+                let start = Instant::now();
+                let r = tr.render(&camera, &ReferenceSettings::default());
+                (r.distance, ms(start))
+            })
+        };
+        // A GPU leaves the CPU free: trace the reference while the methods
+        // render. A CPU rasteriser would share its cores with the trace and
+        // time its frames slower, so there the two take turns.
+        let (reference, rendered) = if overlap {
+            rayon::join(trace, || render_lanes(&mut lanes, &camera, edit))
+        } else {
+            let rendered = render_lanes(&mut lanes, &camera, edit);
+            (trace(), rendered)
+        };
+        rendered?;
+        if dig_now {
+            dig_frame = Some(f);
+        }
+        let reference = reference.map(|(distance, ms)| {
+            reference_ms.push(ms);
+            distance
+        });
+        for lane in &mut lanes {
+            if let Some(reference) = &reference {
+                let depth = lane.renderer.read_depth()?;
+                let distance = strata_reference::distance_from_depth(&camera, &depth);
+                if let (Some(prev), Some(prev_ref)) = (&lane.previous, &previous_reference) {
+                    let p = flicker_percent((prev, &distance), (prev_ref, reference));
+                    lane.flicker.add(f, p);
+                }
+                lane.previous = Some(distance);
+            }
+        }
+        previous_reference = reference;
+        if let (Some(sink), Some((w, h))) = (sink.as_deref_mut(), opts.frame) {
+            let note = dig_frame
+                .filter(|&d| (f - d) as f32 <= DIG_NOTE_SECONDS * opts.fps as f32)
+                .map(|_| "crater dug");
+            let frame = compose(&lanes, &camera, (w, h), note)?;
+            sink.write(&frame)?;
+        }
+        bar.inc(1);
+    }
+    let wall = start.elapsed().as_secs_f64();
+    let mut methods: Vec<MethodTrack> = lanes
+        .into_iter()
+        .map(|lane| track(lane, opts.temporal))
+        .collect();
+    methods.extend(tracks_failed);
+    let (fw, fh) = opts.frame.unwrap_or((tw, th));
+    Ok(Recording {
+        level: world.name.clone(),
+        adapter: gpu.report.name.clone(),
+        backend: gpu.report.backend.clone(),
+        timestamps: gpu.report.timestamps,
+        frame_width: fw,
+        frame_height: fh,
+        tile_width: tw,
+        tile_height: th,
+        fps: opts.fps,
+        frames,
+        path: path.to_text(),
+        dig_frame,
+        methods,
+        wall_seconds: wall,
+        output_fps: f64::from(frames) / wall.max(1e-9),
+        reference_ms_mean: mean(&reference_ms),
+        output: String::new(),
+    })
+}
+
+/// Draw one frame with every method, applying `edit` first when given (the
+/// dig frame: the edit and that frame are timed together).
+fn render_lanes(
+    lanes: &mut [Lane],
+    camera: &Camera,
+    edit: Option<&(Level, Vec<DirtyRect>)>,
+) -> anyhow::Result<()> {
+    for lane in lanes {
+        let start = Instant::now();
+        if let Some((level, rects)) = edit {
+            lane.renderer.apply_edit(level, rects)?;
+        }
+        let timing = lane.renderer.render_frame(camera)?;
+        if edit.is_some() {
+            lane.first_post_edit_ms = Some(ms(start));
+        }
+        lane.gpu_timed = timing.gpu_ms.is_some();
+        lane.frame_ms.push(timing.gpu_ms.unwrap_or(timing.cpu_ms));
+    }
+    Ok(())
+}
+
+/// Every method's lane; the tracks of those that could not be built.
+fn build_lanes(
+    gpu: &Gpu,
+    level: &Level,
+    colors: &TerrainColors,
+    opts: &VideoOptions,
+    first: &Camera,
+    bar: &ProgressBar,
+) -> (Vec<Lane>, Vec<MethodTrack>) {
+    let (mut lanes, mut failed) = (Vec::new(), Vec::new());
+    for choice in &opts.methods {
+        bar.set_message(format!("{}: setup", choice.label()));
+        match build_lane(gpu, level, colors, choice, opts, first) {
+            Ok(lane) => lanes.push(lane),
+            Err(e) => {
+                bar.println(format!("{}: left out: {e:#}", choice.label()));
+                failed.push(failed_track(choice, &e));
+            }
+        }
+    }
+    (lanes, failed)
+}
+
+/// The edited level and its dirty rectangles, made up front so the dig
+/// frame pays only the upload; `None` when the path does not dig.
+fn prepare_edit(
+    world: &World,
+    path: &CameraPath,
+    bar: &ProgressBar,
+) -> Option<(Level, Vec<DirtyRect>)> {
+    path.dig_at?;
+    let Some(site) = &world.edit else {
+        bar.println(format!(
+            "note: the path digs, but level `{}` has no edit site: no dig",
+            world.name
+        ));
+        return None;
+    };
+    let mut level = world.level.clone();
+    let rects = strata_level::edit::crater(&mut level, site);
+    Some((level, rects))
+}
+
+/// Frames in `seconds` at `fps`, the last keyframe included.
+pub fn frame_count(seconds: f32, fps: u32) -> u32 {
+    (seconds * fps as f32).floor() as u32 + 1
+}
+
+fn build_lane(
+    gpu: &Gpu,
+    level: &Level,
+    colors: &TerrainColors,
+    choice: &MethodChoice,
+    opts: &VideoOptions,
+    first: &Camera,
+) -> anyhow::Result<Lane> {
+    let settings = settings_for(choice, opts.shadows)?;
+    let start = Instant::now();
+    let mut renderer = Renderer::new(
+        gpu,
+        level,
+        colors,
+        &choice.name,
+        &settings,
+        opts.tile.0,
+        opts.tile.1,
+    )?;
+    let setup_ms = ms(start);
+    // Settle incremental builds before the first frame (as compare's first
+    // view does), so the video shows the edit's catch-up, not the initial build.
+    let texels = u64::from(level.width()) * u64::from(level.height());
+    let cap = u32::try_from(texels.div_ceil(INCREMENTAL_BUDGET_TEXELS)).unwrap_or(u32::MAX);
+    warm_up(&mut renderer, first, 1, cap + 1, gpu.report.timestamps)?;
+    Ok(Lane {
+        choice: choice.clone(),
+        renderer,
+        frame_ms: Vec::new(),
+        gpu_timed: false,
+        first_post_edit_ms: None,
+        flicker: FlickerTracker::default(),
+        previous: None,
+        setup_ms,
+        settings: describe(&choice.name, &settings),
+    })
+}
+
+fn compose(
+    lanes: &[Lane],
+    camera: &Camera,
+    (w, h): (u32, u32),
+    note: Option<&str>,
+) -> anyhow::Result<image::RgbaImage> {
+    let images = lanes
+        .iter()
+        .map(|lane| color_image(camera.width, camera.height, lane.renderer.read_color()?))
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    let tiles: Vec<tiles::Tile<'_>> = lanes
+        .iter()
+        .zip(&images)
+        .map(|(lane, image)| tiles::Tile {
+            image,
+            label: format!(
+                "{} {:.1} ms",
+                lane.choice.label(),
+                lane.frame_ms.last().copied().unwrap_or(f64::NAN)
+            ),
+        })
+        .collect();
+    Ok(tiles::compose(w, h, &tiles, note))
+}
+
+fn track(lane: Lane, temporal: bool) -> MethodTrack {
+    MethodTrack {
+        method: lane.choice.label(),
+        settings: lane.settings,
+        setup_ms: lane.setup_ms,
+        frame_ms_mean: mean(&lane.frame_ms).unwrap_or(f64::NAN),
+        frame_ms_max: lane.frame_ms.iter().copied().fold(f64::NAN, f64::max),
+        gpu_timed: lane.gpu_timed,
+        first_post_edit_ms: lane.first_post_edit_ms,
+        flicker: temporal.then(|| lane.flicker.result()),
+        error: None,
+    }
+}
+
+fn failed_track(choice: &MethodChoice, e: &anyhow::Error) -> MethodTrack {
+    MethodTrack {
+        method: choice.label(),
+        settings: String::new(),
+        setup_ms: 0.0,
+        frame_ms_mean: 0.0,
+        frame_ms_max: 0.0,
+        gpu_timed: false,
+        first_post_edit_ms: None,
+        flicker: None,
+        error: Some(format!("{e:#}")),
+    }
+}
