@@ -37,6 +37,7 @@
 //! - A method that binds the shared targets, or sizes anything by them, in
 //!   `create` must redo that in `resize` (the viewer follows its window).
 
+mod build_bindings;
 mod common;
 pub mod forward;
 pub mod mesh;

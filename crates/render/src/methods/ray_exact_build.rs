@@ -9,6 +9,7 @@
 //! the shadow map and the march read the pyramid, so the first post-edit
 //! frame equals a fresh build.
 
+use super::build_bindings::BuildBindings;
 use crate::frame::Shared;
 use crate::timing::PassTimer;
 use strata_level::{DirtyRect, Level};
@@ -60,65 +61,20 @@ impl GpuMaxMip {
                 level.height()
             );
         }
-        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("ray-exact pyramid"),
-            size: bytes,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        });
-        let slot_stride = (std::mem::size_of::<BuildParams>() as u64)
-            .next_multiple_of(u64::from(limits.min_uniform_buffer_offset_alignment));
-        let slots = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("ray-exact build params"),
-            size: slot_stride * MAX_SLOTS as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let group_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("ray-exact build"),
-            entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: true,
-                        min_binding_size: wgpu::BufferSize::new(
-                            std::mem::size_of::<BuildParams>() as u64
-                        ),
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Storage { read_only: false },
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
-            ],
-        });
-        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("ray-exact build"),
-            layout: &group_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer: &slots,
-                        offset: 0,
-                        size: wgpu::BufferSize::new(std::mem::size_of::<BuildParams>() as u64),
-                    }),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: buffer.as_entire_binding(),
-                },
-            ],
-        });
+        let BuildBindings {
+            buffer,
+            slots,
+            slot_stride,
+            group_layout,
+            group,
+        } = BuildBindings::new(
+            device,
+            "ray-exact pyramid",
+            "ray-exact build",
+            bytes,
+            std::mem::size_of::<BuildParams>() as u64,
+            MAX_SLOTS,
+        );
         let frame_group = super::voxel_build::build_frame_group(shared, level)?;
         let module = shared.shader("ray_exact_build.wgsl")?;
         let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {

@@ -8,6 +8,7 @@
 //! queue their dirty tile columns and each frame takes what the budget
 //! allows, re-reducing the ancestors of exactly what it rebuilt.
 
+use super::build_bindings::BuildBindings;
 use crate::frame::{Globals, LevelShape, Shared};
 use std::collections::VecDeque;
 use strata_camera::Camera;
@@ -87,65 +88,20 @@ impl GpuPyramid {
             anyhow::bail!("the voxel build budget must be at least one texel per frame");
         }
         let device = &shared.device;
-        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("voxel occupancy"),
-            size: bytes,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        });
-        let slot_stride = (std::mem::size_of::<BuildParams>() as u64)
-            .next_multiple_of(u64::from(limits.min_uniform_buffer_offset_alignment));
-        let slots = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("voxel build params"),
-            size: slot_stride * MAX_SLOTS as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let group_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("voxel build"),
-            entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: true,
-                        min_binding_size: wgpu::BufferSize::new(
-                            std::mem::size_of::<BuildParams>() as u64
-                        ),
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Storage { read_only: false },
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
-            ],
-        });
-        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("voxel build"),
-            layout: &group_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer: &slots,
-                        offset: 0,
-                        size: wgpu::BufferSize::new(std::mem::size_of::<BuildParams>() as u64),
-                    }),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: buffer.as_entire_binding(),
-                },
-            ],
-        });
+        let BuildBindings {
+            buffer,
+            slots,
+            slot_stride,
+            group_layout,
+            group,
+        } = BuildBindings::new(
+            device,
+            "voxel occupancy",
+            "voxel build",
+            bytes,
+            std::mem::size_of::<BuildParams>() as u64,
+            MAX_SLOTS,
+        );
         let frame_group = build_frame_group(shared, level)?;
         let module = shared.shader("voxel_build.wgsl")?;
         let pipeline_layout = shared.pipeline_layout("voxel build", &[&group_layout]);
