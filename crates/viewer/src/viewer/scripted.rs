@@ -205,8 +205,11 @@ impl Viewer {
             Command::Screenshot(path) => self.screenshot_after_frame = Some(path),
             Command::CopyView(name) => self.copy_view(&name),
             Command::Score => {
+                // Counted before: natively the read-back may finish inside
+                // `score` itself, and waiting for one more would never end.
+                let scored = self.scored + 1;
                 self.score()?;
-                running = Some(Running::WaitScore(self.scored + 1));
+                running = Some(Running::WaitScore(scored));
             }
             Command::Quit => self.quit = true,
         }
