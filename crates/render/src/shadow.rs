@@ -109,31 +109,7 @@ impl ShadowPass {
         // Group 0 here omits the shadow map: it cannot be sampled and written
         // in the same pass.
         let device = &shared.device;
-        let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("shadow frame"),
-            entries: &[
-                crate::frame::uniform_layout_entry(0),
-                crate::frame::texture_entry(
-                    2,
-                    wgpu::TextureSampleType::Uint,
-                    wgpu::TextureViewDimension::D2Array,
-                ),
-            ],
-        });
-        let frame_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("shadow frame"),
-            layout: &frame_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: shared.globals.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: wgpu::BindingResource::TextureView(&shared.terrain.view),
-                },
-            ],
-        });
+        let (frame_layout, frame_group) = frame_without_shadow_map(shared, "shadow frame");
         let module = shared.shader("shadow.wgsl")?;
         let kind = shared.caps.shadow_pass().ok_or_else(|| {
             anyhow::anyhow!(
@@ -224,4 +200,40 @@ impl ShadowPass {
             ),
         }
     }
+}
+
+/// Group 0 without the shadow map (globals and terrain only), for a pass
+/// that writes the map: it cannot be sampled and written in the same pass.
+pub(crate) fn frame_without_shadow_map(
+    shared: &Shared,
+    label: &str,
+) -> (wgpu::BindGroupLayout, wgpu::BindGroup) {
+    let layout = shared
+        .device
+        .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some(label),
+            entries: &[
+                crate::frame::uniform_layout_entry(0),
+                crate::frame::texture_entry(
+                    2,
+                    wgpu::TextureSampleType::Uint,
+                    wgpu::TextureViewDimension::D2Array,
+                ),
+            ],
+        });
+    let group = shared.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout: &layout,
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: shared.globals.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 2,
+                resource: wgpu::BindingResource::TextureView(&shared.terrain.view),
+            },
+        ],
+    });
+    (layout, group)
 }

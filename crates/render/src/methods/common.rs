@@ -106,6 +106,18 @@ pub(crate) fn compute_pipeline(
     layout: &wgpu::PipelineLayout,
     entry: &str,
 ) -> anyhow::Result<wgpu::ComputePipeline> {
+    compute_pipeline_with_constants(shared, label, shader, layout, entry, &[])
+}
+
+/// [`compute_pipeline`] with values for the shader's `override` constants.
+pub(crate) fn compute_pipeline_with_constants(
+    shared: &Shared,
+    label: &str,
+    shader: &str,
+    layout: &wgpu::PipelineLayout,
+    entry: &str,
+    constants: &[(&str, f64)],
+) -> anyhow::Result<wgpu::ComputePipeline> {
     let module = shared.shader(shader)?;
     Ok(shared
         .device
@@ -114,7 +126,10 @@ pub(crate) fn compute_pipeline(
             layout: Some(layout),
             module: &module,
             entry_point: Some(entry),
-            compilation_options: Default::default(),
+            compilation_options: wgpu::PipelineCompilationOptions {
+                constants,
+                ..Default::default()
+            },
             cache: None,
         }))
 }

@@ -306,23 +306,17 @@ fn exact_pipeline(
     entry: &str,
     options: ExactOptions,
 ) -> anyhow::Result<wgpu::ComputePipeline> {
-    let module = shared.shader(shader)?;
-    Ok(shared
-        .device
-        .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some(label),
-            layout: Some(layout),
-            module: &module,
-            entry_point: Some(entry),
-            compilation_options: wgpu::PipelineCompilationOptions {
-                constants: &[
-                    ("EXACT_CLIMB", f64::from(options.climb)),
-                    ("EXACT_LOG_RATIO", f64::from(options.log_ratio)),
-                ],
-                ..Default::default()
-            },
-            cache: None,
-        }))
+    super::common::compute_pipeline_with_constants(
+        shared,
+        label,
+        shader,
+        layout,
+        entry,
+        &[
+            ("EXACT_CLIMB", f64::from(options.climb)),
+            ("EXACT_LOG_RATIO", f64::from(options.log_ratio)),
+        ],
+    )
 }
 
 /// The traversal's level table for `layout`.
@@ -443,31 +437,8 @@ fn exact_shadow(
     options: ExactOptions,
 ) -> anyhow::Result<ExactShadow> {
     let device = &shared.device;
-    let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("ray-exact shadow frame"),
-        entries: &[
-            crate::frame::uniform_layout_entry(0),
-            crate::frame::texture_entry(
-                2,
-                wgpu::TextureSampleType::Uint,
-                wgpu::TextureViewDimension::D2Array,
-            ),
-        ],
-    });
-    let frame_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("ray-exact shadow frame"),
-        layout: &frame_layout,
-        entries: &[
-            wgpu::BindGroupEntry {
-                binding: 0,
-                resource: shared.globals.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 2,
-                resource: wgpu::BindingResource::TextureView(&shared.terrain.view),
-            },
-        ],
-    });
+    let (frame_layout, frame_group) =
+        crate::shadow::frame_without_shadow_map(shared, "ray-exact shadow frame");
     let mut entries = core_entries(wgpu::ShaderStages::COMPUTE);
     entries.push(storage_texture_entry(3, wgpu::TextureFormat::R32Float));
     let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
