@@ -83,6 +83,7 @@ pub fn run(adapter: &str) -> RunResults {
             method_settings: vec!["ray steps=128".into(), "mesh q=0.5".into()],
             warmup_first_view: 4,
             warmup_frames: 3,
+            hold_busy_ms: 0,
             views,
             edits: true,
             mid_rule: "original".into(),

@@ -49,7 +49,7 @@ pub fn render(runs: &[RunResults], pictures: &Pictures, disagreements: &[Disagre
     let _ = writeln!(md, "# Strata comparison: {}\n", base.level.name);
     let _ = writeln!(
         md,
-        "Level `{}` ({}x{}, content hash `{}`); {}x{} pixels, far {}, {} timed frames per cell, shadows {}, \
+        "Level `{}` ({}x{}, content hash `{}`); {}x{} pixels, far {}, {} timed frames per cell{}, shadows {}, \
          {} views x {} methods. Protocol version {}.\n",
         base.level.name,
         base.level.width,
@@ -59,6 +59,14 @@ pub fn render(runs: &[RunResults], pictures: &Pictures, disagreements: &[Disagre
         s.height,
         s.far,
         s.frames,
+        if s.hold_busy_ms > 0 {
+            format!(
+                " (each after {} ms of untimed frames back to back, which keeps the GPU at its busy clock)",
+                s.hold_busy_ms
+            )
+        } else {
+            String::new()
+        },
         if s.shadows { "on" } else { "off" },
         s.views.len(),
         methods.len(),

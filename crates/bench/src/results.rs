@@ -124,6 +124,10 @@ pub struct Settings {
     pub warmup_first_view: u32,
     /// Pre-timing frames at every later view.
     pub warmup_frames: u32,
+    /// Ms of back-to-back untimed frames before each cell's warm-up (0: none;
+    /// absent in results written before it existed).
+    #[serde(default)]
+    pub hold_busy_ms: u32,
     pub edits: bool,
     /// The cave-ceiling convention (`original` or `vange-rs`).
     pub mid_rule: String,

@@ -51,6 +51,10 @@ pub struct Options {
     pub frames: u32,
     /// Pre-timing frames at every view (the first view adds the build budget).
     pub min_warmup: u32,
+    /// Before each cell's warm-up, keep the GPU busy with the cell's frames
+    /// back to back for this many ms (0: off), so every cell is timed at the
+    /// clock a busy GPU runs at ([`Renderer::hold_busy`]).
+    pub hold_busy_ms: u32,
     pub shadows: bool,
     pub edits: EditMode,
     /// Fly a short path with every method and measure flicker (`--temporal`).
@@ -203,6 +207,7 @@ impl Plan {
                 views: self.opts.views.clone(),
                 warmup_first_view: self.warmup_first,
                 warmup_frames: self.opts.min_warmup,
+                hold_busy_ms: self.opts.hold_busy_ms,
                 edits: self.edit.is_some(),
                 mid_rule: format!("{:?}", level.mid_rule).to_lowercase(),
             },
@@ -508,6 +513,12 @@ impl Plan {
     ) -> anyhow::Result<Row> {
         let view = &self.opts.views[v];
         let label = self.opts.methods[m].label();
+        if self.opts.hold_busy_ms > 0 {
+            renderer.hold_busy(
+                camera,
+                std::time::Duration::from_millis(u64::from(self.opts.hold_busy_ms)),
+            )?;
+        }
         let warm = warm_up(
             renderer,
             camera,

@@ -36,6 +36,7 @@ fn options(world: &World, out: PathBuf) -> Options {
         height: 40,
         frames: 2,
         min_warmup: 1,
+        hold_busy_ms: 0,
         shadows: true,
         edits: EditMode::Auto,
         temporal: false,

@@ -50,6 +50,7 @@ fn a_method_the_adapter_cannot_run_is_one_failure_and_no_edit_row() {
         height: 20,
         frames: 1,
         min_warmup: 1,
+        hold_busy_ms: 0,
         shadows: true,
         edits: EditMode::Required,
         temporal: false,

@@ -51,7 +51,12 @@ pub struct Renderer {
     shadow_drawn: Option<ShadowFrame>,
     /// Depth read-back through a pass, where depth copies are missing.
     depth_reader: Option<DepthReader>,
+    /// The newest frame's submission ([`Renderer::hold_busy`] bounds the queue by it).
+    last_submission: Option<wgpu::SubmissionIndex>,
 }
+
+/// Frames [`Renderer::hold_busy`] lets queue up before it waits for the oldest.
+const FRAMES_IN_FLIGHT: usize = 3;
 
 impl Renderer {
     /// Upload `level`, build method `method` for `width` x `height` targets.
@@ -93,6 +98,7 @@ impl Renderer {
             errors: gpu.errors.clone(),
             level_shape: LevelShape::of(level),
             frames: 0,
+            last_submission: None,
             adapter: gpu.report.clone(),
             setup_ms: 0.0,
             // Off by default (the protocol pays for every frame's map);
@@ -255,6 +261,59 @@ impl Renderer {
     /// Render one frame and wait for it. GPU time is the sum of the per-pass
     /// timestamp intervals; CPU time is submit until the GPU is done.
     pub fn render_frame(&mut self, camera: &Camera) -> anyhow::Result<FrameTimings> {
+        let record_ms = self.submit_frame(camera)?;
+        let submit_start = Instant::now();
+        wait_device(&self.shared.device, &self.errors)?;
+        let cpu_ms = ms(submit_start);
+
+        let (gpu_ms, passes) = self.timer.read(&self.shared.device, &self.errors)?;
+        Ok(FrameTimings {
+            gpu_ms,
+            cpu_ms,
+            record_ms,
+            passes,
+            untimed_passes: self.timer.untimed(),
+        })
+    }
+
+    /// Keep the GPU busy with this camera's frames, submitted back to back
+    /// (at most [`FRAMES_IN_FLIGHT`] queued), for `duration` of wall clock;
+    /// returns how many frames ran. Why: a GPU lowers its clock when it is
+    /// mostly idle, and the protocol's submit-and-wait frames leave it idle
+    /// most of the time: on the H100 the SM clock fell from 1980 MHz to
+    /// 700–1000 MHz a few seconds into a run, so a method measured later in
+    /// one process looked up to 2.5x slower. Running this before a cell's
+    /// timed frames measures every method at the clock a GPU-bound
+    /// application gets. Frames here are untimed (their stamps are not read).
+    pub fn hold_busy(
+        &mut self,
+        camera: &Camera,
+        duration: std::time::Duration,
+    ) -> anyhow::Result<u32> {
+        let start = Instant::now();
+        let mut in_flight = std::collections::VecDeque::new();
+        let mut frames = 0;
+        while start.elapsed() < duration {
+            self.submit_frame(camera)?;
+            in_flight.push_back(self.last_submission.clone());
+            frames += 1;
+            if in_flight.len() > FRAMES_IN_FLIGHT
+                && let Some(Some(oldest)) = in_flight.pop_front()
+            {
+                let _ = self.shared.device.poll(wgpu::PollType::Wait {
+                    submission_index: Some(oldest),
+                    timeout: Some(crate::gpu::GPU_WAIT_TIMEOUT),
+                });
+                self.errors.check()?;
+            }
+        }
+        wait_device(&self.shared.device, &self.errors)?;
+        Ok(frames)
+    }
+
+    /// Record and submit one frame without waiting for it; returns the CPU
+    /// ms spent preparing and recording it.
+    fn submit_frame(&mut self, camera: &Camera) -> anyhow::Result<f64> {
         if camera.width != self.shared.width || camera.height != self.shared.height {
             anyhow::bail!(
                 "camera is {}x{} but the renderer was built for {}x{}",
@@ -298,20 +357,9 @@ impl Renderer {
         let commands = encoder.finish();
         let record_ms = ms(record_start);
 
-        let submit_start = Instant::now();
-        self.shared.queue.submit([commands]);
-        wait_device(&self.shared.device, &self.errors)?;
-        let cpu_ms = ms(submit_start);
+        self.last_submission = Some(self.shared.queue.submit([commands]));
         self.frames += 1;
-
-        let (gpu_ms, passes) = self.timer.read(&self.shared.device, &self.errors)?;
-        Ok(FrameTimings {
-            gpu_ms,
-            cpu_ms,
-            record_ms,
-            passes,
-            untimed_passes: self.timer.untimed(),
-        })
+        Ok(record_ms)
     }
 
     /// The protocol's frame loop: one first frame, `warmup` untimed frames,

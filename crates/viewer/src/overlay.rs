@@ -122,7 +122,7 @@ pub const CONTROLS: &[(&str, &str)] = &[
     ("right mouse drag", "look around"),
     ("left click", "dig a crater at the cursor"),
     ("Ctrl+Z or U", "undo the last dig"),
-    ("1 .. 8", "switch method (built on first use)"),
+    ("1 .. 9, 0", "switch method (built on first use)"),
     ("B", "A/B split: this method left, the previous one right"),
     ("F1 .. F12", "jump to the level's views"),
     (
@@ -422,7 +422,7 @@ fn methods_section(
     editable: &mut Editable<'_>,
     actions: &mut Vec<Action>,
 ) {
-    ui.label("method (keys 1-8)");
+    ui.label("method (keys 1 .. 9, 0)");
     ui.horizontal_wrapped(|ui| {
         for (i, name) in methods::names().into_iter().enumerate() {
             let refused = methods::check_support(name, status.caps).err();

@@ -94,6 +94,8 @@ pub async fn run(
         height: SIZE.1,
         frames: FRAMES,
         min_warmup: MIN_WARMUP,
+        // A page cannot block on the GPU; its frames are paced by the browser.
+        hold_busy_ms: 0,
         shadows: true,
         edits: EditMode::Off,
         temporal: false,

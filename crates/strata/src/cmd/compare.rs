@@ -58,6 +58,11 @@ pub struct Args {
     /// renderer's first view goes on while an incremental build is in flight.
     #[arg(long, value_name = "N")]
     pub warmup: Option<u32>,
+    /// Ms of untimed frames back to back before each cell (default 300; 0
+    /// with --quick), so a GPU that lowers its clock when mostly idle times
+    /// every method at its busy clock. 0 turns it off.
+    #[arg(long, value_name = "MS")]
+    pub hold_busy: Option<u32>,
     #[command(flatten)]
     pub adapter: AdapterArgs,
     /// Run the protocol on every adapter of --backend (default: every backend), each into
@@ -181,6 +186,7 @@ fn options_for(args: &Args, p: &Prepared, adapter: &AdapterReport, out: PathBuf)
         height,
         frames: args.frames.unwrap_or(if quick { 4 } else { 40 }),
         min_warmup: args.warmup.unwrap_or(if quick { 1 } else { 3 }),
+        hold_busy_ms: args.hold_busy.unwrap_or(if quick { 0 } else { 300 }),
         shadows: !args.no_shadows,
         edits: p.edits,
         temporal: args.temporal,

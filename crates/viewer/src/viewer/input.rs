@@ -107,7 +107,8 @@ impl Viewer {
     }
 
     fn on_key(&mut self, code: KeyCode) -> anyhow::Result<()> {
-        const DIGITS: [KeyCode; 8] = [
+        // 1 .. 9 then 0: the ten methods in registry order.
+        const DIGITS: [KeyCode; 10] = [
             KeyCode::Digit1,
             KeyCode::Digit2,
             KeyCode::Digit3,
@@ -116,6 +117,8 @@ impl Viewer {
             KeyCode::Digit6,
             KeyCode::Digit7,
             KeyCode::Digit8,
+            KeyCode::Digit9,
+            KeyCode::Digit0,
         ];
         const F_KEYS: [KeyCode; 12] = [
             KeyCode::F1,
