@@ -27,6 +27,9 @@ pub struct EditInput<'a> {
     /// one frame, continued while an incremental build is in flight, so the
     /// edit meets a settled renderer.
     pub warmup_cap: u32,
+    /// Ms of untimed frames back to back after that warm-up, so the edit
+    /// frame is timed at the GPU's busy clock (see `Options::hold_busy_ms`).
+    pub hold_busy_ms: u32,
     pub timestamps: bool,
     /// Frames of the fresh edited build whose median is the steady time.
     pub steady_frames: u32,
@@ -72,6 +75,12 @@ fn build(
         input.camera.height,
     )?;
     crate::run::warm_up(&mut r, input.camera, 1, input.warmup_cap, input.timestamps)?;
+    if input.hold_busy_ms > 0 {
+        r.hold_busy(
+            input.camera,
+            std::time::Duration::from_millis(u64::from(input.hold_busy_ms)),
+        )?;
+    }
     Ok(r)
 }
 

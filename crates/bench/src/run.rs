@@ -296,6 +296,7 @@ impl Plan {
                     colors: &self.colors,
                     camera,
                     warmup_cap: self.warmup_first,
+                    hold_busy_ms: self.opts.hold_busy_ms,
                     timestamps: gpu.report.timestamps,
                     steady_frames: self.opts.frames.min(10),
                 };
