@@ -395,7 +395,10 @@ impl DepthCopy {
         self.bytes
     }
 
-    /// Record the timed copy pass (it clears depth first, per the contract).
+    /// Record the timed copy pass. It loads the old depth rather than
+    /// clearing it: the pass writes every pixel (compare `Always`), so the
+    /// image is the same, and on the H100 the clear was half of the pass
+    /// (0.149 ms cleared, 0.076 loaded, `bench/ray-exact.md`).
     pub(crate) fn record(
         &self,
         shared: &Shared,
@@ -451,10 +454,15 @@ impl DepthCopy {
         label: &str,
         points: bool,
     ) {
+        let mut attachment = depth_attachment(shared);
+        attachment.depth_ops = Some(wgpu::Operations {
+            load: wgpu::LoadOp::Load,
+            store: wgpu::StoreOp::Store,
+        });
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some(label),
             color_attachments: &[],
-            depth_stencil_attachment: Some(depth_attachment(shared)),
+            depth_stencil_attachment: Some(attachment),
             timestamp_writes: frame.timer.render(label),
             occlusion_query_set: None,
             multiview_mask: None,

@@ -607,11 +607,11 @@ impl Method for RayExact {
                 );
                 let label = "ray-exact depth";
                 match mode {
-                    DepthMode::Blit => depth.record(shared, frame, encoder, label),
-                    DepthMode::Points => depth.record_with(shared, frame, encoder, label, true),
-                    DepthMode::BlitLoad => {
-                        depth.record_blit(shared, frame, encoder, label, false, false)
+                    DepthMode::Blit => {
+                        depth.record_blit(shared, frame, encoder, label, false, true)
                     }
+                    DepthMode::Points => depth.record_with(shared, frame, encoder, label, true),
+                    DepthMode::BlitLoad => depth.record(shared, frame, encoder, label),
                     DepthMode::Scissor => {
                         depth.record_blit(shared, frame, encoder, label, true, true)
                     }
