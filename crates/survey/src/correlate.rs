@@ -25,7 +25,9 @@ mod tests {
 
     #[test]
     fn known_values() {
-        let line: Vec<_> = (0..5).map(|i| (f64::from(i), 3.0 - 2.0 * f64::from(i))).collect();
+        let line: Vec<_> = (0..5)
+            .map(|i| (f64::from(i), 3.0 - 2.0 * f64::from(i)))
+            .collect();
         assert!((pearson(&line).unwrap() + 1.0).abs() < 1e-12);
         // x = 1..5, y = 2, 4, 5, 4, 5: r = 0.7746 (textbook example).
         let pts = [(1.0, 2.0), (2.0, 4.0), (3.0, 5.0), (4.0, 4.0), (5.0, 5.0)];

@@ -15,7 +15,10 @@ pub const FLOOR_ROUGHNESSES: [f64; 3] = [0.0, 1.0, 3.0];
 #[derive(Clone, Debug, PartialEq)]
 pub enum WorldSpec {
     /// Generated with knobs turned.
-    Generated { params: GenerateParams, knobs: Knobs },
+    Generated {
+        params: GenerateParams,
+        knobs: Knobs,
+    },
     /// A world directory (`world.ini` + map + palette).
     Dir(PathBuf),
 }

@@ -110,7 +110,12 @@ fn causes(path: &Path, survey: &Survey) -> anyhow::Result<()> {
         .y_desc("insertions")
         .draw()
         .map_err(plot_error)?;
-    let names = ["floor", "slab interior", "single/double boundary", "chunk border"];
+    let names = [
+        "floor",
+        "slab interior",
+        "single/double boundary",
+        "chunk border",
+    ];
     let colours = [GREEN, BLUE, RED, BLACK];
     for (k, (name, colour)) in names.iter().zip(colours).enumerate() {
         let points: Vec<(f64, f64)> = totals
@@ -121,9 +126,15 @@ fn causes(path: &Path, survey: &Survey) -> anyhow::Result<()> {
             .draw_series(LineSeries::new(points.clone(), colour.stroke_width(2)))
             .map_err(plot_error)?
             .label(*name)
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], colour.stroke_width(2)));
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 16, y)], colour.stroke_width(2))
+            });
         chart
-            .draw_series(points.into_iter().map(|p| Circle::new(p, 3, colour.filled())))
+            .draw_series(
+                points
+                    .into_iter()
+                    .map(|p| Circle::new(p, 3, colour.filled())),
+            )
             .map_err(plot_error)?;
     }
     chart

@@ -22,8 +22,11 @@ pub struct Correlations {
     pub slab_share: Option<f64>,
 }
 
-/// The predictors, in table order: name and how to read one from a world.
-pub const PREDICTORS: [(&str, fn(&WorldRow, &FitRow) -> f64); 4] = [
+/// How to read one predictor from a world and its fit.
+pub type Predictor = fn(&WorldRow, &FitRow) -> f64;
+
+/// The predictors, in table order: name and how to read one.
+pub const PREDICTORS: [(&str, Predictor); 4] = [
     ("r_f", |w, _| w.r_f),
     ("dual %", |w, _| w.dual_percent),
     ("r_s", |w, _| w.r_s),
@@ -106,7 +109,7 @@ pub fn markdown(
     let _ = writeln!(md, "# Fit survey\n");
     let _ = writeln!(
         md,
-        "`{command}` — {} worlds × {} qualities, {} fit ({}), {:.0} s on {} threads.\n",
+        "`{command}` — {} worlds × {} qualities, {} fit (max error 2^(4(1−q))), {:.0} s on {} threads.\n",
         survey.worlds.len(),
         survey.qualities.len(),
         if survey.outline {
@@ -114,7 +117,6 @@ pub fn markdown(
         } else {
             "unconstrained"
         },
-        "max error 2^(4(1−q))",
         survey.wall_seconds,
         survey.threads
     );

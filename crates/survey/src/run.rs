@@ -3,11 +3,13 @@
 //! fails to load keeps its row, with the error, and the survey goes on.
 
 use serde::Serialize;
+use std::time::Instant;
 use strata_level::generate::generate_with;
 use strata_level::stats::LevelStats;
 use strata_level::{Level, MidRule, io};
-use strata_mesh::{CAUSES, LODS, MeshStats, fit_on_threads, tolerance_for_quality};
-use std::time::Instant;
+use strata_mesh::{
+    CAUSES, FitOptions, LODS, MeshStats, fit_on_threads_with, tolerance_for_quality,
+};
 
 use crate::plan::{Plan, WorldSpec};
 
@@ -174,9 +176,8 @@ fn load(spec: &WorldSpec) -> Result<Level, String> {
 
 fn fit(level: &Level, q: f64, threads: usize, outline: bool) -> Result<(FitRow, usize), String> {
     let tol = tolerance_for_quality(q).ok_or_else(|| format!("quality {q} is outside [0, 1]"))?;
-    let _ = outline;
-    let (mesh, timing) =
-        fit_on_threads(level, tol, threads).map_err(|e| format!("worker threads: {e}"))?;
+    let (mesh, timing) = fit_on_threads_with(level, tol, threads, FitOptions { outline })
+        .map_err(|e| format!("worker threads: {e}"))?;
     let s = mesh.stats();
     let full = 2 * u64::from(level.width()) * u64::from(level.height());
     Ok((row_of(q, &s, full, timing.wall_seconds), timing.threads))

@@ -28,6 +28,9 @@ pub struct Args {
     /// Fit worker threads (default: all cores).
     #[arg(long)]
     threads: Option<usize>,
+    /// Use the outline-constrained fit.
+    #[arg(long)]
+    outline: bool,
 }
 
 /// Progress on the terminal: one bar over every fit.
@@ -53,6 +56,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         Plan::grid(args.seed, w, h)
     } else {
         Plan::dirs(args.level.clone())
+    };
+    let plan = Plan {
+        outline: args.outline,
+        ..plan
     };
     if plan.worlds.is_empty() {
         bail!("nothing to survey");
