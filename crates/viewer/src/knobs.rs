@@ -108,6 +108,16 @@ pub fn relevant(name: &str, s: &MethodSettings) -> MethodSettings {
         } else {
             d.mesh_quality
         },
+        mesh_outline: if uses(Knob::MeshQuality) {
+            s.mesh_outline
+        } else {
+            d.mesh_outline
+        },
+        mesh_lod_pixels: if uses(Knob::MeshQuality) {
+            s.mesh_lod_pixels
+        } else {
+            d.mesh_lod_pixels
+        },
         shadows: d.shadows,
     }
 }
