@@ -55,14 +55,29 @@ pub fn settings_for(choice: &MethodChoice, shadows: bool) -> anyhow::Result<Meth
             };
         }
         "mesh" => {
-            let q: f32 = text
+            // `Q`, `q=Q`, `Qo` (outline-constrained), then `/PX` (the LOD
+            // tolerance in pixels; `/`, as `,` separates methods).
+            let (q, px) = match text.split_once('/') {
+                Some((q, px)) => (q.trim(), Some(px.trim())),
+                None => (text.trim(), None),
+            };
+            let q = q.trim_start_matches("q=");
+            let (q, outline) = match q.strip_suffix('o') {
+                Some(q) => (q, true),
+                None => (q, false),
+            };
+            let q: f32 = q
                 .trim()
-                .trim_start_matches("q=")
                 .parse()
                 .ok()
                 .filter(|q: &f32| (0.0..=1.0).contains(q))
                 .with_context(|| format!("{}: mesh quality must be a number in [0, 1]", ctx()))?;
             s.mesh_quality = q;
+            s.mesh_outline = outline;
+            if let Some(px) = px {
+                let px = px.trim_start_matches("px=");
+                s.mesh_lod_pixels = positive_f32(px).with_context(ctx)?;
+            }
         }
         _ => bail!("{}: `{name}` has no setting to change", ctx()),
     }
@@ -96,7 +111,12 @@ pub fn describe(name: &str, s: &MethodSettings) -> String {
             let [x, y, z] = s.scatter_density;
             format!("{name} density={x},{y},{z}")
         }
-        "mesh" => format!("{name} q={}", s.mesh_quality),
+        "mesh" => format!(
+            "{name} q={}{} lod={}px",
+            s.mesh_quality,
+            if s.mesh_outline { " outline" } else { "" },
+            s.mesh_lod_pixels
+        ),
         _ => name.to_string(),
     }
 }
@@ -121,7 +141,7 @@ mod tests {
         );
         assert_eq!(
             describe("mesh", &settings_for(&choice("mesh", None), true).unwrap()),
-            "mesh q=0.5"
+            "mesh q=0.5 lod=1px"
         );
     }
 
@@ -153,6 +173,18 @@ mod tests {
                 .mesh_quality,
             0.25
         );
+        let o = settings_for(&choice("mesh", Some("0.5o/2")), true).unwrap();
+        assert_eq!(
+            (o.mesh_quality, o.mesh_outline, o.mesh_lod_pixels),
+            (0.5, true, 2.0)
+        );
+        assert_eq!(describe("mesh", &o), "mesh q=0.5 outline lod=2px");
+        for bad in ["0.5x", "0.5o,2", "0.5/px=0", "0.5/-1", "1.5o"] {
+            assert!(
+                settings_for(&choice("mesh", Some(bad)), true).is_err(),
+                "{bad}"
+            );
+        }
     }
 
     #[test]

@@ -49,6 +49,49 @@ pub fn fit_border(edge: &[Sample], tol: f64, out: &mut Vec<u32>) {
     out.sort_unstable();
 }
 
+/// [`fit_border`] for the outline-constrained fit: a segment between two
+/// dual samples is a slab edge, measured on all three fields; any other
+/// segment draws the floor only and is measured on `low`, plus the whole
+/// missing slab (`high - low`) of a dual sample on it. The same rules as
+/// [`crate::candidate::outline_error`], and like [`fit_border`] a pure
+/// function of the edge's samples.
+pub fn fit_border_outline(edge: &[Sample], tol: f64, out: &mut Vec<u32>) {
+    out.clear();
+    if edge.len() < 3 {
+        return;
+    }
+    let mut stack = vec![(0usize, edge.len() - 1)];
+    while let Some((i, j)) = stack.pop() {
+        let len = (j - i) as i64;
+        let (zi, zj) = (edge[i].z, edge[j].z);
+        let slab = edge[i].dual() && edge[j].dual();
+        let fields = if slab { 3 } else { 1 };
+        let mut best = (0i64, 0usize);
+        for (k, s) in edge.iter().enumerate().take(j).skip(i + 1) {
+            let (a, b) = ((j - k) as i64, (k - i) as i64);
+            let mut e = (0..fields)
+                .map(|f| {
+                    let interp = i64::from(zi[f]) * a + i64::from(zj[f]) * b;
+                    (interp - i64::from(s.z[f]) * len).abs()
+                })
+                .max()
+                .unwrap_or(0);
+            if s.dual() && !slab {
+                e = e.max((i64::from(s.z[2]) - i64::from(s.z[0])) * len);
+            }
+            if e > best.0 {
+                best = (e, k);
+            }
+        }
+        if best.1 != 0 && exceeds(best.0, len, tol) {
+            out.push(best.1 as u32);
+            stack.push((i, best.1));
+            stack.push((best.1, j));
+        }
+    }
+    out.sort_unstable();
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -309,3 +309,114 @@ fn row_max<const F: usize>(rows: [&[u8]; 3], n: [i32; 3], dn: [i32; 3], den: i32
     }
     m
 }
+
+/// [`scan`] for the outline-constrained fit. A slab triangle (`duals` all
+/// true) should hold only dual samples, and is measured on all three
+/// fields; any other triangle draws the floor only, so it is measured on
+/// `low`, and should hold no dual sample except on an edge between two dual
+/// vertices (the slab triangle across draws it). A sample on the wrong side
+/// of the outline is measured by what drawing it wrong costs: a single
+/// sample under a slab by the slab's interpolated fields, a dual sample
+/// without one by its missing slab (`high - low`) as well. So a fit within
+/// tolerance never straddles the outline by more than the tolerance.
+pub fn scan_outline(
+    pts: [Pt; 3],
+    zs: [[u8; 3]; 3],
+    duals: [bool; 3],
+    chunk: &ChunkSamples,
+) -> (i64, i64, u32) {
+    let [a, b, c] = pts;
+    let den = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+    if den <= 1 {
+        return (0, 1, 0);
+    }
+    let (sx, sy) = (chunk.size_x as i32, chunk.size_y as i32);
+    let x0 = a[0].min(b[0]).min(c[0]).max(1);
+    let x1 = a[0].max(b[0]).max(c[0]).min(sx - 1);
+    let y0 = a[1].min(b[1]).min(c[1]).max(1);
+    let y1 = a[1].max(b[1]).max(c[1]).min(sy - 1);
+    if x0 > x1 || y0 > y1 {
+        return (0, i64::from(den), 0);
+    }
+    let slab = duals.iter().all(|&d| d);
+    let duals_in = chunk.duals_in(x0, y0, x1, y1);
+    let bbox = [x0, y0, x1, y1];
+    // Nothing can be on the wrong side: the vectorised kernels.
+    let (best, at) = if !slab && duals_in == 0 {
+        scan_rows::<1>(pts, zs, den, bbox, chunk)
+    } else if slab && duals_in as i32 == (x1 - x0 + 1) * (y1 - y0 + 1) {
+        scan_rows::<3>(pts, zs, den, bbox, chunk)
+    } else {
+        // Edge k (opposite vertex k) joins two dual vertices.
+        let covered = [0, 1, 2].map(|k| duals[(k + 1) % 3] && duals[(k + 2) % 3]);
+        scan_classes(pts, zs, den, slab, covered, bbox, chunk)
+    };
+    (i64::from(best), i64::from(den), at)
+}
+
+/// The error numerator of sample `s` (barycentric numerators `w`) in an
+/// outline fit's triangle; `covered[k]`: a dual sample on edge `k` is drawn
+/// by the slab across.
+#[inline]
+pub fn outline_error(
+    w: [i32; 3],
+    den: i32,
+    zs: [[u8; 3]; 3],
+    s: &crate::samples::Sample,
+    slab: bool,
+    covered: [bool; 3],
+) -> i32 {
+    let e = errors(w, den, zs, s.z);
+    match (slab, s.dual()) {
+        (true, true) => e[0].max(e[1]).max(e[2]),
+        // A slab drawn over a single sample: its fields say by how much.
+        (true, false) => e[0].max(e[1]).max(e[2]),
+        (false, false) => e[0],
+        (false, true) => {
+            let vertex = w.iter().filter(|&&v| v == 0).count() >= 2;
+            if vertex || (0..3).any(|k| w[k] == 0 && covered[k]) {
+                e[0]
+            } else {
+                // No slab drawn here: all of it is missing.
+                e[0].max((i32::from(s.z[2]) - i32::from(s.z[0])) * den)
+            }
+        }
+    }
+}
+
+/// The per-sample loop of [`scan_outline`] where both classes are present.
+fn scan_classes(
+    pts: [Pt; 3],
+    zs: [[u8; 3]; 3],
+    den: i32,
+    slab: bool,
+    covered: [bool; 3],
+    bbox: [i32; 4],
+    chunk: &ChunkSamples,
+) -> (i32, u32) {
+    let [a, b, c] = pts;
+    let [x0, y0, x1, y1] = bbox;
+    let stride = chunk.stride();
+    let (dx, dy) = edge_steps(pts);
+    let mut w_row = barycentric(a, b, c, [x0, y0]);
+    let mut best = (0i32, 0u32);
+    for y in y0..=y1 {
+        let mut w = w_row;
+        for x in x0..=x1 {
+            if (w[0] | w[1] | w[2]) >= 0 {
+                let i = y as usize * stride + x as usize;
+                let e = outline_error(w, den, zs, &chunk.samples[i], slab, covered);
+                if e > best.0 {
+                    best = (e, i as u32);
+                }
+            }
+            for k in 0..3 {
+                w[k] += dx[k];
+            }
+        }
+        for k in 0..3 {
+            w_row[k] += dy[k];
+        }
+    }
+    best
+}

@@ -8,8 +8,8 @@ use std::collections::BinaryHeap;
 
 use strata_level::Level;
 
-use crate::border::{exceeds, fit_border};
-use crate::candidate::{Candidate, barycentric, errors, scan};
+use crate::border::{exceeds, fit_border, fit_border_outline};
+use crate::candidate::{Candidate, barycentric, errors, scan, scan_outline};
 use crate::emit::{ChunkMesh, Emitter};
 use crate::predicates::Pt;
 use crate::samples::{ChunkLayout, ChunkSamples, DUAL_INTERIOR, Sample};
@@ -40,6 +40,16 @@ pub enum Cause {
 
 pub const CAUSES: usize = 4;
 
+/// How a fit runs, besides its tolerance.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize)]
+pub struct FitOptions {
+    /// Constrain the triangulation to the single/double region outline
+    /// (issue 17): no triangle holds samples of both classes, so the slab is
+    /// never interpolated across the outline, and triangles without a slab
+    /// are measured on the floor alone (the only field they draw).
+    pub outline: bool,
+}
+
 /// Reusable scratch for fitting chunks one after another on one thread.
 #[derive(Default)]
 pub struct ChunkFitter {
@@ -65,14 +75,30 @@ impl ChunkFitter {
         cy: u32,
         tol: f64,
     ) -> ChunkMesh {
+        self.fit_with(level, layout, cx, cy, tol, FitOptions::default())
+    }
+
+    /// [`fit`](Self::fit) with `options`.
+    pub fn fit_with(
+        &mut self,
+        level: &Level,
+        layout: &ChunkLayout,
+        cx: u32,
+        cy: u32,
+        tol: f64,
+        options: FitOptions,
+    ) -> ChunkMesh {
         self.samples.load(level, layout, cx, cy);
         let (sx, sy) = (layout.size_x as i32, layout.size_y as i32);
         let stride = self.samples.stride();
         self.tr.reset(sx, sy);
+        self.tr.outline = options.outline;
         self.vsample.clear();
-        for p in &self.tr.pts {
-            self.vsample
-                .push((p[1] as usize * stride + p[0] as usize) as u32);
+        for v in 0..self.tr.pts.len() {
+            let p = self.tr.pts[v];
+            let i = p[1] as usize * stride + p[0] as usize;
+            self.vsample.push(i as u32);
+            self.tr.vdual[v] = self.samples.samples[i].dual();
         }
         let mut causes = [0u32; CAUSES];
 
@@ -89,13 +115,18 @@ impl ChunkFitter {
                 let p = [start[0] + step[0] * k, start[1] + step[1] * k];
                 self.edge.push(*self.samples.at(p[0], p[1]));
             }
-            fit_border(&self.edge, tol, &mut self.border);
+            if options.outline {
+                fit_border_outline(&self.edge, tol, &mut self.border);
+            } else {
+                fit_border(&self.edge, tol, &mut self.border);
+            }
             for &k in &self.border {
                 let p = [start[0] + step[0] * k as i32, start[1] + step[1] * k as i32];
                 let Some((t, _)) = self.tr.locate_scan(p) else {
                     continue;
                 };
-                if self.tr.insert(t, p).is_some() {
+                let dual = self.samples.at(p[0], p[1]).dual();
+                if self.tr.insert_classed(t, p, dual).is_some() {
                     self.vsample
                         .push((p[1] as usize * stride + p[0] as usize) as u32);
                     causes[Cause::Border as usize] += 1;
@@ -139,7 +170,8 @@ impl ChunkFitter {
             let stride = stride as u32;
             let p = [(c.sample() % stride) as i32, (c.sample() / stride) as i32];
             causes[self.cause(c.tri(), p) as usize] += 1;
-            if self.tr.insert(c.tri(), p).is_none() {
+            let dual = self.samples.samples[c.sample() as usize].dual();
+            if self.tr.insert_classed(c.tri(), p, dual).is_none() {
                 // Cannot happen for a candidate of a live triangle; drop it.
                 continue;
             }
@@ -170,7 +202,12 @@ impl ChunkFitter {
         let zs = tri
             .v
             .map(|v| self.samples.samples[self.vsample[v as usize] as usize].z);
-        let (num, den, sample) = scan(pts, zs, &self.samples);
+        let (num, den, sample) = if self.tr.outline {
+            let duals = tri.v.map(|v| self.tr.vdual[v as usize]);
+            scan_outline(pts, zs, duals, &self.samples)
+        } else {
+            scan(pts, zs, &self.samples)
+        };
         if num > 0 && exceeds(num, den, tol) {
             self.heap
                 .push(Candidate::new(num, den, sample, t, self.stamps[t as usize]));
@@ -191,6 +228,17 @@ impl ChunkFitter {
             .v
             .iter()
             .all(|&v| self.samples.samples[self.vsample[v as usize] as usize].dual());
+        if self.tr.outline {
+            // The sample is on the wrong side of the outline, or the floor
+            // is worst, or (slab triangles only) the slab's own relief.
+            return if s.dual() != all_dual {
+                Cause::Boundary
+            } else if !all_dual || (e[0] >= e[1] && e[0] >= e[2]) {
+                Cause::Floor
+            } else {
+                Cause::SlabInterior
+            };
+        }
         if e[0] >= e[1] && e[0] >= e[2] {
             Cause::Floor
         } else if all_dual && s.flags & DUAL_INTERIOR != 0 {

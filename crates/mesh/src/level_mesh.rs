@@ -8,7 +8,7 @@ use serde::Serialize;
 use strata_level::{DirtyRect, Level};
 
 use crate::emit::ChunkMesh;
-use crate::fit::{CAUSES, ChunkFitter, LODS};
+use crate::fit::{CAUSES, ChunkFitter, FitOptions, LODS};
 use crate::samples::ChunkLayout;
 
 /// Max vertical error for quality `q` in [0, 1]: `2^(4(1 - q))` height
@@ -23,6 +23,8 @@ pub struct LevelMesh {
     pub layout: ChunkLayout,
     /// Finest-LOD max error; LOD k has `tolerance · 2^k`.
     pub tolerance_bits: u64,
+    /// How it was fitted (a refit fits the same way).
+    pub options: FitOptions,
     pub chunks: Vec<ChunkMesh>,
 }
 
@@ -45,6 +47,17 @@ impl LevelMesh {
         tolerance: f64,
         progress: &(dyn Fn(usize, usize) + Sync),
     ) -> Self {
+        Self::fit_with_options(level, tolerance, FitOptions::default(), progress)
+    }
+
+    /// [`fit_with_progress`](Self::fit_with_progress) with `options` (e.g.
+    /// the outline-constrained fit).
+    pub fn fit_with_options(
+        level: &Level,
+        tolerance: f64,
+        options: FitOptions,
+        progress: &(dyn Fn(usize, usize) + Sync),
+    ) -> Self {
         let layout = ChunkLayout::of(level);
         let tol = sanitize(tolerance);
         let total = layout.count();
@@ -53,7 +66,7 @@ impl LevelMesh {
             .into_par_iter()
             .map_init(ChunkFitter::default, |f, i| {
                 let (cx, cy) = layout.coords(i);
-                let mesh = f.fit(level, &layout, cx, cy, tol);
+                let mesh = f.fit_with(level, &layout, cx, cy, tol, options);
                 let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
                 progress(n, total);
                 mesh
@@ -62,6 +75,7 @@ impl LevelMesh {
         LevelMesh {
             layout,
             tolerance_bits: tol.to_bits(),
+            options,
             chunks,
         }
     }
@@ -70,10 +84,16 @@ impl LevelMesh {
     /// ([`FitInSteps::step`]): a browser page has one thread and must give
     /// it back between frames. The finished mesh equals [`fit`](Self::fit)'s.
     pub fn fit_in_steps(level: &Level, tolerance: f64) -> FitInSteps {
+        Self::fit_in_steps_with(level, tolerance, FitOptions::default())
+    }
+
+    /// [`fit_in_steps`](Self::fit_in_steps) with `options`.
+    pub fn fit_in_steps_with(level: &Level, tolerance: f64, options: FitOptions) -> FitInSteps {
         let layout = ChunkLayout::of(level);
         FitInSteps {
             layout,
             tolerance: sanitize(tolerance),
+            options,
             fitter: ChunkFitter::default(),
             chunks: Vec::with_capacity(layout.count()),
         }
@@ -86,16 +106,16 @@ impl LevelMesh {
         let layout = ChunkLayout::of(level);
         if layout != self.layout {
             // A different map size: nothing local survives.
-            *self = Self::fit(level, self.tolerance());
+            *self = Self::fit_with_options(level, self.tolerance(), self.options, &|_, _| {});
             return (0..self.chunks.len()).collect();
         }
         let ids = dirty_chunks(&layout, level.width(), level.height(), dirty);
-        let tol = self.tolerance();
+        let (tol, options) = (self.tolerance(), self.options);
         let fresh: Vec<(usize, ChunkMesh)> = ids
             .par_iter()
             .map_init(ChunkFitter::default, |f, &i| {
                 let (cx, cy) = layout.coords(i);
-                (i, f.fit(level, &layout, cx, cy, tol))
+                (i, f.fit_with(level, &layout, cx, cy, tol, options))
             })
             .collect();
         let mut changed = Vec::new();
@@ -154,6 +174,7 @@ impl LevelMesh {
 pub struct FitInSteps {
     layout: ChunkLayout,
     tolerance: f64,
+    options: FitOptions,
     fitter: ChunkFitter,
     chunks: Vec<ChunkMesh>,
 }
@@ -165,7 +186,9 @@ impl FitInSteps {
     pub fn step(&mut self, level: &Level, mut keep_going: impl FnMut() -> bool) -> bool {
         while self.chunks.len() < self.layout.count() {
             let (cx, cy) = self.layout.coords(self.chunks.len());
-            let mesh = self.fitter.fit(level, &self.layout, cx, cy, self.tolerance);
+            let mesh =
+                self.fitter
+                    .fit_with(level, &self.layout, cx, cy, self.tolerance, self.options);
             self.chunks.push(mesh);
             if !keep_going() {
                 break;
@@ -188,6 +211,7 @@ impl FitInSteps {
         self.is_done().then(|| LevelMesh {
             layout: self.layout,
             tolerance_bits: self.tolerance.to_bits(),
+            options: self.options,
             chunks: self.chunks,
         })
     }
@@ -283,8 +307,13 @@ pub struct MeshStats {
 
 /// Fit `level` and time it (wall clock, current rayon pool).
 pub fn timed_fit(level: &Level, tolerance: f64) -> (LevelMesh, f64) {
+    timed_fit_with(level, tolerance, FitOptions::default())
+}
+
+/// [`timed_fit`] with `options`.
+pub fn timed_fit_with(level: &Level, tolerance: f64, options: FitOptions) -> (LevelMesh, f64) {
     let t = Instant::now();
-    let mesh = LevelMesh::fit(level, tolerance);
+    let mesh = LevelMesh::fit_with_options(level, tolerance, options, &|_, _| {});
     (mesh, t.elapsed().as_secs_f64())
 }
 
@@ -303,6 +332,16 @@ pub fn fit_on_threads(
     tolerance: f64,
     threads: usize,
 ) -> Result<(LevelMesh, FitTiming), rayon::ThreadPoolBuildError> {
+    fit_on_threads_with(level, tolerance, threads, FitOptions::default())
+}
+
+/// [`fit_on_threads`] with `options`.
+pub fn fit_on_threads_with(
+    level: &Level,
+    tolerance: f64,
+    threads: usize,
+    options: FitOptions,
+) -> Result<(LevelMesh, FitTiming), rayon::ThreadPoolBuildError> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()?;
@@ -310,7 +349,7 @@ pub fn fit_on_threads(
     pool.broadcast(|_| ());
     Ok(pool.install(|| {
         let cpu0 = crate::cpu_time::process_cpu_seconds();
-        let (mesh, wall_seconds) = timed_fit(level, tolerance);
+        let (mesh, wall_seconds) = timed_fit_with(level, tolerance, options);
         let cpu_seconds = crate::cpu_time::process_cpu_seconds()
             .zip(cpu0)
             .map(|(b, a)| b - a);

@@ -23,6 +23,14 @@ pub struct Tri {
 #[derive(Clone, Debug, Default)]
 pub struct Triangulation {
     pub pts: Vec<Pt>,
+    /// Per vertex: its sample is dual (has a slab). Only read when
+    /// [`outline`](Self::outline) is on.
+    pub vdual: Vec<bool>,
+    /// Keep the slab outline: never flip an edge that separates a slab
+    /// triangle (three dual vertices) from a non-slab one. Those edges are
+    /// the constraints of a constrained Delaunay triangulation; every other
+    /// edge stays locally Delaunay.
+    pub outline: bool,
     pub tris: Vec<Tri>,
     /// Triangles created or rewritten by the last insertion (may repeat).
     pub touched: Vec<u32>,
@@ -53,9 +61,11 @@ impl Triangulation {
     /// Reset to the rectangle `[0, sx] x [0, sy]` split along its diagonal.
     pub fn reset(&mut self, sx: i32, sy: i32) {
         self.pts.clear();
+        self.vdual.clear();
         self.tris.clear();
         self.touched.clear();
         self.pts.extend([[0, 0], [sx, 0], [sx, sy], [0, sy]]);
+        self.vdual.extend([false; 4]);
         // (0,1,2) and (0,2,3), both counter-clockwise.
         self.tris.push(Tri {
             v: [0, 1, 2],
@@ -105,16 +115,24 @@ impl Triangulation {
     /// restore the Delaunay property. Returns the new vertex id, or `None`
     /// when `p` is not in `t` or is already a vertex.
     pub fn insert(&mut self, t: u32, p: Pt) -> Option<u32> {
+        self.insert_classed(t, p, false)
+    }
+
+    /// [`insert`](Self::insert) a vertex whose sample is dual or not (what
+    /// the outline constraint reads).
+    pub fn insert_classed(&mut self, t: u32, p: Pt, dual: bool) -> Option<u32> {
         self.touched.clear();
         let loc = self.locate_in(t, p);
         let pv = self.pts.len() as u32;
         match loc {
             Location::Inside => {
                 self.pts.push(p);
+                self.vdual.push(dual);
                 self.split_triangle(t, pv);
             }
             Location::OnEdge(i) => {
                 self.pts.push(p);
+                self.vdual.push(dual);
                 self.split_edge(t, i, pv);
             }
             Location::Vertex(_) | Location::Outside => return None,
@@ -232,6 +250,9 @@ impl Triangulation {
             };
             let [p, a, b] = tri.v;
             let d = ut.v[j];
+            if self.is_outline_edge(p, a, b, d) {
+                continue;
+            }
             // Flip only when d is strictly inside: cocircular quads keep their
             // current diagonal, which makes the result a deterministic
             // function of the insertion order.
@@ -257,8 +278,26 @@ impl Triangulation {
         }
     }
 
+    /// With [`outline`](Self::outline) on: does edge `a`-`b`, with `p` and
+    /// `d` opposite it, separate a slab triangle from a non-slab one?
+    #[inline]
+    fn is_outline_edge(&self, p: u32, a: u32, b: u32, d: u32) -> bool {
+        let dual = |v: u32| self.vdual[v as usize];
+        self.outline && dual(a) && dual(b) && dual(p) != dual(d)
+    }
+
+    /// Is triangle `t` a slab triangle (all three vertices dual)?
+    #[inline]
+    pub fn is_slab(&self, t: u32) -> bool {
+        self.tris[t as usize]
+            .v
+            .iter()
+            .all(|&v| self.vdual[v as usize])
+    }
+
     /// Edges whose opposite vertex lies strictly inside the circumcircle of
-    /// the triangle across (should be none). For tests and debug checks.
+    /// the triangle across (should be none; outline constraints excepted).
+    /// For tests and debug checks.
     pub fn delaunay_violations(&self) -> usize {
         let mut bad = 0;
         for (t, tri) in self.tris.iter().enumerate() {
@@ -273,6 +312,10 @@ impl Triangulation {
                     continue;
                 };
                 let [a, b, c] = tri.v.map(|v| self.pt(v));
+                let (p, ea, eb) = (tri.v[i], tri.v[next(i)], tri.v[prev(i)]);
+                if self.is_outline_edge(p, ea, eb, ut.v[j]) {
+                    continue;
+                }
                 if crate::predicates::incircle(a, b, c, self.pt(ut.v[j])) > 0 {
                     bad += 1;
                 }

@@ -64,3 +64,25 @@ pub fn dig(level: &mut Level, cx: i64, cy: i64, r: i64, depth: f64) -> Vec<Dirty
     }
     rects
 }
+
+/// Boundary edges of a LOD's floor on one side of the chunk, as sorted
+/// (from, to) positions along that side.
+pub fn side_edges(
+    chunk: &strata_mesh::ChunkMesh,
+    lod: usize,
+    axis: usize,
+    at: i32,
+) -> Vec<(i32, i32)> {
+    let mut out = Vec::new();
+    for t in floor_triangles(chunk, lod) {
+        for k in 0..3 {
+            let (p, q) = (t[k], t[(k + 1) % 3]);
+            if p[axis] == at && q[axis] == at {
+                let (u, v) = (p[1 - axis], q[1 - axis]);
+                out.push((u.min(v), u.max(v)));
+            }
+        }
+    }
+    out.sort_unstable();
+    out
+}

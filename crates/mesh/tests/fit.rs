@@ -2,7 +2,7 @@
 
 mod common;
 
-use common::{dig, floor_triangles};
+use common::{dig, floor_triangles, side_edges};
 use strata_level::Level;
 use strata_mesh::candidate::barycentric;
 use strata_mesh::predicates::orient2d;
@@ -105,23 +105,6 @@ fn every_sample_is_within_tolerance_at_every_lod() {
     }
     let s = mesh.stats();
     assert!(s.lods[0].planar > s.lods[1].planar && s.lods[1].planar > s.lods[2].planar);
-}
-
-/// Boundary edges of a LOD's floor on one side of the chunk, as sorted
-/// (from, to) positions along that side.
-fn side_edges(chunk: &strata_mesh::ChunkMesh, lod: usize, axis: usize, at: i32) -> Vec<(i32, i32)> {
-    let mut out = Vec::new();
-    for t in floor_triangles(chunk, lod) {
-        for k in 0..3 {
-            let (p, q) = (t[k], t[(k + 1) % 3]);
-            if p[axis] == at && q[axis] == at {
-                let (u, v) = (p[1 - axis], q[1 - axis]);
-                out.push((u.min(v), u.max(v)));
-            }
-        }
-    }
-    out.sort_unstable();
-    out
 }
 
 #[test]

@@ -19,6 +19,14 @@ fn settings() -> MethodSettings {
     }
 }
 
+/// [`settings`] with the outline-constrained fit (`mesh:0.5o`).
+fn outline_settings() -> MethodSettings {
+    MethodSettings {
+        mesh_outline: true,
+        ..settings()
+    }
+}
+
 /// Worst metrics over `views` at `size`, printing each view's.
 fn worst_over(
     gpu: &Gpu,
@@ -26,8 +34,9 @@ fn worst_over(
     colors: &TerrainColors,
     views: &[ViewSpec],
     (w, h): (u32, u32),
+    settings: &MethodSettings,
 ) -> Metrics {
-    let mut r = Renderer::new(gpu, level, colors, "mesh", &settings(), w, h).unwrap();
+    let mut r = Renderer::new(gpu, level, colors, "mesh", settings, w, h).unwrap();
     eprintln!(
         "mesh setup (fit + upload + pipelines): {:.1} ms",
         r.setup_ms()
@@ -70,6 +79,7 @@ fn mesh_matches_the_reference() {
             &TerrainColors::test_ramps(),
             &common::synthetic_views(),
             (160, 100),
+            &settings(),
         );
         eprintln!("mesh worst (synthetic, 160x100): {m:?}");
         // Measured: 0 % see-through at every view but `high` (pitch 0, 1.0 %):
@@ -91,9 +101,28 @@ fn mesh_matches_the_reference_on_a_generated_world() {
             &TerrainColors::from_world(&w),
             &w.views,
             (320, 200),
+            &settings(),
         );
         eprintln!("mesh worst (generated, 320x200): {m:?}");
         // Measured: see-through 0 %, covers-sky 0 %, coherence <= 0.18 % (spiral).
+        assert!(m.see_through <= 0.5 && m.coherence <= 0.5, "{m:?}");
+        assert!(m.covers_sky <= 0.5, "{m:?}");
+    }
+}
+
+#[test]
+fn outline_mesh_matches_the_reference_on_a_generated_world() {
+    for gpu in common::gpus() {
+        let w = common::generated_world();
+        let m = worst_over(
+            &gpu,
+            &w.level,
+            &TerrainColors::from_world(&w),
+            &w.views,
+            (320, 200),
+            &outline_settings(),
+        );
+        eprintln!("outline mesh worst (generated, 320x200): {m:?}");
         assert!(m.see_through <= 0.5 && m.coherence <= 0.5, "{m:?}");
         assert!(m.covers_sky <= 0.5, "{m:?}");
     }
@@ -128,57 +157,63 @@ fn sequential_refit_cpu_ms(
 #[test]
 fn a_crater_equals_a_fresh_fit_in_the_next_frame() {
     for gpu in common::gpus() {
-        // The fixture's camera: the crater is ~14 degrees down, in frame only in
-        // a tall image.
-        let (w_px, h_px) = (160, 400);
-        let w = common::generated_world();
-        let colors = TerrainColors::from_world(&w);
-        let site = w.edit.clone().expect("generated worlds carry an edit site");
-        let mut level = w.level.clone();
-        let camera = Camera::from_view(&level, &site.camera, w_px, h_px).unwrap();
-        let mut r = Renderer::new(&gpu, &level, &colors, "mesh", &settings(), w_px, h_px).unwrap();
-        r.render_frame(&camera).unwrap();
-        let before = r.read_depth().unwrap();
-        let retained = r.retained_bytes();
-        let rects = strata_level::edit::crater(&mut level, &site);
-        let (cpu_ms, chunks) = sequential_refit_cpu_ms(&level, &rects);
-        let t0 = std::time::Instant::now();
-        r.apply_edit(&level, &rects).unwrap();
-        let wall_ms = t0.elapsed().as_secs_f64() * 1e3;
-        eprintln!("mesh crater: {chunks} dirty chunks");
-        r.render_frame(&camera).unwrap();
-        let after = r.read_depth().unwrap();
-        let mut fresh =
-            Renderer::new(&gpu, &level, &colors, "mesh", &settings(), w_px, h_px).unwrap();
-        fresh.render_frame(&camera).unwrap();
-        let want = fresh.read_depth().unwrap();
-        let changed = before.iter().zip(&after).filter(|(a, b)| a != b).count();
-        let class = after
-            .iter()
-            .zip(&want)
-            .filter(|(a, b)| (**a >= 1.0) != (**b >= 1.0))
-            .count();
-        let max_diff = after
-            .iter()
-            .zip(&want)
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0f32, f32::max);
-        eprintln!(
-            "mesh crater: {} rects, apply_edit (texture upload + refit + pool writes) wall {wall_ms:.2} ms, CPU {cpu_ms:?} ms; \
+        for settings in [settings(), outline_settings()] {
+            // The fixture's camera: the crater is ~14 degrees down, in frame only in
+            // a tall image.
+            let (w_px, h_px) = (160, 400);
+            let w = common::generated_world();
+            let colors = TerrainColors::from_world(&w);
+            let site = w.edit.clone().expect("generated worlds carry an edit site");
+            let mut level = w.level.clone();
+            let camera = Camera::from_view(&level, &site.camera, w_px, h_px).unwrap();
+            let mut r =
+                Renderer::new(&gpu, &level, &colors, "mesh", &settings, w_px, h_px).unwrap();
+            r.render_frame(&camera).unwrap();
+            let before = r.read_depth().unwrap();
+            let retained = r.retained_bytes();
+            let rects = strata_level::edit::crater(&mut level, &site);
+            let (cpu_ms, chunks) = sequential_refit_cpu_ms(&level, &rects);
+            let t0 = std::time::Instant::now();
+            r.apply_edit(&level, &rects).unwrap();
+            let wall_ms = t0.elapsed().as_secs_f64() * 1e3;
+            eprintln!(
+                "mesh crater (outline {}): {chunks} dirty chunks",
+                settings.mesh_outline
+            );
+            r.render_frame(&camera).unwrap();
+            let after = r.read_depth().unwrap();
+            let mut fresh =
+                Renderer::new(&gpu, &level, &colors, "mesh", &settings, w_px, h_px).unwrap();
+            fresh.render_frame(&camera).unwrap();
+            let want = fresh.read_depth().unwrap();
+            let changed = before.iter().zip(&after).filter(|(a, b)| a != b).count();
+            let class = after
+                .iter()
+                .zip(&want)
+                .filter(|(a, b)| (**a >= 1.0) != (**b >= 1.0))
+                .count();
+            let max_diff = after
+                .iter()
+                .zip(&want)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0f32, f32::max);
+            eprintln!(
+                "mesh crater: {} rects, apply_edit (texture upload + refit + pool writes) wall {wall_ms:.2} ms, CPU {cpu_ms:?} ms; \
          {changed} pixels changed; vs fresh: class mismatch {class}, max depth difference {max_diff}; \
          retained before {retained:?}, after {:?}",
-            rects.len(),
-            r.retained_bytes()
-        );
-        assert!(
-            changed > 100,
-            "the crater left (almost) no trace: {changed}"
-        );
-        assert_eq!(class, 0, "hit/miss differs from a fresh renderer");
-        assert_eq!(max_diff, 0.0, "depth differs from a fresh renderer");
-        // The slot table does not grow with an edit; the pool is not reallocated
-        // for a crater (its tail has room).
-        assert_eq!(r.retained_bytes(), retained);
+                rects.len(),
+                r.retained_bytes()
+            );
+            assert!(
+                changed > 100,
+                "the crater left (almost) no trace: {changed}"
+            );
+            assert_eq!(class, 0, "hit/miss differs from a fresh renderer");
+            assert_eq!(max_diff, 0.0, "depth differs from a fresh renderer");
+            // The slot table does not grow with an edit; the pool is not reallocated
+            // for a crater (its tail has room).
+            assert_eq!(r.retained_bytes(), retained);
+        }
     }
 }
 
@@ -281,7 +316,14 @@ fn default_world_views_memory_and_crater() {
         let world = generate(&Default::default()).unwrap();
         let colors = TerrainColors::from_world(&world);
         if std::env::var("MESH_SKIP_VIEWS").is_err() {
-            let m = worst_over(&gpu, &world.level, &colors, &world.views, (w_px, h_px));
+            let m = worst_over(
+                &gpu,
+                &world.level,
+                &colors,
+                &world.views,
+                (w_px, h_px),
+                &settings(),
+            );
             eprintln!("mesh worst (default world, 320x200): {m:?}");
             assert!(m.see_through <= 0.5 && m.coherence <= 0.5, "{m:?}");
         }

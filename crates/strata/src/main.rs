@@ -31,6 +31,8 @@ enum Command {
     Render(cmd::render::Args),
     /// Fit the TIN mesh and report its size, causes, time and memory.
     Fit(cmd::fit::Args),
+    /// Fit a grid of generated worlds (or given ones) at five qualities: table, correlations, causes, plots.
+    Survey(cmd::survey::Args),
     /// The one-command comparison of every method over the level's views.
     Compare(cmd::compare::Args),
     /// Merge results from several machines into one report.
@@ -55,6 +57,7 @@ fn main() -> std::process::ExitCode {
         Command::Render(args) => cmd::render::run(args),
         Command::Fit(args) => cmd::fit::run(args),
         Command::Compare(args) => cmd::compare::run(args),
+        Command::Survey(args) => cmd::survey::run(args),
         Command::Merge(args) => cmd::merge::run(args),
         Command::View(args) => cmd::view::run(args),
         Command::Video(args) => cmd::video::run(args),

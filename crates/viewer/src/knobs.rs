@@ -12,16 +12,22 @@ pub enum Knob {
     Slices,
     Density,
     MeshQuality,
+    /// The outline-constrained mesh fit (0 off, else on).
+    MeshOutline,
+    /// The mesh's LOD tolerance in pixels.
+    MeshLodPixels,
     Shadows,
 }
 
 impl Knob {
-    pub const ALL: [(&'static str, Knob); 6] = [
+    pub const ALL: [(&'static str, Knob); 8] = [
         ("ray-steps", Knob::RaySteps),
         ("voxel-steps", Knob::VoxelSteps),
         ("slices", Knob::Slices),
         ("density", Knob::Density),
         ("mesh-quality", Knob::MeshQuality),
+        ("mesh-outline", Knob::MeshOutline),
+        ("mesh-lod-pixels", Knob::MeshLodPixels),
         ("shadows", Knob::Shadows),
     ];
 
@@ -42,7 +48,7 @@ impl Knob {
             Knob::VoxelSteps => &["voxel", "voxel-compute"],
             Knob::Slices => &["sliced"],
             Knob::Density => &["scattered"],
-            Knob::MeshQuality => &["mesh"],
+            Knob::MeshQuality | Knob::MeshOutline | Knob::MeshLodPixels => &["mesh"],
             Knob::Shadows => &[],
         }
     }
@@ -66,6 +72,8 @@ impl Knob {
             Knob::Slices => settings.slices = count(value)?,
             Knob::Density => settings.scatter_density = [value; 3],
             Knob::MeshQuality => settings.mesh_quality = value,
+            Knob::MeshOutline => settings.mesh_outline = value != 0.0,
+            Knob::MeshLodPixels => settings.mesh_lod_pixels = value,
             Knob::Shadows => settings.shadows = value != 0.0,
         }
         Ok(())
@@ -107,6 +115,16 @@ pub fn relevant(name: &str, s: &MethodSettings) -> MethodSettings {
             s.mesh_quality
         } else {
             d.mesh_quality
+        },
+        mesh_outline: if uses(Knob::MeshOutline) {
+            s.mesh_outline
+        } else {
+            d.mesh_outline
+        },
+        mesh_lod_pixels: if uses(Knob::MeshLodPixels) {
+            s.mesh_lod_pixels
+        } else {
+            d.mesh_lod_pixels
         },
         shadows: d.shadows,
     }

@@ -521,7 +521,7 @@ fn knobs(
     // Knobs methods take in place apply while dragging; the mesh quality (a
     // new fit, in the background) when the drag ends or a click changes it.
     let mut knob = |k: Knob, response: egui::Response| {
-        let live = k != Knob::MeshQuality && response.changed();
+        let live = !matches!(k, Knob::MeshQuality | Knob::MeshLodPixels) && response.changed();
         if live || response.drag_stopped() || (response.changed() && !response.dragged()) {
             actions.push(Action::Knob(k));
         }
@@ -547,6 +547,10 @@ fn knobs(
     if relevant(Knob::MeshQuality) {
         let r = ui.add(egui::Slider::new(&mut s.mesh_quality, 0.0..=1.0).text("mesh quality"));
         knob(Knob::MeshQuality, r);
+        let r = ui.checkbox(&mut s.mesh_outline, "mesh outline-constrained (refits)");
+        knob(Knob::MeshOutline, r);
+        let r = ui.add(egui::Slider::new(&mut s.mesh_lod_pixels, 0.25..=16.0).text("mesh LOD px"));
+        knob(Knob::MeshLodPixels, r);
     }
     let r = ui.checkbox(&mut s.shadows, "shadows");
     knob(Knob::Shadows, r);

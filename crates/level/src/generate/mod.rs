@@ -7,6 +7,7 @@
 //! in parallel, so the bytes are the same at any thread count.
 
 mod assets;
+pub mod knobs;
 pub mod landmarks;
 mod noise;
 pub mod preview;
@@ -19,6 +20,7 @@ use crate::model::{
 use rayon::prelude::*;
 
 pub use assets::{BEGIN_COLORS, END_COLORS, palette, world_config};
+pub use knobs::{Knobs, MAX_DUAL_FRACTION, MAX_FLOOR_ROUGHNESS};
 pub use terrain::SEA;
 
 /// Bumped whenever the output for a given seed and size changes (cache key).
@@ -63,6 +65,12 @@ pub enum GenerateError {
         width: u32,
         height: u32,
         landmark: &'static str,
+    },
+    #[error("{name} {value} is outside its range {range}")]
+    Knob {
+        name: &'static str,
+        value: String,
+        range: String,
     },
     #[error(transparent)]
     Shape(#[from] ShapeError),
@@ -177,10 +185,16 @@ fn encode_pair(a: Texel, b: Texel, heights: &mut [u8], metas: &mut [u8]) {
 
 /// Generate the world for `params`.
 pub fn generate(params: &GenerateParams) -> Result<World, GenerateError> {
-    let mut generation = Generation::new(params)?;
+    generate_with(params, &Knobs::default())
+}
+
+/// Generate the world for `params` with `knobs` turned (checked first).
+pub fn generate_with(params: &GenerateParams, knobs: &Knobs) -> Result<World, GenerateError> {
+    let mut generation = Generation::with_knobs(params, knobs)?;
     let Generation {
         terrain,
         layout,
+        mask,
         heights,
         metas,
         ..
@@ -190,7 +204,9 @@ pub fn generate(params: &GenerateParams) -> Result<World, GenerateError> {
         .par_chunks_mut(w)
         .zip(metas.par_chunks_mut(w))
         .enumerate()
-        .for_each(|(y, (hrow, mrow))| fill_row(terrain, layout, y as u32, hrow, mrow));
+        .for_each(|(y, (hrow, mrow))| {
+            fill_row(terrain, layout, mask.as_ref(), y as u32, hrow, mrow)
+        });
     generation.next_row = params.height;
     generation.finish()
 }
@@ -200,8 +216,10 @@ pub fn generate(params: &GenerateParams) -> Result<World, GenerateError> {
 /// rows, so the same world byte for byte.
 pub struct Generation {
     params: GenerateParams,
+    knobs: Knobs,
     terrain: terrain::Terrain,
     layout: landmarks::Layout,
+    mask: Option<knobs::SlabMask>,
     heights: Vec<u8>,
     metas: Vec<u8>,
     next_row: u32,
@@ -210,14 +228,28 @@ pub struct Generation {
 impl Generation {
     /// Set up the terrain and place the landmarks (no rows yet).
     pub fn new(params: &GenerateParams) -> Result<Self, GenerateError> {
+        Self::with_knobs(params, &Knobs::default())
+    }
+
+    /// [`new`](Self::new) with `knobs` turned (checked first).
+    pub fn with_knobs(params: &GenerateParams, knobs: &Knobs) -> Result<Self, GenerateError> {
         check_size(params.width, params.height)?;
-        let terrain = terrain::Terrain::new(params.seed, params.width, params.height);
+        knobs.check()?;
+        let mut terrain = terrain::Terrain::new(params.seed, params.width, params.height);
+        if let Some(r) = knobs.floor_roughness {
+            terrain.set_fine_scale(r as f32);
+        }
+        let mask = knobs
+            .dual_fraction
+            .map(|f| knobs::SlabMask::new(terrain.seed, params.width, params.height, f));
         let layout = landmarks::place(&terrain)?;
         let texels = params.width as usize * params.height as usize;
         Ok(Generation {
             params: *params,
+            knobs: *knobs,
             terrain,
             layout,
+            mask,
             heights: vec![0u8; texels],
             metas: vec![0u8; texels],
             next_row: 0,
@@ -233,6 +265,7 @@ impl Generation {
             fill_row(
                 &self.terrain,
                 &self.layout,
+                self.mask.as_ref(),
                 y,
                 &mut self.heights[span.clone()],
                 &mut self.metas[span],
@@ -263,7 +296,7 @@ impl Generation {
         let config = world_config(width, height)?;
         let sections = crate::vpr::VprLayout::of(&config).sections();
         Ok(World {
-            name: format!("generated-{seed}"),
+            name: format!("generated-{seed}{}", self.knobs.name_suffix()),
             config,
             palette: palette(),
             water: Some(vec![SEA; sections]),
@@ -279,15 +312,22 @@ impl Generation {
 fn fill_row(
     terrain: &terrain::Terrain,
     layout: &landmarks::Layout,
+    mask: Option<&knobs::SlabMask>,
     y: u32,
     hrow: &mut [u8],
     mrow: &mut [u8],
 ) {
     let sites: Vec<&landmarks::Landmark> = layout.list.iter().filter(|l| l.covers_row(y)).collect();
     let row = terrain.row(y);
-    let texel = |x: u32| match sites.iter().find(|l| l.covers_x(x)) {
-        Some(site) => site.texel(terrain, x, y),
-        None => terrain.texel(x, &row),
+    let texel = |x: u32| {
+        let t = match sites.iter().find(|l| l.covers_x(x)) {
+            Some(site) => site.texel(terrain, x, y),
+            None => terrain.texel(x, &row),
+        };
+        match mask {
+            Some(m) => m.apply(t, x, y),
+            None => t,
+        }
     };
     for x in (0..terrain.width).step_by(2) {
         let i = x as usize;

@@ -58,6 +58,9 @@ pub struct Terrain {
     districts: Vec<DistrictPlan>,
     road_period_y: i32,
     road_period_x: i32,
+    /// `--floor-roughness`: the small relief's amplitude factor; `None` is
+    /// the default world's formula, kept as written so its bytes never move.
+    fine_scale: Option<f32>,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -120,6 +123,7 @@ impl Terrain {
             districts: Vec::new(),
             road_period_y: 512.min(height as i32 / 2),
             road_period_x: 1024.min(width as i32),
+            fine_scale: None,
         };
         t.districts = t.plan_districts();
         t
@@ -168,13 +172,22 @@ impl Terrain {
         }
     }
 
+    /// Scale the small relief (bumps and specks) by `scale` (1: as the
+    /// default world; see [`super::Knobs::floor_roughness`]).
+    pub fn set_fine_scale(&mut self, scale: f32) {
+        self.fine_scale = Some(scale);
+    }
+
     /// Small organic bumps for flat ground: a few units, blob-shaped.
     #[inline]
     pub fn fine(&self, x: f32, y: f32) -> i32 {
         let v = self.fine.at(x, y);
         let mixed = (x as u32).wrapping_mul(0x9e37_79b1) ^ (y as u32).wrapping_mul(0x85eb_ca77);
         let speck = (hash32(mixed ^ self.seed) & 15 == 0) as i32;
-        fast_round((v - 0.5) * 5.0) + speck
+        match self.fine_scale {
+            None => fast_round((v - 0.5) * 5.0) + speck,
+            Some(s) => fast_round((v - 0.5) * 5.0 * s) + fast_round(speck as f32 * s),
+        }
     }
 
     /// Terrain type of the region around (x, y): 1..=7 in broad patches.

@@ -10,9 +10,14 @@
 //! (the map is a torus; a chunk near the edge is also seen at its wrapped
 //! copies), each copy is frustum-culled by its box, takes LOD 0 within
 //! [`LOD_DISTANCE`]`[0]`, LOD 1 within `[1]`, LOD 2 beyond (distance from the
-//! eye to the box), and the copies are drawn front to back, one
+//! eye to the box; superseded, see below), and the copies are drawn front to back, one
 //! `draw_indexed` per LOD range with the copy's origin at its
 //! `first_instance`. Borders are crack-free across LODs by construction.
+//!
+//! LOD by projected error (issue 17): a copy takes the coarsest LOD whose
+//! max error (`τ·2^k` height units), seen square-on at the distance of the
+//! copy's box from the eye, covers at most `mesh_lod_pixels` pixels
+//! (default 1): resolution and field of view decide, not fixed distances.
 //!
 //! Edits refit the dirty chunks from scratch (equal to a fresh fit of the
 //! edited level) and rewrite only their slots.
@@ -28,15 +33,28 @@ use strata_camera::Camera;
 use strata_level::model::decode_column;
 use strata_level::{DirtyRect, Level};
 use strata_mesh::{
-    ChunkFitter, ChunkLayout, ChunkMesh, FitInSteps, LevelMesh, dirty_chunks, tolerance_for_quality,
+    ChunkFitter, ChunkLayout, ChunkMesh, FitInSteps, FitOptions, LODS, LevelMesh, dirty_chunks,
+    tolerance_for_quality,
 };
 
-/// LOD 0 within the first distance, LOD 1 within the second, LOD 2 beyond
-/// (world units from the eye to the chunk's box). At q = 0.5 LOD 2's 16
-/// units of error seen edge-on at 300 moved horizon silhouettes by ~27 px
-/// (1.1 % covers-sky on the hand-built level's `high` view at 150/300; 0.6 %
-/// at these distances).
+/// The fixed distances the LOD pick used before issue 17 (LOD 0 within 250,
+/// LOD 1 within 450, LOD 2 beyond): blind to resolution and field of view.
+/// Kept for comparison only; [`lod_for`] replaced them.
 pub const LOD_DISTANCE: [f32; 2] = [250.0, 450.0];
+
+/// The coarsest LOD whose max error (`tolerance · 2^k` height units) seen
+/// square-on at `distance` covers at most `pixels` on a camera with focal
+/// length `focal_px`. A box the eye is inside (distance 0) takes LOD 0.
+pub fn lod_for(tolerance: f64, distance: f32, focal_px: f32, pixels: f32) -> u8 {
+    let mut lod = 0;
+    for k in 1..LODS {
+        let error = tolerance as f32 * (1u32 << k) as f32;
+        if error * focal_px <= pixels * distance {
+            lod = k as u8;
+        }
+    }
+    lod
+}
 
 /// Per-draw record: the chunk copy's sample (0, 0) in unwrapped texels.
 const DRAW_BYTES: u64 = 16;
@@ -62,6 +80,9 @@ pub struct Mesh {
     slots: Vec<Slot>,
     layout: ChunkLayout,
     tolerance: f64,
+    options: FitOptions,
+    /// LOD tolerance in pixels (`mesh_lod_pixels`).
+    lod_pixels: f32,
     /// This frame's visible copies, front to back (written by `prepare`).
     draws: Vec<Draw>,
 }
@@ -120,14 +141,14 @@ fn draws_binding(
 
 /// Fit `level` at `tolerance` on the rayon pool (reporting the fit's
 /// progress to `shared`).
-fn fit_all(shared: &Shared, level: &Level, tolerance: f64) -> LevelMesh {
+fn fit_all(shared: &Shared, level: &Level, tolerance: f64, options: FitOptions) -> LevelMesh {
     // Every 1/64th is enough for a progress bar and keeps the lock cold.
     let report = |done: usize, total: usize| {
         if done * 64 / total != (done - 1) * 64 / total {
             shared.progress.report("mesh", done as f32 / total as f32);
         }
     };
-    let mesh = LevelMesh::fit_with_progress(level, tolerance, &report);
+    let mesh = LevelMesh::fit_with_options(level, tolerance, options, &report);
     shared.progress.clear("mesh");
     mesh
 }
@@ -153,9 +174,26 @@ fn tolerance_of(settings: &MethodSettings) -> anyhow::Result<f64> {
         .ok_or_else(|| anyhow::anyhow!("mesh quality {q} is outside [0, 1] (max error 2^(4(1-q)))"))
 }
 
+fn options_of(settings: &MethodSettings) -> FitOptions {
+    FitOptions {
+        outline: settings.mesh_outline,
+    }
+}
+
+fn lod_pixels_of(settings: &MethodSettings) -> anyhow::Result<f32> {
+    let p = settings.mesh_lod_pixels;
+    if p.is_finite() && p > 0.0 {
+        Ok(p)
+    } else {
+        anyhow::bail!("mesh LOD tolerance {p} pixels is not a positive number")
+    }
+}
+
 /// The fit a few chunks per step, then the upload (the browser's build).
 struct MeshSteps {
     tolerance: f64,
+    options: FitOptions,
+    lod_pixels: f32,
     fit: Option<FitInSteps>,
 }
 
@@ -163,6 +201,8 @@ struct MeshSteps {
 pub fn build_in_steps(settings: &MethodSettings) -> anyhow::Result<Box<dyn super::BuildSteps>> {
     Ok(Box::new(MeshSteps {
         tolerance: tolerance_of(settings)?,
+        options: options_of(settings),
+        lod_pixels: lod_pixels_of(settings)?,
         fit: None,
     }))
 }
@@ -175,9 +215,9 @@ impl super::BuildSteps for MeshSteps {
         budget_ms: f64,
     ) -> anyhow::Result<Option<Box<dyn Method>>> {
         let start = web_time::Instant::now();
-        let fit = self
-            .fit
-            .get_or_insert_with(|| LevelMesh::fit_in_steps(level, self.tolerance));
+        let fit = self.fit.get_or_insert_with(|| {
+            LevelMesh::fit_in_steps_with(level, self.tolerance, self.options)
+        });
         let done = fit.step(level, || start.elapsed().as_secs_f64() * 1e3 < budget_ms);
         shared.progress.report("mesh", fit.progress());
         if !done {
@@ -189,7 +229,7 @@ impl super::BuildSteps for MeshSteps {
             .take()
             .and_then(FitInSteps::finish)
             .ok_or_else(|| anyhow::anyhow!("the mesh fit stopped before its last chunk"))?;
-        from_fit(shared, level, self.tolerance, mesh).map(Some)
+        from_fit(shared, level, self.tolerance, self.lod_pixels, mesh).map(Some)
     }
 }
 
@@ -199,8 +239,9 @@ pub fn create(
     settings: &MethodSettings,
 ) -> anyhow::Result<Box<dyn Method>> {
     let tolerance = tolerance_of(settings)?;
-    let mesh = fit_all(shared, level, tolerance);
-    from_fit(shared, level, tolerance, mesh)
+    let lod_pixels = lod_pixels_of(settings)?;
+    let mesh = fit_all(shared, level, tolerance, options_of(settings));
+    from_fit(shared, level, tolerance, lod_pixels, mesh)
 }
 
 /// Upload a fitted mesh and make the method.
@@ -208,8 +249,10 @@ fn from_fit(
     shared: &Shared,
     level: &Level,
     tolerance: f64,
+    lod_pixels: f32,
     mesh: LevelMesh,
 ) -> anyhow::Result<Box<dyn Method>> {
+    let options = mesh.options;
     let (layout, chunks) = with_z_ranges(level, mesh);
     let headroom = pool_headroom(&chunks);
     let (pool, slots) = IndexPool::build(&shared.device, &shared.queue, &chunks, headroom)?;
@@ -254,6 +297,8 @@ fn from_fit(
         slots,
         layout,
         tolerance,
+        options,
+        lod_pixels,
         draws: Vec::new(),
     }))
 }
@@ -266,13 +311,19 @@ fn pool_headroom(chunks: &[Fitted]) -> u32 {
 }
 
 /// Fit `ids` of `level` at `tol`, split over the available cores.
-fn refit_chunks(level: &Level, layout: &ChunkLayout, tol: f64, ids: &[usize]) -> Vec<Fitted> {
+fn refit_chunks(
+    level: &Level,
+    layout: &ChunkLayout,
+    tol: f64,
+    options: FitOptions,
+    ids: &[usize],
+) -> Vec<Fitted> {
     let fit = |ids: &[usize]| -> Vec<Fitted> {
         let mut fitter = ChunkFitter::default();
         ids.iter()
             .map(|&i| {
                 let (cx, cy) = layout.coords(i);
-                let m = fitter.fit(level, layout, cx, cy, tol);
+                let m = fitter.fit_with(level, layout, cx, cy, tol, options);
                 let z = z_range(level, layout, i, &m);
                 (m, z)
             })
@@ -361,7 +412,7 @@ impl Mesh {
                     continue;
                 }
                 let distance = (e.clamp(lo, hi) - e).length();
-                let lod = LOD_DISTANCE.iter().filter(|&&d| distance >= d).count() as u8;
+                let lod = lod_for(self.tolerance, distance, camera.focal_px, self.lod_pixels);
                 self.draws.push(Draw {
                     chunk: chunk as u32,
                     lod,
@@ -384,9 +435,15 @@ impl Method for Mesh {
         _shared: &Shared,
         settings: &MethodSettings,
     ) -> anyhow::Result<bool> {
-        // A new quality is a new fit: only the same tolerance is taken.
+        // A new quality or outline is a new fit; the LOD tolerance is a
+        // per-frame choice, taken in place.
         let q = f64::from(settings.mesh_quality);
-        Ok(tolerance_for_quality(q) == Some(self.tolerance))
+        let same_fit = tolerance_for_quality(q) == Some(self.tolerance)
+            && options_of(settings) == self.options;
+        if same_fit {
+            self.lod_pixels = lod_pixels_of(settings)?;
+        }
+        Ok(same_fit)
     }
 
     fn apply_edit(
@@ -398,7 +455,8 @@ impl Method for Mesh {
         let layout = ChunkLayout::of(level);
         if layout != self.layout {
             // Another map size: nothing local survives.
-            let (layout, chunks) = with_z_ranges(level, fit_all(shared, level, self.tolerance));
+            let (layout, chunks) =
+                with_z_ranges(level, fit_all(shared, level, self.tolerance, self.options));
             let headroom = pool_headroom(&chunks);
             let (pool, slots) = IndexPool::build(&shared.device, &shared.queue, &chunks, headroom)?;
             (self.layout, self.pool, self.slots) = (layout, pool, slots);
@@ -410,7 +468,7 @@ impl Method for Mesh {
             return Ok(());
         }
         let ids = dirty_chunks(&layout, level.width(), level.height(), rects);
-        let fresh = refit_chunks(level, &layout, self.tolerance, &ids);
+        let fresh = refit_chunks(level, &layout, self.tolerance, self.options, &ids);
         for (&i, (mesh, z)) in ids.iter().zip(&fresh) {
             self.pool
                 .replace(&shared.device, &shared.queue, &mut self.slots[i], mesh, *z);
@@ -466,5 +524,28 @@ impl Method for Mesh {
                 + (self.slots.capacity() * std::mem::size_of::<Slot>()
                     + self.draws.capacity() * std::mem::size_of::<Draw>()) as u64,
         }
+    }
+}
+
+#[cfg(test)]
+mod lod_tests {
+    use super::lod_for;
+
+    #[test]
+    fn lod_follows_projected_error_not_distance() {
+        // 320x200 at a 60-degree vertical field of view: focal 173 px.
+        let focal = 100.0 / (30f32).to_radians().tan();
+        // q = 0.5 (max error 4): LOD 1's 8 units cover 1 px at 1386 units,
+        // LOD 2's 16 units at 2771; the old fixed pick took LOD 1 at 250.
+        assert_eq!(lod_for(4.0, 0.0, focal, 1.0), 0);
+        assert_eq!(lod_for(4.0, 250.0, focal, 1.0), 0);
+        assert_eq!(lod_for(4.0, 1400.0, focal, 1.0), 1);
+        assert_eq!(lod_for(4.0, 2800.0, focal, 1.0), 2);
+        // Four times the resolution: finer at the same distance.
+        assert_eq!(lod_for(4.0, 2800.0, 4.0 * focal, 1.0), 0);
+        // A looser pixel tolerance or a coarser fit: coarser LODs sooner.
+        assert_eq!(lod_for(4.0, 250.0, focal, 8.0), 1);
+        assert_eq!(lod_for(4.0, 250.0, focal, 12.0), 2);
+        assert_eq!(lod_for(1.0, 400.0, focal, 1.0), 1);
     }
 }

@@ -82,6 +82,13 @@ pub struct MethodSettings {
     pub scatter_density: [f32; 3],
     /// `mesh`: fit quality q in [0, 1]; max error 2^(4(1 - q)) (0.5 → 4).
     pub mesh_quality: f32,
+    /// `mesh`: fit constrained to the single/double outline (`mesh:0.5o`).
+    #[serde(default)]
+    pub mesh_outline: bool,
+    /// `mesh`: each chunk takes the coarsest LOD whose max error, projected
+    /// to the screen at the chunk's distance, is at most this many pixels.
+    #[serde(default = "default_lod_pixels")]
+    pub mesh_lod_pixels: f32,
     /// The shared shadow map (`--no-shadows` turns it off).
     pub shadows: bool,
 }
@@ -95,9 +102,16 @@ impl Default for MethodSettings {
             slices: 512,
             scatter_density: [4.0, 4.0, 4.0],
             mesh_quality: 0.5,
+            mesh_outline: false,
+            mesh_lod_pixels: default_lod_pixels(),
             shadows: true,
         }
     }
+}
+
+/// The mesh's LOD tolerance in pixels (issue 17: at most 1).
+fn default_lod_pixels() -> f32 {
+    1.0
 }
 
 /// Memory a method keeps beyond the shared resources.

@@ -5,7 +5,7 @@ use anyhow::{Context, bail};
 use serde::Serialize;
 use strata_level::Level;
 use strata_mesh::synthetic::synthetic_level;
-use strata_mesh::{LODS, MeshStats, fit_on_threads, tolerance_for_quality};
+use strata_mesh::{FitOptions, LODS, MeshStats, fit_on_threads_with, tolerance_for_quality};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -23,6 +23,9 @@ pub struct Args {
     /// Worker threads (default: all cores).
     #[arg(long)]
     threads: Option<usize>,
+    /// Constrain the triangulation to the single/double region outline (issue 17).
+    #[arg(long)]
+    outline: bool,
 }
 
 #[derive(Serialize)]
@@ -53,6 +56,8 @@ struct Report {
     height: u32,
     quality: f64,
     max_error: f64,
+    /// The outline-constrained fit.
+    outline: bool,
     chunks: usize,
     threads: usize,
     /// Sum over chunks of finest-LOD vertices (shared border vertices in both chunks).
@@ -101,7 +106,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         bail!("--quality {} is outside [0, 1]", args.quality);
     };
     let (name, level) = load(&args)?;
-    let (mesh, timing) = fit_on_threads(&level, tolerance, args.threads.unwrap_or(0))
+    let options = FitOptions {
+        outline: args.outline,
+    };
+    let (mesh, timing) = fit_on_threads_with(&level, tolerance, args.threads.unwrap_or(0), options)
         .context("starting the worker threads")?;
     let (seconds, cpu, threads) = (timing.wall_seconds, timing.cpu_seconds, timing.threads);
     let report = report(
@@ -113,6 +121,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         cpu,
         threads,
     );
+    let report = Report {
+        outline: args.outline,
+        ..report
+    };
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else {
@@ -153,6 +165,7 @@ fn report(
         height: level.height(),
         quality,
         max_error: s.tolerance,
+        outline: false,
         chunks: s.chunks,
         threads,
         vertices: s.planar_vertices,
@@ -193,8 +206,18 @@ fn report(
 fn print_text(r: &Report) {
     let mib = |b: u64| b as f64 / (1024.0 * 1024.0);
     println!(
-        "{} ({}x{}), q={} (max error {}), {} chunks",
-        r.world, r.width, r.height, r.quality, r.max_error, r.chunks
+        "{} ({}x{}), q={} (max error {}){}, {} chunks",
+        r.world,
+        r.width,
+        r.height,
+        r.quality,
+        r.max_error,
+        if r.outline {
+            ", outline-constrained"
+        } else {
+            ""
+        },
+        r.chunks
     );
     println!(
         "finest LOD: {} vertices, {} triangles; full grid {} -> reduction {:.1}x",

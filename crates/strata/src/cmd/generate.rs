@@ -4,7 +4,9 @@
 use anyhow::{Context, bail};
 use std::path::PathBuf;
 use std::time::Instant;
-use strata_level::generate::{GenerateParams, generate, landmark_list, parse_size, preview};
+use strata_level::generate::{
+    GenerateParams, Knobs, generate_with, landmark_list, parse_size, preview,
+};
 use strata_level::stats::LevelStats;
 use strata_level::{World, io};
 
@@ -19,6 +21,12 @@ pub struct Args {
     /// Map size WIDTHxHEIGHT, powers of two from 256 to 32768 a side.
     #[arg(long, default_value = "2048x16384")]
     size: String,
+    /// Share of texels under a slab, 0 … 0.5: every slab is replaced by roofs over blobs covering this share (default: the world's own slabs, about 10 %).
+    #[arg(long, value_name = "F")]
+    dual_fraction: Option<f64>,
+    /// Factor on the floor's small relief (bumps, specks), 0 … 4 (default 1).
+    #[arg(long, value_name = "R")]
+    floor_roughness: Option<f64>,
     /// Overwrite a directory that already holds a world.
     #[arg(long)]
     force: bool,
@@ -45,6 +53,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         width,
         height,
     };
+    let knobs = Knobs {
+        dual_fraction: args.dual_fraction,
+        floor_roughness: args.floor_roughness,
+    };
+    knobs.check()?;
     if args.out.join("world.ini").exists() && !args.force {
         bail!(
             "{} already holds a world (world.ini); pass --force to overwrite it",
@@ -56,7 +69,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         None => None,
     };
     let t0 = Instant::now();
-    let world = generate(&params)?;
+    let world = generate_with(&params, &knobs)?;
     let generate_s = t0.elapsed().as_secs_f64();
     let t1 = Instant::now();
     io::write_world(&args.out, &world)

@@ -82,6 +82,13 @@ pub struct MethodArgs {
     #[arg(long, value_name = "Q", value_parser = parse_quality,
           default_value_t = MethodSettings::default().mesh_quality)]
     pub mesh_quality: f32,
+    /// `mesh`: constrain the fit to the single/double region outline.
+    #[arg(long)]
+    pub mesh_outline: bool,
+    /// `mesh`: LOD by projected error: the most a chunk's max error may cover on screen, in pixels.
+    #[arg(long, value_name = "PX", value_parser = parse_lod_pixels,
+          default_value_t = MethodSettings::default().mesh_lod_pixels)]
+    pub mesh_lod_pixels: f32,
     /// Turn the shared shadow map off.
     #[arg(long)]
     pub no_shadows: bool,
@@ -96,6 +103,8 @@ impl MethodArgs {
             slices: self.slices,
             scatter_density: self.scatter_density.0,
             mesh_quality: self.mesh_quality,
+            mesh_outline: self.mesh_outline,
+            mesh_lod_pixels: self.mesh_lod_pixels,
             shadows: !self.no_shadows,
         }
     }
@@ -157,6 +166,15 @@ fn parse_quality(text: &str) -> Result<f32, String> {
         Ok(q) if (0.0..=1.0).contains(&q) => Ok(q),
         Ok(q) => Err(format!("mesh quality {q} is outside [0, 1]")),
         Err(_) => Err(format!("`{text}` is not a number in [0, 1]")),
+    }
+}
+
+fn parse_lod_pixels(text: &str) -> Result<f32, String> {
+    match text.trim().parse::<f32>() {
+        Ok(p) if p.is_finite() && p > 0.0 => Ok(p),
+        _ => Err(format!(
+            "mesh LOD tolerance `{text}` is not a positive number of pixels"
+        )),
     }
 }
 
@@ -333,6 +351,7 @@ mod tests {
             scatter_density: [2.0, 3.0, 4.5],
             mesh_quality: 0.75,
             shadows: false,
+            ..MethodSettings::default()
         };
         assert_eq!(s, want);
         assert_eq!(
