@@ -16,6 +16,7 @@ use crate::knobs::{Knob, relevant};
 use crate::minimap::Minimap;
 use crate::overlay::{self, Action, Building, Drawn, Editable, Overlay, Status};
 use crate::present::{Compositor, WINDOW_FORMAT};
+use crate::save::Saver;
 use anyhow::{Context, bail};
 use readback::Scoring;
 use scripted::Player;
@@ -114,6 +115,8 @@ pub struct Viewer {
     screenshot_reading: Option<(PathBuf, TextureReadback)>,
     screenshots: u32,
     out: PathBuf,
+    /// The loaded world's other files, for saving the edited level.
+    saver: Saver,
     quit: bool,
 }
 
@@ -209,6 +212,7 @@ impl Viewer {
             vsync,
             adapter: _,
             out,
+            save,
         } = options;
         let opened = Instant::now();
         let _ = size;
@@ -228,8 +232,10 @@ impl Viewer {
             bail!("--render-scale {scale} must be in (0, 4]");
         }
         let render_size = scaled(window_size, scale);
-        let level = world.level;
-        let mut views = world.views;
+        let (saver, level) = Saver::new(world, save, &out);
+        let world = saver.world();
+        let name = world.name.clone();
+        let mut views = world.views.clone();
         // The edit fixture's camera is a view too: it looks at the crater site.
         if let Some(edit) = &world.edit
             && !views.iter().any(|v| v.name == edit.camera.name)
@@ -323,11 +329,12 @@ impl Viewer {
             screenshot_reading: None,
             screenshots: 0,
             out,
+            saver,
             quit: false,
         };
         viewer.say(format!(
             "{} on {} ({}), render {}x{}; window, device and {FIRST_METHOD} ready in {:.2} s",
-            world.name,
+            name,
             viewer.gpu.report.name,
             viewer.gpu.report.backend,
             render_size.0,
@@ -540,6 +547,23 @@ impl Viewer {
             start.elapsed().as_secs_f64() * 1e3
         ));
         Ok(())
+    }
+
+    /// Save the edited world to `dir` (Ctrl+S: the default directory).
+    /// A refused or failed save is said and the session goes on.
+    fn save(&mut self, dir: Option<PathBuf>) -> anyhow::Result<()> {
+        let dir = dir.unwrap_or_else(|| self.saver.default_dir.clone());
+        let said = self.saver.save(&dir, &self.level);
+        match said {
+            Ok(line) => {
+                self.say(line);
+                Ok(())
+            }
+            Err(e) => {
+                self.say(format!("not saved: {e:#}"));
+                Err(e)
+            }
+        }
     }
 
     fn undo(&mut self) -> anyhow::Result<()> {

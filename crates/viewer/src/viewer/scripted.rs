@@ -186,6 +186,7 @@ impl Viewer {
                 self.dig_at((px, py))?;
             }
             Command::Undo => self.undo()?,
+            Command::Save(dir) => self.save(Some(dir))?,
             Command::Set(knob, value) => {
                 self.set_knob(knob, value)?;
                 running = Some(Running::WaitBuilds);
