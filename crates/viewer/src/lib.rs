@@ -122,6 +122,11 @@ impl App {
     }
 
     fn fail(&mut self, event_loop: &ActiveEventLoop, error: anyhow::Error) {
+        eprintln!("strata view: stopping: {error:#}");
+        // The level lives on the CPU: a lost device loses no edits.
+        if let Some(viewer) = &mut self.viewer {
+            viewer.rescue();
+        }
         self.error.get_or_insert(error);
         // Drop the window and GPU state before the loop ends.
         self.viewer = None;

@@ -20,6 +20,8 @@
 //! screenshot PATH           save what the window shows as PNG
 //! copy-view [NAME]          print the current view as a views.txt line
 //! score                     print the drawn method(s)' metrics against the CPU reference
+//! lose-device               destroy the GPU device, as a driver reset would (tests
+//!                           that the edits are saved to OUT/<world>-recovered)
 //! quit                      stop here (the end of the file does too)
 //! ```
 
@@ -57,6 +59,7 @@ pub enum Command {
     Screenshot(PathBuf),
     CopyView(String),
     Score,
+    LoseDevice,
     Quit,
 }
 
@@ -227,13 +230,17 @@ fn parse_line(line: &str) -> anyhow::Result<Command> {
             arity(0, 0)?;
             Command::Score
         }
+        "lose-device" => {
+            arity(0, 0)?;
+            Command::LoseDevice
+        }
         "quit" => {
             arity(0, 0)?;
             Command::Quit
         }
         other => bail!(
             "unknown command `{other}` (view, method, split, fly, goto, turn, frames, dig, undo, \
-             save, set, overlay, window, screenshot, copy-view, score, quit)"
+             save, set, overlay, window, screenshot, copy-view, score, lose-device, quit)"
         ),
     })
 }

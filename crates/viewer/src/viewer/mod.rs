@@ -117,6 +117,8 @@ pub struct Viewer {
     out: PathBuf,
     /// The loaded world's other files, for saving the edited level.
     saver: Saver,
+    /// Edits made since the world was loaded or last saved.
+    unsaved: bool,
     quit: bool,
 }
 
@@ -330,6 +332,7 @@ impl Viewer {
             screenshots: 0,
             out,
             saver,
+            unsaved: false,
             quit: false,
         };
         viewer.say(format!(
@@ -557,12 +560,37 @@ impl Viewer {
         match said {
             Ok(line) => {
                 self.say(line);
+                self.unsaved = false;
                 Ok(())
             }
             Err(e) => {
                 self.say(format!("not saved: {e:#}"));
                 Err(e)
             }
+        }
+    }
+
+    /// The viewer is stopping on an error (a lost device, say): save the
+    /// edits, if any, to `<out>/<world>-recovered` so none are lost, and
+    /// say where.
+    pub fn rescue(&mut self) {
+        if let Some(why) = self.gpu.errors.lost() {
+            self.say(format!(
+                "the GPU device was lost ({why}); what failed after it is a consequence"
+            ));
+        }
+        if !self.unsaved {
+            self.say("stopping on an error; no unsaved edits".into());
+            return;
+        }
+        let dir = self
+            .out
+            .join(format!("{}-recovered", self.saver.world().name));
+        match self.saver.save(&dir, &self.level) {
+            Ok(line) => self.say(format!("stopping on an error; your edits are kept: {line}")),
+            Err(e) => self.say(format!(
+                "stopping on an error; the edits could not be saved: {e:#}"
+            )),
         }
     }
 
@@ -582,6 +610,7 @@ impl Viewer {
         if dirty.is_empty() {
             return Ok(());
         }
+        self.unsaved = true;
         self.builds.record_edit(dirty);
         self.renderer.apply_edit(&self.level, dirty)?;
         let repainted = self.map.update(&self.level, &self.colors, dirty);

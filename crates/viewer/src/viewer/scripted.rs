@@ -212,6 +212,10 @@ impl Viewer {
                 self.score()?;
                 running = Some(Running::WaitScore(scored));
             }
+            Command::LoseDevice => {
+                self.say("destroying the GPU device (script)".into());
+                self.gpu.device.destroy();
+            }
             Command::Quit => self.quit = true,
         }
         // Run the first frame of a multi-frame command now.
