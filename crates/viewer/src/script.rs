@@ -20,6 +20,8 @@
 //! screenshot PATH           save what the window shows as PNG
 //! copy-view [NAME]          print the current view as a views.txt line
 //! score                     print the drawn method(s)' metrics against the CPU reference
+//! memory                    print a `memory …` line: process RSS, the renderer's GPU and
+//!                           CPU bytes (shared + kept methods), undo bytes (the soak)
 //! lose-device               destroy the GPU device, as a driver reset would (tests
 //!                           that the edits are saved to OUT/<world>-recovered)
 //! quit                      stop here (the end of the file does too)
@@ -59,6 +61,7 @@ pub enum Command {
     Screenshot(PathBuf),
     CopyView(String),
     Score,
+    Memory,
     LoseDevice,
     Quit,
 }
@@ -230,6 +233,10 @@ fn parse_line(line: &str) -> anyhow::Result<Command> {
             arity(0, 0)?;
             Command::Score
         }
+        "memory" => {
+            arity(0, 0)?;
+            Command::Memory
+        }
         "lose-device" => {
             arity(0, 0)?;
             Command::LoseDevice
@@ -240,7 +247,7 @@ fn parse_line(line: &str) -> anyhow::Result<Command> {
         }
         other => bail!(
             "unknown command `{other}` (view, method, split, fly, goto, turn, frames, dig, undo, \
-             save, set, overlay, window, screenshot, copy-view, score, lose-device, quit)"
+             save, set, overlay, window, screenshot, copy-view, score, memory, lose-device, quit)"
         ),
     })
 }
@@ -254,7 +261,7 @@ mod tests {
         let script = Script::parse(
             "# a flight\nview hangar\nmethod mesh  # switch\nsplit ray\nsplit off\n\
              fly 10 -2 3 5\ngoto 100 2000\nturn 15 -5\nframes 4\ndig 0.5 0.25\nundo\nsave out/w\nset ray-steps 64\n\
-             overlay off\nwindow 640 480\nscreenshot out/a.png\ncopy-view\nscore\nquit\n",
+             overlay off\nwindow 640 480\nscreenshot out/a.png\ncopy-view\nscore\nmemory\nlose-device\nquit\n",
         )
         .unwrap();
         let commands: Vec<_> = script.commands.iter().map(|(_, c)| c.clone()).collect();
@@ -284,6 +291,8 @@ mod tests {
                 Command::Screenshot("out/a.png".into()),
                 Command::CopyView("viewer".into()),
                 Command::Score,
+                Command::Memory,
+                Command::LoseDevice,
                 Command::Quit,
             ]
         );

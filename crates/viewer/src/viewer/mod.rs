@@ -594,6 +594,26 @@ impl Viewer {
         }
     }
 
+    /// One `memory` line (script `memory`; `strata soak` reads them):
+    /// frames, process RSS, the renderer's GPU bytes (shared + every kept
+    /// method) and kept methods' CPU bytes, the undo snapshots' bytes.
+    fn memory_line(&self) -> String {
+        let r = &self.renderer;
+        let kept = r.method_names();
+        let retained: Vec<_> = kept.iter().filter_map(|m| r.retained_bytes_of(m)).collect();
+        let gpu = r.shared_gpu_bytes() + retained.iter().map(|b| b.gpu).sum::<u64>();
+        let cpu: u64 = retained.iter().map(|b| b.cpu).sum();
+        let rss = crate::platform::rss_bytes().map_or("-".into(), |b| b.to_string());
+        format!(
+            "memory frames={} rss_bytes={rss} gpu_bytes={gpu} method_cpu_bytes={cpu} \
+             undo_bytes={} undo_depth={} kept={}",
+            self.frames,
+            self.digger.undo_bytes(),
+            self.digger.can_undo(),
+            kept.len()
+        )
+    }
+
     fn undo(&mut self) -> anyhow::Result<()> {
         match self.digger.undo(Arc::make_mut(&mut self.level)) {
             Some(dirty) => {

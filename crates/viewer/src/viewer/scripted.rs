@@ -212,6 +212,7 @@ impl Viewer {
                 self.score()?;
                 running = Some(Running::WaitScore(scored));
             }
+            Command::Memory => println!("{}", self.memory_line()),
             Command::LoseDevice => {
                 self.say("destroying the GPU device (script)".into());
                 self.gpu.device.destroy();
