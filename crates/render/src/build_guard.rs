@@ -5,7 +5,6 @@
 //! names the method, the picture size and the level size, so `compare` can
 //! record the cell and go on and the viewer can say what failed.
 
-use anyhow::Context;
 use strata_level::Level;
 
 /// Set to a method name, its build also asks for a buffer over the device's
@@ -65,13 +64,19 @@ pub fn guarded<T>(
                 innermost(&e)
             );
         }
-        built.with_context(|| target.describe())
+        flatten(built, target)
     }
     #[cfg(target_arch = "wasm32")]
     {
         let _ = device;
-        build().with_context(|| target.describe())
+        flatten(build(), target)
     }
+}
+
+/// The build's own error, prefixed with what was built, as one message (its
+/// `Display` keeps the reason, which a context layer would hide).
+fn flatten<T>(built: anyhow::Result<T>, target: &BuildTarget<'_>) -> anyhow::Result<T> {
+    built.map_err(|e| anyhow::anyhow!("{}: {e:#}", target.describe()))
 }
 
 /// The root cause of a wgpu error, one line (its full text is a

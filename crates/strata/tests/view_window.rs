@@ -326,6 +326,8 @@ fn scripted_save_writes_the_edited_world_and_keeps_the_source() {
         .arg(&world)
         .args(["--size", "320x200", "--render-scale", "0.5", "--script"])
         .arg(&script)
+        .arg("--out")
+        .arg(dir.join("out"))
         .env("DISPLAY", &display.name)
         .env_remove("WAYLAND_DISPLAY")
         .env("XDG_RUNTIME_DIR", &runtime);
