@@ -14,6 +14,7 @@ pub mod huffman;
 pub mod io;
 pub mod model;
 pub mod palette;
+pub mod save;
 pub mod stats;
 pub mod views;
 pub mod vmc;

@@ -25,12 +25,24 @@ pub struct AdapterReport {
 /// Errors reported by the device asynchronously (validation, out of memory,
 /// device lost). Shared with every renderer built on the device.
 #[derive(Clone, Default)]
-pub struct ErrorSink(Arc<Mutex<Vec<String>>>);
+pub struct ErrorSink(Arc<Mutex<Vec<String>>>, Arc<Mutex<Option<String>>>);
 
 impl ErrorSink {
     fn push(&self, msg: String) {
         if let Ok(mut v) = self.0.lock() {
             v.push(msg);
+        }
+    }
+
+    /// Why the device was lost (destroyed included), once it has been: what
+    /// fails after that is only a consequence.
+    pub fn lost(&self) -> Option<String> {
+        self.1.lock().ok().and_then(|l| l.clone())
+    }
+
+    fn set_lost(&self, why: String) {
+        if let Ok(mut l) = self.1.lock() {
+            l.get_or_insert(why);
         }
     }
 
@@ -311,6 +323,10 @@ impl Gpu {
         device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| sink.push(e.to_string())));
         let sink = errors.clone();
         device.set_device_lost_callback(move |reason, msg| {
+            sink.set_lost(match msg.as_str() {
+                "" => format!("{reason:?}"),
+                _ => format!("{reason:?}: {msg}"),
+            });
             // A deliberate drop of the device is not an error.
             if reason != wgpu::DeviceLostReason::Destroyed {
                 sink.push(format!("device lost ({reason:?}): {msg}"));

@@ -19,6 +19,7 @@
 #[cfg(test)]
 extern crate self as strata_render;
 
+pub mod build_guard;
 pub mod caps;
 pub mod depth_read;
 pub mod frame;

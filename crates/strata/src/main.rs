@@ -43,6 +43,8 @@ enum Command {
     Video(cmd::video::Args),
     /// Open a window: fly over the level, switch methods live, dig craters.
     View(cmd::view::Args),
+    /// A long scripted viewer session (digs, undos, switches, resizes, splits) sampling memory.
+    Soak(cmd::soak::Args),
     /// Serve the browser build of the viewer (and a world directory) on localhost.
     Serve(cmd::serve::Args),
 }
@@ -62,6 +64,7 @@ fn main() -> std::process::ExitCode {
         Command::View(args) => cmd::view::run(args),
         Command::Video(args) => cmd::video::run(args),
         Command::Serve(args) => cmd::serve::run(args),
+        Command::Soak(args) => cmd::soak::run(args),
         Command::Adapters(args) => cmd::adapters::run(args),
     };
     match result {

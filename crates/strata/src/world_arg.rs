@@ -25,6 +25,14 @@ impl WorldArgs {
         }
     }
 
+    /// The directory the world is loaded from: `--level`, else the default
+    /// world's cache (saves must not write over either unasked).
+    pub fn source_dir(&self) -> Option<PathBuf> {
+        self.level
+            .clone()
+            .or_else(|| cache_root().map(|root| cache_dir(&root, &GenerateParams::default())))
+    }
+
     /// The world named by `--level`, else the default generated world, read
     /// from the on-disk cache (written there the first time).
     pub fn load(&self) -> anyhow::Result<World> {

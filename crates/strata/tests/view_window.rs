@@ -67,7 +67,10 @@ fn display() -> Option<Display> {
 }
 
 fn run(mut command: Command, limit: Duration) -> (bool, String, String) {
-    let out_path = std::env::temp_dir().join(format!("strata-view-{}.out", std::process::id()));
+    // One file pair per run: the tests of this file run in parallel.
+    static RUNS: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
+    let n = RUNS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let out_path = std::env::temp_dir().join(format!("strata-view-{}-{n}.out", std::process::id()));
     let err_path = out_path.with_extension("err");
     let mut child = command
         .stdout(std::fs::File::create(&out_path).unwrap())
@@ -260,4 +263,173 @@ fn scripted_flight_switches_method_digs_and_undoes() {
     for (x, y) in [(0, 0), (319, 0), (0, 239), (319, 239), (160, 1), (1, 120)] {
         assert_ne!(*resized.get_pixel(x, y), bars, "bars at {x},{y}");
     }
+}
+
+/// Every file of a directory, by name.
+fn dir_files(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut files: Vec<_> = std::fs::read_dir(dir)
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+        .map(|e| {
+            let e = e.unwrap();
+            let name = e.file_name().to_string_lossy().into_owned();
+            (name, std::fs::read(e.path()).unwrap())
+        })
+        .collect();
+    files.sort();
+    files
+}
+
+/// `save DIR` writes the edited world in the real format (reloaded, its
+/// level is the one the viewer held: same hash), an undone edit saves the
+/// source's exact bytes, and a save over the loaded world is refused
+/// without `--overwrite`, leaving it untouched.
+#[test]
+fn scripted_save_writes_the_edited_world_and_keeps_the_source() {
+    let Some(display) = display() else {
+        skip_loudly(
+            "no display (set DISPLAY or install xvfb)",
+            "STRATA_REQUIRE_DISPLAY",
+        );
+        return;
+    };
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("view_save");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let world = dir.join("world");
+    let generated = Command::new(STRATA)
+        .args(["generate", "--size", "256x512", "--out"])
+        .arg(&world)
+        .output()
+        .unwrap();
+    assert!(generated.status.success(), "{generated:?}");
+    let source = dir_files(&world);
+    let script = dir.join("save.txt");
+    std::fs::write(
+        &script,
+        format!(
+            "view edit\noverlay off\ndig 0.5 0.5\nsave {d}/dug\nundo\nsave {d}/undone\nsave {w}\n",
+            d = dir.display(),
+            w = world.display()
+        ),
+    )
+    .unwrap();
+    let runtime = dir.join("xdg");
+    std::fs::create_dir_all(&runtime).unwrap();
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        std::fs::set_permissions(&runtime, std::fs::Permissions::from_mode(0o700)).unwrap();
+    }
+    let mut command = Command::new(STRATA);
+    command
+        .args(["view", "--level"])
+        .arg(&world)
+        .args(["--size", "320x200", "--render-scale", "0.5", "--script"])
+        .arg(&script)
+        .arg("--out")
+        .arg(dir.join("out"))
+        .env("DISPLAY", &display.name)
+        .env_remove("WAYLAND_DISPLAY")
+        .env("XDG_RUNTIME_DIR", &runtime);
+    let (ok, _, stderr) = run(command, Duration::from_secs(300));
+    if !ok && stderr.contains("no GPU adapter") {
+        skip_loudly("no GPU adapter", "STRATA_REQUIRE_GPU");
+        return;
+    }
+    // The last line (a save over the loaded world) fails the script.
+    assert!(
+        !ok,
+        "saving over the loaded world was not refused:\n{stderr}"
+    );
+    assert!(stderr.contains("--overwrite"), "{stderr}");
+    assert_eq!(
+        dir_files(&world),
+        source,
+        "the refused save changed the source"
+    );
+
+    let said: Vec<&str> = stderr
+        .lines()
+        .filter(|l| l.contains("saved the world to"))
+        .collect();
+    assert_eq!(said.len(), 2, "{stderr}");
+    let hash_said = |line: &str| line.split("level ").nth(1).unwrap()[..16].to_string();
+    let load = |name: &str| {
+        strata_level::io::load_world(&dir.join(name), strata_level::MidRule::Original).unwrap()
+    };
+    let (dug, original) = (load("dug"), load("world"));
+    assert_eq!(&dug.level.content_hash()[..16], hash_said(said[0]));
+    assert_ne!(dug.level, original.level, "the saved dig changed nothing");
+    assert_eq!(dug.palette.colors, original.palette.colors);
+    assert_eq!(dug.views, original.views);
+    // Undone: the source's files byte for byte (unedited rows keep their codes).
+    assert_eq!(&original.level.content_hash()[..16], hash_said(said[1]));
+    assert_eq!(dir_files(&dir.join("undone")), source);
+}
+
+/// A lost GPU device (the script destroys it, as a driver reset would)
+/// stops the viewer with the reason said, and the edits are saved to
+/// `OUT/<world>-recovered`: the same level as a save of the same dig (made,
+/// undone and dug again, so that unsaved edits are what is lost).
+#[test]
+fn a_lost_device_stops_the_viewer_and_keeps_the_edits() {
+    let Some(display) = display() else {
+        skip_loudly(
+            "no display (set DISPLAY or install xvfb)",
+            "STRATA_REQUIRE_DISPLAY",
+        );
+        return;
+    };
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("view_lost");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let world = dir.join("world");
+    let generated = Command::new(STRATA)
+        .args(["generate", "--size", "256x512", "--out"])
+        .arg(&world)
+        .output()
+        .unwrap();
+    assert!(generated.status.success(), "{generated:?}");
+    let script = dir.join("lose.txt");
+    std::fs::write(
+        &script,
+        format!(
+            "view edit\noverlay off\ndig 0.5 0.5\nsave {d}/dug\nundo\ndig 0.5 0.5\n\
+             lose-device\nframes 3\n",
+            d = dir.display()
+        ),
+    )
+    .unwrap();
+    let runtime = dir.join("xdg");
+    std::fs::create_dir_all(&runtime).unwrap();
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        std::fs::set_permissions(&runtime, std::fs::Permissions::from_mode(0o700)).unwrap();
+    }
+    let out = dir.join("out");
+    let mut command = Command::new(STRATA);
+    command
+        .args(["view", "--level"])
+        .arg(&world)
+        .args(["--size", "320x200", "--render-scale", "0.5", "--script"])
+        .arg(&script)
+        .arg("--out")
+        .arg(&out)
+        .env("DISPLAY", &display.name)
+        .env_remove("WAYLAND_DISPLAY")
+        .env("XDG_RUNTIME_DIR", &runtime);
+    let (ok, _, stderr) = run(command, Duration::from_secs(300));
+    if !ok && stderr.contains("no GPU adapter") {
+        skip_loudly("no GPU adapter", "STRATA_REQUIRE_GPU");
+        return;
+    }
+    assert!(!ok, "the viewer went on without a device:\n{stderr}");
+    assert!(stderr.contains("the GPU device was lost"), "{stderr}");
+    assert!(stderr.contains("your edits are kept"), "{stderr}");
+    let load =
+        |path: &Path| strata_level::io::load_world(path, strata_level::MidRule::Original).unwrap();
+    let recovered = load(&out.join("world-recovered"));
+    assert_eq!(recovered.level, load(&dir.join("dug")).level);
+    assert_ne!(recovered.level, load(&world).level);
 }

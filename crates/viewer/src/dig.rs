@@ -82,6 +82,11 @@ impl Digger {
     pub fn can_undo(&self) -> usize {
         self.undo.len()
     }
+
+    /// Bytes the undo snapshots hold.
+    pub fn undo_bytes(&self) -> usize {
+        self.undo.iter().map(Snapshot::bytes).sum()
+    }
 }
 
 #[cfg(test)]

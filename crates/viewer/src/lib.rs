@@ -9,7 +9,7 @@
 //!
 //! Modules: [`fly`] (camera), [`dig`] (pick, crater, undo), [`knobs`]
 //! (settings), [`minimap`], [`script`],
-//! [`builds`] (background method builds), [`present`] (picture to window),
+//! [`builds`] (background method builds), [`save`] (Ctrl+S), [`present`] (picture to window),
 //! [`overlay`] (egui), [`viewer`] (state and frame), and here the event loop.
 
 pub mod builds;
@@ -20,6 +20,7 @@ pub mod minimap;
 pub mod overlay;
 pub mod platform;
 pub mod present;
+pub mod save;
 pub mod script;
 pub mod viewer;
 #[cfg(target_arch = "wasm32")]
@@ -55,6 +56,8 @@ pub struct Options {
     pub adapter: strata_render::AdapterChoice,
     /// Where screenshots taken with P or the overlay go.
     pub out: PathBuf,
+    /// Where Ctrl+S and script `save` may write the edited world.
+    pub save: save::SaveOptions,
 }
 
 /// Open the window and run until it is closed or the script ends.
@@ -119,6 +122,11 @@ impl App {
     }
 
     fn fail(&mut self, event_loop: &ActiveEventLoop, error: anyhow::Error) {
+        eprintln!("strata view: stopping: {error:#}");
+        // The level lives on the CPU: a lost device loses no edits.
+        if let Some(viewer) = &mut self.viewer {
+            viewer.rescue();
+        }
         self.error.get_or_insert(error);
         // Drop the window and GPU state before the loop ends.
         self.viewer = None;

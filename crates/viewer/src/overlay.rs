@@ -122,6 +122,10 @@ pub const CONTROLS: &[(&str, &str)] = &[
     ("right mouse drag", "look around"),
     ("left click", "dig a crater at the cursor"),
     ("Ctrl+Z or U", "undo the last dig"),
+    #[cfg(not(target_arch = "wasm32"))]
+    ("Ctrl+S", "save the edited world (--save-to)"),
+    #[cfg(target_arch = "wasm32")]
+    ("Ctrl+S", "saving: not available in the browser"),
     ("1 .. 9, 0", "switch method (built on first use)"),
     ("B", "A/B split: this method left, the previous one right"),
     ("F1 .. F12", "jump to the level's views"),

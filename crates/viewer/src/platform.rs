@@ -1,6 +1,6 @@
 //! What differs between a native window and a browser page, besides the
 //! event loop and the device request (in `lib.rs` and [`crate::web`]):
-//! where a saved file goes.
+//! where a saved file goes, and the process's resident memory.
 
 use std::path::Path;
 
@@ -22,4 +22,13 @@ pub fn save_file(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
         }
         std::fs::write(path, bytes).with_context(|| format!("writing {}", path.display()))
     }
+}
+
+/// The process's resident set size in bytes (`VmRSS` of `/proc/self/status`,
+/// Linux); `None` where there is no such file (other systems, a browser).
+pub fn rss_bytes() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmRSS:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
 }

@@ -13,12 +13,17 @@
 //! frames N                  render N frames
 //! dig X Y                   click at (X, Y) of the picture, fractions 0..1 (0.5 0.5 = centre)
 //! undo                      undo the last dig
+//! save DIR                  save the edited world as a world directory (see `save`)
 //! set KNOB VALUE            ray-steps, voxel-steps, slices, density, mesh-quality, shadows (0/1)
 //! overlay on|off            show or hide the overlay
 //! window W H                resize the window (the picture follows)
 //! screenshot PATH           save what the window shows as PNG
 //! copy-view [NAME]          print the current view as a views.txt line
 //! score                     print the drawn method(s)' metrics against the CPU reference
+//! memory                    print a `memory …` line: process RSS, the renderer's GPU and
+//!                           CPU bytes (shared + kept methods), undo bytes (the soak)
+//! lose-device               destroy the GPU device, as a driver reset would (tests
+//!                           that the edits are saved to OUT/<world>-recovered)
 //! quit                      stop here (the end of the file does too)
 //! ```
 
@@ -47,6 +52,8 @@ pub enum Command {
     /// Fractions of the picture's width and height.
     Dig(f32, f32),
     Undo,
+    /// A world directory to save the edited world into.
+    Save(PathBuf),
     Set(Knob, f32),
     Overlay(bool),
     /// Window inner size, pixels.
@@ -54,6 +61,8 @@ pub enum Command {
     Screenshot(PathBuf),
     CopyView(String),
     Score,
+    Memory,
+    LoseDevice,
     Quit,
 }
 
@@ -186,6 +195,10 @@ fn parse_line(line: &str) -> anyhow::Result<Command> {
             arity(0, 0)?;
             Command::Undo
         }
+        "save" => {
+            arity(1, 1)?;
+            Command::Save(PathBuf::from(args[0]))
+        }
         "set" => {
             arity(2, 2)?;
             Command::Set(Knob::parse(args[0])?, finite(args[1], "value")?)
@@ -220,13 +233,21 @@ fn parse_line(line: &str) -> anyhow::Result<Command> {
             arity(0, 0)?;
             Command::Score
         }
+        "memory" => {
+            arity(0, 0)?;
+            Command::Memory
+        }
+        "lose-device" => {
+            arity(0, 0)?;
+            Command::LoseDevice
+        }
         "quit" => {
             arity(0, 0)?;
             Command::Quit
         }
         other => bail!(
             "unknown command `{other}` (view, method, split, fly, goto, turn, frames, dig, undo, \
-             set, overlay, window, screenshot, copy-view, score, quit)"
+             save, set, overlay, window, screenshot, copy-view, score, memory, lose-device, quit)"
         ),
     })
 }
@@ -239,8 +260,8 @@ mod tests {
     fn parses_every_command() {
         let script = Script::parse(
             "# a flight\nview hangar\nmethod mesh  # switch\nsplit ray\nsplit off\n\
-             fly 10 -2 3 5\ngoto 100 2000\nturn 15 -5\nframes 4\ndig 0.5 0.25\nundo\nset ray-steps 64\n\
-             overlay off\nwindow 640 480\nscreenshot out/a.png\ncopy-view\nscore\nquit\n",
+             fly 10 -2 3 5\ngoto 100 2000\nturn 15 -5\nframes 4\ndig 0.5 0.25\nundo\nsave out/w\nset ray-steps 64\n\
+             overlay off\nwindow 640 480\nscreenshot out/a.png\ncopy-view\nscore\nmemory\nlose-device\nquit\n",
         )
         .unwrap();
         let commands: Vec<_> = script.commands.iter().map(|(_, c)| c.clone()).collect();
@@ -263,12 +284,15 @@ mod tests {
                 Command::Frames(4),
                 Command::Dig(0.5, 0.25),
                 Command::Undo,
+                Command::Save("out/w".into()),
                 Command::Set(Knob::RaySteps, 64.0),
                 Command::Overlay(false),
                 Command::Window(640, 480),
                 Command::Screenshot("out/a.png".into()),
                 Command::CopyView("viewer".into()),
                 Command::Score,
+                Command::Memory,
+                Command::LoseDevice,
                 Command::Quit,
             ]
         );

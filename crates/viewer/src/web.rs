@@ -254,6 +254,7 @@ impl App {
                 vsync: parts.vsync,
                 adapter: Default::default(),
                 out: parts.out,
+                save: Default::default(),
             };
             let opened = Viewer::new(parts.window, parts.surface, parts.gpu, options);
             self.opened(event_loop, opened);

@@ -128,6 +128,7 @@ pub async fn run() -> anyhow::Result<()> {
             vsync: true,
             adapter: Default::default(),
             out: "screenshots".into(),
+            save: Default::default(),
         },
         params.backend,
     )

@@ -357,7 +357,9 @@ pub fn supported(caps: &Capabilities) -> Vec<&'static str> {
 }
 
 /// Build the method called `name`; refused before any GPU work when the
-/// shared frame's adapter lacks what it needs.
+/// shared frame's adapter lacks what it needs. A GPU error during the build
+/// (out of memory, a refused allocation) is an error naming the method and
+/// the sizes ([`crate::build_guard`]).
 pub fn create(
     name: &str,
     shared: &Shared,
@@ -366,7 +368,15 @@ pub fn create(
 ) -> anyhow::Result<Box<dyn Method>> {
     let entry = entry(name)?;
     entry.check(&shared.caps)?;
-    (entry.create)(shared, level, settings)
+    let target = crate::build_guard::BuildTarget {
+        method: entry.name,
+        width: shared.width,
+        height: shared.height,
+        level,
+    };
+    crate::build_guard::guarded(&shared.device, &target, || {
+        (entry.create)(shared, level, settings)
+    })
 }
 
 /// Start building the method called `name` in slices ([`BuildSteps`]);

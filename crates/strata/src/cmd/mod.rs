@@ -10,6 +10,7 @@ pub mod metrics;
 pub mod reference;
 pub mod render;
 pub mod serve;
+pub mod soak;
 pub mod survey;
 pub mod video;
 pub mod view;

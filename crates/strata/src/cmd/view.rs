@@ -6,6 +6,8 @@ use crate::adapter_arg::AdapterArgs;
 use crate::cmd::render::{MethodArgs, parse_size};
 use crate::world_arg::WorldArgs;
 use std::path::PathBuf;
+use strata_level::save::SavePolicy;
+use strata_viewer::save::SaveOptions;
 use strata_viewer::{Options, Script};
 
 #[derive(clap::Args)]
@@ -43,6 +45,12 @@ pub struct Args {
     /// Where screenshots (key P) go.
     #[arg(long, default_value = "out/view")]
     pub out: PathBuf,
+    /// Where Ctrl+S saves the edited world [default: OUT/<world>-edited, or the loaded world's directory with --overwrite].
+    #[arg(long, value_name = "DIR")]
+    pub save_to: Option<PathBuf>,
+    /// Let a save (Ctrl+S, script `save`) write over the loaded world's own directory.
+    #[arg(long)]
+    pub overwrite: bool,
 }
 
 pub fn run(args: Args) -> anyhow::Result<()> {
@@ -73,5 +81,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         vsync: !args.no_vsync,
         adapter: args.adapter.choice(),
         out: args.out,
+        save: SaveOptions {
+            policy: SavePolicy {
+                source: args.world.source_dir(),
+                overwrite: args.overwrite,
+            },
+            dir: args.save_to,
+        },
     })
 }

@@ -1,5 +1,5 @@
 //! Keys and mouse: the fly camera's motion, looking around, digging, and
-//! the command keys (methods, views, split, undo, copy view, screenshot).
+//! the command keys (methods, views, split, undo, save, copy view, screenshot).
 
 use super::{Viewer, scaled};
 use crate::fly::Motion;
@@ -156,6 +156,10 @@ impl Viewer {
                 KeyCode::KeyP => self.screenshot_after_frame = Some(self.next_screenshot_path()),
                 KeyCode::KeyU => self.undo()?,
                 KeyCode::KeyZ if self.ctrl => self.undo()?,
+                // A failed save is in the log; the session and its edits go on.
+                KeyCode::KeyS if self.ctrl => {
+                    let _ = self.save(None);
+                }
                 _ => {}
             }
         }

@@ -16,6 +16,7 @@ use crate::knobs::{Knob, relevant};
 use crate::minimap::Minimap;
 use crate::overlay::{self, Action, Building, Drawn, Editable, Overlay, Status};
 use crate::present::{Compositor, WINDOW_FORMAT};
+use crate::save::Saver;
 use anyhow::{Context, bail};
 use readback::Scoring;
 use scripted::Player;
@@ -114,6 +115,10 @@ pub struct Viewer {
     screenshot_reading: Option<(PathBuf, TextureReadback)>,
     screenshots: u32,
     out: PathBuf,
+    /// The loaded world's other files, for saving the edited level.
+    saver: Saver,
+    /// Edits made since the world was loaded or last saved.
+    unsaved: bool,
     quit: bool,
 }
 
@@ -209,6 +214,7 @@ impl Viewer {
             vsync,
             adapter: _,
             out,
+            save,
         } = options;
         let opened = Instant::now();
         let _ = size;
@@ -228,8 +234,10 @@ impl Viewer {
             bail!("--render-scale {scale} must be in (0, 4]");
         }
         let render_size = scaled(window_size, scale);
-        let level = world.level;
-        let mut views = world.views;
+        let (saver, level) = Saver::new(world, save, &out);
+        let world = saver.world();
+        let name = world.name.clone();
+        let mut views = world.views.clone();
         // The edit fixture's camera is a view too: it looks at the crater site.
         if let Some(edit) = &world.edit
             && !views.iter().any(|v| v.name == edit.camera.name)
@@ -323,11 +331,13 @@ impl Viewer {
             screenshot_reading: None,
             screenshots: 0,
             out,
+            saver,
+            unsaved: false,
             quit: false,
         };
         viewer.say(format!(
             "{} on {} ({}), render {}x{}; window, device and {FIRST_METHOD} ready in {:.2} s",
-            world.name,
+            name,
             viewer.gpu.report.name,
             viewer.gpu.report.backend,
             render_size.0,
@@ -542,6 +552,68 @@ impl Viewer {
         Ok(())
     }
 
+    /// Save the edited world to `dir` (Ctrl+S: the default directory).
+    /// A refused or failed save is said and the session goes on.
+    fn save(&mut self, dir: Option<PathBuf>) -> anyhow::Result<()> {
+        let dir = dir.unwrap_or_else(|| self.saver.default_dir.clone());
+        let said = self.saver.save(&dir, &self.level);
+        match said {
+            Ok(line) => {
+                self.say(line);
+                self.unsaved = false;
+                Ok(())
+            }
+            Err(e) => {
+                self.say(format!("not saved: {e:#}"));
+                Err(e)
+            }
+        }
+    }
+
+    /// The viewer is stopping on an error (a lost device, say): save the
+    /// edits, if any, to `<out>/<world>-recovered` so none are lost, and
+    /// say where.
+    pub fn rescue(&mut self) {
+        if let Some(why) = self.gpu.errors.lost() {
+            self.say(format!(
+                "the GPU device was lost ({why}); what failed after it is a consequence"
+            ));
+        }
+        if !self.unsaved {
+            self.say("stopping on an error; no unsaved edits".into());
+            return;
+        }
+        let dir = self
+            .out
+            .join(format!("{}-recovered", self.saver.world().name));
+        match self.saver.save(&dir, &self.level) {
+            Ok(line) => self.say(format!("stopping on an error; your edits are kept: {line}")),
+            Err(e) => self.say(format!(
+                "stopping on an error; the edits could not be saved: {e:#}"
+            )),
+        }
+    }
+
+    /// One `memory` line (script `memory`; `strata soak` reads them):
+    /// frames, process RSS, the renderer's GPU bytes (shared + every kept
+    /// method) and kept methods' CPU bytes, the undo snapshots' bytes.
+    fn memory_line(&self) -> String {
+        let r = &self.renderer;
+        let kept = r.method_names();
+        let retained: Vec<_> = kept.iter().filter_map(|m| r.retained_bytes_of(m)).collect();
+        let gpu = r.shared_gpu_bytes() + retained.iter().map(|b| b.gpu).sum::<u64>();
+        let cpu: u64 = retained.iter().map(|b| b.cpu).sum();
+        let rss = crate::platform::rss_bytes().map_or("-".into(), |b| b.to_string());
+        format!(
+            "memory frames={} rss_bytes={rss} gpu_bytes={gpu} method_cpu_bytes={cpu} \
+             undo_bytes={} undo_depth={} kept={}",
+            self.frames,
+            self.digger.undo_bytes(),
+            self.digger.can_undo(),
+            kept.len()
+        )
+    }
+
     fn undo(&mut self) -> anyhow::Result<()> {
         match self.digger.undo(Arc::make_mut(&mut self.level)) {
             Some(dirty) => {
@@ -558,6 +630,7 @@ impl Viewer {
         if dirty.is_empty() {
             return Ok(());
         }
+        self.unsaved = true;
         self.builds.record_edit(dirty);
         self.renderer.apply_edit(&self.level, dirty)?;
         let repainted = self.map.update(&self.level, &self.colors, dirty);

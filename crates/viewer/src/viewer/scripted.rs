@@ -186,6 +186,7 @@ impl Viewer {
                 self.dig_at((px, py))?;
             }
             Command::Undo => self.undo()?,
+            Command::Save(dir) => self.save(Some(dir))?,
             Command::Set(knob, value) => {
                 self.set_knob(knob, value)?;
                 running = Some(Running::WaitBuilds);
@@ -210,6 +211,11 @@ impl Viewer {
                 let scored = self.scored + 1;
                 self.score()?;
                 running = Some(Running::WaitScore(scored));
+            }
+            Command::Memory => println!("{}", self.memory_line()),
+            Command::LoseDevice => {
+                self.say("destroying the GPU device (script)".into());
+                self.gpu.device.destroy();
             }
             Command::Quit => self.quit = true,
         }

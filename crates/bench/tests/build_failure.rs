@@ -1,0 +1,101 @@
+//! A method whose build the GPU refuses (here: forced to ask for a buffer
+//! over the device's `max_buffer_size`, as a build too large for the GPU
+//! would) is one failure naming the method and the sizes, in the results
+//! JSON and the report, and the run goes on with the next method, whose
+//! cells and edit row are all there. Runs on any adapter.
+
+use strata_bench::plan::MethodChoice;
+use strata_bench::run::{EditMode, Options, Plan};
+use strata_level::ViewSpec;
+use strata_level::generate::{GenerateParams, generate};
+use strata_render::Gpu;
+use strata_render::build_guard::FORCE_OVERSIZE_ENV;
+
+fn skip_loudly(why: &str) {
+    use std::io::Write;
+    if std::env::var_os("STRATA_REQUIRE_GPU").is_some_and(|v| v == "1") {
+        panic!("STRATA_REQUIRE_GPU=1 but {why}");
+    }
+    let _ = writeln!(std::io::stderr(), "\n*** SKIPPED GPU test: {why} ***\n");
+}
+
+#[test]
+fn a_build_the_gpu_refuses_is_recorded_and_the_next_method_runs() {
+    // SAFETY: this file holds one test, so no other thread reads the
+    // environment meanwhile.
+    unsafe { std::env::set_var(FORCE_OVERSIZE_ENV, "ray") };
+    let gpu = match Gpu::headless() {
+        Ok(gpu) => gpu,
+        Err(e) => return skip_loudly(&format!("no GPU adapter ({e:#})")),
+    };
+    let world = generate(&GenerateParams {
+        seed: 4,
+        width: 256,
+        height: 512,
+    })
+    .unwrap();
+    let out = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("build_failure");
+    let _ = std::fs::remove_dir_all(&out);
+    let methods = ["ray", "painted"]
+        .iter()
+        .map(|n| MethodChoice {
+            name: (*n).into(),
+            setting: None,
+        })
+        .collect();
+    let opts = Options {
+        out: out.clone(),
+        methods,
+        views: vec![
+            ViewSpec::parse("low", "100,100:0:30", 0.0).unwrap(),
+            ViewSpec::parse("down", "120,300:90:80", -60.0).unwrap(),
+        ],
+        width: 32,
+        height: 20,
+        frames: 1,
+        min_warmup: 1,
+        shadows: true,
+        edits: EditMode::Required,
+        temporal: false,
+        cache_dir: out.join("cache"),
+    };
+    let (json, report) = Plan::new(world, opts).unwrap().run(&gpu).unwrap();
+    let run = strata_bench::merge::read_run(&json).unwrap();
+    // The other method: every view and its edit row.
+    let drawn: Vec<(&str, &str)> = run
+        .rows
+        .iter()
+        .map(|r| (r.method.as_str(), r.view.as_str()))
+        .collect();
+    assert_eq!(drawn, vec![("painted", "low"), ("painted", "down")]);
+    let edits: Vec<&str> = run.edit_rows.iter().map(|e| e.method.as_str()).collect();
+    assert_eq!(edits, vec!["painted"]);
+    // The refused build: its column and its edit row, each naming the method
+    // and the sizes.
+    let failed: Vec<(&str, &str)> = run
+        .failures
+        .iter()
+        .map(|f| (f.view.as_str(), f.method.as_str()))
+        .collect();
+    assert_eq!(
+        failed,
+        vec![("*", "ray"), ("edit", "ray")],
+        "{:?}",
+        run.failures
+    );
+    for f in &run.failures {
+        for needle in [
+            "building `ray`",
+            "32x20 picture",
+            "256x512 level",
+            "refused",
+        ] {
+            assert!(f.error.contains(needle), "`{needle}` not in: {}", f.error);
+        }
+    }
+    assert!(run.complete);
+    let report = std::fs::read_to_string(report).unwrap();
+    assert!(report.contains("building `ray`"), "{report}");
+    // The device is still good: the failure left nothing in its error sink.
+    gpu.wait().unwrap();
+}
