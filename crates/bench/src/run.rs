@@ -263,7 +263,10 @@ impl Plan {
             self.cameras.len() * n_methods + if self.edit.is_some() { n_methods } else { 0 };
         let kept = session.results.rows.len() + session.results.edit_rows.len();
         let bar = ProgressBar::new(total.saturating_sub(kept) as u64);
-        let mut measured = 0usize;
+        let mut count = CellCount {
+            measured: 0,
+            stop_after: stop_after_cells,
+        };
         bar.set_style(
             ProgressStyle::with_template(
                 "{bar:30} {pos}/{len} cells  {msg}  [{elapsed_precise}, {eta_precise} left]",
@@ -281,15 +284,7 @@ impl Plan {
                 session.save_json()?;
                 continue;
             }
-            let column = self.method_column(
-                gpu,
-                &mut session,
-                &references,
-                m,
-                &bar,
-                &mut measured,
-                stop_after_cells,
-            );
+            let column = self.method_column(gpu, &mut session, &references, m, &bar, &mut count);
             if let Err(e) = column {
                 if e.is::<Stopped>() {
                     return Err(e);
@@ -485,8 +480,7 @@ impl Plan {
         references: &[Reference],
         m: usize,
         bar: &ProgressBar,
-        measured: &mut usize,
-        stop_after_cells: Option<usize>,
+        count: &mut CellCount,
     ) -> anyhow::Result<()> {
         let choice = &self.opts.methods[m];
         let label = choice.label();
@@ -512,8 +506,8 @@ impl Plan {
         )?;
         let setup_ms = ms(start);
         for (i, &v) in todo.iter().enumerate() {
-            if stop_after_cells.is_some_and(|n| *measured >= n) {
-                return Err(Stopped(*measured).into());
+            if count.stop_after.is_some_and(|n| count.measured >= n) {
+                return Err(Stopped(count.measured).into());
             }
             let (view, camera) = (&self.opts.views[v], &self.cameras[v]);
             bar.set_message(format!("{} / {label}", view.name));
@@ -546,7 +540,7 @@ impl Plan {
             }
             session.save_json()?;
             bar.inc(1);
-            *measured += 1;
+            count.measured += 1;
         }
         Ok(())
     }
@@ -662,6 +656,12 @@ impl Plan {
             image,
         })
     }
+}
+
+/// Cells measured so far in this call, and where [`Plan::run_until`] stops.
+struct CellCount {
+    measured: usize,
+    stop_after: Option<usize>,
 }
 
 /// [`Plan::run_until`] stopped on purpose after this many cells.

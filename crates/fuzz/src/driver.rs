@@ -167,10 +167,13 @@ pub fn save_regression(dir: &Path, reader: &str, input: &[u8]) -> std::io::Resul
     Ok(path)
 }
 
+/// A regression file and what its reader did with it.
+pub type Replayed = (PathBuf, Result<(), String>);
+
 /// Every regression file under `dir` run through its reader: the files
 /// found and the outcome of each. A directory not named after a reader is
 /// an error.
-pub fn replay(dir: &Path) -> Result<Vec<(PathBuf, Result<(), String>)>, String> {
+pub fn replay(dir: &Path) -> Result<Vec<Replayed>, String> {
     let mut out = Vec::new();
     let Ok(entries) = std::fs::read_dir(dir) else {
         return Ok(out);

@@ -20,12 +20,14 @@ use strata_level::{EditSite, LevelError, Palette, WorldConfig, vmc, vmp};
 /// Most edits applied to one seed.
 const MAX_EDITS: usize = 6;
 
+/// Runs the reader on one input; `Err` says how it misbehaved short of panicking.
+pub type Check = fn(&[u8]) -> Result<(), String>;
+
 pub struct Reader {
     /// Also the regression directory's name.
     pub name: &'static str,
     pub inputs: BoxedStrategy<Vec<u8>>,
-    /// Run the reader; `Err` says how it misbehaved short of panicking.
-    pub check: fn(&[u8]) -> Result<(), String>,
+    pub check: Check,
 }
 
 /// Every reader's name, in the order [`all`] gives them.
@@ -46,7 +48,7 @@ pub fn all() -> Vec<Reader> {
 }
 
 pub fn by_name(name: &str) -> Option<Reader> {
-    let (inputs, check): (BoxedStrategy<Vec<u8>>, fn(&[u8]) -> Result<(), String>) = match name {
+    let (inputs, check): (BoxedStrategy<Vec<u8>>, Check) = match name {
         "world-ini" => (text(seeds::world_ini(), INI_WORDS), check_ini),
         "vmc" => (vmc_inputs(), check_vmc),
         "vmp" => (map_inputs(seeds::vmp()), check_vmp),
