@@ -74,16 +74,17 @@ fn main() {
         seed,
     };
     println!(
-        "{:<14} {:>12} {:>10} {:>12} {:>9}",
-        "reader", "inputs", "seconds", "inputs/s", "failures"
+        "{:<14} {:>12} {:>9} {:>10} {:>12} {:>9}",
+        "reader", "inputs", "accepted", "seconds", "inputs/s", "failures"
     );
     let mut failed = 0;
     for reader in &readers {
         let outcome = fuzz(reader, budget);
         println!(
-            "{:<14} {:>12} {:>10.1} {:>12.0} {:>9}",
+            "{:<14} {:>12} {:>8.1}% {:>10.1} {:>12.0} {:>9}",
             outcome.reader,
             outcome.inputs,
+            100.0 * outcome.accepted as f64 / outcome.inputs.max(1) as f64,
             outcome.seconds,
             outcome.per_second(),
             outcome.failures.len()

@@ -33,13 +33,13 @@ pub fn quiet_panics() {
     }));
 }
 
-/// Run one input: `Err` when the reader panicked, allocated more than
-/// [`alloc_bound`], or failed its check.
-pub fn try_input(reader: &Reader, input: &[u8]) -> Result<(), String> {
+/// Run one input: whether the reader accepted it, or `Err` when it
+/// panicked, allocated more than [`alloc_bound`], or failed its check.
+pub fn try_input(reader: &Reader, input: &[u8]) -> Result<bool, String> {
     let run = catch_unwind(AssertUnwindSafe(|| peak_during(|| (reader.check)(input))));
     match run {
         Ok((checked, peak)) => {
-            checked?;
+            let accepted = checked?;
             let bound = alloc_bound(input.len());
             if peak > bound {
                 return Err(format!(
@@ -47,7 +47,7 @@ pub fn try_input(reader: &Reader, input: &[u8]) -> Result<(), String> {
                     input.len()
                 ));
             }
-            Ok(())
+            Ok(accepted)
         }
         Err(payload) => {
             let hooked = LAST_PANIC.lock().ok().and_then(|mut p| p.take());
@@ -85,6 +85,8 @@ pub struct Outcome {
     pub reader: &'static str,
     /// Inputs run, shrinking steps included.
     pub inputs: u64,
+    /// Inputs the reader accepted (the rest it refused with an error).
+    pub accepted: u64,
     pub seconds: f64,
     pub failures: Vec<Failure>,
 }
@@ -103,6 +105,7 @@ const BATCH: u32 = 2000;
 pub fn fuzz(reader: &Reader, budget: Budget) -> Outcome {
     let start = Instant::now();
     let count = Cell::new(0u64);
+    let accepted = Cell::new(0u64);
     let mut failures = Vec::new();
     let mut batch = 0u64;
     while count.get() < budget.max_inputs && start.elapsed() < budget.max_time {
@@ -121,7 +124,9 @@ pub fn fuzz(reader: &Reader, budget: Budget) -> Outcome {
         let mut runner = TestRunner::new_with_rng(config, rng);
         let result = runner.run(&reader.inputs, |input| {
             count.set(count.get() + 1);
-            try_input(reader, &input).map_err(TestCaseError::fail)
+            let ok = try_input(reader, &input).map_err(TestCaseError::fail)?;
+            accepted.set(accepted.get() + u64::from(ok));
+            Ok(())
         });
         match result {
             Ok(()) => {}
@@ -139,6 +144,7 @@ pub fn fuzz(reader: &Reader, budget: Budget) -> Outcome {
     Outcome {
         reader: reader.name,
         inputs: count.get(),
+        accepted: accepted.get(),
         seconds: start.elapsed().as_secs_f64(),
         failures,
     }
@@ -168,7 +174,7 @@ pub fn save_regression(dir: &Path, reader: &str, input: &[u8]) -> std::io::Resul
 }
 
 /// A regression file and what its reader did with it.
-pub type Replayed = (PathBuf, Result<(), String>);
+pub type Replayed = (PathBuf, Result<bool, String>);
 
 /// Every regression file under `dir` run through its reader: the files
 /// found and the outcome of each. A directory not named after a reader is

@@ -20,8 +20,10 @@ use strata_level::{EditSite, LevelError, Palette, WorldConfig, vmc, vmp};
 /// Most edits applied to one seed.
 const MAX_EDITS: usize = 6;
 
-/// Runs the reader on one input; `Err` says how it misbehaved short of panicking.
-pub type Check = fn(&[u8]) -> Result<(), String>;
+/// Runs the reader on one input: whether the reader accepted it (a
+/// measure of how deep the mutations reach), or how it misbehaved short of
+/// panicking.
+pub type Check = fn(&[u8]) -> Result<bool, String>;
 
 pub struct Reader {
     /// Also the regression directory's name.
@@ -199,15 +201,15 @@ fn vmc_inputs() -> BoxedStrategy<Vec<u8>> {
 }
 
 /// A reader's error must name the file it is about.
-fn names_file<T>(result: Result<T, LevelError>, path: &Path) -> Result<(), String> {
+fn names_file<T>(result: Result<T, LevelError>, path: &Path) -> Result<bool, String> {
     match result {
-        Ok(_) => Ok(()),
-        Err(e) if e.to_string().starts_with(&format!("{}: ", path.display())) => Ok(()),
+        Ok(_) => Ok(true),
+        Err(e) if e.to_string().starts_with(&format!("{}: ", path.display())) => Ok(false),
         Err(e) => Err(format!("the error does not name {}: {e}", path.display())),
     }
 }
 
-fn check_ini(input: &[u8]) -> Result<(), String> {
+fn check_ini(input: &[u8]) -> Result<bool, String> {
     let path = Path::new("fuzz/world.ini");
     let parsed = WorldConfig::parse_bytes(input, path);
     if let Ok(config) = &parsed {
@@ -224,32 +226,32 @@ fn check_ini(input: &[u8]) -> Result<(), String> {
     names_file(parsed, path)
 }
 
-fn check_vmc(input: &[u8]) -> Result<(), String> {
+fn check_vmc(input: &[u8]) -> Result<bool, String> {
     let Some((d, file)) = split_declared(input) else {
-        return Ok(());
+        return Ok(false);
     };
     let path = Path::new("fuzz/output.vmc");
     let decoded = vmc::decode_vmc(file, d.width(), d.height(), MidRule::Original, path);
     names_file(decoded, path)
 }
 
-fn check_vmp(input: &[u8]) -> Result<(), String> {
+fn check_vmp(input: &[u8]) -> Result<bool, String> {
     let Some((d, file)) = split_declared(input) else {
-        return Ok(());
+        return Ok(false);
     };
     let path = Path::new("fuzz/output.vmp");
     let decoded = vmp::decode_vmp(file, d.width(), d.height(), MidRule::VangeRs, path);
     names_file(decoded, path)
 }
 
-fn check_palette(input: &[u8]) -> Result<(), String> {
+fn check_palette(input: &[u8]) -> Result<bool, String> {
     let path = Path::new("fuzz/harmony.pal");
     names_file(Palette::from_bytes(input, path), path)
 }
 
-fn check_vpr(input: &[u8]) -> Result<(), String> {
+fn check_vpr(input: &[u8]) -> Result<bool, String> {
     let Some((d, file)) = split_declared(input) else {
-        return Ok(());
+        return Ok(false);
     };
     let layout = VprLayout {
         width: d.width(),
@@ -276,25 +278,22 @@ fn lossy(input: &[u8]) -> std::borrow::Cow<'_, str> {
     String::from_utf8_lossy(input)
 }
 
-fn check_views(input: &[u8]) -> Result<(), String> {
-    let _ = parse_views(&lossy(input));
-    Ok(())
+fn check_views(input: &[u8]) -> Result<bool, String> {
+    Ok(parse_views(&lossy(input)).is_ok())
 }
 
-fn check_edit(input: &[u8]) -> Result<(), String> {
-    let _ = EditSite::parse(&lossy(input));
-    Ok(())
+fn check_edit(input: &[u8]) -> Result<bool, String> {
+    Ok(EditSite::parse(&lossy(input)).is_ok())
 }
 
 /// `strata merge`'s path: parse, check two runs against each other, report.
-fn check_results(input: &[u8]) -> Result<(), String> {
-    if let Ok(run) = strata_bench::results::RunResults::from_json(&lossy(input)) {
-        let _ = strata_bench::merge::merge(&[run.clone(), run]);
+fn check_results(input: &[u8]) -> Result<bool, String> {
+    match strata_bench::results::RunResults::from_json(&lossy(input)) {
+        Ok(run) => Ok(strata_bench::merge::merge(&[run.clone(), run]).is_ok()),
+        Err(_) => Ok(false),
     }
-    Ok(())
 }
 
-fn check_script(input: &[u8]) -> Result<(), String> {
-    let _ = strata_viewer::Script::parse(&lossy(input));
-    Ok(())
+fn check_script(input: &[u8]) -> Result<bool, String> {
+    Ok(strata_viewer::Script::parse(&lossy(input)).is_ok())
 }
