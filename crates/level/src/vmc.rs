@@ -61,9 +61,11 @@ fn read_header(bytes: &[u8], width: u32, height: u32, path: &Path) -> Result<Hea
     let min_row = 2 * (width as usize).div_ceil(8);
     let mut rows = Vec::with_capacity(height as usize);
     // Rows lie apart in the file (the writers put them one after another),
-    // so their sizes add up to at most the bytes after the header. This is
-    // what bounds the map by the file: a row table whose rows all point at
-    // the same few bytes would otherwise make a short file decode to any
+    // so their sizes add up to the bytes after the header. At most twice
+    // that is accepted here (a row whose size is off by a few bytes gets its
+    // own row's error from the decoder); more means rows share bytes. This
+    // is what bounds the map by the file: a row table whose rows all point
+    // at the same few bytes would otherwise make a short file decode to any
     // declared size (2 GiB of planes for 2^15 x 2^15).
     let mut row_bytes = 0usize;
     let body = bytes.len() - header;
@@ -98,11 +100,11 @@ fn read_header(bytes: &[u8], width: u32, height: u32, path: &Path) -> Result<Hea
             )));
         }
         row_bytes += len;
-        if row_bytes > body {
+        if row_bytes > 2 * body {
             return Err(err(format!(
-                "rows 0..={y} of the row table add up to {row_bytes} bytes, more than the {body} \
-                 bytes after the row table and trees: rows overlap, or the map size in world.ini \
-                 ({width}x{height}) does not match the file"
+                "rows 0..={y} of the row table add up to {row_bytes} bytes, more than twice the \
+                 {body} bytes after the row table and trees: rows share bytes, or the map size in \
+                 world.ini ({width}x{height}) does not match the file"
             )));
         }
         rows.push(start..start + len);
