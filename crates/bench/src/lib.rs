@@ -11,6 +11,7 @@ pub mod plan;
 pub mod portability;
 pub mod report;
 pub mod results;
+pub mod resume;
 pub mod run;
 pub mod session;
 pub mod stats;

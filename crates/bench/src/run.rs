@@ -60,6 +60,9 @@ pub struct Options {
     /// Fly a short path with every method and measure flicker (`--temporal`).
     pub temporal: bool,
     pub cache_dir: PathBuf,
+    /// `--resume`: `out` holds an interrupted run of this comparison whose
+    /// finished cells are kept ([`crate::resume`]).
+    pub resume: bool,
 }
 
 /// A checked comparison, ready to run: nothing here touches the GPU.
@@ -226,7 +229,24 @@ impl Plan {
     /// Run the protocol on `gpu`, writing into the output directory as it goes.
     /// Returns the results file and the report.
     pub fn run(self, gpu: &Gpu) -> anyhow::Result<(PathBuf, PathBuf)> {
-        let mut session = Session::new(&self.opts.out, self.results_header(gpu));
+        self.run_until(gpu, None)
+    }
+
+    /// [`Plan::run`], stopped with an error once `stop_after_cells` view x
+    /// method cells have been measured in this call, as an interruption
+    /// would stop it (for testing `--resume`).
+    pub fn run_until(
+        self,
+        gpu: &Gpu,
+        stop_after_cells: Option<usize>,
+    ) -> anyhow::Result<(PathBuf, PathBuf)> {
+        let mut header = self.results_header(gpu);
+        if self.opts.resume {
+            let there = crate::resume::load(&self.opts.out, &header)?;
+            crate::resume::carry_over(there, &mut header);
+        }
+        let mut session = Session::new(&self.opts.out, header);
+        session.restore_thumbnails();
         let json = session.save_json()?;
         let references = self.references(&mut session)?;
 
@@ -246,7 +266,12 @@ impl Plan {
         let n_methods = refused.iter().filter(|r| r.is_none()).count();
         let total =
             self.cameras.len() * n_methods + if self.edit.is_some() { n_methods } else { 0 };
-        let bar = ProgressBar::new(total as u64);
+        let kept = session.results.rows.len() + session.results.edit_rows.len();
+        let bar = ProgressBar::new(total.saturating_sub(kept) as u64);
+        let mut count = CellCount {
+            measured: 0,
+            stop_after: stop_after_cells,
+        };
         bar.set_style(
             ProgressStyle::with_template(
                 "{bar:30} {pos}/{len} cells  {msg}  [{elapsed_precise}, {eta_precise} left]",
@@ -264,7 +289,11 @@ impl Plan {
                 session.save_json()?;
                 continue;
             }
-            if let Err(e) = self.method_column(gpu, &mut session, &references, m, &bar) {
+            let column = self.method_column(gpu, &mut session, &references, m, &bar, &mut count);
+            if let Err(e) = column {
+                if e.is::<Stopped>() {
+                    return Err(e);
+                }
                 bar.println(format!("{}: {e:#}", choice.label()));
                 session.results.failures.push(Failure {
                     view: "*".into(),
@@ -287,6 +316,10 @@ impl Plan {
                 .filter(|(_, why)| why.is_none())
                 .map(|(pair, _)| pair);
             for (choice, settings) in runnable {
+                let label = choice.label();
+                if session.results.edit_rows.iter().any(|r| r.method == label) {
+                    continue;
+                }
                 bar.set_message(format!("edit / {}", choice.label()));
                 let input = edits::EditInput {
                     gpu,
@@ -323,7 +356,8 @@ impl Plan {
                 bar.inc(1);
             }
         }
-        if self.opts.temporal {
+        // A resumed run keeps the temporal rows of one that got that far.
+        if self.opts.temporal && session.results.temporal.is_empty() {
             self.temporal(gpu, &mut session, &refused, &bar)?;
         }
         bar.finish_and_clear();
@@ -452,9 +486,19 @@ impl Plan {
         references: &[Reference],
         m: usize,
         bar: &ProgressBar,
+        count: &mut CellCount,
     ) -> anyhow::Result<()> {
         let choice = &self.opts.methods[m];
         let label = choice.label();
+        // The views a resumed run has not measured yet.
+        let todo: Vec<usize> = (0..self.cameras.len())
+            .filter(|&v| {
+                !crate::resume::has_row(&session.results, &self.opts.views[v].name, &label)
+            })
+            .collect();
+        if todo.is_empty() {
+            return Ok(());
+        }
         bar.set_message(format!("{label}: setup"));
         let start = Instant::now();
         let mut renderer = Renderer::new(
@@ -467,9 +511,15 @@ impl Plan {
             self.opts.height,
         )?;
         let setup_ms = ms(start);
-        for (v, (view, camera)) in self.opts.views.iter().zip(&self.cameras).enumerate() {
+        for (i, &v) in todo.iter().enumerate() {
+            if count.stop_after.is_some_and(|n| count.measured >= n) {
+                return Err(Stopped(count.measured).into());
+            }
+            let (view, camera) = (&self.opts.views[v], &self.cameras[v]);
             bar.set_message(format!("{} / {label}", view.name));
-            let warmup = if v == 0 {
+            // The renderer's first view covers its incremental build (view 0
+            // in a fresh run; the first view left in a resumed one).
+            let warmup = if i == 0 {
                 self.warmup_first
             } else {
                 self.opts.min_warmup
@@ -496,6 +546,7 @@ impl Plan {
             }
             session.save_json()?;
             bar.inc(1);
+            count.measured += 1;
         }
         Ok(())
     }
@@ -618,6 +669,24 @@ impl Plan {
         })
     }
 }
+
+/// Cells measured so far in this call, and where [`Plan::run_until`] stops.
+struct CellCount {
+    measured: usize,
+    stop_after: Option<usize>,
+}
+
+/// [`Plan::run_until`] stopped on purpose after this many cells.
+#[derive(Debug)]
+pub struct Stopped(pub usize);
+
+impl std::fmt::Display for Stopped {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "stopped after {} cells, as asked", self.0)
+    }
+}
+
+impl std::error::Error for Stopped {}
 
 /// What one cell measured, before it becomes a [`Row`].
 pub struct Measured {

@@ -31,6 +31,23 @@ impl Session {
         }
     }
 
+    /// The grid thumbnails of cells already in the results (a resumed
+    /// run's), from their pictures; a picture that cannot be read leaves
+    /// its grid cell empty.
+    pub fn restore_thumbnails(&mut self) {
+        let settings = &self.results.settings;
+        for row in &self.results.rows {
+            let v = settings.views.iter().position(|v| v.name == row.view);
+            let m = settings.methods.iter().position(|m| *m == row.method);
+            let (Some(v), Some(m)) = (v, m) else {
+                continue;
+            };
+            if let Ok(img) = image::open(self.out.join(&row.image)) {
+                self.thumbs[v][m + 1] = Some(grid::thumbnail(&img.to_rgba8()));
+            }
+        }
+    }
+
     /// Rewrite `results-<adapter>.json`.
     pub fn save_json(&self) -> anyhow::Result<PathBuf> {
         self.results.write(&self.out)

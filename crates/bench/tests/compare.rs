@@ -41,6 +41,7 @@ fn options(world: &World, out: PathBuf) -> Options {
         edits: EditMode::Auto,
         temporal: false,
         cache_dir: out.join("cache"),
+        resume: false,
     }
 }
 
@@ -85,10 +86,11 @@ fn bad_input_is_refused_before_gpu_work() {
     std::fs::remove_dir_all(&base).unwrap();
 }
 
-#[test]
-fn tiny_run_writes_sane_results() {
-    let gpu = match strata_render::Gpu::headless() {
-        Ok(g) => g,
+/// The headless adapter, or `None` after a loud SKIPPED line (a failure
+/// under `STRATA_REQUIRE_GPU=1`).
+fn gpu_or_skip(test: &str) -> Option<strata_render::Gpu> {
+    match strata_render::Gpu::headless() {
+        Ok(g) => Some(g),
         Err(e) => {
             // Straight to stderr: libtest swallows eprintln! of passing tests.
             use std::io::Write;
@@ -97,10 +99,17 @@ fn tiny_run_writes_sane_results() {
             }
             let _ = writeln!(
                 std::io::stderr(),
-                "\n*** SKIPPED tiny_run_writes_sane_results: no GPU adapter ({e:#}) ***\n"
+                "\n*** SKIPPED {test}: no GPU adapter ({e:#}) ***\n"
             );
-            return;
+            None
         }
+    }
+}
+
+#[test]
+fn tiny_run_writes_sane_results() {
+    let Some(gpu) = gpu_or_skip("tiny_run_writes_sane_results") else {
+        return;
     };
     let w = world();
     let out = temp("tiny");
@@ -162,4 +171,122 @@ fn tiny_run_writes_sane_results() {
     assert!(out.join(&run.edit_images[0].before).is_file());
     assert!(md.contains("figures/edit.png") && out.join("figures/edit.png").is_file());
     std::fs::remove_dir_all(&out).unwrap();
+}
+
+/// The (view, method) cells of a results file.
+fn cells(run: &RunResults) -> Vec<(String, String)> {
+    let mut c: Vec<_> = run
+        .rows
+        .iter()
+        .map(|r| (r.view.clone(), r.method.clone()))
+        .collect();
+    c.sort();
+    c
+}
+
+#[test]
+fn interrupted_run_resumes_to_the_full_cell_set() {
+    let Some(gpu) = gpu_or_skip("interrupted_run_resumes_to_the_full_cell_set") else {
+        return;
+    };
+    let w = world();
+    let base = temp("resume");
+    let two_methods = |out: PathBuf| {
+        let mut o = options(&w, out);
+        o.methods = ["ray", "ray-compute"]
+            .map(|n| MethodChoice {
+                name: n.into(),
+                setting: None,
+            })
+            .to_vec();
+        o.edits = EditMode::Off;
+        // One reference cache for the three runs.
+        o.cache_dir = base.join("cache");
+        o
+    };
+    let read = |json: &std::path::Path| {
+        RunResults::from_json(&std::fs::read_to_string(json).unwrap()).unwrap()
+    };
+
+    // Uninterrupted: 2 views x 2 methods.
+    let (json, _) = Plan::new(w.clone(), two_methods(base.join("full")))
+        .unwrap()
+        .run(&gpu)
+        .unwrap();
+    let full = read(&json);
+    assert!(
+        full.complete && full.failures.is_empty(),
+        "{:?}",
+        full.failures
+    );
+    assert_eq!(cells(&full).len(), 4);
+
+    // Interrupted after three cells: the results file holds those three.
+    let dir = base.join("cut");
+    let err = Plan::new(w.clone(), two_methods(dir.clone()))
+        .unwrap()
+        .run_until(&gpu, Some(3))
+        .unwrap_err();
+    assert!(err.to_string().contains("stopped after 3 cells"), "{err:#}");
+    let json = dir.join(full.file_name());
+    let cut = read(&json);
+    assert!(!cut.complete);
+    assert_eq!(cut.rows.len(), 3);
+
+    // A resume with other settings is refused, naming them.
+    let mut other = two_methods(dir.clone());
+    other.frames = 3;
+    other.resume = true;
+    let err = Plan::new(w.clone(), other).unwrap().run(&gpu).unwrap_err();
+    let msg = format!("{err:#}");
+    assert!(msg.contains("frames (there 2, here 3)"), "{msg}");
+    assert_eq!(
+        read(&json),
+        cut,
+        "a refused resume must leave the file alone"
+    );
+
+    // Resumed: the three kept as measured, the fourth measured now.
+    let mut resume = two_methods(dir.clone());
+    resume.resume = true;
+    Plan::new(w.clone(), resume).unwrap().run(&gpu).unwrap();
+    let resumed = read(&json);
+    assert!(
+        resumed.complete && resumed.failures.is_empty(),
+        "{:?}",
+        resumed.failures
+    );
+    assert_eq!(cells(&resumed), cells(&full));
+    assert_eq!(
+        resumed.rows[..3],
+        cut.rows[..],
+        "kept cells were measured again"
+    );
+    // Rendering is deterministic (tests/determinism.rs in strata-render), so
+    // the new cell's accuracy equals the uninterrupted run's.
+    let (a, b) = (
+        &resumed.rows[3],
+        full.rows
+            .iter()
+            .find(|r| r.view == resumed.rows[3].view && r.method == resumed.rows[3].method)
+            .unwrap(),
+    );
+    assert_eq!(
+        (
+            a.see_through,
+            a.covers_sky,
+            a.depth_p50,
+            a.depth_p95,
+            a.coherence
+        ),
+        (
+            b.see_through,
+            b.covers_sky,
+            b.depth_p50,
+            b.depth_p95,
+            b.coherence
+        )
+    );
+    assert!(dir.join(&a.image).is_file() && dir.join("grid.png").is_file());
+    std::fs::remove_dir_all(&base).unwrap();
 }

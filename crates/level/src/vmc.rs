@@ -60,6 +60,15 @@ fn read_header(bytes: &[u8], width: u32, height: u32, path: &Path) -> Result<Hea
     let table_end = height as usize * ENTRY_BYTES;
     let min_row = 2 * (width as usize).div_ceil(8);
     let mut rows = Vec::with_capacity(height as usize);
+    // Rows lie apart in the file (the writers put them one after another),
+    // so their sizes add up to the bytes after the header. At most twice
+    // that is accepted here (a row whose size is off by a few bytes gets its
+    // own row's error from the decoder); more means rows share bytes. This
+    // is what bounds the map by the file: a row table whose rows all point
+    // at the same few bytes would otherwise make a short file decode to any
+    // declared size (2 GiB of planes for 2^15 x 2^15).
+    let mut row_bytes = 0usize;
+    let body = bytes.len() - header;
     for (y, e) in bytes[..table_end].chunks_exact(ENTRY_BYTES).enumerate() {
         let offset = i32::from_le_bytes([e[0], e[1], e[2], e[3]]);
         let size = i16::from_le_bytes([e[4], e[5]]);
@@ -88,6 +97,14 @@ fn read_header(bytes: &[u8], width: u32, height: u32, path: &Path) -> Result<Hea
                  ({} bytes; truncated?)",
                 start + len,
                 bytes.len()
+            )));
+        }
+        row_bytes += len;
+        if row_bytes > 2 * body {
+            return Err(err(format!(
+                "rows 0..={y} of the row table add up to {row_bytes} bytes, more than twice the \
+                 {body} bytes after the row table and trees: rows share bytes, or the map size in \
+                 world.ini ({width}x{height}) does not match the file"
             )));
         }
         rows.push(start..start + len);

@@ -74,6 +74,18 @@ pub struct Args {
     /// Reference cache directory (default: $STRATA_CACHE_DIR/reference or ~/.cache/strata/reference).
     #[arg(long, value_name = "DIR")]
     pub cache: Option<PathBuf>,
+    /// Finish the interrupted run in DIR (its output directory): its finished cells are kept
+    /// and only the rest are measured. Refused, naming what differs, unless the protocol,
+    /// level, adapter and settings (give the same flags) are the same.
+    #[arg(long, value_name = "DIR", conflicts_with_all = ["out", "all_adapters"])]
+    pub resume: Option<PathBuf>,
+}
+
+impl Args {
+    /// Where the run writes: the `--resume` directory, else `--out`.
+    fn out_dir(&self) -> PathBuf {
+        self.resume.clone().unwrap_or_else(|| self.out.clone())
+    }
 }
 
 /// Everything checked before any adapter is opened.
@@ -92,7 +104,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     }
     let gpu = Gpu::open(&args.adapter.choice())?;
     announce(&gpu.report);
-    let options = options_for(&args, &prepared, &gpu.report, args.out.clone());
+    let options = options_for(&args, &prepared, &gpu.report, args.out_dir());
     let plan = Plan::new(prepared.world, options)?;
     let (json, report) = plan.run(&gpu)?;
     println!("wrote {}", json.display());
@@ -125,7 +137,15 @@ fn prepare(args: &Args) -> anyhow::Result<Prepared> {
         }
         None => None,
     };
-    prepare_out_dir(&args.out)?;
+    if let Some(dir) = &args.resume
+        && !dir.join("cells").is_dir()
+    {
+        anyhow::bail!(
+            "--resume {}: not the output directory of a compare run (no cells/ inside)",
+            dir.display()
+        );
+    }
+    prepare_out_dir(&args.out_dir())?;
     if args.all_adapters {
         // The per-adapter subfolders hold the cells; the top level only the merged report.
         let _ = std::fs::remove_dir(args.out.join("cells"));
@@ -194,6 +214,7 @@ fn options_for(args: &Args, p: &Prepared, adapter: &AdapterReport, out: PathBuf)
             .cache
             .clone()
             .unwrap_or_else(strata_reference::default_cache_dir),
+        resume: args.resume.is_some(),
     }
 }
 
