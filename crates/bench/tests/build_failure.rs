@@ -54,10 +54,12 @@ fn a_build_the_gpu_refuses_is_recorded_and_the_next_method_runs() {
         height: 20,
         frames: 1,
         min_warmup: 1,
+        hold_busy_ms: 0,
         shadows: true,
         edits: EditMode::Required,
         temporal: false,
         cache_dir: out.join("cache"),
+        resume: false,
     };
     let (json, report) = Plan::new(world, opts).unwrap().run(&gpu).unwrap();
     let run = strata_bench::merge::read_run(&json).unwrap();
