@@ -13,10 +13,9 @@ use strata_level::{Level, World};
 pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 /// Depth target format: the depth-buffer values `depth.f32` holds.
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
-/// Side of the shared shadow map, texels.
-pub const SHADOW_SIZE: u32 = 1024;
-/// Background colour where rays miss (linear 0..1 RGB).
-pub const SKY: [f32; 3] = [0.62, 0.74, 0.86];
+/// Side of the shared shadow map, texels, and the sky colour: shared with the
+/// CPU colour reference.
+pub use strata_camera::light::{SHADOW_SIZE, SKY};
 
 /// The sky as a clear colour, for the first pass of object-order methods.
 pub fn sky_clear() -> wgpu::Color {
