@@ -400,7 +400,8 @@ impl Shared {
             "shadow map",
             (SHADOW_SIZE, SHADOW_SIZE),
             wgpu::TextureFormat::R32Float,
-            shadow_usage | wgpu::TextureUsages::TEXTURE_BINDING,
+            // COPY_SRC: tests read the map back to hold it to its CPU twin.
+            shadow_usage | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC,
         );
         let Targets {
             color,
