@@ -3,6 +3,8 @@
 
 pub mod edits;
 pub mod figures;
+#[cfg(not(target_arch = "wasm32"))]
+pub mod flip;
 pub mod font;
 pub mod grid;
 pub mod merge;

@@ -40,6 +40,7 @@ fn options(world: &World, out: PathBuf) -> Options {
         edits: EditMode::Auto,
         temporal: false,
         cache_dir: out.join("cache"),
+        grid: Default::default(),
     }
 }
 

@@ -54,6 +54,7 @@ fn a_method_the_adapter_cannot_run_is_one_failure_and_no_edit_row() {
         edits: EditMode::Required,
         temporal: false,
         cache_dir: out.join("cache"),
+        grid: Default::default(),
     };
     let (json, _) = Plan::new(world, opts).unwrap().run(&gpu).unwrap();
     let run = strata_bench::merge::read_run(&json).unwrap();

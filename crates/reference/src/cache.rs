@@ -170,6 +170,31 @@ impl ReferenceCache {
         h.finalize().iter().map(|b| format!("{b:02x}")).collect()
     }
 
+    fn color_path(
+        &self,
+        level_hash: &str,
+        camera: &Camera,
+        ramps: &TerrainRamps,
+        shadows: bool,
+    ) -> PathBuf {
+        self.dir.join(format!(
+            "{}.rgb",
+            Self::color_key(level_hash, camera, ramps, shadows)
+        ))
+    }
+
+    /// The cached colour reference, or `None` when absent or unreadable.
+    pub fn get_color(
+        &self,
+        level_hash: &str,
+        camera: &Camera,
+        ramps: &TerrainRamps,
+        shadows: bool,
+    ) -> Option<ColorImage> {
+        let bytes = std::fs::read(self.color_path(level_hash, camera, ramps, shadows)).ok()?;
+        decode_color(&bytes).filter(|c| c.width == camera.width && c.height == camera.height)
+    }
+
     /// The colour reference of `camera`'s view (shadows on or off), from the
     /// cache or computed and stored. Returns it and whether it was cached.
     pub fn get_or_compute_color(
@@ -180,17 +205,10 @@ impl ReferenceCache {
         ramps: &TerrainRamps,
         shadows: bool,
     ) -> Result<(ColorImage, bool), CacheError> {
-        let path = self.dir.join(format!(
-            "{}.rgb",
-            Self::color_key(level_hash, camera, ramps, shadows)
-        ));
-        let cached = std::fs::read(&path)
-            .ok()
-            .and_then(|b| decode_color(&b))
-            .filter(|c| c.width == camera.width && c.height == camera.height);
-        if let Some(c) = cached {
+        if let Some(c) = self.get_color(level_hash, camera, ramps, shadows) {
             return Ok((c, true));
         }
+        let path = self.color_path(level_hash, camera, ramps, shadows);
         let c = render_color(tracer, ramps, camera, shadows);
         let io_err = |path: &Path| {
             let path = path.to_path_buf();

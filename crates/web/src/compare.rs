@@ -98,6 +98,7 @@ pub async fn run(
         edits: EditMode::Off,
         temporal: false,
         cache_dir: PathBuf::new(),
+        grid: Default::default(),
     };
     let plan = Plan::without_output(world, options)?;
     // The folder picker opens worlds for the viewer, which this page does not run.

@@ -48,6 +48,10 @@ pub struct Args {
     /// every method and report each one's depth flicker beyond the CPU reference's.
     #[arg(long)]
     pub temporal: bool,
+    /// What grid.png shows: `pictures` (each method's picture) or `flip` (each cell's ꟻLIP
+    /// error map against the CPU colour reference, which fills the reference column).
+    #[arg(long, value_name = "MODE", default_value = "pictures")]
+    pub grid: strata_bench::session::GridMode,
     /// Image size WxH (default 1280x800; 320x200 with --quick).
     #[arg(long, value_name = "WxH")]
     pub size: Option<String>,
@@ -188,6 +192,7 @@ fn options_for(args: &Args, p: &Prepared, adapter: &AdapterReport, out: PathBuf)
             .cache
             .clone()
             .unwrap_or_else(strata_reference::default_cache_dir),
+        grid: args.grid,
     }
 }
 
