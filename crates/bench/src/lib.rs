@@ -16,6 +16,7 @@ pub mod results;
 pub mod run;
 pub mod session;
 pub mod stats;
+pub mod tune;
 pub mod video;
 
 #[cfg(test)]

@@ -33,6 +33,8 @@ enum Command {
     Fit(cmd::fit::Args),
     /// The one-command comparison of every method over the level's views.
     Compare(cmd::compare::Args),
+    /// Tune each method's knob on this level: sweeps, the one-point rule, tuning.md, settings.json.
+    Tune(cmd::tune::Args),
     /// Merge results from several machines into one report.
     Merge(cmd::merge::Args),
     /// List every GPU adapter: backend, driver, capabilities, limits, the methods it runs.
@@ -56,6 +58,7 @@ fn main() -> std::process::ExitCode {
         Command::Fit(args) => cmd::fit::run(args),
         Command::Compare(args) => cmd::compare::run(args),
         Command::Merge(args) => cmd::merge::run(args),
+        Command::Tune(args) => cmd::tune::run(args),
         Command::View(args) => cmd::view::run(args),
         Command::Video(args) => cmd::video::run(args),
         Command::Serve(args) => cmd::serve::run(args),

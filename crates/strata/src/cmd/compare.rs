@@ -32,6 +32,9 @@ pub struct Args {
     /// (`ray:64`, `voxel:4,8,2/100`, `scattered:4,4,4`, `sliced:512`, `mesh:0.5`). Default: all.
     #[arg(long, value_name = "LIST")]
     pub methods: Option<String>,
+    /// `strata tune`'s settings.json: each method named without a setting takes its tuned one.
+    #[arg(long, value_name = "FILE")]
+    pub settings: Option<PathBuf>,
     /// Views file (`NAME X,Y:YAW:EYE[:under] PITCH` per line). Default: the level's own views.
     #[arg(long, value_name = "FILE")]
     pub views: Option<PathBuf>,
@@ -102,7 +105,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 /// Cheap checks first, then the level; the GPU comes later.
 fn prepare(args: &Args) -> anyhow::Result<Prepared> {
     let known = strata_render::methods::names();
-    let methods = match &args.methods {
+    let mut methods = match &args.methods {
         Some(list) => parse_methods(list, &known)?,
         None => known
             .iter()
@@ -112,6 +115,14 @@ fn prepare(args: &Args) -> anyhow::Result<Prepared> {
             })
             .collect(),
     };
+    if let Some(path) = &args.settings {
+        strata_bench::tune::output::TunedSettings::read(path)?.apply(&mut methods);
+        // A tuned setting that does not parse fails here, naming the file.
+        for m in &methods {
+            strata_bench::methods::settings_for(m, true)
+                .with_context(|| format!("settings file {}", path.display()))?;
+        }
+    }
     // Parse an explicit size now, so a bad one fails before any GPU work.
     let explicit_size = args.size.as_deref().map(parse_size).transpose()?;
     let file_views = match &args.views {

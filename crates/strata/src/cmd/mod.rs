@@ -10,5 +10,6 @@ pub mod metrics;
 pub mod reference;
 pub mod render;
 pub mod serve;
+pub mod tune;
 pub mod video;
 pub mod view;
