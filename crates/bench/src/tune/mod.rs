@@ -57,7 +57,8 @@ pub struct Sweep {
     pub size: (u32, u32),
 }
 
-/// The sweeps of the protocol (issue 16's ranges), fewer points with `quick`.
+/// The sweeps of the protocol (issue 16's ranges), fewer points with `quick`
+/// (always the ends and the paper's setting, so ours can be set beside it).
 pub fn sweeps(quick: bool, size: (u32, u32), mesh_size: Option<(u32, u32)>) -> Vec<Sweep> {
     let pick = |full: &[&str], few: &[&str]| -> Vec<Option<String>> {
         let list = if quick { few } else { full };
@@ -65,7 +66,7 @@ pub fn sweeps(quick: bool, size: (u32, u32), mesh_size: Option<(u32, u32)>) -> V
     };
     let voxel: Vec<String> = {
         let steps: &[&str] = if quick {
-            &["40", "400"]
+            &["40", "100", "400"]
         } else {
             &["40", "70", "100", "200", "400"]
         };
@@ -79,7 +80,7 @@ pub fn sweeps(quick: bool, size: (u32, u32), mesh_size: Option<(u32, u32)>) -> V
         Sweep {
             method: "ray",
             knob: "steps",
-            settings: pick(&["16", "32", "64", "128", "256"], &["16", "64", "256"]),
+            settings: pick(&["16", "32", "64", "128", "256"], &["16", "128", "256"]),
             paper: Some("128"),
             size,
         },
@@ -95,7 +96,7 @@ pub fn sweeps(quick: bool, size: (u32, u32), mesh_size: Option<(u32, u32)>) -> V
             knob: "slices",
             settings: pick(
                 &["32", "64", "128", "256", "512", "1024"],
-                &["32", "256", "1024"],
+                &["32", "512", "1024"],
             ),
             paper: Some("512"),
             size,
@@ -372,5 +373,34 @@ fn choice(method: &str, setting: &Option<String>) -> MethodChoice {
     MethodChoice {
         name: method.to_string(),
         setting: setting.clone(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_sweep_holds_the_papers_setting_and_parses() {
+        for quick in [false, true] {
+            for s in sweeps(quick, (400, 260), Some((1280, 800))) {
+                if let Some(p) = s.paper {
+                    assert!(
+                        s.settings.iter().any(|x| x.as_deref() == Some(p)),
+                        "{} (quick {quick}) lacks the paper's {p}",
+                        s.method
+                    );
+                }
+                for setting in &s.settings {
+                    settings_for(&choice(s.method, setting), true).unwrap();
+                }
+            }
+        }
+        // The mesh's 1280x800 pass is there without --quick only.
+        let full = sweeps(false, (400, 260), Some((1280, 800)));
+        assert!(
+            full.iter()
+                .any(|s| s.method == "mesh" && s.size == (1280, 800))
+        );
     }
 }

@@ -209,3 +209,96 @@ pub fn markdown(t: &Tuning, plots: &[(String, String)]) -> String {
     }
     md
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::tune::{MethodTuning, TunePoint};
+
+    fn point(setting: &str, combined: f64, cost: f64) -> TunePoint {
+        TunePoint {
+            setting: Some(setting.into()),
+            label: setting.into(),
+            see_through: combined,
+            covers_sky: 0.0,
+            coherence: 0.0,
+            combined,
+            cost_ms: cost,
+            error: None,
+        }
+    }
+
+    fn tuning(size: [u32; 2], method: &str, chosen: usize, points: Vec<TunePoint>) -> MethodTuning {
+        MethodTuning {
+            method: method.into(),
+            knob: "k".into(),
+            size,
+            points,
+            chosen: Some(chosen),
+            best: Some(0),
+            paper_setting: Some("128".into()),
+        }
+    }
+
+    #[test]
+    fn settings_take_the_choices_and_the_largest_mesh_pass() {
+        let t = Tuning {
+            level: "w".into(),
+            level_hash: "h".into(),
+            adapter: "a".into(),
+            backend: "vulkan".into(),
+            timing_source: "gpu-timestamps".into(),
+            views: Vec::new(),
+            quick: false,
+            frames: 1,
+            shadows: true,
+            tolerance_points: 1.0,
+            methods: vec![
+                tuning(
+                    [400, 260],
+                    "ray",
+                    1,
+                    vec![point("128", 1.0, 5.0), point("64", 1.5, 3.0)],
+                ),
+                tuning([400, 260], "mesh", 0, vec![point("0.25", 1.0, 1.0)]),
+                tuning([1280, 800], "mesh", 0, vec![point("0.75", 1.0, 1.0)]),
+            ],
+            seconds: 1.0,
+        };
+        let s = TunedSettings::from_tuning(&t);
+        assert_eq!(s.methods["ray"], "64");
+        assert_eq!(s.methods["ray-compute"], "64");
+        assert_eq!(s.methods["mesh"], "0.75");
+        // Applied only where the command line named no setting.
+        let mut choices = vec![
+            MethodChoice {
+                name: "ray".into(),
+                setting: None,
+            },
+            MethodChoice {
+                name: "mesh".into(),
+                setting: Some("0.5".into()),
+            },
+            MethodChoice {
+                name: "painted".into(),
+                setting: None,
+            },
+        ];
+        s.apply(&mut choices);
+        assert_eq!(choices[0].setting.as_deref(), Some("64"));
+        assert_eq!(choices[1].setting.as_deref(), Some("0.5"));
+        assert_eq!(choices[2].setting, None);
+        // The chosen row is bold, the paper's marked.
+        let md = markdown(&t, &[]);
+        assert!(md.contains("| **64** |"), "{md}");
+        assert!(md.contains("paper"));
+        // A file that is not a settings.json is a clear error naming it.
+        let dir = std::env::temp_dir().join(format!("strata-tune-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let bad = dir.join("bad.json");
+        std::fs::write(&bad, "[1, 2]").unwrap();
+        let e = TunedSettings::read(&bad).unwrap_err();
+        assert!(format!("{e:#}").contains("bad.json"));
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}
