@@ -199,6 +199,9 @@ pub struct Tuning {
     pub seconds: f64,
 }
 
+/// One sweep size's cameras and CPU references, one per view.
+type Fixture = ((u32, u32), Vec<Camera>, Vec<Reference>);
+
 /// The horizon fixture: the level's first three 0° views.
 pub fn horizon_fixture(world: &World) -> Vec<ViewSpec> {
     world
@@ -239,7 +242,7 @@ pub fn run(world: &World, gpu: &Gpu, opts: &TuneOptions) -> anyhow::Result<Tunin
     let cache = ReferenceCache::new(&opts.cache_dir);
     let mut tracer: Option<Tracer> = None;
     // Cameras and references per size.
-    let mut fixtures: Vec<((u32, u32), Vec<Camera>, Vec<Reference>)> = Vec::new();
+    let mut fixtures: Vec<Fixture> = Vec::new();
     for size in sweeps.iter().map(|s| s.size) {
         if fixtures.iter().any(|f| f.0 == size) {
             continue;
