@@ -178,7 +178,7 @@ fn refined_slices_are_more_coherent_than_plain_ones() {
         .into_iter()
         .filter(|v| v.pitch == 0.0)
         .collect();
-    let mut mean = |refine: bool| {
+    let mean = |refine: bool| {
         let settings = MethodSettings {
             sliced_refine: refine,
             ..MethodSettings::default()
