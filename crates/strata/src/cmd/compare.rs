@@ -29,7 +29,7 @@ pub struct Args {
     #[arg(long)]
     pub quick: bool,
     /// Comma-separated methods, each `name` or `name:setting`
-    /// (`ray:64`, `voxel:4,8,2/100`, `scattered:4,4,4`, `sliced:512`, `mesh:0.5`). Default: all.
+    /// (`ray:64`, `voxel:4,8,2/100`, `scattered:4,4,4`, `sliced:512`, `sliced:512/refine`, `mesh:0.5`). Default: all.
     #[arg(long, value_name = "LIST")]
     pub methods: Option<String>,
     /// `strata tune`'s settings.json: each method named without a setting takes its tuned one.
