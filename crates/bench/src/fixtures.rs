@@ -51,6 +51,7 @@ pub fn row(view: &str, pitch: f32, method: &str, see: f64, coh: f64, gpu: &[f64]
         cpu_bytes: 0,
         passes: Vec::new(),
         image: format!("cells/{view}-{method}.png"),
+        flip: None,
     }
 }
 

@@ -3,6 +3,8 @@
 
 pub mod edits;
 pub mod figures;
+#[cfg(not(target_arch = "wasm32"))]
+pub mod flip;
 pub mod font;
 pub mod grid;
 pub mod merge;
@@ -15,6 +17,7 @@ pub mod resume;
 pub mod run;
 pub mod session;
 pub mod stats;
+pub mod tune;
 pub mod video;
 
 #[cfg(test)]

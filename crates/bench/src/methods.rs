@@ -19,7 +19,16 @@ pub fn settings_for(choice: &MethodChoice, shadows: bool) -> anyhow::Result<Meth
     let ctx = || format!("method `{}`: setting `{text}`", choice.label());
     match name {
         "ray" | "ray-compute" => s.ray_steps = positive(text).with_context(ctx)?,
-        "sliced" => s.slices = positive(text).with_context(ctx)?,
+        "sliced" => {
+            // `N` (the paper's plain slicer) or `N/refine`.
+            let (n, refine) = match text.split_once('/') {
+                Some((n, "refine")) => (n, true),
+                Some((_, other)) => bail!("{}: `{other}` is not `refine`", ctx()),
+                None => (text, false),
+            };
+            s.slices = positive(n).with_context(ctx)?;
+            s.sliced_refine = refine;
+        }
         "voxel" | "voxel-compute" => {
             // `X,Y,Z/STEPS`, `(X,Y,Z)/STEPS`, `X,Y,Z` or `/STEPS`.
             let (grid, steps) = match text.split_once('/') {
@@ -106,6 +115,7 @@ pub fn describe(name: &str, s: &MethodSettings) -> String {
             let [x, y, z] = s.voxel_size;
             format!("{name} grid=({x},{y},{z}) steps={}", s.voxel_steps)
         }
+        "sliced" if s.sliced_refine => format!("{name} slices={} refined", s.slices),
         "sliced" => format!("{name} slices={}", s.slices),
         "scattered" => {
             let [x, y, z] = s.scatter_density;

@@ -3,7 +3,7 @@
 //! (the baseline); the other runs are cross-checked in `merge`.
 
 use crate::merge::Disagreement;
-use crate::results::{EditRow, Row, RunResults, TimingSource};
+use crate::results::{EditRow, FlipScore, Row, RunResults, TimingSource};
 use crate::stats;
 use std::fmt::Write as _;
 
@@ -121,6 +121,7 @@ pub fn render(runs: &[RunResults], pictures: &Pictures, disagreements: &[Disagre
     }
 
     accuracy_tables(&mut md, base);
+    flip_table(&mut md, base);
     if runs.len() > 1 {
         cross_check(&mut md, runs, disagreements);
     }
@@ -273,6 +274,44 @@ fn accuracy_tables(md: &mut String, run: &RunResults) {
             match (sky, p50, p95) {
                 (Some(a), Some(b), Some(c)) => {
                     let _ = write!(md, " {a:.1} / {b:.2} / {c:.2} |");
+                }
+                _ => md.push_str(" — |"),
+            }
+        }
+        md.push('\n');
+    }
+    md.push('\n');
+}
+
+/// Mean ꟻLIP per pitch, where the run measured it (older runs and the
+/// browser's did not: then no table).
+fn flip_table(md: &mut String, run: &RunResults) {
+    if !run.rows.iter().any(|r| r.flip.is_some()) {
+        return;
+    }
+    let methods = &run.settings.methods;
+    md.push_str("## Colour error by pitch (ꟻLIP)\n\n");
+    let _ = writeln!(
+        md,
+        "ꟻLIP of each picture against the CPU colour reference (the shared shading at the exact hits, \
+         shadows from the CPU twin of the shadow map): mean ꟻLIP / % of pixels above 0.5, arithmetic \
+         mean over the views at each pitch ({}). Error maps: `cells/*-flip.png`.\n",
+        cell_text(&run.adapter.name)
+    );
+    header(md, "pitch", methods);
+    for p in pitches(run) {
+        let _ = write!(md, "| {} |", pitch_label(p));
+        for m in methods {
+            let flip = |f: fn(&FlipScore) -> f64| {
+                let xs: Vec<f64> = rows_of(run, m)
+                    .filter(|r| r.pitch == p)
+                    .filter_map(|r| r.flip.as_ref().map(f))
+                    .collect();
+                stats::mean(&xs)
+            };
+            match (flip(|f| f.mean), flip(|f| f.over_half)) {
+                (Some(a), Some(b)) => {
+                    let _ = write!(md, " {a:.3} / {b:.1} |");
                 }
                 _ => md.push_str(" — |"),
             }

@@ -174,6 +174,22 @@ pub struct Row {
     /// directory holding the results file (`merge --portability` finds the
     /// pictures there).
     pub image: String,
+    /// ꟻLIP against the CPU colour reference (absent in older results files
+    /// and in the browser's runs).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub flip: Option<FlipScore>,
+}
+
+/// A cell's perceptual colour error: ꟻLIP between its picture and the CPU
+/// colour reference (`strata_reference::shading`), per pixel in [0, 1].
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FlipScore {
+    /// Mean ꟻLIP over the image.
+    pub mean: f64,
+    /// Percent of pixels with ꟻLIP above 0.5 (clearly visible errors).
+    pub over_half: f64,
+    /// The error map (magma colours), relative to the output directory.
+    pub image: String,
 }
 
 impl Row {

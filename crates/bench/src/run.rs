@@ -7,7 +7,7 @@ use crate::edits;
 use crate::methods::{describe, settings_for};
 use crate::plan::{MethodChoice, check_view_names, file_part, prepare_out_dir, source_revision};
 use crate::results::*;
-use crate::session::{Session, color_image, reference_image};
+use crate::session::{GridMode, Session, color_image, reference_image};
 use crate::stats::summarize;
 use crate::video;
 use anyhow::Context;
@@ -16,7 +16,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 use strata_camera::Camera;
 use strata_level::{EditSite, ViewSpec, World};
-use strata_reference::{Reference, ReferenceCache, Tracer};
+use strata_reference::{ColorImage, Reference, ReferenceCache, Tracer};
 use strata_render::{Gpu, MethodSettings, Renderer, TerrainColors};
 
 /// Texels the incremental voxel build processes per frame
@@ -63,6 +63,8 @@ pub struct Options {
     /// `--resume`: `out` holds an interrupted run of this comparison whose
     /// finished cells are kept ([`crate::resume`]).
     pub resume: bool,
+    /// What `grid.png` shows (`--grid`).
+    pub grid: GridMode,
 }
 
 /// A checked comparison, ready to run: nothing here touches the GPU.
@@ -247,8 +249,10 @@ impl Plan {
         }
         let mut session = Session::new(&self.opts.out, header);
         session.restore_thumbnails();
+        session.grid = self.opts.grid;
         let json = session.save_json()?;
         let references = self.references(&mut session)?;
+        let colors = self.color_references(&mut session)?;
 
         // A method the adapter cannot run is refused here, before any GPU
         // work, with the missing capability named: one failure for every view
@@ -289,7 +293,7 @@ impl Plan {
                 session.save_json()?;
                 continue;
             }
-            let column = self.method_column(gpu, &mut session, &references, m, &bar, &mut count);
+            let column = self.method_column(gpu, &mut session, &references, &colors, m, &bar, &mut count);
             if let Err(e) = column {
                 if e.is::<Stopped>() {
                     return Err(e);
@@ -478,12 +482,63 @@ impl Plan {
         Ok(out)
     }
 
+    /// The CPU colour reference of every view (cached), saved as the
+    /// view's colour picture; `None` per view where ꟻLIP is not measured
+    /// (the browser build).
+    fn color_references(&self, session: &mut Session) -> anyhow::Result<Vec<Option<ColorImage>>> {
+        #[cfg(not(target_arch = "wasm32"))]
+        {
+            let cache = ReferenceCache::new(&self.opts.cache_dir);
+            let level = &self.world.level;
+            let hash = level.content_hash();
+            let ramps = strata_reference::TerrainRamps::from_world(&self.world);
+            let bar = ProgressBar::new(self.cameras.len() as u64);
+            bar.set_style(
+                ProgressStyle::with_template(
+                    "{bar:30} {pos}/{len} colour references  {msg}  [{elapsed_precise}]",
+                )
+                .unwrap_or_else(|_| ProgressStyle::default_bar()),
+            );
+            let mut tracer: Option<Tracer> = None;
+            let mut out = Vec::new();
+            for (v, (view, camera)) in self.opts.views.iter().zip(&self.cameras).enumerate() {
+                bar.set_message(view.name.clone());
+                let c = match cache.get_color(&hash, camera, &ramps, self.opts.shadows) {
+                    Some(c) => c,
+                    None => {
+                        let tracer = tracer.get_or_insert_with(|| Tracer::new(level));
+                        cache
+                            .get_or_compute_color(tracer, &hash, camera, &ramps, self.opts.shadows)
+                            .with_context(|| format!("colour reference of view `{}`", view.name))?
+                            .0
+                    }
+                };
+                session.save_flip_picture(
+                    v,
+                    0,
+                    &format!("{}-color-reference", view.name),
+                    crate::flip::reference_picture(&c),
+                )?;
+                out.push(Some(c));
+                bar.inc(1);
+            }
+            bar.finish_and_clear();
+            Ok(out)
+        }
+        #[cfg(target_arch = "wasm32")]
+        {
+            let _ = session;
+            Ok(vec![None; self.cameras.len()])
+        }
+    }
+
     /// Every view of method `m`, one renderer.
     fn method_column(
         &self,
         gpu: &Gpu,
         session: &mut Session,
         references: &[Reference],
+        colors: &[Option<ColorImage>],
         m: usize,
         bar: &ProgressBar,
         count: &mut CellCount,
@@ -527,7 +582,7 @@ impl Plan {
             match self.cell(
                 session,
                 &mut renderer,
-                &references[v],
+                (&references[v], colors[v].as_ref()),
                 v,
                 m,
                 camera,
@@ -556,7 +611,7 @@ impl Plan {
         &self,
         session: &mut Session,
         renderer: &mut Renderer,
-        reference: &Reference,
+        (reference, color_reference): (&Reference, Option<&ColorImage>),
         v: usize,
         m: usize,
         camera: &Camera,
@@ -585,12 +640,24 @@ impl Plan {
         let distance = strata_reference::distance_from_depth(camera, &depth);
         let metrics = strata_reference::metrics::try_compare(reference, &distance)?;
         let color = color_image(camera.width, camera.height, renderer.read_color()?)?;
-        let image = session.save_picture(
-            v,
-            m + 1,
-            &format!("{}-{}", view.name, file_part(&label)),
-            color,
-        )?;
+        let file = format!("{}-{}", view.name, file_part(&label));
+        #[cfg(not(target_arch = "wasm32"))]
+        let flip = match color_reference {
+            Some(c) => {
+                let map = crate::flip::FlipMap::compare(c, &color)?;
+                let image =
+                    session.save_flip_picture(v, m + 1, &format!("{file}-flip"), map.picture())?;
+                Some(FlipScore {
+                    mean: map.mean(),
+                    over_half: map.percent_over_half(),
+                    image,
+                })
+            }
+            None => None,
+        };
+        #[cfg(target_arch = "wasm32")]
+        let flip = color_reference.and(None);
+        let image = session.save_picture(v, m + 1, &file, color)?;
         let measured = Measured {
             metrics,
             frames,
@@ -598,7 +665,9 @@ impl Plan {
             setup_ms,
             retained: renderer.retained_bytes(),
         };
-        self.row(v, m, measured, image)
+        let mut row = self.row(v, m, measured, image)?;
+        row.flip = flip;
+        Ok(row)
     }
 
     /// The row of cell (view `v`, method `m`) from what was measured there
@@ -666,6 +735,7 @@ impl Plan {
             cpu_bytes: retained.cpu,
             passes,
             image,
+            flip: None,
         })
     }
 }

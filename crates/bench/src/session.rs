@@ -9,6 +9,28 @@ use anyhow::Context;
 use image::RgbaImage;
 use std::path::{Path, PathBuf};
 
+/// What `grid.png` shows in each cell.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum GridMode {
+    /// The method's picture (the reference column: the distance picture).
+    #[default]
+    Pictures,
+    /// `--grid flip`: the ꟻLIP error map against the CPU colour reference
+    /// (the reference column: the colour reference).
+    Flip,
+}
+
+impl std::str::FromStr for GridMode {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "pictures" => Ok(GridMode::Pictures),
+            "flip" => Ok(GridMode::Flip),
+            _ => Err(format!("grid mode `{s}` is not `pictures` or `flip`")),
+        }
+    }
+}
+
 pub struct Session {
     pub out: PathBuf,
     pub results: RunResults,
@@ -16,6 +38,7 @@ pub struct Session {
     pub columns: Vec<String>,
     /// `thumbs[view][column]`.
     pub thumbs: Vec<Vec<Option<RgbaImage>>>,
+    pub grid: GridMode,
 }
 
 impl Session {
@@ -28,6 +51,7 @@ impl Session {
             results,
             columns,
             thumbs,
+            grid: GridMode::Pictures,
         }
     }
 
@@ -54,7 +78,8 @@ impl Session {
     }
 
     /// Write a full-size cell picture under `cells/` and keep its thumbnail
-    /// for the grid. Returns the path relative to the output directory.
+    /// for the grid (in [`GridMode::Pictures`]). Returns the path relative
+    /// to the output directory.
     pub fn save_picture(
         &mut self,
         view: usize,
@@ -62,11 +87,36 @@ impl Session {
         file: &str,
         img: RgbaImage,
     ) -> anyhow::Result<String> {
+        let shown = self.grid == GridMode::Pictures;
+        self.save_cell_file(view, column, file, img, shown)
+    }
+
+    /// [`Session::save_picture`] for what `--grid flip` shows: a ꟻLIP error
+    /// map, or the colour reference in the reference column.
+    pub fn save_flip_picture(
+        &mut self,
+        view: usize,
+        column: usize,
+        file: &str,
+        img: RgbaImage,
+    ) -> anyhow::Result<String> {
+        let shown = self.grid == GridMode::Flip;
+        self.save_cell_file(view, column, file, img, shown)
+    }
+
+    fn save_cell_file(
+        &mut self,
+        view: usize,
+        column: usize,
+        file: &str,
+        img: RgbaImage,
+        thumbnail: bool,
+    ) -> anyhow::Result<String> {
         let rel = format!("cells/{file}.png");
         let path = self.out.join(&rel);
         img.save(&path)
             .with_context(|| format!("writing {}", path.display()))?;
-        if let Some(slot) = self.thumbs.get_mut(view).and_then(|r| r.get_mut(column)) {
+        if thumbnail && let Some(slot) = self.thumbs.get_mut(view).and_then(|r| r.get_mut(column)) {
             *slot = Some(grid::thumbnail(&img));
         }
         Ok(rel)

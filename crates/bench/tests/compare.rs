@@ -42,6 +42,7 @@ fn options(world: &World, out: PathBuf) -> Options {
         temporal: false,
         cache_dir: out.join("cache"),
         resume: false,
+        grid: Default::default(),
     }
 }
 
@@ -140,6 +141,18 @@ fn tiny_run_writes_sane_results() {
         assert_eq!(r.gpu_ms_mean.is_some(), run.adapter.timestamps);
         assert!(r.prep_setup_ms > 0.0 && r.prep_warmup_ms >= r.prep_first_frame_ms);
         assert!(out.join(&r.image).is_file());
+        // ꟻLIP against the CPU colour reference: the march shades the
+        // surface the reference hits, so the error stays well below a wrong
+        // palette's (seen: mean 0.15 on `river` at 64x40, where the march's
+        // misses are a large share of so few pixels), and its map is written
+        // beside the picture.
+        let flip = r.flip.as_ref().expect("every native cell has ꟻLIP");
+        assert!(
+            flip.mean < 0.25 && flip.over_half < 10.0,
+            "{}: {flip:?}",
+            r.view
+        );
+        assert!(out.join(&flip.image).is_file());
     }
     // The ray march reads the edited texture directly: consistent on the first frame.
     assert_eq!(run.edit_rows.len(), 1);
@@ -148,6 +161,7 @@ fn tiny_run_writes_sane_results() {
     assert_eq!(e.consistent_after_frames, Some(1), "{:?}", e.checks);
     let md = std::fs::read_to_string(report).unwrap();
     assert!(md.contains("![views down, methods across](grid.png)") && md.contains("| ray | "));
+    assert!(md.contains("## Colour error by pitch"), "{md}");
     assert!(out.join("grid.png").is_file());
     // --temporal: the default path in 2 s at 10 fps, the crater dug on the
     // way. Played this fast, frames are far apart, and under the depot's roof

@@ -56,6 +56,7 @@ fn a_method_the_adapter_cannot_run_is_one_failure_and_no_edit_row() {
         temporal: false,
         cache_dir: out.join("cache"),
         resume: false,
+        grid: Default::default(),
     };
     let (json, _) = Plan::new(world, opts).unwrap().run(&gpu).unwrap();
     let run = strata_bench::merge::read_run(&json).unwrap();

@@ -8,6 +8,8 @@
 //! world: the original map's y axis points down the screen, and keeping that
 //! handedness makes our images line up with vange-rs pixel for pixel.
 
+pub mod light;
+
 use glam::{Mat4, Vec3, Vec4};
 use serde::{Deserialize, Serialize};
 use strata_level::views::{ViewError, check_pitch};

@@ -5,7 +5,8 @@
 
 use crate::pyramid::Pyramid;
 use crate::raycast::Tracer;
-use crate::{HitClass, REFERENCE_VERSION, Reference, ReferenceSettings};
+use crate::shading::{ColorImage, TerrainRamps, render_color};
+use crate::{COLOR_VERSION, HitClass, REFERENCE_VERSION, Reference, ReferenceSettings};
 use sha2::{Digest, Sha256};
 use std::io;
 use std::path::{Path, PathBuf};
@@ -14,6 +15,7 @@ use strata_camera::Camera;
 use strata_level::Level;
 
 const MAGIC: &[u8; 8] = b"STRATARF";
+const COLOR_MAGIC: &[u8; 8] = b"STRATACL";
 
 /// `$STRATA_CACHE_DIR/reference`, else `$XDG_CACHE_HOME/strata/reference`,
 /// else `~/.cache/strata/reference`, else `./.strata-cache/reference`.
@@ -150,6 +152,90 @@ impl ReferenceCache {
     }
 }
 
+impl ReferenceCache {
+    /// The cache key of a colour reference: the distance reference's key,
+    /// the colours, the shadow switch and the colour version.
+    pub fn color_key(
+        level_hash: &str,
+        camera: &Camera,
+        ramps: &TerrainRamps,
+        shadows: bool,
+    ) -> String {
+        let mut h = Sha256::new();
+        h.update(b"strata-color");
+        h.update(COLOR_VERSION.to_le_bytes());
+        h.update(Self::key(level_hash, camera).as_bytes());
+        h.update(ramps.key_bytes());
+        h.update([u8::from(shadows)]);
+        h.finalize().iter().map(|b| format!("{b:02x}")).collect()
+    }
+
+    fn color_path(
+        &self,
+        level_hash: &str,
+        camera: &Camera,
+        ramps: &TerrainRamps,
+        shadows: bool,
+    ) -> PathBuf {
+        self.dir.join(format!(
+            "{}.rgb",
+            Self::color_key(level_hash, camera, ramps, shadows)
+        ))
+    }
+
+    /// The cached colour reference, or `None` when absent or unreadable.
+    pub fn get_color(
+        &self,
+        level_hash: &str,
+        camera: &Camera,
+        ramps: &TerrainRamps,
+        shadows: bool,
+    ) -> Option<ColorImage> {
+        let bytes = std::fs::read(self.color_path(level_hash, camera, ramps, shadows)).ok()?;
+        decode_color(&bytes).filter(|c| c.width == camera.width && c.height == camera.height)
+    }
+
+    /// The colour reference of `camera`'s view (shadows on or off), from the
+    /// cache or computed and stored. Returns it and whether it was cached.
+    pub fn get_or_compute_color(
+        &self,
+        tracer: &Tracer,
+        level_hash: &str,
+        camera: &Camera,
+        ramps: &TerrainRamps,
+        shadows: bool,
+    ) -> Result<(ColorImage, bool), CacheError> {
+        if let Some(c) = self.get_color(level_hash, camera, ramps, shadows) {
+            return Ok((c, true));
+        }
+        let path = self.color_path(level_hash, camera, ramps, shadows);
+        let c = render_color(tracer, ramps, camera, shadows);
+        let io_err = |path: &Path| {
+            let path = path.to_path_buf();
+            move |source| CacheError::Io { path, source }
+        };
+        std::fs::create_dir_all(&self.dir).map_err(io_err(&self.dir))?;
+        let tmp = path.with_extension(format!("tmp{}", std::process::id()));
+        let mut bytes = COLOR_MAGIC.to_vec();
+        bytes.extend_from_slice(&c.width.to_le_bytes());
+        bytes.extend_from_slice(&c.height.to_le_bytes());
+        bytes.extend_from_slice(&c.rgb);
+        std::fs::write(&tmp, bytes).map_err(io_err(&tmp))?;
+        std::fs::rename(&tmp, &path).map_err(io_err(&path))?;
+        Ok((c, false))
+    }
+}
+
+fn decode_color(bytes: &[u8]) -> Option<ColorImage> {
+    let u32_at = |k: usize| Some(u32::from_le_bytes(bytes.get(k..k + 4)?.try_into().ok()?));
+    if bytes.get(..8)? != COLOR_MAGIC {
+        return None;
+    }
+    let (width, height) = (u32_at(8)?, u32_at(12)?);
+    let rgb = bytes[16..].to_vec();
+    (rgb.len() == 3 * width as usize * height as usize).then_some(ColorImage { width, height, rgb })
+}
+
 fn encode(r: &Reference) -> Vec<u8> {
     let n = r.pixel_count();
     let mut out = Vec::with_capacity(20 + 6 * n);
@@ -242,6 +328,26 @@ mod tests {
         assert!(cache.get(&hash, &cam).is_none());
         assert_eq!(cache.get_or_compute(&level, &cam).unwrap(), a);
         assert!(cache.get(&hash, &cam).is_some());
+        // The colour reference: computed once, then served, per shadow switch.
+        let ramps = crate::TerrainRamps {
+            palette: std::array::from_fn(|i| [i as u8; 3]),
+            begin: [0; 8],
+            end: [255; 8],
+        };
+        let tracer = Tracer::new(&level);
+        let (c, hit) = cache
+            .get_or_compute_color(&tracer, &hash, &cam, &ramps, true)
+            .unwrap();
+        assert!(!hit);
+        let (again, hit) = cache
+            .get_or_compute_color(&tracer, &hash, &cam, &ramps, true)
+            .unwrap();
+        assert!(hit);
+        assert_eq!(again, c);
+        let (_, hit) = cache
+            .get_or_compute_color(&tracer, &hash, &cam, &ramps, false)
+            .unwrap();
+        assert!(!hit);
         let _ = std::fs::remove_dir_all(&dir);
     }
 }

@@ -26,6 +26,8 @@ pub mod metrics;
 pub mod output;
 mod pyramid;
 mod raycast;
+pub mod shading;
+pub mod shadow_map;
 
 use serde::{Deserialize, Serialize};
 use strata_camera::Camera;
@@ -34,10 +36,16 @@ use strata_level::Level;
 pub use cache::{ReferenceCache, default_cache_dir};
 pub use metrics::{Metrics, compare, distance_from_depth};
 pub use raycast::{RayHit, Tracer};
+pub use shading::{ColorImage, TerrainRamps, render_color};
+pub use shadow_map::ShadowMap;
 
 /// Bumped whenever the reference's output for the same level and camera can
 /// change; part of every cache key.
 pub const REFERENCE_VERSION: u32 = 1;
+
+/// Bumped whenever the colour reference (`shading`, `shadow_map`) can change
+/// for the same level, camera and colours; part of every colour cache key.
+pub const COLOR_VERSION: u32 = 1;
 
 /// What a pixel's ray hit.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]

@@ -221,3 +221,20 @@ pub fn class_rgb(c: HitClass) -> [u8; 3] {
         HitClass::Wall => [80, 100, 170],
     }
 }
+
+/// `color.png`: the colour reference of a view.
+pub const COLOR_FILE: &str = "color.png";
+
+/// Write the colour reference as `dir/color.png`.
+pub fn write_color(dir: &Path, color: &crate::ColorImage) -> Result<(), OutputError> {
+    std::fs::create_dir_all(dir).map_err(io(dir))?;
+    let path = dir.join(COLOR_FILE);
+    image::save_buffer(
+        &path,
+        &color.rgb,
+        color.width,
+        color.height,
+        image::ExtendedColorType::Rgb8,
+    )
+    .map_err(|source| OutputError::Png { path, source })
+}

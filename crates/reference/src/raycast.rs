@@ -21,6 +21,9 @@ pub struct RayHit {
     pub distance: f64,
     pub class: HitClass,
     pub terrain: u8,
+    /// The texel column hit (a wall hit lies on its texel line, where the
+    /// point alone does not say which side's column it was).
+    pub column: [i64; 2],
 }
 
 /// A level prepared for ray casting (its pyramid built once). Build one per
@@ -168,7 +171,7 @@ impl<'a> Tracer<'a> {
                 }
             } else {
                 let column = self.level.column(cx, cy);
-                let hit = if settings.subdivision <= 1 {
+                let mut hit = if settings.subdivision <= 1 {
                     column_hit(&column, o, d, t, t_out, t > t_start)
                 } else {
                     subdivided_hit(
@@ -182,8 +185,9 @@ impl<'a> Tracer<'a> {
                         settings.subdivision,
                     )
                 };
-                if hit.is_some() {
-                    return hit;
+                if let Some(hit) = &mut hit {
+                    hit.column = [cx, cy];
+                    return Some(*hit);
                 }
             }
             if t_exit >= t_end {
@@ -266,6 +270,8 @@ fn column_hit(c: &Column, o: DVec3, d: DVec3, t0: f64, t1: f64, entry: bool) -> 
         distance: t,
         class,
         terrain: if is_slab { c.upper_type } else { c.lower_type },
+        // Filled in by the traversal, which knows the column's coordinates.
+        column: [0, 0],
     })
 }
 

@@ -50,6 +50,35 @@ fn vs_mesh(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) -> Ve
     return out;
 }
 
+// Where the eye's ray through `p` meets the height field's own surface (the
+// interval of `kind`), near `p`: the TIN lies up to its fit error above or
+// below that surface, and off-axis rays (every pixel away from the image
+// centre) then reach it several texels away from where the true ray hits,
+// taking those texels' terrain type. Two fixed-point steps along the ray to
+// the column's altitude, the shift capped at 4 texels; the mesh's geometry,
+// depth and flat normal are unchanged.
+const PARALLAX_STEPS: u32 = 2u;
+const PARALLAX_MAX: f32 = 4.0;
+
+fn surface_along_ray(p: vec3<f32>, kind: u32) -> vec2<f32> {
+    let d = normalize(p - globals.eye.xyz);
+    if (abs(d.z) < 0.2) {
+        // Grazing rays: a height error moves the hit far; keep the mesh's.
+        return p.xy;
+    }
+    var q = p.xy;
+    for (var i = 0u; i < PARALLAX_STEPS; i = i + 1u) {
+        let c = decode_column(i32(floor(q.x)), i32(floor(q.y)));
+        var z = c.low;
+        if (kind != KIND_FLOOR && c.dual) {
+            z = select(c.mid, c.high, kind == KIND_TOP);
+        }
+        let t = clamp((z - p.z) / d.z, -PARALLAX_MAX, PARALLAX_MAX);
+        q = p.xy + d.xy * t;
+    }
+    return q;
+}
+
 @fragment
 fn fs_mesh(in: VertexOut) -> @location(0) vec4<f32> {
     let p = in.world;
@@ -70,6 +99,8 @@ fn fs_mesh(in: VertexOut) -> @location(0) vec4<f32> {
     let across = length(n.xy);
     if (across > 0.7) {
         at -= n.xy / across * 0.5;
+    } else {
+        at = surface_along_ray(p, in.kind);
     }
     let c = decode_column(i32(floor(at.x)), i32(floor(at.y)));
     var kind = SURFACE_FLOOR;

@@ -13,10 +13,9 @@ use strata_level::{Level, World};
 pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 /// Depth target format: the depth-buffer values `depth.f32` holds.
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
-/// Side of the shared shadow map, texels.
-pub const SHADOW_SIZE: u32 = 1024;
-/// Background colour where rays miss (linear 0..1 RGB).
-pub const SKY: [f32; 3] = [0.62, 0.74, 0.86];
+/// Side of the shared shadow map, texels, and the sky colour: shared with the
+/// CPU colour reference.
+pub use strata_camera::light::{SHADOW_SIZE, SKY};
 
 /// The sky as a clear colour, for the first pass of object-order methods.
 pub fn sky_clear() -> wgpu::Color {
@@ -401,7 +400,8 @@ impl Shared {
             "shadow map",
             (SHADOW_SIZE, SHADOW_SIZE),
             wgpu::TextureFormat::R32Float,
-            shadow_usage | wgpu::TextureUsages::TEXTURE_BINDING,
+            // COPY_SRC: tests read the map back to hold it to its CPU twin.
+            shadow_usage | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC,
         );
         let Targets {
             color,

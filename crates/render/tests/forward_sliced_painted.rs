@@ -165,3 +165,50 @@ fn bad_settings_fail_clearly() {
         }
     }
 }
+
+/// `sliced_refine` against the plain slicer on the synthetic level's 0°
+/// views: the surface, not the slice plane, writes depth, so coherence
+/// drops and the see-through (the slicer's misses between planes) stays.
+#[test]
+fn refined_slices_are_more_coherent_than_plain_ones() {
+    let Some(gpu) = common::gpu() else { return };
+    let level = common::synthetic_level();
+    let colors = TerrainColors::test_ramps();
+    let views: Vec<ViewSpec> = common::synthetic_views()
+        .into_iter()
+        .filter(|v| v.pitch == 0.0)
+        .collect();
+    let mean = |refine: bool| {
+        let settings = MethodSettings {
+            sliced_refine: refine,
+            ..MethodSettings::default()
+        };
+        let mut r = Renderer::new(&gpu, &level, &colors, "sliced", &settings, W, H).unwrap();
+        let (mut see, mut coh) = (0.0, 0.0);
+        common::worst_over_views(
+            &mut r,
+            &level,
+            &views,
+            (W, H),
+            "sliced",
+            |_, _, reference, d| {
+                let m = strata_reference::metrics::compare(reference, d);
+                see += m.see_through;
+                coh += m.coherence;
+            },
+        );
+        let n = views.len() as f64;
+        (see / n, coh / n)
+    };
+    let (plain_see, plain_coh) = mean(false);
+    let (see, coh) = mean(true);
+    eprintln!(
+        "sliced 0°: plain see-through {plain_see:.2} % coherence {plain_coh:.2} %, refined {see:.2} % / {coh:.2} %"
+    );
+    assert!(coh < 0.75 * plain_coh, "refined {coh} vs plain {plain_coh}");
+    assert!(
+        see <= plain_see + 0.05,
+        "refined see-through {see} vs {plain_see}"
+    );
+    gpu.errors.check().unwrap();
+}

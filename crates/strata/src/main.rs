@@ -35,6 +35,8 @@ enum Command {
     Survey(cmd::survey::Args),
     /// The one-command comparison of every method over the level's views.
     Compare(cmd::compare::Args),
+    /// Tune each method's knob on this level: sweeps, the one-point rule, tuning.md, settings.json.
+    Tune(cmd::tune::Args),
     /// Merge results from several machines into one report.
     Merge(cmd::merge::Args),
     /// List every GPU adapter: backend, driver, capabilities, limits, the methods it runs.
@@ -61,6 +63,7 @@ fn main() -> std::process::ExitCode {
         Command::Compare(args) => cmd::compare::run(args),
         Command::Survey(args) => cmd::survey::run(args),
         Command::Merge(args) => cmd::merge::run(args),
+        Command::Tune(args) => cmd::tune::run(args),
         Command::View(args) => cmd::view::run(args),
         Command::Video(args) => cmd::video::run(args),
         Command::Serve(args) => cmd::serve::run(args),

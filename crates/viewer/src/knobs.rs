@@ -106,6 +106,7 @@ pub fn relevant(name: &str, s: &MethodSettings) -> MethodSettings {
         } else {
             d.slices
         },
+        sliced_refine: name == "sliced" && s.sliced_refine,
         scatter_density: if uses(Knob::Density) {
             s.scatter_density
         } else {

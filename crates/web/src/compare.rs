@@ -101,6 +101,7 @@ pub async fn run(
         temporal: false,
         cache_dir: PathBuf::new(),
         resume: false,
+        grid: Default::default(),
     };
     let plan = Plan::without_output(world, options)?;
     // The folder picker opens worlds for the viewer, which this page does not run.

@@ -78,6 +78,11 @@ pub struct MethodSettings {
     pub voxel_steps: u32,
     /// `sliced`: horizontal slices (the paper's 512).
     pub slices: u32,
+    /// `sliced`: refine each kept fragment to the exact surface crossing
+    /// inside its slice interval (the surface writes depth and colour).
+    /// Off: the paper's plain slicer.
+    #[serde(default)]
+    pub sliced_refine: bool,
     /// `scattered`: footprint grid density (x, y, z); the paper's (4, 4, 4).
     pub scatter_density: [f32; 3],
     /// `mesh`: fit quality q in [0, 1]; max error 2^(4(1 - q)) (0.5 → 4).
@@ -100,6 +105,7 @@ impl Default for MethodSettings {
             voxel_size: [4, 8, 2],
             voxel_steps: 100,
             slices: 512,
+            sliced_refine: false,
             scatter_density: [4.0, 4.0, 4.0],
             mesh_quality: 0.5,
             mesh_outline: false,

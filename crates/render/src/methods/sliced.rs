@@ -20,6 +20,8 @@ pub struct Sliced {
     group: wgpu::BindGroup,
     params: wgpu::Buffer,
     slices: u32,
+    /// The pipeline refines fragments to the exact crossing (`sliced_refine`).
+    refine: bool,
     /// Whether the footprint is empty this frame (nothing to draw).
     empty: bool,
 }
@@ -39,18 +41,27 @@ pub fn create(
 ) -> anyhow::Result<Box<dyn Method>> {
     let slices = checked_slices(settings)?;
     let (params, layout, group) = footprint_binding(shared, "sliced");
+    // Two fragment entry points rather than a branch: the refined one
+    // writes depth, which turns early depth testing off, and the plain
+    // slicer must keep it to stay the paper's.
+    let fragment = if settings.sliced_refine {
+        "fs_sliced_refined"
+    } else {
+        "fs_sliced"
+    };
     let pipeline = forward_pipeline(
         shared,
         "sliced",
         "sliced.wgsl",
         &layout,
-        ("vs_sliced", "fs_sliced"),
+        ("vs_sliced", fragment),
     )?;
     Ok(Box::new(Sliced {
         pipeline,
         group,
         params,
         slices,
+        refine: settings.sliced_refine,
         empty: true,
     }))
 }
@@ -71,7 +82,12 @@ impl Method for Sliced {
         _shared: &Shared,
         settings: &MethodSettings,
     ) -> anyhow::Result<bool> {
-        self.slices = checked_slices(settings)?;
+        let slices = checked_slices(settings)?;
+        if settings.sliced_refine != self.refine {
+            // Another pipeline: a rebuild.
+            return Ok(false);
+        }
+        self.slices = slices;
         Ok(true)
     }
 

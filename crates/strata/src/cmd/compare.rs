@@ -29,9 +29,12 @@ pub struct Args {
     #[arg(long)]
     pub quick: bool,
     /// Comma-separated methods, each `name` or `name:setting`
-    /// (`ray:64`, `voxel:4,8,2/100`, `scattered:4,4,4`, `sliced:512`, `mesh:0.5`, `mesh:0.5o` outline-constrained, `mesh:0.5/2` LOD tolerance 2 px). Default: all.
+    /// (`ray:64`, `voxel:4,8,2/100`, `scattered:4,4,4`, `sliced:512`, `sliced:512/refine`, `mesh:0.5`, `mesh:0.5o` outline-constrained, `mesh:0.5/2` LOD tolerance 2 px). Default: all.
     #[arg(long, value_name = "LIST")]
     pub methods: Option<String>,
+    /// `strata tune`'s settings.json: each method named without a setting takes its tuned one.
+    #[arg(long, value_name = "FILE")]
+    pub settings: Option<PathBuf>,
     /// Views file (`NAME X,Y:YAW:EYE[:under] PITCH` per line). Default: the level's own views.
     #[arg(long, value_name = "FILE")]
     pub views: Option<PathBuf>,
@@ -48,6 +51,10 @@ pub struct Args {
     /// every method and report each one's depth flicker beyond the CPU reference's.
     #[arg(long)]
     pub temporal: bool,
+    /// What grid.png shows: `pictures` (each method's picture) or `flip` (each cell's ꟻLIP
+    /// error map against the CPU colour reference, which fills the reference column).
+    #[arg(long, value_name = "MODE", default_value = "pictures")]
+    pub grid: strata_bench::session::GridMode,
     /// Image size WxH (default 1280x800; 320x200 with --quick).
     #[arg(long, value_name = "WxH")]
     pub size: Option<String>,
@@ -115,7 +122,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 /// Cheap checks first, then the level; the GPU comes later.
 fn prepare(args: &Args) -> anyhow::Result<Prepared> {
     let known = strata_render::methods::names();
-    let methods = match &args.methods {
+    let mut methods = match &args.methods {
         Some(list) => parse_methods(list, &known)?,
         None => known
             .iter()
@@ -125,6 +132,14 @@ fn prepare(args: &Args) -> anyhow::Result<Prepared> {
             })
             .collect(),
     };
+    if let Some(path) = &args.settings {
+        strata_bench::tune::output::TunedSettings::read(path)?.apply(&mut methods);
+        // A tuned setting that does not parse fails here, naming the file.
+        for m in &methods {
+            strata_bench::methods::settings_for(m, true)
+                .with_context(|| format!("settings file {}", path.display()))?;
+        }
+    }
     // Parse an explicit size now, so a bad one fails before any GPU work.
     let explicit_size = args.size.as_deref().map(parse_size).transpose()?;
     let file_views = match &args.views {
@@ -215,6 +230,7 @@ fn options_for(args: &Args, p: &Prepared, adapter: &AdapterReport, out: PathBuf)
             .clone()
             .unwrap_or_else(strata_reference::default_cache_dir),
         resume: args.resume.is_some(),
+        grid: args.grid,
     }
 }
 

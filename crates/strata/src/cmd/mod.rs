@@ -12,5 +12,6 @@ pub mod render;
 pub mod serve;
 pub mod soak;
 pub mod survey;
+pub mod tune;
 pub mod video;
 pub mod view;

@@ -11,8 +11,10 @@ use std::path::PathBuf;
 use std::time::Instant;
 use strata_camera::Camera;
 use strata_level::{ViewSpec, views::parse_views};
-use strata_reference::output::{FORMAT_NOTE, ViewHeader, write_view};
-use strata_reference::{REFERENCE_VERSION, ReferenceCache, ReferenceSettings, Tracer};
+use strata_reference::output::{FORMAT_NOTE, ViewHeader, write_color, write_view};
+use strata_reference::{
+    REFERENCE_VERSION, ReferenceCache, ReferenceSettings, TerrainRamps, Tracer, render_color,
+};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -49,6 +51,9 @@ pub struct Args {
     /// Always compute; neither read nor write the reference cache.
     #[arg(long)]
     pub no_cache: bool,
+    /// Shade color.png without the shadow map (as `compare --no-shadows`).
+    #[arg(long)]
+    pub no_shadows: bool,
     /// Cache directory. Default: $STRATA_CACHE_DIR/reference, else ~/.cache/strata/reference.
     #[arg(long, value_name = "DIR")]
     pub cache_dir: Option<PathBuf>,
@@ -137,14 +142,25 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             "view", "sky %", "min", "median", "max", "seconds"
         )?;
     }
+    let ramps = TerrainRamps::from_world(&world);
+    let shadows = !args.no_shadows;
     for (view, camera) in views.iter().zip(&cameras) {
         let start = Instant::now();
-        let (reference, from_cache) = if args.no_cache {
-            (tracer.render(camera, &ReferenceSettings::default()), false)
+        let (reference, color, from_cache) = if args.no_cache {
+            (
+                tracer.render(camera, &ReferenceSettings::default()),
+                render_color(&tracer, &ramps, camera, shadows),
+                false,
+            )
         } else {
-            cache
+            let context = "reference cache (use --no-cache to bypass)";
+            let (r, r_hit) = cache
                 .get_or_compute_traced(&tracer, &level_hash, camera)
-                .context("reference cache (use --no-cache to bypass)")?
+                .context(context)?;
+            let (c, c_hit) = cache
+                .get_or_compute_color(&tracer, &level_hash, camera, &ramps, shadows)
+                .context(context)?;
+            (r, c, r_hit && c_hit)
         };
         let seconds = if from_cache {
             0.0
@@ -169,6 +185,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         };
         let dir = args.out.join(&view.name);
         write_view(&dir, &header, &reference)?;
+        write_color(&dir, &color)?;
         if args.json {
             let line = ViewSummary {
                 view: &view.name,

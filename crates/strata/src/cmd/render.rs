@@ -74,6 +74,9 @@ pub struct MethodArgs {
     #[arg(long, value_name = "N", value_parser = parse_positive,
           default_value_t = MethodSettings::default().slices)]
     pub slices: u32,
+    /// `sliced`: refine each kept fragment to the exact surface crossing in its slice interval.
+    #[arg(long)]
+    pub sliced_refine: bool,
     /// `scattered`: grid density X,Y,Z in screen terms (4 → 1.25 samples per pixel across, 1 per pixel along, 1.25 per pixel of projected height), or one D for all three.
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_density,
           default_value_t = Triple(MethodSettings::default().scatter_density))]
@@ -101,6 +104,7 @@ impl MethodArgs {
             voxel_size: self.voxel_size.0,
             voxel_steps: self.voxel_steps,
             slices: self.slices,
+            sliced_refine: self.sliced_refine,
             scatter_density: self.scatter_density.0,
             mesh_quality: self.mesh_quality,
             mesh_outline: self.mesh_outline,
@@ -348,6 +352,7 @@ mod tests {
             voxel_size: [2, 4, 1],
             voxel_steps: 50,
             slices: 256,
+            sliced_refine: false,
             scatter_density: [2.0, 3.0, 4.5],
             mesh_quality: 0.75,
             shadows: false,
