@@ -293,7 +293,8 @@ impl Plan {
                 session.save_json()?;
                 continue;
             }
-            let column = self.method_column(gpu, &mut session, &references, &colors, m, &bar, &mut count);
+            let column =
+                self.method_column(gpu, &mut session, &references, &colors, m, &bar, &mut count);
             if let Err(e) = column {
                 if e.is::<Stopped>() {
                     return Err(e);

@@ -60,6 +60,7 @@ fn a_build_the_gpu_refuses_is_recorded_and_the_next_method_runs() {
         temporal: false,
         cache_dir: out.join("cache"),
         resume: false,
+        grid: Default::default(),
     };
     let (json, report) = Plan::new(world, opts).unwrap().run(&gpu).unwrap();
     let run = strata_bench::merge::read_run(&json).unwrap();

@@ -39,6 +39,10 @@ pub struct TuneOptions {
     /// Timed frames per point and view.
     pub frames: u32,
     pub min_warmup: u32,
+    /// Ms of untimed frames back to back before each point's timed frames
+    /// at each view (0: off), as `compare --hold-busy`: a mostly idle GPU
+    /// lowers its clock, which would charge later points more.
+    pub hold_busy_ms: u32,
     pub shadows: bool,
     pub cache_dir: PathBuf,
     /// Only these methods (default: every swept method).
@@ -297,6 +301,12 @@ pub fn run(world: &World, gpu: &Gpu, opts: &TuneOptions) -> anyhow::Result<Tunin
                     // The first view may wait out an incremental build.
                     let cap = if v == 0 { 64 } else { opts.min_warmup };
                     warm_up(&mut r, cam, opts.min_warmup, cap, timestamps)?;
+                    if opts.hold_busy_ms > 0 {
+                        r.hold_busy(
+                            cam,
+                            std::time::Duration::from_millis(u64::from(opts.hold_busy_ms)),
+                        )?;
+                    }
                     let mut ms = 0.0;
                     for _ in 0..opts.frames {
                         let t = r.render_frame(cam)?;

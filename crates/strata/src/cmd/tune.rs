@@ -33,6 +33,11 @@ pub struct Args {
     /// Timed frames per point and view (default 5; 1 with --quick).
     #[arg(long, value_name = "N")]
     pub frames: Option<u32>,
+    /// Ms of untimed frames back to back before each point's timed frames
+    /// at each view (default 100; 0 with --quick), so every point is timed
+    /// at the GPU's busy clock (see `compare --hold-busy`).
+    #[arg(long, value_name = "MS")]
+    pub hold_busy: Option<u32>,
     /// Turn the shared shadow map off.
     #[arg(long)]
     pub no_shadows: bool,
@@ -73,6 +78,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         quick: args.quick,
         frames: args.frames.unwrap_or(if args.quick { 1 } else { 5 }),
         min_warmup: if args.quick { 1 } else { 3 },
+        hold_busy_ms: args.hold_busy.unwrap_or(if args.quick { 0 } else { 100 }),
         shadows: !args.no_shadows,
         cache_dir: args
             .cache
