@@ -31,6 +31,10 @@ enum Command {
     Render(cmd::render::Args),
     /// Fit the TIN mesh and report its size, causes, time and memory.
     Fit(cmd::fit::Args),
+    /// Build the terrain collider: build time, memory, crater refit, ray-cast throughput.
+    Collide(cmd::collide::Args),
+    /// Export the fitted mesh with terrain colours as glTF (.glb) or OBJ.
+    Export(cmd::export::Args),
     /// The one-command comparison of every method over the level's views.
     Compare(cmd::compare::Args),
     /// Merge results from several machines into one report.
@@ -54,6 +58,8 @@ fn main() -> std::process::ExitCode {
         Command::Metrics(args) => cmd::metrics::run(args),
         Command::Render(args) => cmd::render::run(args),
         Command::Fit(args) => cmd::fit::run(args),
+        Command::Collide(args) => cmd::collide::run(args),
+        Command::Export(args) => cmd::export::run(args),
         Command::Compare(args) => cmd::compare::run(args),
         Command::Merge(args) => cmd::merge::run(args),
         Command::View(args) => cmd::view::run(args),
