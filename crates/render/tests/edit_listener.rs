@@ -25,7 +25,8 @@ fn collider_follows_the_renderers_edit() {
     let calls = Rc::new(RefCell::new(Vec::new()));
     let (c, k) = (collider.clone(), calls.clone());
     renderer.set_edit_listener(Some(Box::new(move |level, rects| {
-        k.borrow_mut().extend(c.borrow_mut().apply_edit(level, rects));
+        k.borrow_mut()
+            .extend(c.borrow_mut().apply_edit(level, rects));
     })));
     let (cx, cy) = (i64::from(level.width() / 2), i64::from(level.height() / 2));
     let probe = |c: &TerrainCollider| {
