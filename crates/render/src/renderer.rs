@@ -59,7 +59,7 @@ pub struct Renderer {
 /// `strata_collide::TerrainCollider::apply_edit`): called with the edited
 /// level and the dirty rectangles inside [`Renderer::apply_edit`], after the
 /// GPU data changed, so both change on the same consistency boundary.
-pub type EditListener = Box<dyn FnMut(&Level, &[DirtyRect])>;
+pub type EditListener = Box<dyn FnMut(&Level, &[DirtyRect]) + Send>;
 
 impl Renderer {
     /// Upload `level`, build method `method` for `width` x `height` targets.
