@@ -1,4 +1,5 @@
-//! Issue 18 (embedding): after any method's frame, the caller's own
+//! Issue 18 (embedding): on the caller's own device and queue
+//! (`Gpu::from_device`), after any method's frame, the caller's own
 //! rasterised object, drawn with its own pipeline and vertex buffer into the
 //! renderer's colour and depth targets (`COLOR_FORMAT`, `DEPTH_FORMAT`: depth
 //! 0 near .. 1 far under `Camera::view_proj`, compare `Less`), composes with
@@ -136,9 +137,22 @@ fn pixel(color: &[u8], x: u32, y: u32) -> [u8; 3] {
 
 #[test]
 fn callers_object_composes_by_depth_in_every_method() {
-    let Some(gpu) = common::gpu() else {
+    // The caller's own device and queue, with every feature and limit its
+    // adapter offers, handed to Strata (embedding).
+    let instance = strata_render::AdapterChoice::default().instance();
+    let Ok(adapter) = pollster::block_on(instance.request_adapter(&Default::default())) else {
+        common::skip_loudly("no GPU adapter for the caller's device");
         return;
     };
+    let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+        label: Some("the caller's device"),
+        required_features: adapter.features(),
+        required_limits: adapter.limits(),
+        ..Default::default()
+    }))
+    .expect("the caller's device");
+    eprintln!("caller's adapter: {:?}", adapter.get_info().name);
+    let gpu = strata_render::Gpu::from_device(instance, adapter, device, queue).unwrap();
     let level = common::synthetic_level();
     let view = common::synthetic_views()
         .into_iter()
