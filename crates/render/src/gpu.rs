@@ -317,7 +317,34 @@ impl Gpu {
             })
             .await
             .map_err(|e| anyhow::anyhow!("adapter `{}` refused a device: {e}", info.name))?;
+        Self::from_parts(instance, adapter, device, queue, caps)
+    }
 
+    /// Embedding: run Strata on the caller's own device and queue (made from
+    /// `adapter` of `instance` with whatever features and limits the caller
+    /// chose). Methods the device's limits or features cannot run are
+    /// refused by name when they are created ([`Capabilities`]). This
+    /// installs Strata's uncaptured-error and device-lost handlers on the
+    /// device (they collect errors that [`Gpu::wait`] and every frame report),
+    /// replacing the caller's.
+    pub fn from_device(
+        instance: wgpu::Instance,
+        adapter: wgpu::Adapter,
+        device: wgpu::Device,
+        queue: wgpu::Queue,
+    ) -> anyhow::Result<Self> {
+        let caps = Capabilities::of(&adapter, &device.limits(), device.features());
+        Self::from_parts(instance, adapter, device, queue, caps)
+    }
+
+    fn from_parts(
+        instance: wgpu::Instance,
+        adapter: wgpu::Adapter,
+        device: wgpu::Device,
+        queue: wgpu::Queue,
+        caps: Capabilities,
+    ) -> anyhow::Result<Self> {
+        let info = adapter.get_info();
         let errors = ErrorSink::default();
         let sink = errors.clone();
         device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| sink.push(e.to_string())));

@@ -53,10 +53,18 @@ pub struct Renderer {
     depth_reader: Option<DepthReader>,
     /// The newest frame's submission ([`Renderer::hold_busy`] bounds the queue by it).
     last_submission: Option<wgpu::SubmissionIndex>,
+    /// Called by [`Renderer::apply_edit`] after the GPU copies changed.
+    edit_listener: Option<EditListener>,
 }
 
 /// Frames [`Renderer::hold_busy`] lets queue up before it waits for the oldest.
 const FRAMES_IN_FLIGHT: usize = 3;
+
+/// Something that follows the level's edits on the CPU (a terrain collider,
+/// `strata_collide::TerrainCollider::apply_edit`): called with the edited
+/// level and the dirty rectangles inside [`Renderer::apply_edit`], after the
+/// GPU data changed, so both change on the same consistency boundary.
+pub type EditListener = Box<dyn FnMut(&Level, &[DirtyRect]) + Send>;
 
 impl Renderer {
     /// Upload `level`, build method `method` for `width` x `height` targets.
@@ -106,6 +114,7 @@ impl Renderer {
             shadow_reuse: shadow_reuse_from_env(),
             shadow_drawn: None,
             depth_reader,
+            edit_listener: None,
         };
         wait_device(&renderer.shared.device, &renderer.errors)?;
         renderer.setup_ms = ms(start);
@@ -399,7 +408,16 @@ impl Renderer {
         for built in &mut self.methods {
             built.method.apply_edit(&self.shared, level, rects)?;
         }
+        if let Some(listener) = &mut self.edit_listener {
+            listener(level, rects);
+        }
         Ok(())
+    }
+
+    /// Follow every later [`apply_edit`](Self::apply_edit) on the CPU too
+    /// (replaces any earlier listener; `None` removes it).
+    pub fn set_edit_listener(&mut self, listener: Option<EditListener>) {
+        self.edit_listener = listener;
     }
 
     /// The colour target, RGBA8, row-major, top row first.

@@ -33,6 +33,10 @@ enum Command {
     Fit(cmd::fit::Args),
     /// Fit a grid of generated worlds (or given ones) at five qualities: table, correlations, causes, plots.
     Survey(cmd::survey::Args),
+    /// Build the terrain collider: build time, memory, crater refit, ray-cast throughput.
+    Collide(cmd::collide::Args),
+    /// Export the fitted mesh with terrain colours as glTF (.glb) or OBJ.
+    Export(cmd::export::Args),
     /// The one-command comparison of every method over the level's views.
     Compare(cmd::compare::Args),
     /// Tune each method's knob on this level: sweeps, the one-point rule, tuning.md, settings.json.
@@ -60,6 +64,8 @@ fn main() -> std::process::ExitCode {
         Command::Metrics(args) => cmd::metrics::run(args),
         Command::Render(args) => cmd::render::run(args),
         Command::Fit(args) => cmd::fit::run(args),
+        Command::Collide(args) => cmd::collide::run(args),
+        Command::Export(args) => cmd::export::run(args),
         Command::Compare(args) => cmd::compare::run(args),
         Command::Survey(args) => cmd::survey::run(args),
         Command::Merge(args) => cmd::merge::run(args),

@@ -1,7 +1,9 @@
 //! One module per subcommand: its arguments and its `run`.
 
 pub mod adapters;
+pub mod collide;
 pub mod compare;
+pub mod export;
 pub mod fit;
 pub mod generate;
 pub mod info;

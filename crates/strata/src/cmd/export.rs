@@ -1,0 +1,50 @@
+//! `strata export`: the fitted mesh with terrain colours as glTF or OBJ.
+
+use anyhow::Context;
+use std::path::PathBuf;
+use strata_export::{Format, Region, TerrainSoup};
+
+#[derive(clap::Args)]
+pub struct Args {
+    #[command(flatten)]
+    world: crate::world_arg::WorldArgs,
+    /// Output format: gltf (binary .glb) or obj.
+    #[arg(long, default_value = "gltf")]
+    format: String,
+    /// Texels X0,Y0,X1,Y1 (half-open); X1/Y1 may pass the map edge (it wraps; the piece stays whole). Default: the whole map.
+    #[arg(long, value_name = "X0,Y0,X1,Y1")]
+    region: Option<String>,
+    /// Mesh quality q in [0, 1] (max vertical error 2^(4(1-q))).
+    #[arg(long, default_value_t = 0.5)]
+    quality: f64,
+    /// Output file.
+    #[arg(long)]
+    out: PathBuf,
+}
+
+pub fn run(args: Args) -> anyhow::Result<()> {
+    let format: Format = args.format.parse()?;
+    let world = args.world.load()?;
+    let region = match &args.region {
+        Some(text) => Region::parse(text, &world.level)?,
+        None => Region::whole(&world.level),
+    };
+    // Open the file first: an unwritable path fails before the fit.
+    let file = std::fs::File::create(&args.out)
+        .with_context(|| format!("cannot write the export to {}", args.out.display()))?;
+    let soup = TerrainSoup::build(&world, region, args.quality)?;
+    let mut out = std::io::BufWriter::new(file);
+    soup.write(format, &mut out)
+        .with_context(|| format!("writing {}", args.out.display()))?;
+    drop(out);
+    let bytes = std::fs::metadata(&args.out).map(|m| m.len()).unwrap_or(0);
+    println!(
+        "{}: {} vertices, {} triangles, max error {}, {:.1} MiB",
+        args.out.display(),
+        soup.positions.len(),
+        soup.triangles.len(),
+        soup.max_error,
+        bytes as f64 / (1 << 20) as f64
+    );
+    Ok(())
+}

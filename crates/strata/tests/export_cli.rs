@@ -1,0 +1,128 @@
+//! `strata export` and `strata collide` end to end on a small generated
+//! world (CPU only): a written glTF and OBJ, clear errors for a bad region
+//! and an unwritable path, and the collider report's numbers.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const STRATA: &str = env!("CARGO_BIN_EXE_strata");
+
+fn strata(args: &[&str]) -> Output {
+    Command::new(STRATA)
+        .args(args)
+        .output()
+        .expect("strata runs")
+}
+
+fn text(o: &Output) -> String {
+    format!(
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    )
+}
+
+fn small_world(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("strata-export-cli-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    let world = d.join("world");
+    let out = strata(&[
+        "generate",
+        "--size",
+        "256x256",
+        "--seed",
+        "3",
+        "--out",
+        p(&world),
+    ]);
+    assert!(out.status.success(), "generate: {}", text(&out));
+    world
+}
+
+fn p(path: &Path) -> &str {
+    path.to_str().unwrap()
+}
+
+#[test]
+fn export_writes_files_and_names_bad_input() {
+    let world = small_world("export");
+    let glb = world.with_file_name("t.glb");
+    let out = strata(&[
+        "export",
+        "--level",
+        p(&world),
+        "--format",
+        "gltf",
+        "--out",
+        p(&glb),
+    ]);
+    assert!(out.status.success(), "{}", text(&out));
+    let bytes = std::fs::read(&glb).unwrap();
+    assert_eq!(&bytes[..4], b"glTF");
+    assert!(bytes.len() > 10_000, "{} bytes", bytes.len());
+
+    let obj = world.with_file_name("t.obj");
+    let args = [
+        "export",
+        "--level",
+        p(&world),
+        "--format",
+        "obj",
+        "--region",
+        "200,0,300,64",
+        "--out",
+        p(&obj),
+    ];
+    let out = strata(&args);
+    assert!(out.status.success(), "{}", text(&out));
+    let faces = std::fs::read_to_string(&obj)
+        .unwrap()
+        .lines()
+        .filter(|l| l.starts_with("f "))
+        .count();
+    assert!(faces > 100, "{faces} faces");
+
+    for (args, expect) in [
+        (
+            vec!["--region", "0,0,300,10", "--out", p(&obj)],
+            "wider or taller than the map",
+        ),
+        (vec!["--region", "5,5,5,9", "--out", p(&obj)], "empty"),
+        (
+            vec!["--out", "/nonexistent-dir/x.glb"],
+            "cannot write the export to /nonexistent-dir/x.glb",
+        ),
+        (
+            vec!["--format", "fbx", "--out", p(&obj)],
+            "expected gltf or obj",
+        ),
+        (
+            vec!["--quality", "2", "--out", p(&obj)],
+            "quality 2 is outside [0, 1]",
+        ),
+    ] {
+        let mut all = vec!["export", "--level", p(&world)];
+        all.extend(args);
+        let out = strata(&all);
+        assert!(!out.status.success());
+        let t = text(&out);
+        assert!(
+            t.contains(expect) && !t.contains("panicked"),
+            "{all:?}: {t}"
+        );
+    }
+}
+
+#[test]
+fn collide_reports_its_numbers() {
+    let world = small_world("collide");
+    let out = strata(&["collide", "--level", p(&world), "--rays", "500", "--json"]);
+    assert!(out.status.success(), "{}", text(&out));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["chunks"], 4);
+    assert!(v["triangles"].as_u64().unwrap() > 1000);
+    assert!(v["memory_bytes"].as_u64().unwrap() > 10_000);
+    assert!(v["collider_rays_per_second"].as_f64().unwrap() > 0.0);
+    assert!(v["hits_both"].as_u64().unwrap() > 400, "{v}");
+}
