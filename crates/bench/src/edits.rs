@@ -78,7 +78,8 @@ fn build(
     if input.hold_busy_ms > 0 {
         r.hold_busy(
             input.camera,
-            std::time::Duration::from_millis(u64::from(input.hold_busy_ms)),
+            // Four holds: it follows the renderer's setup (see `Plan::cell`).
+            std::time::Duration::from_millis(4 * u64::from(input.hold_busy_ms)),
         )?;
     }
     Ok(r)
