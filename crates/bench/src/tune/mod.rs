@@ -302,9 +302,12 @@ pub fn run(world: &World, gpu: &Gpu, opts: &TuneOptions) -> anyhow::Result<Tunin
                     let cap = if v == 0 { 64 } else { opts.min_warmup };
                     warm_up(&mut r, cam, opts.min_warmup, cap, timestamps)?;
                     if opts.hold_busy_ms > 0 {
+                        // The first view follows the renderer's setup, when
+                        // the GPU idled down (see `compare`'s first view).
+                        let scale = if v == 0 { 4 } else { 1 };
                         r.hold_busy(
                             cam,
-                            std::time::Duration::from_millis(u64::from(opts.hold_busy_ms)),
+                            std::time::Duration::from_millis(u64::from(opts.hold_busy_ms) * scale),
                         )?;
                     }
                     let mut ms = 0.0;
