@@ -534,6 +534,7 @@ impl Plan {
     }
 
     /// Every view of method `m`, one renderer.
+    #[allow(clippy::too_many_arguments)]
     fn method_column(
         &self,
         gpu: &Gpu,
