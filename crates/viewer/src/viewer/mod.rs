@@ -2,15 +2,17 @@
 //! builds, the method (or A/B pair) drawn through the harness's
 //! [`Renderer`], the overlay, and the swapchain. Input handling is in
 //! [`input`], script running in [`scripted`], the score and screenshot
-//! read-backs (finished a frame or more later) in [`readback`].
+//! read-backs (finished a frame or more later) in [`readback`], digging,
+//! undo, saving and the memory report in [`editing`].
 
+mod editing;
 mod input;
 mod readback;
 mod scripted;
 
 use crate::Options;
 use crate::builds::{Builds, Finished};
-use crate::dig::{Digger, pick};
+use crate::dig::Digger;
 use crate::fly::FlyCamera;
 use crate::knobs::{Knob, relevant};
 use crate::minimap::Minimap;
@@ -24,7 +26,7 @@ use std::collections::HashSet;
 use std::path::PathBuf;
 use std::sync::Arc;
 use strata_camera::Camera;
-use strata_level::{DirtyRect, EditSite, Level, ViewSpec};
+use strata_level::{EditSite, Level, ViewSpec};
 use strata_render::gpu::TextureReadback;
 use strata_render::timing::PassTimer;
 use strata_render::{FrameTimings, Gpu, MethodSettings, Renderer, TerrainColors, methods};
@@ -525,117 +527,6 @@ impl Viewer {
     fn camera(&self) -> anyhow::Result<Camera> {
         let (w, h) = self.render_size();
         self.fly.camera(w, h)
-    }
-
-    /// Dig where picture point `at` (render pixels) shows terrain.
-    fn dig_at(&mut self, at: (f32, f32)) -> anyhow::Result<()> {
-        let camera = self.camera()?;
-        let start = Instant::now();
-        let Some(hit) = pick(&self.level, &camera, at.0, at.1) else {
-            self.say("nothing to dig there: sky".into());
-            return Ok(());
-        };
-        let pick_ms = start.elapsed().as_secs_f64() * 1e3;
-        let start = Instant::now();
-        let dirty = self.digger.dig(Arc::make_mut(&mut self.level), hit.point);
-        self.edited(&dirty)?;
-        let p = hit.point;
-        self.say(format!(
-            "dug r={} at {:.0}, {:.0}, {:.0}: {} rect(s); pick {pick_ms:.2} ms, edit + upload {:.2} ms",
-            self.digger.radius,
-            p.x,
-            p.y,
-            p.z,
-            dirty.len(),
-            start.elapsed().as_secs_f64() * 1e3
-        ));
-        Ok(())
-    }
-
-    /// Save the edited world to `dir` (Ctrl+S: the default directory).
-    /// A refused or failed save is said and the session goes on.
-    fn save(&mut self, dir: Option<PathBuf>) -> anyhow::Result<()> {
-        let dir = dir.unwrap_or_else(|| self.saver.default_dir.clone());
-        let said = self.saver.save(&dir, &self.level);
-        match said {
-            Ok(line) => {
-                self.say(line);
-                self.unsaved = false;
-                Ok(())
-            }
-            Err(e) => {
-                self.say(format!("not saved: {e:#}"));
-                Err(e)
-            }
-        }
-    }
-
-    /// The viewer is stopping on an error (a lost device, say): save the
-    /// edits, if any, to `<out>/<world>-recovered` so none are lost, and
-    /// say where.
-    pub fn rescue(&mut self) {
-        if let Some(why) = self.gpu.errors.lost() {
-            self.say(format!(
-                "the GPU device was lost ({why}); what failed after it is a consequence"
-            ));
-        }
-        if !self.unsaved {
-            self.say("stopping on an error; no unsaved edits".into());
-            return;
-        }
-        let dir = self
-            .out
-            .join(format!("{}-recovered", self.saver.world().name));
-        match self.saver.save(&dir, &self.level) {
-            Ok(line) => self.say(format!("stopping on an error; your edits are kept: {line}")),
-            Err(e) => self.say(format!(
-                "stopping on an error; the edits could not be saved: {e:#}"
-            )),
-        }
-    }
-
-    /// One `memory` line (script `memory`; `strata soak` reads them):
-    /// frames, process RSS, the renderer's GPU bytes (shared + every kept
-    /// method) and kept methods' CPU bytes, the undo snapshots' bytes.
-    fn memory_line(&self) -> String {
-        let r = &self.renderer;
-        let kept = r.method_names();
-        let retained: Vec<_> = kept.iter().filter_map(|m| r.retained_bytes_of(m)).collect();
-        let gpu = r.shared_gpu_bytes() + retained.iter().map(|b| b.gpu).sum::<u64>();
-        let cpu: u64 = retained.iter().map(|b| b.cpu).sum();
-        let rss = crate::platform::rss_bytes().map_or("-".into(), |b| b.to_string());
-        format!(
-            "memory frames={} rss_bytes={rss} gpu_bytes={gpu} method_cpu_bytes={cpu} \
-             undo_bytes={} undo_depth={} kept={}",
-            self.frames,
-            self.digger.undo_bytes(),
-            self.digger.can_undo(),
-            kept.len()
-        )
-    }
-
-    fn undo(&mut self) -> anyhow::Result<()> {
-        match self.digger.undo(Arc::make_mut(&mut self.level)) {
-            Some(dirty) => {
-                self.edited(&dirty)?;
-                self.say(format!("undone ({} left)", self.digger.can_undo()));
-            }
-            None => self.say("nothing to undo".into()),
-        }
-        Ok(())
-    }
-
-    /// Every kept method and running build learns of an edit.
-    fn edited(&mut self, dirty: &[DirtyRect]) -> anyhow::Result<()> {
-        if dirty.is_empty() {
-            return Ok(());
-        }
-        self.unsaved = true;
-        self.builds.record_edit(dirty);
-        self.renderer.apply_edit(&self.level, dirty)?;
-        let repainted = self.map.update(&self.level, &self.colors, dirty);
-        self.overlay.update_map(&self.map, &repainted);
-        Ok(())
     }
 
     fn on_knob(&mut self, knob: Knob) -> anyhow::Result<()> {
