@@ -14,7 +14,9 @@
 //! first every time.
 
 use proptest::prelude::*;
-use proptest::test_runner::{Config, FileFailurePersistence, TestCaseError, TestRunner};
+use proptest::test_runner::{
+    Config, FileFailurePersistence, RngAlgorithm, TestCaseError, TestRng, TestRunner,
+};
 use strata_bench::edits::disagreement;
 use strata_bench::results::{EDIT_CHECK_FRAMES, EDIT_MAX_CLASS_MISMATCH, EDIT_MAX_DEPTH_P95};
 use strata_camera::Camera;
@@ -314,7 +316,14 @@ fn random_edit_sequences_match_a_fresh_build() {
     ))));
     // A shrunk GPU failure costs a fresh build per method per try: few tries.
     config.max_shrink_iters = 64;
-    let mut runner = TestRunner::new(config);
+    // In `cargo test` the sequences are the same every run (a test that
+    // sometimes draws only off-camera steps would fail at random: CI saw
+    // 0 of 4 steps visible once); STRATA_EDIT_SEQ_RANDOM=1 draws new ones.
+    let mut runner = if std::env::var_os("STRATA_EDIT_SEQ_RANDOM").is_some() {
+        TestRunner::new(config)
+    } else {
+        TestRunner::new_with_rng(config, TestRng::deterministic_rng(RngAlgorithm::ChaCha))
+    };
     let (checked, visible) = (std::cell::Cell::new(0u32), std::cell::Cell::new(0u32));
     let start = std::time::Instant::now();
     let result = runner.run(&proptest::collection::vec(step(), 1..=steps), |seq| {
