@@ -84,14 +84,16 @@ fn scan_avx2(pts: [Pt; 3], zs: [[u8; 3]; 3], chunk: &ChunkSamples) -> (i64, i64,
     scan_generic(pts, zs, chunk)
 }
 
+/// A scan's twice-area and its bounding box clipped to the chunk's inner
+/// samples, or the scan's answer when no sample lies strictly inside.
 #[inline(always)]
-fn scan_generic(pts: [Pt; 3], zs: [[u8; 3]; 3], chunk: &ChunkSamples) -> (i64, i64, u32) {
+fn scan_setup(pts: [Pt; 3], chunk: &ChunkSamples) -> Result<(i32, [i32; 4]), (i64, i64, u32)> {
     let [a, b, c] = pts;
     let den = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
     // Pick's theorem: a lattice triangle of area 1/2 holds no sample but its
     // vertices, and those interpolate exactly. Common in a fine fit.
     if den <= 1 {
-        return (0, 1, 0);
+        return Err((0, 1, 0));
     }
     let (sx, sy) = (chunk.size_x as i32, chunk.size_y as i32);
     let x0 = a[0].min(b[0]).min(c[0]).max(1);
@@ -99,8 +101,17 @@ fn scan_generic(pts: [Pt; 3], zs: [[u8; 3]; 3], chunk: &ChunkSamples) -> (i64, i
     let y0 = a[1].min(b[1]).min(c[1]).max(1);
     let y1 = a[1].max(b[1]).max(c[1]).min(sy - 1);
     if x0 > x1 || y0 > y1 {
-        return (0, i64::from(den), 0);
+        return Err((0, i64::from(den), 0));
     }
+    Ok((den, [x0, y0, x1, y1]))
+}
+
+#[inline(always)]
+fn scan_generic(pts: [Pt; 3], zs: [[u8; 3]; 3], chunk: &ChunkSamples) -> (i64, i64, u32) {
+    let (den, [x0, y0, x1, y1]) = match scan_setup(pts, chunk) {
+        Ok(setup) => setup,
+        Err(nothing) => return nothing,
+    };
     if (x1 - x0 + 1) * (y1 - y0 + 1) <= SMALL {
         let (best, at) = scan_small(pts, zs, den, [x0, y0, x1, y1], chunk);
         return (i64::from(best), i64::from(den), at);
@@ -325,19 +336,10 @@ pub fn scan_outline(
     duals: [bool; 3],
     chunk: &ChunkSamples,
 ) -> (i64, i64, u32) {
-    let [a, b, c] = pts;
-    let den = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
-    if den <= 1 {
-        return (0, 1, 0);
-    }
-    let (sx, sy) = (chunk.size_x as i32, chunk.size_y as i32);
-    let x0 = a[0].min(b[0]).min(c[0]).max(1);
-    let x1 = a[0].max(b[0]).max(c[0]).min(sx - 1);
-    let y0 = a[1].min(b[1]).min(c[1]).max(1);
-    let y1 = a[1].max(b[1]).max(c[1]).min(sy - 1);
-    if x0 > x1 || y0 > y1 {
-        return (0, i64::from(den), 0);
-    }
+    let (den, [x0, y0, x1, y1]) = match scan_setup(pts, chunk) {
+        Ok(setup) => setup,
+        Err(nothing) => return nothing,
+    };
     let slab = duals.iter().all(|&d| d);
     let duals_in = chunk.duals_in(x0, y0, x1, y1);
     let bbox = [x0, y0, x1, y1];
