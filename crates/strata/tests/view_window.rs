@@ -4,9 +4,8 @@
 //! Without one it skips loudly; with `STRATA_REQUIRE_DISPLAY=1` (CI) it fails.
 
 use image::RgbaImage;
-use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
+use std::process::Command;
 use std::time::{Duration, Instant};
 
 const STRATA: &str = env!("CARGO_BIN_EXE_strata");
@@ -22,48 +21,8 @@ fn skip_loudly(why: &str, required_by: &str) {
 }
 
 /// An X display: the session's own, or an Xvfb started for this test.
-struct Display {
-    name: String,
-    xvfb: Option<Child>,
-}
-
-impl Drop for Display {
-    fn drop(&mut self) {
-        if let Some(child) = &mut self.xvfb {
-            let _ = child.kill();
-            let _ = child.wait();
-        }
-    }
-}
-
-fn display() -> Option<Display> {
-    if let Some(name) = std::env::var("DISPLAY").ok().filter(|d| !d.is_empty()) {
-        return Some(Display { name, xvfb: None });
-    }
-    // -displayfd: Xvfb picks a free display and writes its number when ready.
-    let mut child = Command::new("Xvfb")
-        .args([
-            "-displayfd",
-            "1",
-            "-screen",
-            "0",
-            "1024x768x24",
-            "-nolisten",
-            "tcp",
-        ])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::null())
-        .spawn()
-        .ok()?;
-    let mut line = String::new();
-    let stdout = child.stdout.take()?;
-    let read = BufReader::new(stdout).read_line(&mut line);
-    let number: Option<u32> = read.ok().and_then(|_| line.trim().parse().ok());
-    let display = Display {
-        name: format!(":{}", number?),
-        xvfb: Some(child),
-    };
-    Some(display)
+fn display() -> Option<strata_viewer::x_display::XDisplay> {
+    strata_viewer::x_display::XDisplay::open().ok()
 }
 
 fn run(mut command: Command, limit: Duration) -> (bool, String, String) {

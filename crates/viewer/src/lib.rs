@@ -25,6 +25,8 @@ pub mod script;
 pub mod viewer;
 #[cfg(target_arch = "wasm32")]
 pub mod web;
+#[cfg(not(target_arch = "wasm32"))]
+pub mod x_display;
 
 use std::path::PathBuf;
 use strata_level::World;

@@ -8,9 +8,8 @@
 
 use anyhow::{Context, bail};
 use serde::Serialize;
-use std::io::{BufRead, BufReader};
 use std::path::PathBuf;
-use std::process::{Child, Command, Stdio};
+use std::process::Command;
 use strata_level::generate::{GenerateParams, generate, parse_size};
 
 #[derive(clap::Args)]
@@ -176,55 +175,6 @@ fn script(
     (out, counts)
 }
 
-/// An X display: `DISPLAY`, else an Xvfb started here (killed on drop).
-struct Display {
-    name: String,
-    xvfb: Option<Child>,
-}
-
-impl Drop for Display {
-    fn drop(&mut self) {
-        if let Some(child) = &mut self.xvfb {
-            let _ = child.kill();
-            let _ = child.wait();
-        }
-    }
-}
-
-fn display() -> anyhow::Result<Display> {
-    if let Some(name) = std::env::var("DISPLAY").ok().filter(|d| !d.is_empty()) {
-        return Ok(Display { name, xvfb: None });
-    }
-    // -displayfd: Xvfb picks a free display and writes its number when ready.
-    let mut child = Command::new("Xvfb")
-        .args([
-            "-displayfd",
-            "1",
-            "-screen",
-            "0",
-            "1024x768x24",
-            "-nolisten",
-            "tcp",
-        ])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::null())
-        .spawn()
-        .context("no DISPLAY and Xvfb would not start (apt-get install -y xvfb)")?;
-    let mut line = String::new();
-    let stdout = child.stdout.take().context("Xvfb's stdout")?;
-    BufReader::new(stdout)
-        .read_line(&mut line)
-        .context("reading Xvfb's display number")?;
-    let number: u32 = line
-        .trim()
-        .parse()
-        .with_context(|| format!("Xvfb gave no display number (`{}`)", line.trim()))?;
-    Ok(Display {
-        name: format!(":{number}"),
-        xvfb: Some(child),
-    })
-}
-
 fn mib(bytes: u64) -> f64 {
     bytes as f64 / (1024.0 * 1024.0)
 }
@@ -266,7 +216,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let script_path = args.out.join("soak.txt");
     std::fs::write(&script_path, text)
         .with_context(|| format!("writing {}", script_path.display()))?;
-    let display = display()?;
+    let display = strata_viewer::x_display::XDisplay::open()?;
     let runtime = args.out.join("xdg");
     std::fs::create_dir_all(&runtime)?;
     #[cfg(unix)]
