@@ -70,8 +70,8 @@ pub enum CameraError {
     /// The pitch is outside [-90, 90] degrees.
     #[error(transparent)]
     View(#[from] ViewError),
-    /// [`Camera::from_view`] put the eye inside solid terrain (an `eye` below
-    /// the surface, or `under` in a column with no cave).
+    /// [`Camera::from_view`] put the eye inside solid terrain: an `eye` of 0
+    /// or less, or, with `under`, one that reaches into the slab.
     #[error(
         "view `{name}`: the eye at ({x}, {y}, {z}) is inside solid terrain (column floor {low}, slab {mid}..{high})"
     )]

@@ -229,7 +229,7 @@ impl FitInSteps {
 /// recomputes the dirty chunks from the level.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct ChunkRange {
-    /// First index of the chunk in the renderer's shared index buffer.
+    /// First index of the chunk in an index buffer holding every chunk's list.
     pub first_index: u32,
     /// Number of indices of the chunk (all LODs).
     pub index_count: u32,
