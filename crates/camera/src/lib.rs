@@ -7,6 +7,44 @@
 //! The minus on `right` mirrors the image relative to a right-handed z-up
 //! world: the original map's y axis points down the screen, and keeping that
 //! handedness makes our images line up with vange-rs pixel for pixel.
+//!
+//! Units: positions are world units (one map texel across, one altitude step
+//! up; altitudes run 0..=255), angles are degrees, image coordinates are
+//! pixels from the top-left corner.
+//!
+//! # Example: a camera and a pixel ray
+//!
+//! ```
+//! use glam::Vec3;
+//! use strata_camera::Camera;
+//! use strata_level::{Level, ViewSpec};
+//!
+//! // Yaw 0 looks along +y; pitch -30 looks down.
+//! let camera = Camera::new(Vec3::new(32.0, 10.0, 80.0), 0.0, -30.0, 64, 48).unwrap();
+//! let centre = camera.pixel_ray(32, 24); // unit direction through pixel (32, 24)
+//! assert!((centre.length() - 1.0).abs() < 1e-6);
+//! assert!(centre.y > 0.0 && centre.z < 0.0);
+//!
+//! // A point along that ray projects back onto the pixel's centre.
+//! let p = camera.project(camera.position + centre * 50.0).unwrap();
+//! assert!((p.x - 32.5).abs() < 1e-3 && (p.y - 24.5).abs() < 1e-3);
+//!
+//! // A view resolved against a level: the eye 5 units above the ground.
+//! let level = Level::flat(64, 64, 30, 1).unwrap();
+//! let view = ViewSpec::parse("v", "10,20:90:5", -20.0).unwrap();
+//! let camera = Camera::from_view(&level, &view, 64, 48).unwrap();
+//! assert_eq!(camera.position, Vec3::new(10.0, 20.0, 35.0));
+//! ```
+//!
+//! # Stability
+//!
+//! [`Camera`] (its fields, `new`, `from_view`, `pixel_ray`, `project`,
+//! `view_proj` and the depth conversions), [`Basis`], [`CameraError`] and the
+//! `DEFAULT_*` constants are the stable surface: every method's images depend
+//! on this convention. The [`light`] module (sun, sky, shadow-map frame) is
+//! the shading's and may change with it.
+
+#![warn(missing_docs)]
 
 pub mod light;
 
@@ -18,26 +56,39 @@ use strata_level::{Level, ViewSpec};
 /// Focal length in pixels. Fixed: the field of view depends on the image size
 /// (scaling it with the image height was the paper's first reference bug).
 pub const DEFAULT_FOCAL_PX: f32 = 512.0;
+/// Near plane, world units along the view axis.
 pub const DEFAULT_NEAR: f32 = 1.0;
 /// Far plane, measured along the view axis.
 pub const DEFAULT_FAR: f32 = 600.0;
 
+/// Why a camera could not be made.
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum CameraError {
+    /// The image width or height (pixels) is 0.
     #[error("image size {0}x{1} must be positive")]
     Size(u32, u32),
+    /// The pitch is outside [-90, 90] degrees.
     #[error(transparent)]
     View(#[from] ViewError),
+    /// [`Camera::from_view`] put the eye inside solid terrain: an `eye` of 0
+    /// or less, or, with `under`, one that reaches into the slab.
     #[error(
         "view `{name}`: the eye at ({x}, {y}, {z}) is inside solid terrain (column floor {low}, slab {mid}..{high})"
     )]
     EyeInSolid {
+        /// The view's name.
         name: String,
+        /// Eye x, world units, wrapped onto the map.
         x: f32,
+        /// Eye y, world units, wrapped onto the map.
         y: f32,
+        /// Eye altitude.
         z: f32,
+        /// The column's floor altitude.
         low: u8,
+        /// The column's slab bottom (cave ceiling); equals `high` without a slab.
         mid: u8,
+        /// The column's top altitude.
         high: u8,
     },
 }
@@ -55,20 +106,33 @@ pub struct Basis {
     pub up: Vec3,
 }
 
+/// A pinhole camera and its image size; see the crate docs for the pixel
+/// convention. Build it with [`Camera::new`] or [`Camera::from_view`], which
+/// check the size and pitch.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Camera {
+    /// Eye position, world units (x, y on the map, z altitude).
     pub position: Vec3,
+    /// Heading in degrees: 0 looks along +y, 90 along +x.
     pub yaw_deg: f32,
+    /// Degrees in [-90, 90]; negative looks down.
     pub pitch_deg: f32,
+    /// Focal length in pixels ([`DEFAULT_FOCAL_PX`]).
     pub focal_px: f32,
+    /// Near plane, world units along the view axis.
     pub near: f32,
+    /// Far plane, world units along the view axis.
     pub far: f32,
+    /// Image width, pixels.
     pub width: u32,
+    /// Image height, pixels.
     pub height: u32,
 }
 
 impl Camera {
     /// A camera with the default focal length, near and far planes.
+    /// Errors: [`CameraError::Size`] for a zero side, [`CameraError::View`]
+    /// for a pitch outside [-90, 90].
     pub fn new(
         position: Vec3,
         yaw_deg: f32,
@@ -94,7 +158,7 @@ impl Camera {
 
     /// Resolve a view against a level: wrap the position onto the map, put the
     /// eye `eye` units above the top surface (or the floor, for `under`), and
-    /// refuse an eye inside solid terrain.
+    /// refuse an eye inside solid terrain ([`CameraError::EyeInSolid`]).
     pub fn from_view(
         level: &Level,
         view: &ViewSpec,
@@ -120,6 +184,7 @@ impl Camera {
         Self::new(Vec3::new(x, y, z), view.yaw, view.pitch, width, height)
     }
 
+    /// The view basis from yaw and pitch (see [`Basis`]).
     pub fn basis(&self) -> Basis {
         let (sy, cy) = self.yaw_deg.to_radians().sin_cos();
         let (sp, cp) = self.pitch_deg.to_radians().sin_cos();

@@ -20,11 +20,15 @@ pub fn light_direction() -> Vec3 {
 /// the light, far enough up the light that all terrain lies in front of it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ShadowFrame {
+    /// Whether shadows are on this frame; when off, every point is shaded as lit.
     pub enabled: bool,
+    /// Unit direction the light travels ([`light_direction`]).
     pub light: Vec3,
     /// Corner of the map's square (texel (0, 0)'s outer corner).
     pub origin: Vec3,
+    /// Unit vector along the map's texel x axis, perpendicular to the light.
     pub u: Vec3,
+    /// Unit vector along the map's texel y axis, perpendicular to `u` and the light.
     pub v: Vec3,
     /// World units per texel.
     pub texel: f32,

@@ -274,9 +274,11 @@ impl Default for WorldConfig {
 const MAX_POWER: u32 = 15;
 
 impl WorldConfig {
+    /// Map width in texels, `2^Map Power X`.
     pub fn width(&self) -> u32 {
         1 << self.map_power_x
     }
+    /// Map height in texels, `2^Map Power Y`.
     pub fn height(&self) -> u32 {
         1 << self.map_power_y
     }

@@ -30,13 +30,18 @@ use crate::views::EditSite;
 /// map edge yields several).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct DirtyRect {
+    /// Left column, texels (`0..map width`).
     pub x: u32,
+    /// Top row, texels (`0..map height`).
     pub y: u32,
+    /// Columns; `x + width` is at most the map width.
     pub width: u32,
+    /// Rows; `y + height` is at most the map height.
     pub height: u32,
 }
 
 impl DirtyRect {
+    /// Whether texel `(x, y)` (map coordinates, not wrapped) is inside.
     pub fn contains(&self, x: u32, y: u32) -> bool {
         x >= self.x && x - self.x < self.width && y >= self.y && y - self.y < self.height
     }
@@ -45,9 +50,13 @@ impl DirtyRect {
 /// A rectangle in unwrapped texel coordinates: `x .. x + width`, `y .. y + height`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct EditRect {
+    /// Left column; any value, wrapped onto the map when applied.
     pub x: i64,
+    /// Top row; any value, wrapped onto the map when applied.
     pub y: i64,
+    /// Columns (an edit covers at most one map width).
     pub width: u32,
+    /// Rows (an edit covers at most one map height).
     pub height: u32,
 }
 

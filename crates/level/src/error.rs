@@ -2,29 +2,42 @@
 
 use std::path::{Path, PathBuf};
 
+/// Why a world file could not be read or written; [`LevelError::path`] names it.
 #[derive(Debug, thiserror::Error)]
 pub enum LevelError {
+    /// The file could not be opened, read or written.
     #[error("{path}: {source}")]
     Io {
+        /// The file.
         path: std::path::PathBuf,
+        /// The operating system's error.
         source: std::io::Error,
     },
+    /// The file's contents are not a valid file of its format (wrong size,
+    /// corrupt Huffman tree, a value out of range, ...).
     #[error("{path}: {msg}")]
     Format {
+        /// The file.
         path: std::path::PathBuf,
+        /// What is wrong with it.
         msg: String,
     },
     /// A `world.ini` key that is missing or does not parse.
     #[error("{path}: [{section}] {key}: {msg}")]
     Ini {
+        /// The `world.ini` file.
         path: PathBuf,
+        /// The `[section]` the key belongs to.
         section: String,
+        /// The key.
         key: String,
+        /// What is wrong with it.
         msg: String,
     },
 }
 
 impl LevelError {
+    /// An [`Io`](LevelError::Io) error about `path`.
     pub fn io(path: &Path, source: std::io::Error) -> Self {
         LevelError::Io {
             path: path.to_path_buf(),
@@ -32,6 +45,7 @@ impl LevelError {
         }
     }
 
+    /// A [`Format`](LevelError::Format) error about `path`.
     pub fn format(path: &Path, msg: impl Into<String>) -> Self {
         LevelError::Format {
             path: path.to_path_buf(),

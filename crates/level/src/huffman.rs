@@ -15,12 +15,16 @@ pub const MAX_CODE_LEN: u32 = 24;
 /// Bits resolved by one lookup in the decoder's table.
 const LOOKUP_BITS: u32 = 12;
 
+/// A `.vmc` decode tree as stored: slot `2 node + bit` holds the next node
+/// (positive) or a leaf `-symbol` (at most 0).
 pub type Tree = [i32; TREE_SLOTS];
 
 /// A prefix code: per symbol its code (right-aligned) and length in bits (0 = unused).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Code {
+    /// Each symbol's code, right-aligned.
     pub codes: [u32; 256],
+    /// Each symbol's code length in bits; 0 for a symbol without a code.
     pub lengths: [u8; 256],
 }
 
@@ -190,13 +194,25 @@ impl Code {
 /// Why a decode tree was refused.
 #[derive(Debug, PartialEq, Eq, thiserror::Error)]
 pub enum TreeError {
+    /// A slot links to a node index outside `1..=255`.
     #[error("node {node} links to node {target}, outside 1..=255")]
-    OutOfRange { node: usize, target: i32 },
+    OutOfRange {
+        /// The node whose slot is bad.
+        node: usize,
+        /// The value in the slot.
+        target: i32,
+    },
+    /// A node is reachable along two paths, so the tree is not a tree.
     #[error("node {target} is reached twice (a cycle or shared subtree), from node {node}")]
-    Cycle { node: usize, target: i32 },
+    Cycle {
+        /// The node linking to it the second time.
+        node: usize,
+        /// The node reached twice.
+        target: i32,
+    },
 }
 
-/// A checked decode tree plus lookup tables resolving [`LOOKUP_BITS`] bits
+/// A checked decode tree plus lookup tables resolving `LOOKUP_BITS` (12) bits
 /// at once: up to three whole symbols per lookup (delta-coded terrain is
 /// mostly 1-3 bit codes, so this cuts the per-symbol work), and one symbol
 /// per lookup for the last few symbols of a stream.
@@ -348,6 +364,7 @@ pub struct BitReader<'a> {
 }
 
 impl<'a> BitReader<'a> {
+    /// A reader of `data` starting at byte `start_byte`, MSB first.
     pub fn new(data: &'a [u8], start_byte: usize) -> Self {
         BitReader {
             data,
@@ -395,12 +412,14 @@ impl<'a> BitReader<'a> {
 /// MSB-first bit writer.
 #[derive(Default)]
 pub struct BitWriter {
+    /// The whole bytes written so far (see [`BitWriter::align`] for the rest).
     pub bytes: Vec<u8>,
     acc: u64,
     nbits: u32,
 }
 
 impl BitWriter {
+    /// A writer with room for `n` bytes.
     pub fn with_capacity(n: usize) -> Self {
         BitWriter {
             bytes: Vec::with_capacity(n),
@@ -408,6 +427,7 @@ impl BitWriter {
         }
     }
 
+    /// Append the low `len` bits of `code`, most significant first.
     #[inline]
     pub fn put(&mut self, code: u32, len: u8) {
         self.acc = (self.acc << len) | u64::from(code);

@@ -12,8 +12,11 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use web_time::Instant;
 
+/// The world's configuration file, the one every world directory has.
 pub const WORLD_INI: &str = "world.ini";
+/// Strata's named views of the world (optional).
 pub const VIEWS_TXT: &str = "views.txt";
+/// Strata's edit fixture of the world (optional).
 pub const EDIT_TXT: &str = "edit.txt";
 
 /// The map file a config names inside `dir`.
@@ -45,6 +48,7 @@ pub fn decode_map(
 /// How loading the map went, for `strata info`.
 #[derive(Clone, Debug)]
 pub struct MapLoad {
+    /// The map file read.
     pub path: PathBuf,
     /// Size of the map file.
     pub bytes: u64,
@@ -113,9 +117,13 @@ pub fn load_world_timed(dir: &Path, mid_rule: MidRule) -> Result<(World, MapLoad
 /// A world directory's files besides `world.ini` and the map, as bytes
 /// (read from disk, or fetched over HTTP by the browser page).
 pub struct WorldFiles<'a> {
+    /// The `.pal` file.
     pub palette: &'a [u8],
+    /// The `.vpr` file, when the world has one.
     pub vpr: Option<&'a [u8]>,
+    /// `views.txt`, when present.
     pub views: Option<&'a [u8]>,
+    /// `edit.txt`, when present.
     pub edit: Option<&'a [u8]>,
 }
 

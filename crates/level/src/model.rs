@@ -9,6 +9,7 @@ pub const META_SHADOW: u8 = 0x80;
 pub const META_DOUBLE_LEVEL: u8 = 0x40;
 /// `meta` bits 5..3: terrain type 0..7 (0 = water).
 pub const META_TERRAIN_MASK: u8 = 0x38;
+/// Shift of the terrain type in `meta` (`(meta & META_TERRAIN_MASK) >> 3`).
 pub const META_TERRAIN_SHIFT: u8 = 3;
 /// `meta` bit 2: object shadow (ignored here).
 pub const META_OBJ_SHADOW: u8 = 0x04;
@@ -56,9 +57,13 @@ impl MidRule {
 /// gap `(low, mid)`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Column {
+    /// Top of the floor `[0, low]`.
     pub low: u8,
+    /// Bottom of the slab (the cave ceiling); `low` when single.
     pub mid: u8,
+    /// Top of the slab; `low` when single.
     pub high: u8,
+    /// Whether the column has a slab over a cave (its pair is double-level).
     pub dual: bool,
     /// Terrain type of the floor (the even texel of a dual pair).
     pub lower_type: u8,
@@ -144,19 +149,31 @@ pub struct Level {
     height: u32,
     heights: Vec<u8>,
     metas: Vec<u8>,
+    /// How `mid` is decoded from a pair's gap code.
     pub mid_rule: MidRule,
 }
 
 /// Errors constructing a [`Level`] from planes.
 #[derive(Debug, thiserror::Error, PartialEq, Eq)]
 pub enum ShapeError {
+    /// A side is not a power of two, or the width is below 2 (pairs need two texels).
     #[error("map size {width}x{height} is not a power of two in each direction (at least 2x1)")]
-    NotPowerOfTwo { width: u32, height: u32 },
+    NotPowerOfTwo {
+        /// Width asked for, texels.
+        width: u32,
+        /// Height asked for, texels.
+        height: u32,
+    },
+    /// A plane's length is not `width * height`.
     #[error("plane of {got} bytes does not match the map size {width}x{height} ({expected} bytes)")]
     PlaneSize {
+        /// Map width, texels.
         width: u32,
+        /// Map height, texels.
         height: u32,
+        /// `width * height`.
         expected: usize,
+        /// The plane's length.
         got: usize,
     },
 }
@@ -206,9 +223,11 @@ impl Level {
         )
     }
 
+    /// Map width, texels (a power of two).
     pub fn width(&self) -> u32 {
         self.width
     }
+    /// Map height, texels (a power of two).
     pub fn height(&self) -> u32 {
         self.height
     }

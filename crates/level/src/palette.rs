@@ -6,6 +6,7 @@ use std::path::Path;
 /// A palette in 8-bit RGB (the file's 6-bit values times 4).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Palette {
+    /// RGB of each palette index; every channel a multiple of 4.
     pub colors: [[u8; 3]; 256],
 }
 
@@ -47,10 +48,12 @@ impl Palette {
         self.colors.iter().flat_map(|c| c.map(|v| v >> 2)).collect()
     }
 
+    /// Read and decode a `.pal` file.
     pub fn read(path: &Path) -> Result<Self, LevelError> {
         Self::from_bytes(&crate::error::read_file(path)?, path)
     }
 
+    /// Write the palette as a `.pal` file.
     pub fn write(&self, path: &Path) -> Result<(), LevelError> {
         crate::error::write_file(path, &self.to_bytes())
     }

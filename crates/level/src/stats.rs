@@ -15,9 +15,13 @@ use crate::model::{Level, TERRAIN_TYPES, decode_column};
 use rayon::prelude::*;
 use serde::Serialize;
 
+/// What `strata info` reports about a map (see the module docs for the
+/// roughness figures).
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct LevelStats {
+    /// Map width, texels.
     pub width: u32,
+    /// Map height, texels.
     pub height: u32,
     /// Percent of texels in dual pairs.
     pub dual_percent: f64,
@@ -129,6 +133,7 @@ fn lap_sum(up: &[i32], cur: &[i32], down: &[i32]) -> u64 {
 const BAND: u32 = 64;
 
 impl LevelStats {
+    /// Scan the whole map (in parallel bands of rows).
     pub fn compute(level: &Level) -> LevelStats {
         let (w, h) = (level.width(), level.height());
         let bands = h.div_ceil(BAND);

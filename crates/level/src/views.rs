@@ -11,8 +11,11 @@ use std::fmt;
 /// Where a camera stands and looks, before it is resolved against a level.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ViewSpec {
+    /// Name in reports and output directories.
     pub name: String,
+    /// Eye x, texels; wrapped onto the map when resolved.
     pub x: f32,
+    /// Eye y, texels; wrapped onto the map when resolved.
     pub y: f32,
     /// Degrees; yaw 0 looks along +y, yaw 90 along +x.
     pub yaw: f32,
@@ -24,12 +27,26 @@ pub struct ViewSpec {
     pub pitch: f32,
 }
 
+/// Why a view or edit fixture does not parse.
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum ViewError {
+    /// A line of `views.txt` or `edit.txt` has the wrong shape.
     #[error("line {line}: {msg} (expected `NAME X,Y:YAW:EYE[:under] PITCH`)")]
-    Malformed { line: usize, msg: String },
+    Malformed {
+        /// 1-based line number (0 when the whole file is at fault).
+        line: usize,
+        /// What is wrong.
+        msg: String,
+    },
+    /// The position part `X,Y:YAW:EYE[:under]` does not parse.
     #[error("`{spec}`: {msg} (expected `X,Y:YAW:EYE[:under]`)")]
-    Spec { spec: String, msg: String },
+    Spec {
+        /// The text given.
+        spec: String,
+        /// What is wrong.
+        msg: String,
+    },
+    /// The pitch (degrees) is outside [-90, 90].
     #[error("pitch {0} is outside [-90, 90] degrees")]
     Pitch(f32),
 }
@@ -137,11 +154,15 @@ pub fn format_views(views: &[ViewSpec]) -> String {
 /// The level's edit fixture: a crater and the camera that times it.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct EditSite {
+    /// Crater centre x, texels (any value; wraps).
     pub centre_x: i64,
+    /// Crater centre y, texels (any value; wraps).
     pub centre_y: i64,
+    /// Crater radius, texels.
     pub radius: u32,
     /// Depth at the centre; the crater profile is `depth (1 - d²/r²)`.
     pub depth: f32,
+    /// The view that watches the crater being dug.
     pub camera: ViewSpec,
 }
 
@@ -230,6 +251,7 @@ impl EditSite {
         }
     }
 
+    /// The `edit.txt` text that [`EditSite::parse`] reads back.
     pub fn format(&self) -> String {
         format!(
             "# crater X,Y RADIUS DEPTH  (profile depth * (1 - d^2/r^2), upper layer removed inside)\n\

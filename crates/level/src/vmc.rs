@@ -317,7 +317,10 @@ pub enum VmcReuse {
     Whole,
     /// The source's trees and its unchanged rows' bytes; `changed` rows
     /// encoded with the source's codes.
-    Rows { changed: usize },
+    Rows {
+        /// Rows re-encoded.
+        changed: usize,
+    },
     /// A fresh [`encode_vmc`]: the source does not fit the map, or a changed
     /// row needs a symbol its trees lack a code for.
     Fresh,
@@ -386,6 +389,7 @@ pub fn encode_vmc_reusing(
     }
 }
 
+/// Read and decode a `.vmc` of a `width x height` map (sizes from `world.ini`).
 pub fn read_vmc(
     path: &Path,
     width: u32,
@@ -396,6 +400,7 @@ pub fn read_vmc(
     decode_vmc(&bytes, width, height, mid_rule, path)
 }
 
+/// Encode `level` with fresh Huffman trees and write it as a `.vmc`.
 pub fn write_vmc(path: &Path, level: &Level) -> Result<(), LevelError> {
     crate::error::write_file(path, &encode_vmc(level, path)?)
 }

@@ -55,6 +55,7 @@ pub fn encode_vmp(level: &Level) -> Vec<u8> {
     out
 }
 
+/// Read and decode a `.vmp` of a `width x height` map (sizes from `world.ini`).
 pub fn read_vmp(
     path: &Path,
     width: u32,
@@ -65,6 +66,7 @@ pub fn read_vmp(
     decode_vmp(&bytes, width, height, mid_rule, path)
 }
 
+/// Write `level` as a `.vmp` (uncompressed rows).
 pub fn write_vmp(path: &Path, level: &Level) -> Result<(), LevelError> {
     crate::error::write_file(path, &encode_vmp(level))
 }

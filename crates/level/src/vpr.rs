@@ -36,7 +36,9 @@ const OLD_STRATA_HEADER: u64 = 16;
 /// two `world.ini` powers the game computes it from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct VprLayout {
+    /// Map width, texels.
     pub width: u32,
+    /// Map height, texels.
     pub height: u32,
     /// `[Global Parameters] GeoNet Power`.
     pub geo_net_power: u32,
@@ -54,6 +56,7 @@ pub enum VprFormat {
 }
 
 impl VprLayout {
+    /// The layout a world's config implies.
     pub fn of(config: &WorldConfig) -> Self {
         VprLayout {
             width: config.width(),

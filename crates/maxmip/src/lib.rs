@@ -12,6 +12,38 @@
 //! (little-endian: byte `i` of the buffer is bits `8 (i % 4)..` of word `i / 4`).
 //! [`Pyramid`] is the CPU build and incremental update, the twin the GPU build
 //! is tested against bit for bit. No GPU dependency.
+//!
+//! # Example: build, update after an edit, query
+//!
+//! ```
+//! use strata_level::{DirtyRect, Level};
+//! use strata_maxmip::Pyramid;
+//!
+//! let mut level = Level::flat(64, 64, 40, 1).unwrap();
+//! let mut pyramid = Pyramid::new(&level);
+//! assert_eq!(pyramid.top(), 6); // tiles of 2..64 texels on a 64 x 64 map
+//! assert_eq!(pyramid.global_max(), 40);
+//!
+//! // Raise one texel, then refresh only the tiles above it.
+//! let (heights, _metas) = level.planes_mut();
+//! heights[10 * 64 + 20] = 200;
+//! let dirty = DirtyRect { x: 20, y: 10, width: 1, height: 1 };
+//! pyramid.update(&level, &dirty);
+//! assert_eq!(pyramid.get(1, 10, 5), 200); // level 1 tile (10, 5) holds texel (20, 10)
+//! assert_eq!(pyramid.get(1, 11, 5), 40);
+//! assert_eq!(pyramid.global_max(), 200);
+//! assert_eq!(pyramid, Pyramid::new(&level)); // same bytes as a fresh build
+//! ```
+//!
+//! # Stability
+//!
+//! The stable surface is [`Pyramid`] (`new`, `update`, `get`, `top`,
+//! `global_max`) and [`MAX_LEVEL`]. The byte layout ([`Layout`],
+//! [`LevelInfo`], [`TileRect`], [`Pyramid::words`] and the public `data`)
+//! is shared with the GPU shaders of `strata-render` and may change with
+//! them; treat it as internal to Strata.
+
+#![warn(missing_docs)]
 
 use rayon::prelude::*;
 use strata_level::model::decode_column;
@@ -26,14 +58,16 @@ pub const MAX_LEVEL: u32 = 8;
 pub struct LevelInfo {
     /// Tile side in texels is `1 << log2_tile`.
     pub log2_tile: u32,
-    /// Tiles across (`width >> k`) and down (`height >> k`), powers of two.
+    /// Tiles across (`map width >> k`), a power of two.
     pub width: u32,
+    /// Tiles down (`map height >> k`), a power of two.
     pub height: u32,
     /// First byte of the plane (a multiple of 4).
     pub offset: u32,
 }
 
 impl LevelInfo {
+    /// Bytes of the plane (one per tile), before the padding to 4.
     pub fn bytes(&self) -> u32 {
         self.width * self.height
     }
@@ -50,8 +84,11 @@ impl LevelInfo {
 /// The levels of a `width x height` map; `levels[0]` is level 1.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Layout {
+    /// Map width in texels (a power of two).
     pub map_width: u32,
+    /// Map height in texels (a power of two).
     pub map_height: u32,
+    /// Level 1 first, up to level [`Layout::top`].
     pub levels: Vec<LevelInfo>,
     /// Total bytes, a multiple of 4.
     pub bytes: u32,
@@ -60,15 +97,23 @@ pub struct Layout {
 /// Tiles of one level covering a dirty rectangle: `x0..=x1`, `y0..=y1`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct TileRect {
+    /// First tile column.
     pub x0: u32,
+    /// First tile row.
     pub y0: u32,
+    /// Last tile column (inclusive).
     pub x1: u32,
+    /// Last tile row (inclusive).
     pub y1: u32,
 }
 
 impl Layout {
     /// Levels 1..=min(MAX_LEVEL, log2 width, log2 height). Both sides must be
     /// powers of two (as every map's are).
+    ///
+    /// # Panics
+    ///
+    /// When a side is not a power of two.
     pub fn new(width: u32, height: u32) -> Self {
         assert!(
             width.is_power_of_two() && height.is_power_of_two(),
@@ -103,6 +148,10 @@ impl Layout {
     }
 
     /// Level `k` (1-based).
+    ///
+    /// # Panics
+    ///
+    /// When `k` is 0 or above [`Layout::top`].
     pub fn level(&self, k: u32) -> &LevelInfo {
         &self.levels[k as usize - 1]
     }
@@ -121,7 +170,10 @@ impl Layout {
 /// The pyramid's bytes, laid out by [`Layout`].
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Pyramid {
+    /// Where each level lies in `data`.
     pub layout: Layout,
+    /// Every level's tile maxima (altitude 0..=255), back to back; public for
+    /// the GPU upload and tests, written only by [`Pyramid::update`].
     pub data: Vec<u8>,
     /// Highest top anywhere on the map.
     global_max: u8,

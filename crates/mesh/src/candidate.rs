@@ -18,6 +18,8 @@ pub struct Candidate {
 }
 
 impl Candidate {
+    /// A candidate of error `num / den` height units (`den` > 0) at `sample`
+    /// (chunk sample index) of triangle `tri`, scanned at `stamp`.
     pub fn new(num: i64, den: i64, sample: u32, tri: u32, stamp: u32) -> Self {
         let aux = (u64::from(!(sample as u16)) << 48)
             | (u64::from(!(tri as u16)) << 32)
@@ -31,9 +33,11 @@ impl Candidate {
     pub fn error(&self) -> f64 {
         f64::from_bits(self.key)
     }
+    /// The worst sample's index in the chunk (row-major, stride `size + 1`).
     pub fn sample(&self) -> u32 {
         u32::from(!((self.aux >> 48) as u16))
     }
+    /// The triangle's slot in the [`Triangulation`](crate::triangulation::Triangulation).
     pub fn tri(&self) -> u32 {
         u32::from(!((self.aux >> 32) as u16))
     }

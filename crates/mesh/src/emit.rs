@@ -32,8 +32,11 @@ use crate::fit::LODS;
 use crate::samples::ChunkSamples;
 use crate::triangulation::{NONE, Triangulation};
 
+/// Vertex kind of the floor (`low`, lower terrain type).
 pub const KIND_FLOOR: u16 = 0;
+/// Vertex kind of the slab top (`high`, upper terrain type).
 pub const KIND_TOP: u16 = 1;
+/// Vertex kind of the cave ceiling (`mid`, the slab's underside, upper terrain type).
 pub const KIND_CEILING: u16 = 2;
 
 /// Encode a vertex index (see the module docs); `stride = size_x + 1`,
@@ -59,6 +62,7 @@ pub struct LodStats {
     pub slab: u32,
     /// Wall triangles (of which `border_walls` on chunk-border edges).
     pub wall: u32,
+    /// Wall triangles on the chunk's border edges (included in `wall`).
     pub border_walls: u32,
 }
 
@@ -69,6 +73,7 @@ impl LodStats {
     }
 }
 
+/// What one chunk's fit produced: counts and the content hash.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct ChunkStats {
     /// Vertices of the finest planar triangulation (4 corners + insertions).
@@ -78,6 +83,7 @@ pub struct ChunkStats {
     /// FNV-1a of the index list and LOD ranges: how a refit tells whether a
     /// chunk changed once its CPU copy is gone.
     pub hash: u64,
+    /// Triangle counts per LOD (0 the finest).
     pub lods: [LodStats; LODS],
     /// Insertions by [`crate::fit::Cause`].
     pub causes: [u32; crate::fit::CAUSES],
@@ -91,6 +97,7 @@ pub struct ChunkMesh {
     /// Up to two `[start, end)` index ranges per LOD (LOD 0 the finest);
     /// an unused range is empty.
     pub lods: [[(u32, u32); 2]; LODS],
+    /// Counts and hash; they stay after [`crate::LevelMesh::release_indices`].
     pub stats: ChunkStats,
 }
 
@@ -136,6 +143,8 @@ fn key(t: [u16; 3]) -> u64 {
 }
 
 impl Emitter {
+    /// Start a chunk of `size_x x size_y` texels (its index stride and
+    /// position count), clearing the previous chunk's lists.
     pub fn begin(&mut self, size_x: u32, size_y: u32) {
         self.stride = size_x + 1;
         self.positions = (size_x + 1) * (size_y + 1);

@@ -38,6 +38,7 @@ pub enum Cause {
     Border = 3,
 }
 
+/// Number of [`Cause`] variants (the length of the per-cause counters).
 pub const CAUSES: usize = 4;
 
 /// How a fit runs, besides its tolerance.

@@ -20,15 +20,19 @@ pub fn tolerance_for_quality(q: f64) -> Option<f64> {
 /// The fitted mesh of a level: one [`ChunkMesh`] per chunk, row-major.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct LevelMesh {
+    /// Chunk size and counts of the level fitted.
     pub layout: ChunkLayout,
-    /// Finest-LOD max error; LOD k has `tolerance · 2^k`.
+    /// Finest-LOD max error as `f64` bits (so the mesh is `Eq`); read it
+    /// with [`LevelMesh::tolerance`]. LOD k has `tolerance · 2^k`.
     pub tolerance_bits: u64,
     /// How it was fitted (a refit fits the same way).
     pub options: FitOptions,
+    /// One mesh per chunk, row-major ([`ChunkLayout::index`]).
     pub chunks: Vec<ChunkMesh>,
 }
 
 impl LevelMesh {
+    /// Finest-LOD max vertical error, height units.
     pub fn tolerance(&self) -> f64 {
         f64::from_bits(self.tolerance_bits)
     }
@@ -197,6 +201,7 @@ impl FitInSteps {
         self.is_done()
     }
 
+    /// Whether every chunk is fitted.
     pub fn is_done(&self) -> bool {
         self.chunks.len() == self.layout.count()
     }
@@ -224,7 +229,9 @@ impl FitInSteps {
 /// recomputes the dirty chunks from the level.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct ChunkRange {
+    /// First index of the chunk in an index buffer holding every chunk's list.
     pub first_index: u32,
+    /// Number of indices of the chunk (all LODs).
     pub index_count: u32,
     /// [`ChunkMesh::lods`], relative to `first_index`.
     pub lods: [[(u32, u32); 2]; LODS],
@@ -282,26 +289,37 @@ pub fn dirty_chunks(
 /// Per-LOD totals.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct LodTotals {
+    /// Floor triangles ([`LodStats::planar`](crate::LodStats::planar)).
     pub planar: u64,
+    /// Slab top + cave ceiling triangles.
     pub slab: u64,
+    /// Wall triangles.
     pub wall: u64,
+    /// Wall triangles on chunk borders (included in `wall`).
     pub border_walls: u64,
+    /// Every triangle drawn: `planar + slab + wall`.
     pub emitted: u64,
 }
 
 /// Level-wide totals of a fit.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct MeshStats {
+    /// Number of chunks.
     pub chunks: usize,
+    /// Finest-LOD max error, height units.
     pub tolerance: f64,
     /// Sum over chunks of finest planar vertices (border vertices counted in
     /// both chunks that share them, as they are uploaded).
     pub planar_vertices: u64,
+    /// Indices of all chunks and LODs (each LOD-shared triangle once).
     pub gpu_indices: u64,
+    /// Triangle totals per LOD (0 the finest).
     pub lods: [LodTotals; LODS],
     /// Insertions: floor, slab interior, single/double boundary, chunk border.
     pub causes: [u64; CAUSES],
+    /// Bytes of the index buffers (`u16` indices; there is no vertex buffer).
     pub gpu_bytes: u64,
+    /// Bytes the renderer keeps on the CPU: one [`ChunkRange`] per chunk.
     pub cpu_bytes: u64,
 }
 
@@ -320,7 +338,9 @@ pub fn timed_fit_with(level: &Level, tolerance: f64, options: FitOptions) -> (Le
 /// How long a fit took.
 #[derive(Clone, Copy, Debug, Serialize)]
 pub struct FitTiming {
+    /// Worker threads of the pool the fit ran on.
     pub threads: usize,
+    /// Wall-clock seconds.
     pub wall_seconds: f64,
     /// CPU time of all threads (the machine may be shared), where known.
     pub cpu_seconds: Option<f64>,

@@ -32,6 +32,57 @@
 //! (arena + flips), [`candidate`] (worst-sample scan), [`border`] (1D edge
 //! fit), [`fit`] (one chunk, all LODs), [`emit`] (index data),
 //! [`level_mesh`] (whole level, refit, statistics), [`synthetic`] (fixture).
+//!
+//! # Example: fit a level, read the triangle counts, refit after an edit
+//!
+//! ```
+//! use strata_level::{DirtyRect, Level};
+//! use strata_mesh::{LevelMesh, tolerance_for_quality};
+//!
+//! // Flat ground at 20 with a 16 x 16 block rising to 60.
+//! let mut level = Level::flat(64, 64, 20, 1).unwrap();
+//! let (heights, _metas) = level.planes_mut();
+//! for y in 24..40 {
+//!     for x in 24..40 {
+//!         heights[y * 64 + x] = 60;
+//!     }
+//! }
+//! let tolerance = tolerance_for_quality(0.5).unwrap(); // 4 height units
+//! let mut mesh = LevelMesh::fit(&level, tolerance);
+//! assert_eq!(mesh.chunks.len(), 1); // a map under 128 texels is one chunk
+//!
+//! let stats = mesh.stats();
+//! let finest = &stats.lods[0];
+//! assert!(finest.planar > 2, "the block needs more than the two corner triangles");
+//! assert_eq!(finest.slab, 0); // no dual columns, so no slab or ceiling
+//! assert_eq!(finest.emitted, finest.planar + finest.slab + finest.wall);
+//! assert_eq!(stats.gpu_bytes, 2 * mesh.chunks[0].indices.len() as u64);
+//!
+//! // Flatten the block again; the refit reports the chunk as changed and
+//! // equals a fresh fit of the edited level.
+//! let (heights, _metas) = level.planes_mut();
+//! for y in 24..40 {
+//!     for x in 24..40 {
+//!         heights[y * 64 + x] = 20;
+//!     }
+//! }
+//! let dirty = DirtyRect { x: 24, y: 24, width: 16, height: 16 };
+//! assert_eq!(mesh.refit(&level, &[dirty]), vec![0]);
+//! assert_eq!(mesh, LevelMesh::fit(&level, tolerance));
+//! ```
+//!
+//! # Stability
+//!
+//! The stable surface is [`LevelMesh`] (`fit`, `fit_with_options`,
+//! `fit_in_steps`, `refit`, `release_indices`, `stats`), [`ChunkMesh`] and its
+//! index encoding ([`encode`]/[`decode`]), [`ChunkLayout`], [`CHUNK`], [`LODS`],
+//! [`MeshStats`], [`FitOptions`] and [`tolerance_for_quality`]. The fitting
+//! machinery ([`triangulation`], [`candidate`], [`predicates`], [`border`],
+//! [`samples`], [`fit`]'s [`ChunkFitter`], [`emit::Emitter`]) and the timing
+//! helpers ([`cpu_time`], [`timed_fit`], [`fit_on_threads`]) are public for
+//! Strata's bench, tests and renderer and may change.
+
+#![warn(missing_docs)]
 
 pub mod border;
 pub mod candidate;

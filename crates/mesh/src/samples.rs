@@ -14,12 +14,16 @@ pub const DUAL_INTERIOR: u8 = 2;
 pub struct Sample {
     /// `[low, mid, high]`.
     pub z: [u8; 3],
+    /// [`DUAL`] and [`DUAL_INTERIOR`] bits.
     pub flags: u8,
+    /// Terrain type (0..8) of the floor.
     pub lower_type: u8,
+    /// Terrain type (0..8) of the slab (equal to `lower_type` in a single column).
     pub upper_type: u8,
 }
 
 impl Sample {
+    /// Whether the column has a slab (the [`DUAL`] flag).
     #[inline]
     pub fn dual(&self) -> bool {
         self.flags & DUAL != 0
@@ -30,9 +34,13 @@ impl Sample {
 /// the map is smaller) and the chunk counts.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct ChunkLayout {
+    /// Chunk width, texels.
     pub size_x: u32,
+    /// Chunk height, texels.
     pub size_y: u32,
+    /// Chunks across the map.
     pub chunks_x: u32,
+    /// Chunks down the map.
     pub chunks_y: u32,
 }
 
@@ -40,6 +48,7 @@ pub struct ChunkLayout {
 pub const CHUNK: u32 = 128;
 
 impl ChunkLayout {
+    /// The chunks of `level` (its sides are powers of two, so chunks tile it).
     pub fn of(level: &Level) -> Self {
         let size_x = CHUNK.min(level.width());
         let size_y = CHUNK.min(level.height());
@@ -51,6 +60,7 @@ impl ChunkLayout {
         }
     }
 
+    /// Number of chunks.
     pub fn count(&self) -> usize {
         self.chunks_x as usize * self.chunks_y as usize
     }
@@ -71,8 +81,11 @@ impl ChunkLayout {
 /// The samples of one chunk, row-major with stride `size_x + 1`.
 #[derive(Clone, Debug, Default)]
 pub struct ChunkSamples {
+    /// Chunk width, texels (samples across are `size_x + 1`).
     pub size_x: u32,
+    /// Chunk height, texels (samples down are `size_y + 1`).
     pub size_y: u32,
+    /// The decoded columns, row-major.
     pub samples: Vec<Sample>,
     /// `low`, `mid`, `high` as separate planes (same indexing as `samples`),
     /// for the vectorised candidate scan.
@@ -83,6 +96,7 @@ pub struct ChunkSamples {
 }
 
 impl ChunkSamples {
+    /// Samples per row, `size_x + 1`.
     #[inline]
     pub fn stride(&self) -> usize {
         self.size_x as usize + 1
@@ -96,6 +110,7 @@ impl ChunkSamples {
         (at(x1 + 1, y1 + 1) + at(x0, y0)).wrapping_sub(at(x0, y1 + 1) + at(x1 + 1, y0))
     }
 
+    /// The sample at chunk-local `(x, y)` (in `0..=size`).
     #[inline]
     pub fn at(&self, x: i32, y: i32) -> &Sample {
         &self.samples[y as usize * self.stride() + x as usize]

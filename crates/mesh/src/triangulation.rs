@@ -16,12 +16,16 @@ pub const NONE: u32 = u32::MAX;
 /// opposite `v[i]`, i.e. the edge `v[i+1] -> v[i+2]`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Tri {
+    /// Vertex indices into [`Triangulation::pts`], counter-clockwise.
     pub v: [u32; 3],
+    /// Neighbour triangle across each edge, or [`NONE`] on the boundary.
     pub n: [u32; 3],
 }
 
+/// The planar triangulation of one chunk's grid points (the arena).
 #[derive(Clone, Debug, Default)]
 pub struct Triangulation {
+    /// Vertex positions, chunk-local sample coordinates.
     pub pts: Vec<Pt>,
     /// Per vertex: its sample is dual (has a slab). Only read when
     /// [`outline`](Self::outline) is on.
@@ -31,6 +35,7 @@ pub struct Triangulation {
     /// the constraints of a constrained Delaunay triangulation; every other
     /// edge stays locally Delaunay.
     pub outline: bool,
+    /// Every triangle; all slots are live.
     pub tris: Vec<Tri>,
     /// Triangles created or rewritten by the last insertion (may repeat).
     pub touched: Vec<u32>,
@@ -49,11 +54,13 @@ fn prev(i: usize) -> usize {
 /// Where a point lies relative to a triangle that contains it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Location {
+    /// Strictly inside the triangle.
     Inside,
     /// On the edge opposite vertex `i`.
     OnEdge(usize),
     /// Coincides with vertex `i`.
     Vertex(usize),
+    /// Not in the triangle.
     Outside,
 }
 
@@ -77,6 +84,7 @@ impl Triangulation {
         });
     }
 
+    /// Position of vertex `v`.
     #[inline]
     pub fn pt(&self, v: u32) -> Pt {
         self.pts[v as usize]

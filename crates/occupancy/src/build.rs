@@ -122,7 +122,10 @@ fn reduce_word(child: &[u32], child_info: &LevelInfo, ptile: [u32; 3], w: u32) -
 /// The occupancy pyramid, on the CPU.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Pyramid {
+    /// The shape: levels, tiles and offsets.
     pub layout: Layout,
+    /// The bits, `layout.total_words` words laid out by [`Layout`]; public for
+    /// the GPU upload and the bit-for-bit tests.
     pub words: Vec<u32>,
 }
 
@@ -136,7 +139,9 @@ pub struct UpdateStats {
 }
 
 impl Pyramid {
-    /// Build the whole pyramid from a level.
+    /// Build the whole pyramid from a level. Errors: [`LayoutError::BadMap`]
+    /// for a side that is not a power of two, [`LayoutError::BadSize`] for a
+    /// voxel size the map cannot hold, [`LayoutError::TooLarge`] past 2^32 words.
     pub fn build(level: &Level, voxel: VoxelSize) -> Result<Pyramid, LayoutError> {
         let layout = Layout::new(level.width(), level.height(), voxel)?;
         let mut p = Pyramid {
@@ -152,6 +157,10 @@ impl Pyramid {
 
     /// Bring the pyramid up to date after edits inside `rects`: rebuild the
     /// level-0 tile columns they touch, then every ancestor tile column.
+    /// `level` must already hold the edits. Errors: [`LayoutError::BadMap`]
+    /// when `level` is not the size the pyramid was built for,
+    /// [`LayoutError::BadRect`] for an empty rectangle or one reaching past
+    /// the map (dirty rectangles do not wrap).
     pub fn update(
         &mut self,
         level: &Level,

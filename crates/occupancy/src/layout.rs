@@ -52,8 +52,11 @@ pub fn morton_decode(m: u32) -> (u32, u32, u32) {
 /// Size of a level-0 voxel in texels (x, y) and altitude units (z).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct VoxelSize {
+    /// Texels across; a power of two, at least 2 (a dual pair stays in one voxel).
     pub x: u32,
+    /// Texels down; a power of two.
     pub y: u32,
+    /// Altitude units; a power of two, at most 256.
     pub z: u32,
 }
 
@@ -92,27 +95,49 @@ impl std::str::FromStr for VoxelSize {
     }
 }
 
+/// Why a voxel size, map or dirty rectangle cannot be laid out.
 #[derive(Debug, thiserror::Error, PartialEq, Eq)]
 pub enum LayoutError {
+    /// [`VoxelSize`]'s `from_str` got text other than `X,Y,Z` (the text).
     #[error("voxel size `{0}` is not three comma-separated integers like `4,8,2`")]
     Parse(String),
+    /// The voxel size is not powers of two, has x below 2, or is larger than
+    /// the map (or 256 altitudes).
     #[error(
         "voxel size {size} must be powers of two, x at least 2 (a dual pair must not straddle voxels), \
          at most the map ({width}x{height}) and z at most 256"
     )]
     BadSize {
+        /// The voxel size asked for.
         size: VoxelSize,
+        /// Map width, texels.
         width: u32,
+        /// Map height, texels.
         height: u32,
     },
+    /// The map's sides are not powers of two, or (from [`crate::Pyramid::update`])
+    /// the level is not the size the pyramid was built for.
     #[error("map {width}x{height} is not a power of two in each direction")]
-    BadMap { width: u32, height: u32 },
+    BadMap {
+        /// Map width, texels.
+        width: u32,
+        /// Map height, texels.
+        height: u32,
+    },
+    /// The pyramid would need 2^32 words or more.
     #[error("occupancy pyramid of {bytes} bytes is too large to index with 32-bit words")]
-    TooLarge { bytes: u64 },
+    TooLarge {
+        /// Bytes it would take.
+        bytes: u64,
+    },
+    /// A dirty rectangle is empty or reaches past the map's edge.
     #[error("dirty rectangle {rect:?} is empty or outside the {width}x{height} map")]
     BadRect {
+        /// The rectangle given.
         rect: DirtyRect,
+        /// Map width, texels.
         width: u32,
+        /// Map height, texels.
         height: u32,
     },
 }
@@ -131,6 +156,7 @@ pub struct LevelInfo {
 }
 
 impl LevelInfo {
+    /// Words of the whole level.
     pub fn words(&self) -> u32 {
         self.tiles[0] * self.tiles[1] * self.tiles[2] * TILE_WORDS
     }
@@ -150,9 +176,13 @@ impl LevelInfo {
 /// An inclusive rectangle of tile columns of one level.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct TileRange {
+    /// First tile column in x.
     pub x0: u32,
+    /// First tile column in y.
     pub y0: u32,
+    /// Last tile column in x (inclusive).
     pub x1: u32,
+    /// Last tile column in y (inclusive).
     pub y1: u32,
 }
 
@@ -166,6 +196,7 @@ impl TileRange {
             y1: self.y1 >> 1,
         }
     }
+    /// Number of tile columns in the range.
     pub fn columns(&self) -> u32 {
         (self.x1 - self.x0 + 1) * (self.y1 - self.y0 + 1)
     }
@@ -174,14 +205,21 @@ impl TileRange {
 /// The whole pyramid's shape for one map size and voxel size.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Layout {
+    /// Level 0's voxel size.
     pub voxel: VoxelSize,
+    /// Map width, texels (a power of two).
     pub map_width: u32,
+    /// Map height, texels (a power of two).
     pub map_height: u32,
+    /// Level 0 (finest) first; the last has every dimension at most 8.
     pub levels: Vec<LevelInfo>,
+    /// Words of the whole buffer.
     pub total_words: u32,
 }
 
 impl Layout {
+    /// The levels for a map and voxel size. Errors: [`LayoutError::BadMap`],
+    /// [`LayoutError::BadSize`], [`LayoutError::TooLarge`].
     pub fn new(map_width: u32, map_height: u32, voxel: VoxelSize) -> Result<Layout, LayoutError> {
         if !map_width.is_power_of_two() || !map_height.is_power_of_two() {
             return Err(LayoutError::BadMap {
@@ -241,10 +279,12 @@ impl Layout {
         })
     }
 
+    /// Bytes of the whole buffer.
     pub fn bytes(&self) -> u64 {
         u64::from(self.total_words) * 4
     }
 
+    /// Index of the coarsest level in `levels`.
     pub fn coarsest(&self) -> usize {
         self.levels.len() - 1
     }

@@ -2,6 +2,47 @@
 //! §3.2): the layout the GPU shares ([`layout`]) and the CPU build and
 //! incremental update ([`build`]), which is the twin the GPU build is tested
 //! against. No GPU dependency.
+//!
+//! A level-0 cell is one voxel of [`VoxelSize`] (texels in x and y, altitude
+//! units in z; altitudes span 0..256); it is occupied when a solid interval of
+//! any of its columns (the floor `0..=low`, or the slab `mid..=high` of a dual
+//! column) touches it, faces included. Each coarser level ORs 2x2x2 cells.
+//!
+//! # Example: build and update the pyramid
+//!
+//! ```
+//! use strata_level::{DirtyRect, Level};
+//! use strata_occupancy::{Pyramid, VoxelSize};
+//!
+//! // Flat ground at altitude 10 on the coarse grid (4 x 8 texels, 2 altitudes).
+//! let mut level = Level::flat(64, 64, 10, 1).unwrap();
+//! let mut pyramid = Pyramid::build(&level, VoxelSize::COARSE).unwrap();
+//! assert!(pyramid.occupied(0, 3, 5, 5)); // voxel z 5 spans altitudes 10..=12
+//! assert!(!pyramid.occupied(0, 3, 5, 6));
+//!
+//! // Raise a 4 x 8 patch (texels 12..16, 40..48) to 100 and update only it.
+//! let (heights, _metas) = level.planes_mut();
+//! for y in 40..48 {
+//!     for x in 12..16 {
+//!         heights[y * 64 + x] = 100;
+//!     }
+//! }
+//! let dirty = DirtyRect { x: 12, y: 40, width: 4, height: 8 };
+//! let stats = pyramid.update(&level, &[dirty]).unwrap();
+//! assert_eq!(stats.leaf_columns, 1);
+//! assert!(pyramid.occupied(0, 3, 5, 50)); // voxel (3, 5) now reaches altitude 100
+//! assert_eq!(pyramid, Pyramid::build(&level, VoxelSize::COARSE).unwrap());
+//! ```
+//!
+//! # Stability
+//!
+//! The stable surface is [`Pyramid`] (`build`, `update`, `occupied`, `count`,
+//! `bytes`), [`VoxelSize`] (with its `X,Y,Z` text form), [`UpdateStats`] and
+//! [`LayoutError`]. The bit layout ([`layout`]: [`Layout`], [`LevelInfo`],
+//! [`TileRange`], the Morton helpers, the level table) and the public `words`
+//! are shared with `strata-render`'s shaders and may change with them.
+
+#![warn(missing_docs)]
 
 pub mod build;
 pub mod layout;

@@ -37,12 +37,23 @@ pub fn default_cache_dir() -> PathBuf {
     PathBuf::from(".strata-cache").join("reference")
 }
 
+/// Why the cache could not store an entry.
 #[derive(Debug, thiserror::Error)]
 pub enum CacheError {
+    /// Creating the cache directory or writing an entry failed.
     #[error("reference cache {path}")]
-    Io { path: PathBuf, source: io::Error },
+    Io {
+        /// The file or directory written.
+        path: PathBuf,
+        /// The operating system's error.
+        source: io::Error,
+    },
 }
 
+/// Reference images on disk, keyed by level content hash, camera, size and
+/// [`REFERENCE_VERSION`] (colour entries also by
+/// colours and [`COLOR_VERSION`]). A missing or
+/// unreadable entry is a miss, never an error.
 pub struct ReferenceCache {
     dir: PathBuf,
     /// The pyramid of the last level computed, by content hash, so that
@@ -59,6 +70,7 @@ impl ReferenceCache {
         }
     }
 
+    /// The cache's directory.
     pub fn dir(&self) -> &Path {
         &self.dir
     }

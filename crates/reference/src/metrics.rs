@@ -10,6 +10,8 @@ use strata_camera::Camera;
 /// `max(d, 1)`.
 pub const COHERENCE_TOLERANCE: f32 = 0.04;
 
+/// How a rendered distance image differs from the reference; see the module
+/// docs for the units (percent of all pixels, world units).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Metrics {
     /// Reference solid, renderer empty (% of all pixels).
@@ -28,15 +30,21 @@ pub struct Metrics {
     pub both_solid: f64,
 }
 
+/// Why two images cannot be compared.
 #[derive(Debug, thiserror::Error, PartialEq, Eq)]
 pub enum MetricsError {
+    /// The rendered image's pixel count differs from the reference's.
     #[error(
         "rendered image has {got} pixels, the reference {expected} ({width}x{height}): different sizes"
     )]
     Size {
+        /// Pixels in the rendered image.
         got: usize,
+        /// Pixels in the reference.
         expected: usize,
+        /// Reference width, pixels.
         width: u32,
+        /// Reference height, pixels.
         height: u32,
     },
 }

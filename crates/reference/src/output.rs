@@ -9,9 +9,13 @@ use std::path::{Path, PathBuf};
 use strata_camera::Camera;
 use strata_level::ViewSpec;
 
+/// The JSON header ([`ViewHeader`]).
 pub const HEADER_FILE: &str = "reference.json";
+/// Distances, `width * height` little-endian `f32`, infinity for sky.
 pub const DISTANCE_FILE: &str = "distance.f32";
+/// Hit classes, one [`HitClass::code`] byte per pixel.
 pub const CLASS_FILE: &str = "class.u8";
+/// Terrain types (0..7, 0 for sky), one byte per pixel.
 pub const TERRAIN_FILE: &str = "terrain.u8";
 
 /// Sky in `distance.png` and `class.png`: white, which the ramp never reaches.
@@ -20,46 +24,72 @@ pub const SKY_RGB: [u8; 3] = [255, 255, 255];
 /// `reference.json`: what the raw files hold and how they were made.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ViewHeader {
+    /// Image width, pixels.
     pub width: u32,
+    /// Image height, pixels.
     pub height: u32,
+    /// The camera the view was traced with.
     pub camera: Camera,
+    /// The view it was resolved from, when it came from one.
     pub view: Option<ViewSpec>,
     /// The level's content hash.
     pub level_hash: String,
+    /// [`REFERENCE_VERSION`](crate::REFERENCE_VERSION) of the code that wrote it.
     pub reference_version: u32,
     /// Percent of pixels that are sky.
     pub sky_fraction: f64,
+    /// Nearest hit, world units (`None` when all sky).
     pub distance_min: Option<f32>,
+    /// Median hit distance ([`Reference::distance_summary`]).
     pub distance_median: Option<f32>,
+    /// Farthest hit.
     pub distance_max: Option<f32>,
     /// Wall-clock seconds to compute (0 when read from the cache).
     pub seconds: f64,
+    /// Whether the image came from the [`ReferenceCache`](crate::ReferenceCache).
     pub from_cache: bool,
     /// How to read the raw files, for a person opening the directory.
     pub format: String,
 }
 
+/// Why a view directory could not be written or read; each names the file.
 #[derive(Debug, thiserror::Error)]
 pub enum OutputError {
+    /// Reading or writing a file failed.
     #[error("{path}")]
     Io {
+        /// The file.
         path: PathBuf,
+        /// The operating system's error.
         source: std::io::Error,
     },
+    /// Encoding a picture failed.
     #[error("{path}")]
     Png {
+        /// The picture.
         path: PathBuf,
+        /// The encoder's error.
         source: image::ImageError,
     },
+    /// `reference.json` is not a valid header.
     #[error("{path}")]
     Json {
+        /// The header file.
         path: PathBuf,
+        /// The parser's error.
         source: serde_json::Error,
     },
+    /// A raw file has the wrong size or an unknown class code.
     #[error("{path}: {msg}")]
-    Format { path: PathBuf, msg: String },
+    Format {
+        /// The raw file.
+        path: PathBuf,
+        /// What is wrong with it.
+        msg: String,
+    },
 }
 
+/// The text of [`ViewHeader::format`]: how to read the raw files.
 pub const FORMAT_NOTE: &str = "distance.f32: width*height f32 little-endian, row-major, distance along the pixel ray from the eye, inf = sky; class.u8: 0 sky, 1 floor, 2 slab top, 3 cave ceiling, 4 wall; terrain.u8: terrain type 0..7 (0 for sky)";
 
 fn io(path: &Path) -> impl FnOnce(std::io::Error) -> OutputError + '_ {

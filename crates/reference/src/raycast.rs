@@ -19,7 +19,10 @@ use strata_level::{Column, Level};
 pub struct RayHit {
     /// Distance along the (unit) ray from its origin.
     pub distance: f64,
+    /// Which interval, entered through which face.
     pub class: HitClass,
+    /// Terrain type (0..7) of the interval hit (the floor's lower type, the
+    /// slab's upper type).
     pub terrain: u8,
     /// The texel column hit (a wall hit lies on its texel line, where the
     /// point alone does not say which side's column it was).
@@ -34,6 +37,8 @@ pub struct Tracer<'a> {
 }
 
 impl<'a> Tracer<'a> {
+    /// A tracer with the max-height pyramid of `level` built (in parallel),
+    /// which lets rays skip tiles they pass above.
     pub fn new(level: &'a Level) -> Self {
         Tracer {
             level,
@@ -60,6 +65,7 @@ impl<'a> Tracer<'a> {
         &self.pyramid
     }
 
+    /// The level it traces.
     pub fn level(&self) -> &'a Level {
         self.level
     }

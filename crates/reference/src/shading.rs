@@ -30,12 +30,16 @@ enum Surface {
 /// The world's palette and per-type colour ranges (`Begin/End Colors`).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct TerrainRamps {
+    /// The world's palette, 8-bit RGB.
     pub palette: [[u8; 3]; 256],
+    /// First (darkest-lit) palette index of each terrain type's range.
     pub begin: [u8; 8],
+    /// Last (brightest-lit) palette index of each terrain type's range.
     pub end: [u8; 8],
 }
 
 impl TerrainRamps {
+    /// The ramps of a loaded or generated world.
     pub fn from_world(world: &World) -> Self {
         TerrainRamps {
             palette: world.palette.colors,
@@ -68,8 +72,11 @@ impl TerrainRamps {
 /// (alpha dropped).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct ColorImage {
+    /// Image width, pixels.
     pub width: u32,
+    /// Image height, pixels.
     pub height: u32,
+    /// RGB triples, row-major: `width * height * 3` bytes.
     pub rgb: Vec<u8>,
 }
 

@@ -15,8 +15,11 @@ pub const SHADOW_MISS: f32 = 1e9;
 /// per texel, row-major (`side` x `side`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct ShadowMap {
+    /// Where the map lies (plane, axes, texel size).
     pub frame: ShadowFrame,
+    /// Texels per side ([`SHADOW_SIZE`]).
     pub side: u32,
+    /// World units along the light per texel, [`SHADOW_MISS`] where nothing is hit.
     pub depth: Vec<f32>,
 }
 

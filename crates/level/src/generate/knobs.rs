@@ -43,6 +43,7 @@ impl Knobs {
         Ok(())
     }
 
+    /// Whether no knob is turned (the default world).
     pub fn is_default(&self) -> bool {
         *self == Knobs::default()
     }
@@ -70,6 +71,8 @@ pub struct SlabMask {
 }
 
 impl SlabMask {
+    /// The mask of a `width x height` map putting slabs on `fraction`
+    /// (0 ..= [`MAX_DUAL_FRACTION`]) of its pairs.
     pub fn new(seed: u32, width: u32, height: u32, fraction: f64) -> Self {
         // Blobs about 64 texels across with wiggly outlines (three octaves).
         let noise = Fbm::new(seed ^ 0x51ab, 6, 3, width, height);

@@ -8,9 +8,12 @@
 
 mod assets;
 pub mod knobs;
+// The generator's designs, public only between its own modules.
+#[doc(hidden)]
 pub mod landmarks;
 mod noise;
 pub mod preview;
+#[doc(hidden)]
 pub mod terrain;
 
 use crate::World;
@@ -32,10 +35,14 @@ pub const MAX_SIDE: u32 = 1 << 15;
 /// Largest map, in texels (two bytes each in memory).
 pub const MAX_TEXELS: u64 = 1 << 28;
 
+/// Which world to generate: the same parameters give the same bytes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct GenerateParams {
+    /// Any value; each seed is a different world.
     pub seed: u64,
+    /// Map width, texels ([`check_size`] says which sizes are accepted).
     pub width: u32,
+    /// Map height, texels.
     pub height: u32,
 }
 
@@ -50,28 +57,43 @@ impl Default for GenerateParams {
     }
 }
 
+/// Why a world cannot be generated.
 #[derive(Debug, thiserror::Error, PartialEq, Eq)]
 pub enum GenerateError {
+    /// The size fails [`check_size`].
     #[error("map size {width}x{height}: {reason}")]
     Size {
+        /// Width asked for, texels.
         width: u32,
+        /// Height asked for, texels.
         height: u32,
+        /// Which rule it breaks.
         reason: String,
     },
+    /// [`parse_size`] got text that is not `WIDTHxHEIGHT` (the text).
     #[error("size `{0}` is not WIDTHxHEIGHT (e.g. 2048x16384)")]
     SizeSyntax(String),
+    /// The landmarks do not all fit on the map (a valid but cramped size).
     #[error("map {width}x{height} has no room left for the `{landmark}` landmark")]
     NoRoom {
+        /// Map width, texels.
         width: u32,
+        /// Map height, texels.
         height: u32,
+        /// The landmark that did not fit.
         landmark: &'static str,
     },
+    /// A [`Knobs`] value is outside its range.
     #[error("{name} {value} is outside its range {range}")]
     Knob {
+        /// The knob.
         name: &'static str,
+        /// The value given.
         value: String,
+        /// The accepted range.
         range: String,
     },
+    /// The planes could not form a [`Level`] (a bug if it happens: sizes are checked first).
     #[error(transparent)]
     Shape(#[from] ShapeError),
 }
@@ -86,7 +108,7 @@ pub fn parse_size(text: &str) -> Result<(u32, u32), GenerateError> {
     ))
 }
 
-/// Powers of two from 256 to 65536 a side, at most 2^28 texels.
+/// Powers of two from 256 to 32768 a side, at most 2^28 texels.
 pub fn check_size(width: u32, height: u32) -> Result<(), GenerateError> {
     let err = |reason: &str| GenerateError::Size {
         width,
@@ -111,20 +133,28 @@ pub fn check_size(width: u32, height: u32) -> Result<(), GenerateError> {
 /// An overhead solid layer over a texel: wanted cave ceiling and slab top.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Slab {
+    /// Wanted cave ceiling (`mid`), altitude; encoded as the nearest multiple
+    /// of 8 above the floor at or below it (the gap codes' steps).
     pub ceiling: i32,
+    /// Wanted slab top (`high`), altitude; clamped to 0..=255.
     pub high: i32,
+    /// Terrain type of the slab, 0..8.
     pub ty: u8,
 }
 
 /// What the generator wants at one texel, before pair encoding.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Texel {
+    /// Wanted floor (`low`), altitude; clamped to 0..=255.
     pub floor: i32,
+    /// Terrain type of the floor, 0..8.
     pub ty: u8,
+    /// The layer over a cave, if any.
     pub slab: Option<Slab>,
 }
 
 impl Texel {
+    /// A texel without a slab.
     #[inline]
     pub fn single(floor: i32, ty: u8) -> Self {
         Texel {
@@ -134,6 +164,7 @@ impl Texel {
         }
     }
 
+    /// This texel with a slab from `ceiling` to `high` of type `ty` over it.
     #[inline]
     pub fn with_slab(self, ceiling: i32, high: i32, ty: u8) -> Self {
         Texel {
@@ -275,6 +306,7 @@ impl Generation {
         self.is_done()
     }
 
+    /// Whether every row is generated.
     pub fn is_done(&self) -> bool {
         self.next_row >= self.params.height
     }

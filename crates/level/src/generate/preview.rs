@@ -8,9 +8,13 @@ use crate::{Level, Palette, WorldConfig};
 /// A rectangle of the map to draw, in texels (wraps around the map).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Region {
+    /// Left column, texels (any value; wraps).
     pub x: i64,
+    /// Top row, texels (any value; wraps).
     pub y: i64,
+    /// Columns, pixels of the picture.
     pub width: u32,
+    /// Rows, pixels of the picture.
     pub height: u32,
 }
 
