@@ -44,6 +44,7 @@ extern crate self as strata_render;
 pub mod build_guard;
 pub mod caps;
 pub mod depth_read;
+pub mod embed;
 pub mod frame;
 pub(crate) mod fullscreen;
 pub mod gpu;
@@ -57,6 +58,7 @@ pub mod terrain;
 pub mod timing;
 
 pub use caps::{Capabilities, Capability, Refusal};
+pub use embed::{COLOR_TARGET_FORMATS, DEPTH_TARGET_FORMATS, TargetError, TargetViews};
 pub use frame::{COLOR_FORMAT, DEPTH_FORMAT, SHADOW_SIZE, Shared, TerrainColors};
 pub use gpu::{AdapterChoice, AdapterReport, BackendChoice, Gpu};
 pub use methods::{Method, MethodSettings, RetainedBytes};

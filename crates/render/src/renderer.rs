@@ -40,7 +40,7 @@ pub struct Renderer {
     active: usize,
     shadow: ShadowPass,
     timer: PassTimer,
-    errors: ErrorSink,
+    pub(crate) errors: ErrorSink,
     level_shape: LevelShape,
     frames: u64,
     adapter: crate::gpu::AdapterReport,
@@ -55,6 +55,8 @@ pub struct Renderer {
     last_submission: Option<wgpu::SubmissionIndex>,
     /// Called by [`Renderer::apply_edit`] after the GPU copies changed.
     edit_listener: Option<EditListener>,
+    /// Pipelines that copy the frame into a caller's targets ([`Renderer::render_into`]).
+    pub(crate) composite: crate::embed::CompositeCache,
 }
 
 /// Frames [`Renderer::hold_busy`] lets queue up before it waits for the oldest.
@@ -115,6 +117,7 @@ impl Renderer {
             shadow_drawn: None,
             depth_reader,
             edit_listener: None,
+            composite: Default::default(),
         };
         wait_device(&renderer.shared.device, &renderer.errors)?;
         renderer.setup_ms = ms(start);
@@ -323,6 +326,17 @@ impl Renderer {
     /// Record and submit one frame without waiting for it; returns the CPU
     /// ms spent preparing and recording it.
     fn submit_frame(&mut self, camera: &Camera) -> anyhow::Result<f64> {
+        let record_start = Instant::now();
+        let encoder = self.record_frame(camera)?;
+        let commands = encoder.finish();
+        let record_ms = ms(record_start);
+        self.submit(commands);
+        Ok(record_ms)
+    }
+
+    /// Prepare one frame and record it into a new encoder (shadow map, the
+    /// active method, timestamp resolve), not yet submitted.
+    pub(crate) fn record_frame(&mut self, camera: &Camera) -> anyhow::Result<wgpu::CommandEncoder> {
         if camera.width != self.shared.width || camera.height != self.shared.height {
             anyhow::bail!(
                 "camera is {}x{} but the renderer was built for {}x{}",
@@ -332,7 +346,6 @@ impl Renderer {
                 self.shared.height
             );
         }
-        let record_start = Instant::now();
         let shadows = self.settings().shadows;
         let shadow = ShadowFrame::fit(camera, shadows);
         let globals = Globals::new(camera, &self.level_shape, &shadow);
@@ -363,12 +376,13 @@ impl Renderer {
         }
         method.record(&self.shared, &frame, &mut encoder);
         self.timer.resolve(&mut encoder);
-        let commands = encoder.finish();
-        let record_ms = ms(record_start);
+        Ok(encoder)
+    }
 
+    /// Submit a frame's commands and count it.
+    pub(crate) fn submit(&mut self, commands: wgpu::CommandBuffer) {
         self.last_submission = Some(self.shared.queue.submit([commands]));
         self.frames += 1;
-        Ok(record_ms)
     }
 
     /// The protocol's frame loop: one first frame, `warmup` untimed frames,
