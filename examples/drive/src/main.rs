@@ -1,7 +1,8 @@
-//! `cargo run -p strata-example-drive -- [METHOD] [--size WxH] [--frames N --out DIR]`
+//! `cargo run -p strata-example-drive -- [METHOD] [--size WxH] [--seconds S] [--frames N --out DIR]`
 //!
 //! With a display: a window drawing the terrain with METHOD (default `mesh`)
-//! and a vehicle driving across it, back and forth, until closed. With
+//! and a vehicle driving across it, back and forth, until closed (or for
+//! `--seconds S`). With
 //! `--frames N --out DIR` (no display needed): N frames along the road as
 //! PNGs, and a line per frame saying whether the vehicle shows.
 
@@ -15,6 +16,8 @@ struct Args {
     size: (u32, u32),
     frames: Option<u32>,
     out: Option<PathBuf>,
+    /// Close the window after this many seconds (a smoke test under Xvfb).
+    seconds: Option<f32>,
 }
 
 fn parse_args() -> anyhow::Result<Args> {
@@ -23,6 +26,7 @@ fn parse_args() -> anyhow::Result<Args> {
         size: (960, 600),
         frames: None,
         out: None,
+        seconds: None,
     };
     let mut it = std::env::args().skip(1);
     while let Some(a) = it.next() {
@@ -39,6 +43,13 @@ fn parse_args() -> anyhow::Result<Args> {
                 );
             }
             "--out" => args.out = Some(value("--out")?.into()),
+            "--seconds" => {
+                let v = value("--seconds")?;
+                args.seconds =
+                    Some(v.parse().ok().filter(|s: &f32| *s > 0.0).ok_or_else(|| {
+                        anyhow::anyhow!("--seconds {v:?}: not a positive number")
+                    })?);
+            }
             "--size" => {
                 let v = value("--size")?;
                 args.size = v
@@ -48,7 +59,7 @@ fn parse_args() -> anyhow::Result<Args> {
                     .ok_or_else(|| anyhow::anyhow!("--size {v:?}: expected WxH, e.g. 960x600"))?;
             }
             "-h" | "--help" => {
-                println!("drive [METHOD] [--size WxH] [--frames N --out DIR]");
+                println!("drive [METHOD] [--size WxH] [--seconds S] [--frames N --out DIR]");
                 std::process::exit(0);
             }
             m if !m.starts_with('-') => args.method = m.to_string(),
@@ -69,7 +80,7 @@ fn run() -> anyhow::Result<()> {
     let args = parse_args()?;
     match (args.frames, &args.out) {
         (Some(frames), Some(out)) => headless(&args.method, args.size, frames, out),
-        (None, None) => window::run(&args.method, args.size),
+        (None, None) => window::run(&args.method, args.size, args.seconds),
         _ => anyhow::bail!("the headless mode needs both --frames N and --out DIR"),
     }
 }

@@ -12,7 +12,7 @@ use winit::event_loop::{ActiveEventLoop, EventLoop};
 use winit::window::{Window, WindowId};
 
 /// Open the window and drive until it is closed.
-pub fn run(method: &str, size: (u32, u32)) -> anyhow::Result<()> {
+pub fn run(method: &str, size: (u32, u32), seconds: Option<f32>) -> anyhow::Result<()> {
     let no_display =
         std::env::var_os("DISPLAY").is_none() && std::env::var_os("WAYLAND_DISPLAY").is_none();
     let event_loop = EventLoop::new().map_err(|e| {
@@ -25,6 +25,7 @@ pub fn run(method: &str, size: (u32, u32)) -> anyhow::Result<()> {
     let mut app = App {
         method: method.to_string(),
         size,
+        seconds,
         state: None,
         error: None,
         display: event_loop.owned_display_handle(),
@@ -36,6 +37,7 @@ pub fn run(method: &str, size: (u32, u32)) -> anyhow::Result<()> {
 struct App {
     method: String,
     size: (u32, u32),
+    seconds: Option<f32>,
     state: Option<State>,
     error: Option<anyhow::Error>,
     display: winit::event_loop::OwnedDisplayHandle,
@@ -50,6 +52,7 @@ struct State {
     drive: Drive,
     depth: wgpu::TextureView,
     start: Instant,
+    frames: u32,
 }
 
 fn depth_view(device: &wgpu::Device, size: (u32, u32)) -> wgpu::TextureView {
@@ -110,6 +113,7 @@ impl State {
             depth,
             gpu,
             start: Instant::now(),
+            frames: 0,
         })
     }
 
@@ -143,6 +147,7 @@ impl State {
         self.drive.draw(Some(t), &color, None, &self.depth)?;
         self.window.pre_present_notify();
         self.gpu.queue.present(frame);
+        self.frames += 1;
         self.window.request_redraw();
         Ok(())
     }
@@ -176,6 +181,20 @@ impl ApplicationHandler for App {
                 return;
             }
             WindowEvent::Resized(size) => state.resize((size.width, size.height)),
+            WindowEvent::RedrawRequested
+                if self
+                    .seconds
+                    .is_some_and(|s| state.start.elapsed().as_secs_f32() >= s) =>
+            {
+                let secs = state.start.elapsed().as_secs_f32();
+                println!(
+                    "drive: {} frames in {secs:.1} s ({} into {:?} + {DEPTH:?})",
+                    state.frames, self.method, state.config.format
+                );
+                self.state = None;
+                event_loop.exit();
+                return;
+            }
             WindowEvent::RedrawRequested => state.redraw(),
             _ => Ok(()),
         };

@@ -38,7 +38,7 @@ fn vehicle_hides_under_the_slab_and_shows_in_the_open_in_every_method() {
                 continue;
             }
         };
-        let camera = drive.camera.clone();
+        let camera = drive.camera;
         let mut frame = |t: Option<f32>| {
             let centre = drive
                 .draw(t, &targets.color_view, None, &targets.depth_view)
@@ -89,7 +89,6 @@ fn vehicle_hides_under_the_slab_and_shows_in_the_open_in_every_method() {
             assert!(vehicle_pixels(&seen) >= 20, "{name}: {what}");
         }
         // The collider saw the crater dug at start.
-        drop(frame);
         let centre = drive.vehicle_centre(in_crater);
         assert!(
             centre.z < f32::from(scene::GROUND),
