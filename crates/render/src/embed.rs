@@ -211,6 +211,8 @@ fn key_of(targets: &TargetViews<'_>, size: (u32, u32)) -> Result<Key, TargetErro
 pub(crate) struct CompositeCache {
     layout: Option<wgpu::BindGroupLayout>,
     sampler: Option<wgpu::Sampler>,
+    /// The sRGB decode table (`composite.wgsl`'s `srgb_to_linear`).
+    decode: Option<wgpu::Buffer>,
     module: Option<wgpu::ShaderModule>,
     pipelines: Vec<(Key, wgpu::RenderPipeline)>,
     /// The bind group and the colour target it was made for (a resize
@@ -243,6 +245,16 @@ impl CompositeCache {
                             ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::NonFiltering),
                             count: None,
                         },
+                        wgpu::BindGroupLayoutEntry {
+                            binding: 3,
+                            visibility: wgpu::ShaderStages::FRAGMENT,
+                            ty: wgpu::BindingType::Buffer {
+                                ty: wgpu::BufferBindingType::Uniform,
+                                has_dynamic_offset: false,
+                                min_binding_size: None,
+                            },
+                            count: None,
+                        },
                     ],
                 })
             })
@@ -265,6 +277,19 @@ impl CompositeCache {
                 })
             })
             .clone();
+        let decode = self
+            .decode
+            .get_or_insert_with(|| {
+                use wgpu::util::DeviceExt;
+                shared
+                    .device
+                    .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                        label: Some("srgb decode"),
+                        contents: bytemuck::cast_slice(&srgb_decode_table()),
+                        usage: wgpu::BufferUsages::UNIFORM,
+                    })
+            })
+            .clone();
         let group = shared.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("composite"),
             layout: &layout,
@@ -280,6 +305,10 @@ impl CompositeCache {
                 wgpu::BindGroupEntry {
                     binding: 2,
                     resource: wgpu::BindingResource::Sampler(&sampler),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: decode.as_entire_binding(),
                 },
             ],
         });
@@ -350,6 +379,18 @@ impl CompositeCache {
     }
 }
 
+/// Linear light of each sRGB-encoded byte (IEC 61966-2-1).
+fn srgb_decode_table() -> [f32; 256] {
+    std::array::from_fn(|k| {
+        let c = k as f32 / 255.0;
+        if c <= 0.04045 {
+            c / 12.92
+        } else {
+            ((c + 0.055) / 1.055).powf(2.4)
+        }
+    })
+}
+
 /// Record the composite pass: the shared frame into the caller's views.
 fn record_composite(
     encoder: &mut wgpu::CommandEncoder,
@@ -357,6 +398,7 @@ fn record_composite(
     key: Key,
     pipeline: &wgpu::RenderPipeline,
     group: &wgpu::BindGroup,
+    timestamp_writes: Option<wgpu::RenderPassTimestampWrites<'_>>,
 ) {
     // Every pixel is written, so neither view's old contents are loaded;
     // a stencil aspect is kept for the caller.
@@ -383,7 +425,7 @@ fn record_composite(
             }),
             stencil_ops,
         }),
-        timestamp_writes: None,
+        timestamp_writes,
         occlusion_query_set: None,
         multiview_mask: None,
     });
@@ -437,7 +479,7 @@ impl Renderer {
             let pipeline = composite.pipeline(&device, key)?;
             let group = composite.group(self.shared());
             let mut encoder = self.record_frame(camera)?;
-            record_composite(&mut encoder, targets, key, &pipeline, &group);
+            record_composite(&mut encoder, targets, key, &pipeline, &group, None);
             Ok(encoder.finish())
         })();
         self.composite = composite;
@@ -457,6 +499,30 @@ impl Renderer {
         }
         self.submit(recorded?);
         self.errors.check()
+    }
+}
+
+impl Renderer {
+    /// Record only the copy of the frame last drawn (by
+    /// [`Renderer::render_frame`] or [`Renderer::render_into`]) into the
+    /// caller's views, in the caller's encoder: to show one frame in more
+    /// targets, or to time the copy (`timestamp_writes`; what
+    /// `examples/composite_cost.rs` measures). The same checks as
+    /// `render_into`; wgpu errors reach the device's error sink.
+    pub fn record_copy_into(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        targets: &TargetViews<'_>,
+        timestamp_writes: Option<wgpu::RenderPassTimestampWrites<'_>>,
+    ) -> anyhow::Result<()> {
+        let key = key_of(targets, (self.shared().width, self.shared().height))?;
+        let device = self.shared().device.clone();
+        let mut composite = std::mem::take(&mut self.composite);
+        let pipeline = composite.pipeline(&device, key);
+        let group = composite.group(self.shared());
+        self.composite = composite;
+        record_composite(encoder, targets, key, &pipeline?, &group, timestamp_writes);
+        Ok(())
     }
 }
 
