@@ -451,13 +451,15 @@ impl Renderer {
     ///
     /// ```no_run
     /// # fn f(renderer: &mut strata_render::Renderer, camera: &strata_camera::Camera,
-    /// #      surface: &wgpu::Surface, depth: &wgpu::TextureView) -> anyhow::Result<()> {
-    /// let frame = surface.get_current_texture();
-    /// # let frame: wgpu::SurfaceTexture = unimplemented!();
+    /// #      queue: &wgpu::Queue, surface: &wgpu::Surface, depth: &wgpu::TextureView)
+    /// #      -> anyhow::Result<()> {
+    /// let wgpu::CurrentSurfaceTexture::Success(frame) = surface.get_current_texture() else {
+    ///     return Ok(()); // reconfigure, skip the frame...
+    /// };
     /// let color = frame.texture.create_view(&Default::default());
     /// renderer.render_into(camera, &strata_render::TargetViews::new(&color, depth))?;
-    /// // ... your own passes: LoadOp::Load, depth compare Less ...
-    /// frame.present();
+    /// // ... your own passes into `color` and `depth`: LoadOp::Load, depth compare Less ...
+    /// queue.present(frame);
     /// # Ok(()) }
     /// ```
     pub fn render_into(
