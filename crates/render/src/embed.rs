@@ -6,9 +6,10 @@
 //! [`Renderer::render_frame`], then one full-screen pass in the same command
 //! buffer writes that frame's colour and depth (`frag_depth`) into the
 //! caller's views. One pass serves every format pair and sample count (a
-//! texture copy would serve only an `Rgba8Unorm` colour target of one sample,
-//! and depth cannot be copied into a depth texture from a pass-less path on
-//! every backend), so there is a single path to test.
+//! texture copy would serve only Strata's own formats at one sample, and GL
+//! has no depth copies), so there is a single path to test. A multisampled
+//! target receives each pixel's colour and depth in all its samples (the
+//! terrain is drawn at one sample per pixel; your objects get the MSAA).
 //!
 //! # Depth convention
 //! The depth written is Strata's depth-buffer value under
