@@ -50,10 +50,15 @@ impl fmt::Display for Capability {
 /// The adapter's capabilities and the device limits Strata asked for.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Capabilities {
+    /// Compute shaders.
     pub compute: bool,
+    /// Write-only storage textures (compute methods write colour so).
     pub storage_textures: bool,
+    /// Storage buffers in fragment shaders.
     pub fragment_storage: bool,
+    /// Storage buffers in vertex shaders.
     pub vertex_storage: bool,
+    /// 32-bit float colour targets.
     pub float32_targets: bool,
     /// Depth textures copy to buffers; without it depth is read back
     /// through a pass into an RGBA8 target (`depth_read.rs`).
@@ -61,9 +66,13 @@ pub struct Capabilities {
     /// Per-pass GPU timestamps; without them frames are timed on the CPU
     /// (submit until done).
     pub timestamps: bool,
+    /// Largest 2D texture side, texels.
     pub max_texture_2d: u32,
+    /// Most layers of a texture array.
     pub max_texture_layers: u32,
+    /// Largest storage buffer binding, bytes.
     pub max_storage_binding: u64,
+    /// Largest buffer, bytes.
     pub max_buffer: u64,
 }
 
@@ -206,14 +215,18 @@ pub fn gl_version_has_compute(version: &str) -> bool {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum ShadowPassKind {
+    /// A compute pass writes the map.
     Compute,
+    /// A fragment pass writes the map (no storage textures).
     Fragment,
 }
 
 /// Why a method cannot run on an adapter.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Refusal {
+    /// The method refused.
     pub method: String,
+    /// What the adapter lacks for it.
     pub missing: Vec<Capability>,
 }
 

@@ -30,12 +30,16 @@ pub fn sky_clear() -> wgpu::Color {
 /// Palette and per-type colour ranges (the world's `Begin/End Colors`).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct TerrainColors {
+    /// The world's 256-entry RGB palette.
     pub palette: [[u8; 3]; 256],
+    /// First palette index of each terrain type's colour ramp.
     pub begin: [u8; 8],
+    /// Last palette index of each terrain type's colour ramp.
     pub end: [u8; 8],
 }
 
 impl TerrainColors {
+    /// The world's palette and colour ranges.
     pub fn from_world(world: &World) -> Self {
         TerrainColors {
             palette: world.palette.colors,
@@ -74,17 +78,29 @@ impl TerrainColors {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct Globals {
+    /// `Camera::view_proj`, column-major.
     pub view_proj: [[f32; 4]; 4],
+    /// Eye position (xyz, world units); w: focal length, pixels.
     pub eye: [f32; 4],
+    /// Unit view direction (xyz); w: near plane.
     pub forward: [f32; 4],
+    /// Unit screen-right direction (xyz); w: far plane.
     pub right: [f32; 4],
+    /// Unit screen-up direction (xyz).
     pub up: [f32; 4],
+    /// Width, height (pixels) and their reciprocals.
     pub screen: [f32; 4],
+    /// Unit direction of the light (xyz); w: 1 with shadows on, else 0.
     pub light_dir: [f32; 4],
+    /// Shadow map: world origin (xyz); w: texel size.
     pub shadow_origin: [f32; 4],
+    /// Shadow map: u axis (xyz); w: its side in texels.
     pub shadow_u: [f32; 4],
+    /// Shadow map: v axis (xyz); w: depth bias.
     pub shadow_v: [f32; 4],
+    /// Sky colour, 0..1 RGBA (sRGB-encoded values).
     pub sky: [f32; 4],
+    /// Level width, height, log2 of the rows per texture layer, mid rule (1: original).
     pub level: [u32; 4],
 }
 
@@ -92,11 +108,14 @@ pub struct Globals {
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 pub struct ShadingParams {
+    /// Palette as 0..1 RGBA.
     pub palette: [[f32; 4]; 256],
+    /// Per terrain type: first and last palette index.
     pub ranges: [[u32; 4]; 8],
 }
 
 impl ShadingParams {
+    /// The uniform for `colors`.
     pub fn new(colors: &TerrainColors) -> Self {
         ShadingParams {
             palette: colors.palette.map(|c| {
@@ -113,12 +132,16 @@ impl ShadingParams {
 /// What the globals need of a level: its size and mid rule.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct LevelShape {
+    /// Level width, texels.
     pub width: u32,
+    /// Level height, texels.
     pub height: u32,
+    /// How the level's mid byte is read.
     pub mid_rule: strata_level::MidRule,
 }
 
 impl LevelShape {
+    /// The shape of `level`.
     pub fn of(level: &Level) -> Self {
         LevelShape {
             width: level.width(),
@@ -249,22 +272,35 @@ impl Targets {
 
 /// The resources shared by all methods, and the helpers methods build with.
 pub struct Shared {
+    /// The device everything is built on (the caller's, with `Gpu::from_device`).
     pub device: wgpu::Device,
+    /// The queue frames are submitted on.
     pub queue: wgpu::Queue,
-    /// Render target size, pixels.
+    /// Render target width, pixels.
     pub width: u32,
+    /// Render target height, pixels.
     pub height: u32,
+    /// The level on the GPU (internal layout).
     pub terrain: TerrainTexture,
+    /// The per-frame [`Globals`] uniform.
     pub globals: wgpu::Buffer,
+    /// The [`ShadingParams`] uniform.
     pub shading: wgpu::Buffer,
+    /// The shared shadow map ([`SHADOW_SIZE`]²).
     pub shadow_map: wgpu::Texture,
+    /// Its view.
     pub shadow_view: wgpu::TextureView,
+    /// Strata's colour target ([`COLOR_FORMAT`], `width` x `height`).
     pub color: wgpu::Texture,
+    /// Its view: stable, for drawing your objects over a `render_frame`.
     pub color_view: wgpu::TextureView,
+    /// Strata's depth target ([`DEPTH_FORMAT`]; see the crate's depth convention).
     pub depth: wgpu::Texture,
+    /// Its view: stable, for drawing your objects over a `render_frame`.
     pub depth_view: wgpu::TextureView,
     /// Bind group 0 of every method pipeline (`frame.wgsl`).
     pub frame_layout: wgpu::BindGroupLayout,
+    /// The bind group for `frame_layout`.
     pub frame_group: wgpu::BindGroup,
     /// What the adapter can do: methods check it before building.
     pub caps: Capabilities,

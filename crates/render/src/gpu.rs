@@ -13,10 +13,15 @@ pub const GPU_WAIT_TIMEOUT: Duration = Duration::from_secs(120);
 /// The adapter a result was produced on: printed in every output.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize)]
 pub struct AdapterReport {
+    /// The adapter's name (e.g. `llvmpipe (LLVM 15.0.6, 256 bits)`).
     pub name: String,
+    /// Its backend, lower case (`vulkan`, `gl`, `metal`, `dx12`).
     pub backend: String,
+    /// The driver's name.
     pub driver: String,
+    /// The driver's version information.
     pub driver_info: String,
+    /// `DiscreteGpu`, `IntegratedGpu`, `Cpu`, ...
     pub device_type: String,
     /// Whether per-pass GPU timestamps are available on this device.
     pub timestamps: bool,
@@ -62,13 +67,19 @@ impl ErrorSink {
 
 /// A device, its queue and the adapter it came from.
 pub struct Gpu {
+    /// The wgpu instance the adapter came from.
     pub instance: wgpu::Instance,
+    /// The adapter the device was made on.
     pub adapter: wgpu::Adapter,
+    /// The device Strata builds on (yours, with [`Gpu::from_device`]).
     pub device: wgpu::Device,
+    /// The queue Strata submits on.
     pub queue: wgpu::Queue,
+    /// The adapter, as every output names it.
     pub report: AdapterReport,
     /// What the adapter can do, under the limits requested for the device.
     pub caps: Capabilities,
+    /// Validation errors and device loss, collected (checked by [`Gpu::wait`] and each frame).
     pub errors: ErrorSink,
 }
 
@@ -84,13 +95,18 @@ pub enum BackendChoice {
     /// Every backend, or those `WGPU_BACKEND` names.
     #[default]
     Auto,
+    /// Vulkan only.
     Vulkan,
+    /// OpenGL / GLES (EGL) only.
     Gl,
+    /// Direct3D 12 only.
     Dx12,
+    /// Metal only.
     Metal,
 }
 
 impl BackendChoice {
+    /// The names `--backend` takes, in variant order.
     pub const NAMES: &[&str] = &["auto", "vulkan", "gl", "dx12", "metal"];
 
     /// The instance backends to create.
@@ -140,7 +156,9 @@ impl std::fmt::Display for BackendChoice {
 /// or the one `WGPU_ADAPTER_NAME` names).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct AdapterChoice {
+    /// The backend to look on.
     pub backend: BackendChoice,
+    /// The adapter's index in `list_adapters` (`--adapter N`); `None`: the default.
     pub index: Option<usize>,
 }
 
@@ -169,11 +187,17 @@ pub fn instance_flags(flags: wgpu::InstanceFlags) -> wgpu::InstanceFlags {
 pub struct AdapterListing {
     /// Pass as `--adapter N` (with the same `--backend`).
     pub index: usize,
+    /// The adapter's name (e.g. `llvmpipe (LLVM 15.0.6, 256 bits)`).
     pub name: String,
+    /// Its backend, lower case (`vulkan`, `gl`, `metal`, `dx12`).
     pub backend: String,
+    /// The driver's name.
     pub driver: String,
+    /// The driver's version information.
     pub driver_info: String,
+    /// `DiscreteGpu`, `IntegratedGpu`, `Cpu`, ...
     pub device_type: String,
+    /// What it can do under the limits Strata would request.
     pub capabilities: Capabilities,
     /// Why the adapter as a whole is refused (its device cannot be made,
     /// or fails the GL self-check), if it is.
@@ -185,6 +209,7 @@ pub struct AdapterListing {
 /// Whether one method runs on an adapter.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct MethodSupport {
+    /// The method's name.
     pub name: String,
     /// `None` when it runs; else why not (the capabilities missing).
     pub refused: Option<String>,
@@ -279,6 +304,13 @@ impl Gpu {
     }
 
     /// A headless device on the adapter `choice` names.
+    ///
+    /// ```no_run
+    /// use strata_render::{AdapterChoice, BackendChoice, Gpu};
+    /// let gpu = Gpu::open(&AdapterChoice { backend: BackendChoice::Vulkan, index: None })?;
+    /// println!("on {} ({})", gpu.report.name, gpu.report.backend);
+    /// # anyhow::Ok(())
+    /// ```
     #[cfg(not(target_arch = "wasm32"))]
     pub fn open(choice: &AdapterChoice) -> anyhow::Result<Self> {
         Self::with_instance(choice.instance(), None, choice)
@@ -327,6 +359,15 @@ impl Gpu {
     /// installs Strata's uncaptured-error and device-lost handlers on the
     /// device (they collect errors that [`Gpu::wait`] and every frame report),
     /// replacing the caller's.
+    ///
+    /// ```no_run
+    /// # fn f(instance: wgpu::Instance, adapter: wgpu::Adapter) -> anyhow::Result<()> {
+    /// // Your engine's device and queue...
+    /// let (device, queue) = pollster::block_on(adapter.request_device(&Default::default()))?;
+    /// // ...shared with Strata (wgpu handles are reference-counted clones).
+    /// let gpu = strata_render::Gpu::from_device(instance, adapter, device.clone(), queue.clone())?;
+    /// # Ok(()) }
+    /// ```
     pub fn from_device(
         instance: wgpu::Instance,
         adapter: wgpu::Adapter,

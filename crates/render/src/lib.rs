@@ -14,49 +14,83 @@
 //! let depth = r.read_depth()?;              // depth-buffer values, 1.0 = sky
 //! # Ok(()) }
 //! ```
-
+//!
 //! # Embedding in your own engine
 //! - Your device: [`Gpu::from_device`]`(instance, adapter, device, queue)`
 //!   instead of [`Gpu::headless`]; Strata records and submits on your queue.
-//! - Composing: after [`Renderer::render_frame`] the terrain's colour and
-//!   depth are in [`Renderer::shared`]`().color_view` ([`COLOR_FORMAT`]) and
-//!   `.depth_view` ([`DEPTH_FORMAT`]: 0 near .. 1 far, 1 = sky, one sample)
-//!   under `Camera::view_proj`, for every method. Draw your own objects into
-//!   them with `LoadOp::Load`, depth compare `Less` and the same
-//!   `view_proj`; they compose with the terrain by the ordinary depth test
-//!   (`tests/compose.rs` does it for every method), then copy the colour to
-//!   your surface. Pipelines for those targets must use these two formats
-//!   and a sample count of 1 (wgpu's validation names any other).
+//! - Your targets: [`Renderer::render_into`]`(&camera, &TargetViews::new(&color, &depth))`
+//!   draws the active method's frame into your colour view (one of
+//!   [`COLOR_TARGET_FORMATS`], e.g. the surface's `Bgra8UnormSrgb`) and your
+//!   depth view (one of [`DEPTH_TARGET_FORMATS`]), of any sample count the
+//!   two share, and submits without waiting. Then draw your own objects into
+//!   the same views with `LoadOp::Load`, depth compare `Less` and the same
+//!   `camera.view_proj()`: they compose with the terrain by the ordinary depth
+//!   test. A format, sample count, size or device it cannot draw into is a
+//!   [`TargetError`] naming it. `examples/drive` (a winit window) does it all.
+//! - Or Strata's own targets: after [`Renderer::render_frame`] the terrain's
+//!   colour and depth are in [`Renderer::shared`]`().color_view`
+//!   ([`COLOR_FORMAT`]) and `.depth_view` ([`DEPTH_FORMAT`], one sample);
+//!   draw into those the same way (`tests/compose.rs`).
 //! - Edits: [`Renderer::apply_edit`] updates the GPU data; a CPU follower
 //!   (`strata_collide::TerrainCollider`) registered with
 //!   [`Renderer::set_edit_listener`] changes in the same call.
 //!
-//! Stable: [`Gpu`] (`headless`, `from_device`), [`Renderer`] (`new`,
-//! `render_frame`, `apply_edit`, `set_edit_listener`, `read_color`,
-//! `read_depth`, `shared().color_view/depth_view`), [`TerrainColors`],
-//! [`MethodSettings`], [`COLOR_FORMAT`], [`DEPTH_FORMAT`]. Everything else
-//! (the method modules, `Shared`'s other fields) may change.
+//! # Depth convention
+//! Depth is the depth-buffer value under [`strata_camera::Camera::view_proj`]:
+//! world units, z up, right-handed; a perspective projection onto wgpu's clip
+//! space, **0 at the near plane (`camera.near`, default 1) .. 1 at the far
+//! plane (`camera.far`, default 600)**, not reversed, so compare `Less`; the
+//! sky is **1.0**. [`strata_camera::Camera::depth_to_view_z`] linearises it.
+//! Colours are sRGB-encoded 8-bit values (`Rgba8Unorm` holds them as they are).
+//!
+//! # Stability
+//! Stable (the embedding API): [`Gpu`] (`headless`, `open`, `from_device`,
+//! `wait`), [`Renderer`] (`new`, `render_frame`, `render_into`,
+//! `record_copy_into`, `resize`, `apply_edit`, `set_edit_listener`,
+//! `read_color`, `read_depth`), [`TargetViews`], [`TargetError`],
+//! [`COLOR_TARGET_FORMATS`], [`DEPTH_TARGET_FORMATS`], [`TerrainColors`],
+//! [`MethodSettings`], [`FrameTimings`], [`COLOR_FORMAT`], [`DEPTH_FORMAT`],
+//! `Shared::{color_view, depth_view, device, queue, width, height}`.
+//!
+//! Internal, may change: each method's module under [`methods`] (and the
+//! [`Method`] trait's hooks), `Shared`'s other fields, the measuring hooks
+//! ([`Renderer::hold_busy`], `measure`, `set_shadow_reuse`, `shared_handle`,
+//! `insert_method`), and the modules hidden from these docs (`report`,
+//! `terrain`, `shaders`, `shadow`, `depth_read`, `self_check`,
+//! `build_guard`), which are public only for the CLI, the bench and viewer
+//! crates and the tests.
+
+#![warn(missing_docs)]
 
 // Lets the in-crate tests share `tests/common` (which names this crate).
 #[cfg(test)]
 extern crate self as strata_render;
 
+#[doc(hidden)]
 pub mod build_guard;
 pub mod caps;
+#[doc(hidden)]
 pub mod depth_read;
+pub mod embed;
 pub mod frame;
 pub(crate) mod fullscreen;
 pub mod gpu;
 pub mod methods;
 pub mod renderer;
+#[doc(hidden)]
 pub mod report;
+#[doc(hidden)]
 pub mod self_check;
+#[doc(hidden)]
 pub mod shaders;
+#[doc(hidden)]
 pub mod shadow;
+#[doc(hidden)]
 pub mod terrain;
 pub mod timing;
 
 pub use caps::{Capabilities, Capability, Refusal};
+pub use embed::{COLOR_TARGET_FORMATS, DEPTH_TARGET_FORMATS, TargetError, TargetViews};
 pub use frame::{COLOR_FORMAT, DEPTH_FORMAT, SHADOW_SIZE, Shared, TerrainColors};
 pub use gpu::{AdapterChoice, AdapterReport, BackendChoice, Gpu};
 pub use methods::{Method, MethodSettings, RetainedBytes};

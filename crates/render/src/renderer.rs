@@ -20,8 +20,11 @@ use web_time::Instant;
 /// What [`Renderer::measure`] saw.
 #[derive(Clone, Debug, Default)]
 pub struct Measured {
+    /// Wall-clock ms of the first frame (pipelines warming up).
     pub first_frame_ms: f64,
+    /// Wall-clock ms of the untimed warm-up frames together.
     pub warmup_ms: f64,
+    /// Each timed frame.
     pub timings: Vec<FrameTimings>,
 }
 
@@ -40,7 +43,7 @@ pub struct Renderer {
     active: usize,
     shadow: ShadowPass,
     timer: PassTimer,
-    errors: ErrorSink,
+    pub(crate) errors: ErrorSink,
     level_shape: LevelShape,
     frames: u64,
     adapter: crate::gpu::AdapterReport,
@@ -55,6 +58,8 @@ pub struct Renderer {
     last_submission: Option<wgpu::SubmissionIndex>,
     /// Called by [`Renderer::apply_edit`] after the GPU copies changed.
     edit_listener: Option<EditListener>,
+    /// Pipelines that copy the frame into a caller's targets ([`Renderer::render_into`]).
+    pub(crate) composite: crate::embed::CompositeCache,
 }
 
 /// Frames [`Renderer::hold_busy`] lets queue up before it waits for the oldest.
@@ -67,7 +72,18 @@ const FRAMES_IN_FLIGHT: usize = 3;
 pub type EditListener = Box<dyn FnMut(&Level, &[DirtyRect]) + Send>;
 
 impl Renderer {
-    /// Upload `level`, build method `method` for `width` x `height` targets.
+    /// Upload `level`, build method `method` (a name of
+    /// [`methods::names`]) for `width` x `height` targets. An unknown name, or
+    /// a method this adapter cannot run, is an error naming it.
+    ///
+    /// ```no_run
+    /// # fn f(gpu: &strata_render::Gpu, world: &strata_level::World) -> anyhow::Result<()> {
+    /// use strata_render::{MethodSettings, Renderer, TerrainColors};
+    /// let colors = TerrainColors::from_world(world);
+    /// let renderer = Renderer::new(gpu, &world.level, &colors, "mesh",
+    ///                              &MethodSettings::default(), 1280, 800)?;
+    /// # Ok(()) }
+    /// ```
     pub fn new(
         gpu: &Gpu,
         level: &Level,
@@ -115,6 +131,7 @@ impl Renderer {
             shadow_drawn: None,
             depth_reader,
             edit_listener: None,
+            composite: Default::default(),
         };
         wait_device(&renderer.shared.device, &renderer.errors)?;
         renderer.setup_ms = ms(start);
@@ -267,8 +284,20 @@ impl Renderer {
         &self.shared
     }
 
-    /// Render one frame and wait for it. GPU time is the sum of the per-pass
-    /// timestamp intervals; CPU time is submit until the GPU is done.
+    /// Render one frame into Strata's own targets ([`Shared::color_view`],
+    /// [`Shared::depth_view`]) and wait for it. GPU time is the sum of the
+    /// per-pass timestamp intervals; CPU time is submit until the GPU is done.
+    /// `camera` must be of the renderer's size. To draw into your own
+    /// targets instead, see [`Renderer::render_into`].
+    ///
+    /// ```no_run
+    /// # fn f(renderer: &mut strata_render::Renderer) -> anyhow::Result<()> {
+    /// let camera = strata_camera::Camera::new(glam::Vec3::new(128.0, 0.0, 120.0),
+    ///                                         0.0, -30.0, 1280, 800)?;
+    /// let t = renderer.render_frame(&camera)?;
+    /// println!("{:?} ms on the GPU, {} ms waiting", t.gpu_ms, t.cpu_ms);
+    /// # Ok(()) }
+    /// ```
     pub fn render_frame(&mut self, camera: &Camera) -> anyhow::Result<FrameTimings> {
         let record_ms = self.submit_frame(camera)?;
         let submit_start = Instant::now();
@@ -286,7 +315,7 @@ impl Renderer {
     }
 
     /// Keep the GPU busy with this camera's frames, submitted back to back
-    /// (at most [`FRAMES_IN_FLIGHT`] queued), for `duration` of wall clock;
+    /// (at most `FRAMES_IN_FLIGHT`, 3, queued), for `duration` of wall clock;
     /// returns how many frames ran. Why: a GPU lowers its clock when it is
     /// mostly idle, and the protocol's submit-and-wait frames leave it idle
     /// most of the time: on the H100 the SM clock fell from 1980 MHz to
@@ -323,6 +352,17 @@ impl Renderer {
     /// Record and submit one frame without waiting for it; returns the CPU
     /// ms spent preparing and recording it.
     fn submit_frame(&mut self, camera: &Camera) -> anyhow::Result<f64> {
+        let record_start = Instant::now();
+        let encoder = self.record_frame(camera)?;
+        let commands = encoder.finish();
+        let record_ms = ms(record_start);
+        self.submit(commands);
+        Ok(record_ms)
+    }
+
+    /// Prepare one frame and record it into a new encoder (shadow map, the
+    /// active method, timestamp resolve), not yet submitted.
+    pub(crate) fn record_frame(&mut self, camera: &Camera) -> anyhow::Result<wgpu::CommandEncoder> {
         if camera.width != self.shared.width || camera.height != self.shared.height {
             anyhow::bail!(
                 "camera is {}x{} but the renderer was built for {}x{}",
@@ -332,7 +372,6 @@ impl Renderer {
                 self.shared.height
             );
         }
-        let record_start = Instant::now();
         let shadows = self.settings().shadows;
         let shadow = ShadowFrame::fit(camera, shadows);
         let globals = Globals::new(camera, &self.level_shape, &shadow);
@@ -363,12 +402,13 @@ impl Renderer {
         }
         method.record(&self.shared, &frame, &mut encoder);
         self.timer.resolve(&mut encoder);
-        let commands = encoder.finish();
-        let record_ms = ms(record_start);
+        Ok(encoder)
+    }
 
+    /// Submit a frame's commands and count it.
+    pub(crate) fn submit(&mut self, commands: wgpu::CommandBuffer) {
         self.last_submission = Some(self.shared.queue.submit([commands]));
         self.frames += 1;
-        Ok(record_ms)
     }
 
     /// The protocol's frame loop: one first frame, `warmup` untimed frames,
@@ -399,7 +439,18 @@ impl Renderer {
     }
 
     /// The level changed inside `rects` (`level` is the edited level): upload
-    /// only those rectangles, then let every kept method update its derived data.
+    /// only those rectangles, then let every kept method update its derived
+    /// data, then call the edit listener ([`Renderer::set_edit_listener`]).
+    ///
+    /// ```no_run
+    /// # fn f(renderer: &mut strata_render::Renderer, level: &mut strata_level::Level)
+    /// #     -> anyhow::Result<()> {
+    /// let mut site = strata_level::EditSite::fostral();
+    /// (site.centre_x, site.centre_y, site.radius, site.depth) = (180, 128, 18, 20.0);
+    /// let dirty = strata_level::edit::crater(level, &site);
+    /// renderer.apply_edit(level, &dirty)?;
+    /// # Ok(()) }
+    /// ```
     pub fn apply_edit(&mut self, level: &Level, rects: &[DirtyRect]) -> anyhow::Result<()> {
         self.shared
             .terrain
@@ -416,16 +467,41 @@ impl Renderer {
 
     /// Follow every later [`apply_edit`](Self::apply_edit) on the CPU too
     /// (replaces any earlier listener; `None` removes it).
+    ///
+    /// ```no_run
+    /// # fn f(renderer: &mut strata_render::Renderer, level: &strata_level::Level) {
+    /// use std::sync::{Arc, Mutex};
+    /// let collider = Arc::new(Mutex::new(strata_collide::TerrainCollider::fit(level, 1.0)));
+    /// let follower = Arc::clone(&collider);
+    /// renderer.set_edit_listener(Some(Box::new(move |level, rects| {
+    ///     follower.lock().unwrap().apply_edit(level, rects);
+    /// })));
+    /// # }
+    /// ```
     pub fn set_edit_listener(&mut self, listener: Option<EditListener>) {
         self.edit_listener = listener;
     }
 
-    /// The colour target, RGBA8, row-major, top row first.
+    /// Strata's colour target after the last frame: RGBA8 (sRGB-encoded
+    /// values), row-major, top row first. Blocks until copied.
+    ///
+    /// ```no_run
+    /// # fn f(renderer: &mut strata_render::Renderer, camera: &strata_camera::Camera)
+    /// #     -> anyhow::Result<()> {
+    /// renderer.render_frame(camera)?;
+    /// let rgba = renderer.read_color()?;
+    /// let depth = renderer.read_depth()?;   // 0 near .. 1 far, 1.0 = sky
+    /// let (w, h) = (renderer.shared().width, renderer.shared().height);
+    /// assert_eq!((rgba.len(), depth.len()), (4 * (w * h) as usize, (w * h) as usize));
+    /// # Ok(()) }
+    /// ```
     pub fn read_color(&self) -> anyhow::Result<Vec<u8>> {
         self.read_texture(&self.shared.color, wgpu::TextureAspect::All)
     }
 
-    /// The depth target: depth-buffer values (0 near .. 1 far, 1 = sky), row-major.
+    /// Strata's depth target after the last frame: depth-buffer values (0
+    /// near .. 1 far, 1 = sky; the crate's depth convention), row-major, top
+    /// row first. Blocks until copied (example: [`Renderer::read_color`]).
     pub fn read_depth(&self) -> anyhow::Result<Vec<f32>> {
         if let Some(reader) = &self.depth_reader {
             let s = &self.shared;

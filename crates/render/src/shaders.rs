@@ -29,6 +29,7 @@ pub const SOURCES: &[(&str, &str)] = &[
         "depth_read.wgsl",
         include_str!("../shaders/depth_read.wgsl"),
     ),
+    ("composite.wgsl", include_str!("../shaders/composite.wgsl")),
     ("shadow.wgsl", include_str!("../shaders/shadow.wgsl")),
     (
         "decode_test.wgsl",
@@ -97,6 +98,7 @@ pub const ENTRY_SHADERS: &[&str] = &[
     "ray_compute.wgsl",
     "depth_blit.wgsl",
     "depth_read.wgsl",
+    "composite.wgsl",
     "shadow.wgsl",
     "decode_test.wgsl",
     "voxel.wgsl",

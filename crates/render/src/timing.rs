@@ -169,9 +169,13 @@ impl PassTimer {
 /// Summary statistics of a series of ms values.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct Stats {
+    /// Mean, ms.
     pub mean: f64,
+    /// Median, ms.
     pub median: f64,
+    /// Smallest, ms.
     pub min: f64,
+    /// Largest, ms.
     pub max: f64,
 }
 

@@ -1,7 +1,7 @@
 //! `mesh` (§3.6): the greedy TIN of `strata-mesh`, rasterised.
 //!
 //! Setup fits the whole level (parallel, the method's preparation cost) and
-//! uploads every chunk's three LODs into one index pool ([`mesh_pool`]); the
+//! uploads every chunk's three LODs into one index pool (`mesh_pool`); the
 //! fit itself is not kept. There is no vertex buffer: each u16 index names a
 //! grid sample of its chunk and an altitude kind, and `mesh.wgsl` reads the
 //! column from the shared terrain texture.
@@ -21,8 +21,6 @@
 //!
 //! Edits refit the dirty chunks from scratch (equal to a fresh fit of the
 //! edited level) and rewrite only their slots.
-//!
-//! [`mesh_pool`]: super::mesh_pool
 
 use super::common::{begin_pass, forward_pipeline};
 use super::mesh_pool::{Fitted, IndexPool, Slot};

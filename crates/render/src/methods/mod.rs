@@ -39,18 +39,29 @@
 
 mod build_bindings;
 mod common;
+#[doc(hidden)]
 pub mod forward;
+#[doc(hidden)]
 pub mod mesh;
 mod mesh_pool;
+#[doc(hidden)]
 pub mod painted;
+#[doc(hidden)]
 pub mod ray;
+#[doc(hidden)]
 pub mod ray_compute;
+#[doc(hidden)]
 pub mod ray_exact;
+#[doc(hidden)]
 pub mod ray_exact_build;
+#[doc(hidden)]
 pub mod scattered;
 mod scattered_grid;
+#[doc(hidden)]
 pub mod sliced;
+#[doc(hidden)]
 pub mod voxel;
+#[doc(hidden)]
 pub mod voxel_build;
 
 /// The integration tests' helpers (adapter skip, metric loops, distance
@@ -123,12 +134,15 @@ fn default_lod_pixels() -> f32 {
 /// Memory a method keeps beyond the shared resources.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
 pub struct RetainedBytes {
+    /// Bytes of GPU buffers and textures.
     pub gpu: u64,
+    /// Bytes of CPU-side data.
     pub cpu: u64,
 }
 
 /// What a method gets while recording one frame.
 pub struct Frame<'a> {
+    /// The frame's camera.
     pub camera: &'a Camera,
     /// Timestamp writes for each pass.
     pub timer: &'a PassTimer,
@@ -237,7 +251,9 @@ impl BuildSteps for Whole {
 
 /// A method by name: how to build it and what it needs of the adapter.
 pub struct MethodEntry {
+    /// The name `Renderer::new` and `--method` take.
     pub name: &'static str,
+    /// Builds it whole.
     pub create: Constructor,
     /// A build in slices, for methods whose CPU preparation takes long
     /// (built whole in one step when `None`).

@@ -44,6 +44,7 @@ pub struct ScatterParams {
 }
 
 impl ScatterParams {
+    /// Grid samples this frame dispatches (rows x columns).
     pub fn samples(&self) -> u64 {
         u64::from(self.grid[0]) * u64::from(self.grid[1])
     }

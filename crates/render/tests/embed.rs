@@ -1,0 +1,259 @@
+//! Issue 18 (embedding): `Renderer::render_into` draws every method's frame
+//! into the caller's own colour and depth views, of formats other than
+//! Strata's, with the same picture and depth as Strata's own targets; and
+//! refuses targets it cannot draw into with an error naming what is wrong.
+
+mod common;
+
+use strata_camera::Camera;
+use strata_render::depth_read::DepthReader;
+use strata_render::{Gpu, MethodSettings, Renderer, TargetError, TargetViews, TerrainColors};
+
+const W: u32 = 96;
+const H: u32 = 64;
+
+fn target(
+    gpu: &Gpu,
+    format: wgpu::TextureFormat,
+    (width, height): (u32, u32),
+    samples: u32,
+    usage: wgpu::TextureUsages,
+) -> (wgpu::Texture, wgpu::TextureView) {
+    let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("caller target"),
+        size: wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: samples,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage,
+        view_formats: &[],
+    });
+    let view = texture.create_view(&Default::default());
+    (texture, view)
+}
+
+fn scene() -> (strata_level::Level, Camera) {
+    let level = common::synthetic_level();
+    let view = common::synthetic_views()
+        .into_iter()
+        .find(|v| v.name == "bridge60")
+        .unwrap();
+    let camera = Camera::from_view(&level, &view, W, H).unwrap();
+    (level, camera)
+}
+
+const USAGE: wgpu::TextureUsages = wgpu::TextureUsages::RENDER_ATTACHMENT
+    .union(wgpu::TextureUsages::COPY_SRC)
+    .union(wgpu::TextureUsages::TEXTURE_BINDING);
+
+#[test]
+fn every_method_draws_into_bgra_srgb_and_depth24plus_as_into_its_own_targets() {
+    let Some(gpu) = common::gpu() else { return };
+    let (level, camera) = scene();
+    let settings = MethodSettings {
+        shadows: false,
+        ..Default::default()
+    };
+    let colors = TerrainColors::test_ramps();
+    // Depth24Plus has no copies: read it through the pass-based reader.
+    let mut caps = gpu.caps.clone();
+    caps.depth_copies = false;
+    let reader = DepthReader::new(&gpu.device, &caps).unwrap().unwrap();
+    let (color_tex, color_view) =
+        target(&gpu, wgpu::TextureFormat::Bgra8UnormSrgb, (W, H), 1, USAGE);
+    let (depth_tex, depth_view) = target(&gpu, wgpu::TextureFormat::Depth24Plus, (W, H), 1, USAGE);
+    let mut tested = 0;
+    for name in strata_render::methods::names() {
+        let mut r = match Renderer::new(&gpu, &level, &colors, name, &settings, W, H) {
+            Ok(r) => r,
+            Err(e) => {
+                eprintln!("{name}: not on this adapter ({e:#})");
+                continue;
+            }
+        };
+        r.render_frame(&camera).unwrap();
+        let own_color = r.read_color().unwrap();
+        let own_depth = r.read_depth().unwrap();
+        r.render_into(&camera, &TargetViews::new(&color_view, &depth_view))
+            .unwrap();
+        gpu.wait().unwrap();
+        let bgra = strata_render::gpu::read_texture(
+            &gpu.device,
+            &gpu.queue,
+            &gpu.errors,
+            &color_tex,
+            wgpu::TextureAspect::All,
+        )
+        .unwrap();
+        let depth = reader
+            .read(&gpu.device, &gpu.queue, &gpu.errors, &depth_tex)
+            .unwrap();
+        let mut worst_color = 0u8;
+        for (own, theirs) in own_color.chunks_exact(4).zip(bgra.chunks_exact(4)) {
+            for (a, b) in [
+                (own[0], theirs[2]),
+                (own[1], theirs[1]),
+                (own[2], theirs[0]),
+            ] {
+                worst_color = worst_color.max(a.abs_diff(b));
+            }
+        }
+        let mut worst_depth = 0f32;
+        let mut terrain = 0;
+        for (a, b) in own_depth.iter().zip(&depth) {
+            worst_depth = worst_depth.max((a - b).abs());
+            terrain += usize::from(*a < 1.0);
+        }
+        println!(
+            "{name}: Bgra8UnormSrgb worst channel difference {worst_color}, Depth24Plus worst \
+             depth difference {worst_depth:.2e} ({terrain} terrain pixels)"
+        );
+        // The sRGB decode + encode round trip may move a byte by one.
+        assert!(worst_color <= 1, "{name}: colour differs by {worst_color}");
+        // 24-bit depth: steps of 2^-24.
+        assert!(
+            worst_depth <= 2e-7,
+            "{name}: depth differs by {worst_depth}"
+        );
+        assert!(
+            terrain > (W * H / 4) as usize,
+            "{name}: only {terrain} terrain pixels"
+        );
+        let shades: std::collections::HashSet<&[u8]> = own_color.chunks_exact(4).collect();
+        assert!(
+            shades.len() >= 3,
+            "{name}: a flat picture ({} colours)",
+            shades.len()
+        );
+        let depths: std::collections::HashSet<u32> =
+            own_depth.iter().map(|d| d.to_bits()).collect();
+        assert!(
+            depths.len() > 100,
+            "{name}: {} distinct depths",
+            depths.len()
+        );
+        tested += 1;
+    }
+    assert!(tested >= 2, "{tested} methods ran");
+}
+
+/// The error `render_into` gave, as a `TargetError`.
+fn refusal(r: &mut Renderer, camera: &Camera, targets: TargetViews<'_>) -> TargetError {
+    let e = r
+        .render_into(camera, &targets)
+        .expect_err("bad targets must be refused");
+    println!("refused: {e:#}");
+    e.downcast_ref::<TargetError>()
+        .unwrap_or_else(|| panic!("not a TargetError: {e:#}"))
+        .clone()
+}
+
+#[test]
+fn bad_targets_get_named_errors() {
+    use wgpu::TextureFormat as F;
+    let Some(gpu) = common::gpu() else { return };
+    let (level, camera) = scene();
+    let settings = MethodSettings {
+        shadows: false,
+        ..Default::default()
+    };
+    let mut r = Renderer::new(
+        &gpu,
+        &level,
+        &TerrainColors::test_ramps(),
+        "ray",
+        &settings,
+        W,
+        H,
+    )
+    .unwrap();
+    let (_, color) = target(&gpu, F::Rgba8Unorm, (W, H), 1, USAGE);
+    let (_, depth) = target(&gpu, F::Depth32Float, (W, H), 1, USAGE);
+
+    let (_, unsupported) = target(&gpu, F::R8Unorm, (W, H), 1, USAGE);
+    let e = refusal(&mut r, &camera, TargetViews::new(&unsupported, &depth));
+    assert_eq!(e, TargetError::ColorFormat(F::R8Unorm));
+    assert!(e.to_string().contains("R8Unorm"), "{e}");
+
+    let (_, stencil) = target(&gpu, F::Stencil8, (W, H), 1, USAGE);
+    let e = refusal(&mut r, &camera, TargetViews::new(&color, &stencil));
+    assert_eq!(e, TargetError::DepthFormat(F::Stencil8));
+    assert!(e.to_string().contains("Stencil8"), "{e}");
+
+    let (_, small) = target(&gpu, F::Depth32Float, (W / 2, H), 1, USAGE);
+    let e = refusal(&mut r, &camera, TargetViews::new(&color, &small));
+    assert!(
+        e.to_string().contains("48x64") && e.to_string().contains("96x64"),
+        "{e}"
+    );
+
+    let (_, msaa_color) = target(
+        &gpu,
+        F::Rgba8Unorm,
+        (W, H),
+        4,
+        wgpu::TextureUsages::RENDER_ATTACHMENT,
+    );
+    let e = refusal(&mut r, &camera, TargetViews::new(&msaa_color, &depth));
+    assert_eq!(e, TargetError::SampleCount { color: 4, depth: 1 });
+
+    let (_, unrenderable) = target(
+        &gpu,
+        F::Rgba8Unorm,
+        (W, H),
+        1,
+        wgpu::TextureUsages::COPY_SRC,
+    );
+    let e = refusal(&mut r, &camera, TargetViews::new(&unrenderable, &depth));
+    assert!(
+        matches!(
+            e,
+            TargetError::Usage {
+                target: "colour",
+                ..
+            }
+        ),
+        "{e}"
+    );
+
+    // A view of another device (of the same adapter).
+    let (other, _) = pollster::block_on(gpu.adapter.request_device(&Default::default())).unwrap();
+    let foreign = other
+        .create_texture(&wgpu::TextureDescriptor {
+            label: Some("other device's colour"),
+            size: wgpu::Extent3d {
+                width: W,
+                height: H,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: F::Rgba8Unorm,
+            usage: USAGE,
+            view_formats: &[],
+        })
+        .create_view(&Default::default());
+    let e = refusal(&mut r, &camera, TargetViews::new(&foreign, &depth));
+    assert!(matches!(e, TargetError::OtherDevice(_)), "{e}");
+    assert!(!e.to_string().contains('\n'), "one line: {e}");
+
+    // After all that the renderer still draws, multisampled targets included.
+    let (_, msaa_depth) = target(
+        &gpu,
+        F::Depth24PlusStencil8,
+        (W, H),
+        4,
+        wgpu::TextureUsages::RENDER_ATTACHMENT,
+    );
+    r.render_into(&camera, &TargetViews::new(&msaa_color, &msaa_depth))
+        .unwrap();
+    r.render_into(&camera, &TargetViews::new(&color, &depth))
+        .unwrap();
+    gpu.wait().unwrap();
+}
