@@ -4,47 +4,15 @@
 //! exits 1, without a panic. No display and no Xvfb: a loud skip
 //! (`STRATA_REQUIRE_DISPLAY=1` makes that a failure).
 
-use std::io::{BufRead, BufReader};
-use std::process::{Child, Command, Stdio};
+use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 const DRIVE: &str = env!("CARGO_BIN_EXE_strata-example-drive");
 
-/// An Xvfb started for the test, killed when dropped.
-struct Xvfb(Child);
-
-impl Drop for Xvfb {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
-
-/// The session's display, or an Xvfb's (`-displayfd`: it picks a free
-/// number and writes it when ready).
-fn display() -> Option<(String, Option<Xvfb>)> {
-    if let Some(name) = std::env::var("DISPLAY").ok().filter(|d| !d.is_empty()) {
-        return Some((name, None));
-    }
-    let mut child = Command::new("Xvfb")
-        .args([
-            "-displayfd",
-            "1",
-            "-screen",
-            "0",
-            "640x480x24",
-            "-nolisten",
-            "tcp",
-        ])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::null())
-        .spawn()
-        .ok()?;
-    let mut line = String::new();
-    let read = BufReader::new(child.stdout.take()?).read_line(&mut line);
-    let xvfb = Xvfb(child);
-    let number: u32 = read.ok().and_then(|_| line.trim().parse().ok())?;
-    Some((format!(":{number}"), Some(xvfb)))
+/// The session's display, or an Xvfb of the test's own (the viewer's helper,
+/// shared with `strata soak` and the viewer's window tests).
+fn display() -> Option<strata_viewer::x_display::XDisplay> {
+    strata_viewer::x_display::XDisplay::open().ok()
 }
 
 /// Run to the end or kill after `limit`: (exited 0, stdout, stderr).
@@ -87,7 +55,7 @@ fn without_a_display_the_window_mode_says_so() {
 
 #[test]
 fn the_window_draws_frames_and_closes() {
-    let Some((name, _xvfb)) = display() else {
+    let Some(display) = display() else {
         let why = "no DISPLAY and no Xvfb on the PATH";
         if std::env::var_os("STRATA_REQUIRE_DISPLAY").is_some_and(|v| v == "1") {
             panic!("STRATA_REQUIRE_DISPLAY=1 but {why}");
@@ -98,7 +66,7 @@ fn the_window_draws_frames_and_closes() {
     let mut command = Command::new(DRIVE);
     command
         .args(["ray", "--size", "160x100", "--seconds", "2"])
-        .env("DISPLAY", &name)
+        .env("DISPLAY", &display.name)
         .env_remove("WAYLAND_DISPLAY");
     let (ok, stdout, stderr) = run(command, Duration::from_secs(120));
     println!("{stdout}{stderr}");
