@@ -213,7 +213,7 @@ impl TerrainCollider {
                     continue;
                 };
                 let pose = self.local_pose(b, gx, gy);
-                let Ok(Some(c)) = query::contact(&Pose::IDENTITY, mesh, &pose, &cuboid, margin)
+                let Ok(Some(c)) = query::contact(&Pose::IDENTITY, &**mesh, &pose, &cuboid, margin)
                 else {
                     continue;
                 };
@@ -270,7 +270,7 @@ impl TerrainCollider {
                 let hit = query::cast_shapes(
                     &Pose::IDENTITY,
                     Vector::ZERO,
-                    mesh,
+                    &**mesh,
                     &pose,
                     vel,
                     &cuboid,
