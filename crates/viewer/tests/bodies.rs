@@ -11,8 +11,8 @@ use strata_physics::{BodyShape, PhysicsSettings, TerrainPhysics};
 use strata_render::{Gpu, MethodSettings, Renderer, TerrainColors, methods};
 use strata_viewer::bodies::BodyPainter;
 
-const W: u32 = 128;
-const H: u32 = 96;
+const W: u32 = 160;
+const H: u32 = 160;
 
 /// Flat ground at 40 with a slab (cave 40..64, top 80) over x 100..160,
 /// y 120..200.
@@ -68,11 +68,12 @@ fn bodies_show_in_the_open_and_hide_under_a_slab_in_every_method() {
     let (open_at, cave_at) = (at(open), at(cave));
     assert!((open_at.z - 45.0).abs() < 0.5 && (cave_at.z - 45.0).abs() < 0.5);
 
-    let camera = Camera::new(Vec3::new(130.5, 20.0, 160.0), 0.0, -35.0, W, H).unwrap();
+    let camera = Camera::new(Vec3::new(130.5, 20.0, 160.0), 0.0, -46.0, W, H).unwrap();
     let open_px = camera.project(open_at).unwrap();
     let cave_px = camera.project(cave_at).unwrap();
     for p in [open_px, cave_px] {
-        assert!(p.x > 2.0 && p.x < W as f32 - 2.0 && p.y > 2.0 && p.y < H as f32 - 2.0);
+        let inside = p.x > 2.0 && p.x < W as f32 - 2.0 && p.y > 2.0 && p.y < H as f32 - 2.0;
+        assert!(inside, "{p} outside the picture");
     }
     let settings = MethodSettings {
         shadows: false,

@@ -37,15 +37,19 @@ pub struct Report {
     bodies_fell_into_crater: usize,
 }
 
-/// N bodies (spheres and boxes alternating) on a square grid 12 texels
+/// Grid spacing of the dropped bodies: more than a box's diameter (its
+/// bounding sphere's radius is 9.4), so none start overlapping.
+const SPACING: f64 = 20.0;
+
+/// N bodies (spheres and boxes alternating) on a square grid `SPACING`
 /// apart centred on the crater site, each dropped 10 units above the ground
 /// it is over.
 fn drop_grid(physics: &mut TerrainPhysics, site: &EditSite, n: usize) -> anyhow::Result<()> {
     let side = (n as f64).sqrt().ceil() as usize;
     for k in 0..n {
         let (i, j) = ((k % side) as f64, (k / side) as f64);
-        let x = site.centre_x as f64 + (i - side as f64 / 2.0) * 12.0 + 0.5;
-        let y = site.centre_y as f64 + (j - side as f64 / 2.0) * 12.0 + 0.5;
+        let x = site.centre_x as f64 + (i - side as f64 / 2.0) * SPACING + 0.5;
+        let y = site.centre_y as f64 + (j - side as f64 / 2.0) * SPACING + 0.5;
         let shape = if k % 2 == 0 {
             BodyShape::VEHICLE_SPHERE
         } else {
