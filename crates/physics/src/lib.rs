@@ -1,5 +1,5 @@
 //! Rigid bodies on Strata's terrain (issue 18): a [rapier3d] world whose
-//! ground is the fitted mesh's [`TerrainCollider`], one fixed collider per
+//! ground is the fitted mesh's [`TerrainCollider`](strata_collide::TerrainCollider), one fixed collider per
 //! 128x128 chunk, and whose ground follows edits: [`TerrainPhysics::apply_edit`]
 //! refits the dirty chunks and replaces exactly their colliders, so bodies
 //! resting on dug ground fall into the new crater. No GPU: the viewer draws
