@@ -290,6 +290,31 @@ mod tests {
     use super::*;
 
     #[test]
+    fn parses_the_physics_commands_and_names_bad_ones() {
+        use crate::physics::Drop;
+        let script =
+            Script::parse("physics on\ndrop box 0.25 0.5\nclear-bodies\nphysics off").unwrap();
+        let commands: Vec<_> = script.commands.into_iter().map(|(_, c)| c).collect();
+        assert_eq!(
+            commands,
+            [
+                Command::Physics(true),
+                Command::Drop(Drop::Box, 0.25, 0.5),
+                Command::ClearBodies,
+                Command::Physics(false)
+            ]
+        );
+        for (bad, says) in [
+            ("drop ball 2 0.5", "fractions"),
+            ("drop car 0.5 0.5", "`car`"),
+            ("physics maybe", "`maybe`"),
+        ] {
+            let e = format!("{:#}", Script::parse(bad).unwrap_err());
+            assert!(e.contains(says), "{bad}: {e}");
+        }
+    }
+
+    #[test]
     fn parses_every_command() {
         let script = Script::parse(
             "# a flight\nview hangar\nmethod mesh  # switch\nsplit ray\nsplit off\n\
