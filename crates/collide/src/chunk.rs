@@ -2,6 +2,7 @@
 
 use parry3d::math::Vector;
 use parry3d::shape::TriMesh;
+use std::sync::Arc;
 use strata_level::Level;
 use strata_mesh::{ChunkLayout, ChunkMesh, decode};
 
@@ -10,7 +11,9 @@ use strata_mesh::{ChunkLayout, ChunkMesh, decode};
 /// local coordinates stay small and exact in f32 wherever the map is.
 pub struct ChunkCollider {
     /// `None` for a chunk without triangles (never for a fitted chunk).
-    pub mesh: Option<TriMesh>,
+    /// Shared so a rigid-body world (rapier3d, on the same parry3d) can hold
+    /// the same mesh as a collider shape without copying it.
+    pub mesh: Option<Arc<TriMesh>>,
     /// Lowest and highest altitude of its vertices.
     pub z_range: (f32, f32),
 }
@@ -49,13 +52,24 @@ impl ChunkCollider {
             triangles.push(t);
         }
         // TriMesh::new fails only on an empty index list.
-        let mesh = TriMesh::new(vertices, triangles).ok();
+        let mesh = TriMesh::new(vertices, triangles).ok().map(Arc::new);
         let z_range = if mesh.is_some() {
             (zlo, zhi)
         } else {
             (0.0, 0.0)
         };
         ChunkCollider { mesh, z_range }
+    }
+
+    /// Where the chunk's local frame sits in the world: the translation
+    /// `(cx * size_x, cy * size_y, 0)` that places its mesh.
+    pub fn origin(layout: &ChunkLayout, index: usize) -> [f64; 3] {
+        let (cx, cy) = layout.coords(index);
+        [
+            f64::from(cx * layout.size_x),
+            f64::from(cy * layout.size_y),
+            0.0,
+        ]
     }
 
     /// Approximate heap + inline bytes (parry's own estimate for the mesh).

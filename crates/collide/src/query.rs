@@ -203,6 +203,16 @@ impl TerrainCollider {
 
     /// The deepest contact (or the closest within `margin`) between the box
     /// and the terrain; `None` when they are farther apart than `margin`.
+    ///
+    /// ```
+    /// use strata_collide::{BoxShape, TerrainCollider};
+    /// let level = strata_level::Level::flat(128, 128, 40, 1).unwrap();
+    /// let collider = TerrainCollider::fit(&level, 1.0);
+    /// // A 4x2x1.5 box sunk 0.25 into the ground at 40.
+    /// let b = BoxShape::axis_aligned([60.5, 60.5, 40.5], [2.0, 1.0, 0.75]);
+    /// let c = collider.contact_box(&b, 0.0).unwrap();
+    /// assert!((c.distance + 0.25).abs() < 1e-3 && c.normal[2] > 0.99);
+    /// ```
     pub fn contact_box(&self, b: &BoxShape, margin: f32) -> Option<BoxContact> {
         let r = b.radius() + f64::from(margin);
         let cuboid = Cuboid::new(Vector::from(b.half_extents));
@@ -213,7 +223,7 @@ impl TerrainCollider {
                     continue;
                 };
                 let pose = self.local_pose(b, gx, gy);
-                let Ok(Some(c)) = query::contact(&Pose::IDENTITY, mesh, &pose, &cuboid, margin)
+                let Ok(Some(c)) = query::contact(&Pose::IDENTITY, &**mesh, &pose, &cuboid, margin)
                 else {
                     continue;
                 };
@@ -236,6 +246,15 @@ impl TerrainCollider {
 
     /// Move the box along `dir` (normalised here) up to `max_distance`:
     /// where it first touches the terrain.
+    ///
+    /// ```
+    /// use strata_collide::{BoxShape, TerrainCollider};
+    /// let level = strata_level::Level::flat(128, 128, 40, 1).unwrap();
+    /// let collider = TerrainCollider::fit(&level, 1.0);
+    /// let b = BoxShape::axis_aligned([60.5, 60.5, 50.0], [2.0, 1.0, 0.75]);
+    /// let hit = collider.cast_box(&b, [0.0, 0.0, -1.0], 100.0).unwrap();
+    /// assert!((hit.distance - 9.25).abs() < 1e-3);
+    /// ```
     pub fn cast_box(&self, b: &BoxShape, dir: [f64; 3], max_distance: f64) -> Option<BoxCastHit> {
         let len = (dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]).sqrt();
         if !(len > 0.0 && len.is_finite() && max_distance.is_finite()) {
@@ -270,7 +289,7 @@ impl TerrainCollider {
                 let hit = query::cast_shapes(
                     &Pose::IDENTITY,
                     Vector::ZERO,
-                    mesh,
+                    &**mesh,
                     &pose,
                     vel,
                     &cuboid,

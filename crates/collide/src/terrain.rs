@@ -103,6 +103,22 @@ impl TerrainCollider {
 
     /// Replace chunks from meshes someone else already refit (the renderer's
     /// mesh method, in the call that uploads them): `(chunk index, mesh)`.
+    ///
+    /// ```
+    /// use strata_collide::TerrainCollider;
+    /// use strata_mesh::{ChunkFitter, ChunkLayout};
+    /// let mut level = strata_level::Level::flat(256, 128, 40, 1).unwrap();
+    /// let mut collider = TerrainCollider::fit(&level, 1.0);
+    /// let mut site = strata_level::EditSite::fostral();
+    /// (site.centre_x, site.centre_y, site.radius, site.depth) = (60, 60, 20, 30.0);
+    /// strata_level::edit::crater(&mut level, &site);
+    /// // Chunk 0 refit elsewhere (as the renderer does), handed over.
+    /// let layout = ChunkLayout::of(&level);
+    /// let mesh = ChunkFitter::default().fit(&level, &layout, 0, 0, 1.0);
+    /// collider.replace_chunks(&level, &[(0, &mesh)]);
+    /// let hit = collider.cast_ray([60.5, 60.5, 100.0], [0.0, 0.0, -1.0], 200.0).unwrap();
+    /// assert!(hit.point[2] < 15.0, "the crater floor: {:?}", hit.point);
+    /// ```
     pub fn replace_chunks(&mut self, level: &Level, refit: &[(usize, &ChunkMesh)]) {
         let layout = self.layout;
         let fresh: Vec<(usize, ChunkCollider)> = refit
@@ -116,6 +132,13 @@ impl TerrainCollider {
     }
 
     /// Chunk count, triangles and memory.
+    ///
+    /// ```
+    /// let level = strata_level::Level::flat(256, 256, 40, 1).unwrap();
+    /// let stats = strata_collide::TerrainCollider::fit(&level, 1.0).stats();
+    /// assert_eq!(stats.chunks, 4);
+    /// assert!(stats.triangles >= 8 && stats.memory_bytes > 0);
+    /// ```
     pub fn stats(&self) -> ColliderStats {
         ColliderStats {
             chunks: self.chunks.len(),

@@ -33,7 +33,21 @@ impl Region {
         }
     }
 
-    /// Parse `X0,Y0,X1,Y1` and check it against the map.
+    /// Parse `X0,Y0,X1,Y1` and check it against the map. The map wraps:
+    /// `X1,Y1` may pass its edge (the piece across it is exported at
+    /// unwrapped coordinates), `X0,Y0` must lie inside it.
+    ///
+    /// ```
+    /// use strata_export::Region;
+    /// let level = strata_level::Level::flat(256, 256, 40, 1).unwrap();
+    /// // Across the right edge: columns 200..300 are 200..255 then 0..43.
+    /// let r = Region::parse("200,0,300,64", &level).unwrap();
+    /// assert!(r.contains(290.0, 10.0));
+    /// // Outside the map: a clear error naming the text and the map's size.
+    /// let e = Region::parse("300,0,400,64", &level).unwrap_err();
+    /// assert!(e.to_string().contains("300,0,400,64"));
+    /// assert_eq!(Region::whole(&level).x1, 256);
+    /// ```
     pub fn parse(text: &str, level: &Level) -> Result<Self, ExportError> {
         let v: Vec<i64> = text
             .split(',')

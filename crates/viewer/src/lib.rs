@@ -8,16 +8,20 @@
 //! so what the window shows is what `strata compare` measures.
 //!
 //! Modules: [`fly`] (camera), [`dig`] (pick, crater, undo), [`knobs`]
-//! (settings), [`minimap`], [`script`],
+//! (settings), [`minimap`], [`script`], [`physics`] (the rigid-body toy;
+//! `bodies` draws it),
 //! [`builds`] (background method builds), [`save`] (Ctrl+S), [`present`] (picture to window),
 //! [`overlay`] (egui), [`viewer`] (state and frame), and here the event loop.
 
+#[cfg(not(target_arch = "wasm32"))]
+pub mod bodies;
 pub mod builds;
 pub mod dig;
 pub mod fly;
 pub mod knobs;
 pub mod minimap;
 pub mod overlay;
+pub mod physics;
 pub mod platform;
 pub mod present;
 pub mod save;
@@ -60,6 +64,8 @@ pub struct Options {
     pub out: PathBuf,
     /// Where Ctrl+S and script `save` may write the edited world.
     pub save: save::SaveOptions,
+    /// Start with the physics toy on (key O toggles it).
+    pub physics: bool,
 }
 
 /// Open the window and run until it is closed or the script ends.

@@ -120,7 +120,21 @@ pub const CONTROLS: &[(&str, &str)] = &[
     ("Space, E / C, Q", "up / down"),
     ("Shift", "4x speed; mouse wheel: base speed"),
     ("right mouse drag", "look around"),
-    ("left click", "dig a crater at the cursor"),
+    (
+        "left click",
+        "dig a crater at the cursor (physics on: drop a ball)",
+    ),
+    #[cfg(not(target_arch = "wasm32"))]
+    (
+        "O",
+        "physics toy on / off (rapier bodies on the terrain collider)",
+    ),
+    #[cfg(not(target_arch = "wasm32"))]
+    ("Shift+click, middle click", "physics on: drop a box; dig"),
+    #[cfg(not(target_arch = "wasm32"))]
+    ("X", "clear the physics bodies"),
+    #[cfg(target_arch = "wasm32")]
+    ("O", "physics toy: native only"),
     ("Ctrl+Z or U", "undo the last dig"),
     #[cfg(not(target_arch = "wasm32"))]
     ("Ctrl+S", "save the edited world (--save-to)"),

@@ -13,6 +13,9 @@
 //! frames N                  render N frames
 //! dig X Y                   click at (X, Y) of the picture, fractions 0..1 (0.5 0.5 = centre)
 //! undo                      undo the last dig
+//! physics on|off            the physics toy (on: waits until its collider is fitted)
+//! drop ball|box X Y         drop a body where picture point (X, Y) shows terrain (fractions)
+//! clear-bodies              remove the physics toy's bodies
 //! save DIR                  save the edited world as a world directory (see `save`)
 //! set KNOB VALUE            ray-steps, voxel-steps, slices, density, mesh-quality, shadows (0/1)
 //! overlay on|off            show or hide the overlay
@@ -52,6 +55,11 @@ pub enum Command {
     /// Fractions of the picture's width and height.
     Dig(f32, f32),
     Undo,
+    /// The physics toy on or off.
+    Physics(bool),
+    /// A body dropped at fractions of the picture's width and height.
+    Drop(crate::physics::Drop, f32, f32),
+    ClearBodies,
     /// A world directory to save the edited world into.
     Save(PathBuf),
     Set(Knob, f32),
@@ -203,6 +211,31 @@ fn parse_line(line: &str) -> anyhow::Result<Command> {
             arity(2, 2)?;
             Command::Set(Knob::parse(args[0])?, finite(args[1], "value")?)
         }
+        "physics" => {
+            arity(1, 1)?;
+            match args[0] {
+                "on" => Command::Physics(true),
+                "off" => Command::Physics(false),
+                other => bail!("physics takes on or off, not `{other}`"),
+            }
+        }
+        "drop" => {
+            arity(3, 3)?;
+            let what = match args[0] {
+                "ball" => crate::physics::Drop::Sphere,
+                "box" => crate::physics::Drop::Box,
+                other => bail!("drop takes ball or box, not `{other}`"),
+            };
+            let (x, y) = (finite(args[1], "x")?, finite(args[2], "y")?);
+            if !(0.0..=1.0).contains(&x) || !(0.0..=1.0).contains(&y) {
+                bail!("drop takes fractions of the picture, 0..1");
+            }
+            Command::Drop(what, x, y)
+        }
+        "clear-bodies" => {
+            arity(0, 0)?;
+            Command::ClearBodies
+        }
         "overlay" => {
             arity(1, 1)?;
             match args[0] {
@@ -255,6 +288,31 @@ fn parse_line(line: &str) -> anyhow::Result<Command> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn parses_the_physics_commands_and_names_bad_ones() {
+        use crate::physics::Drop;
+        let script =
+            Script::parse("physics on\ndrop box 0.25 0.5\nclear-bodies\nphysics off").unwrap();
+        let commands: Vec<_> = script.commands.into_iter().map(|(_, c)| c).collect();
+        assert_eq!(
+            commands,
+            [
+                Command::Physics(true),
+                Command::Drop(Drop::Box, 0.25, 0.5),
+                Command::ClearBodies,
+                Command::Physics(false)
+            ]
+        );
+        for (bad, says) in [
+            ("drop ball 2 0.5", "fractions"),
+            ("drop car 0.5 0.5", "`car`"),
+            ("physics maybe", "`maybe`"),
+        ] {
+            let e = format!("{:#}", Script::parse(bad).unwrap_err());
+            assert!(e.contains(says), "{bad}: {e}");
+        }
+    }
 
     #[test]
     fn parses_every_command() {

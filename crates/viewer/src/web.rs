@@ -255,6 +255,7 @@ impl App {
                 adapter: Default::default(),
                 out: parts.out,
                 save: Default::default(),
+                physics: false,
             };
             let opened = Viewer::new(parts.window, parts.surface, parts.gpu, options);
             self.opened(event_loop, opened);

@@ -129,6 +129,7 @@ pub async fn run() -> anyhow::Result<()> {
             adapter: Default::default(),
             out: "screenshots".into(),
             save: Default::default(),
+            physics: false,
         },
         params.backend,
     )

@@ -23,6 +23,19 @@ pub struct Args {
     /// Print one JSON object instead of text.
     #[arg(long)]
     json: bool,
+    /// Instead of the ray-cast numbers: rigid bodies (rapier3d) on the
+    /// collider, step time with each body count, then the crater dug under
+    /// them (its collider swap inside the physics world).
+    #[arg(long)]
+    physics_bench: bool,
+    /// With --physics-bench: the body counts, comma-separated.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "100,1000",
+        requires = "physics_bench"
+    )]
+    bodies: Vec<usize>,
 }
 
 #[derive(Serialize)]
@@ -82,6 +95,29 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let mut collider = TerrainCollider::from_mesh(&level, &mesh);
     let build_seconds = t.elapsed().as_secs_f64();
     drop(mesh);
+    if args.physics_bench {
+        if args.bodies.contains(&0) {
+            bail!("--bodies {:?}: each count must be at least 1", args.bodies);
+        }
+        let site = world.edit.clone().unwrap_or_else(EditSite::fostral);
+        let report = crate::cmd::physics_bench::run(&mut level, collider, &site, &args.bodies)?;
+        if args.json {
+            println!(
+                "{}",
+                serde_json::to_string_pretty(&report).context("writing the report")?
+            );
+        } else {
+            println!(
+                "{} ({}x{}), q={} (max error {tolerance}), fit {fit_seconds:.2} s, collider {build_seconds:.2} s",
+                world.name,
+                level.width(),
+                level.height(),
+                args.quality
+            );
+            crate::cmd::physics_bench::print(&report);
+        }
+        return Ok(());
+    }
     let stats = collider.stats();
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
 

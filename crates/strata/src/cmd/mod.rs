@@ -9,6 +9,7 @@ pub mod generate;
 pub mod info;
 pub mod merge;
 pub mod metrics;
+pub mod physics_bench;
 pub mod reference;
 pub mod render;
 pub mod serve;

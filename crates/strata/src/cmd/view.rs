@@ -51,6 +51,9 @@ pub struct Args {
     /// Let a save (Ctrl+S, script `save`) write over the loaded world's own directory.
     #[arg(long)]
     pub overwrite: bool,
+    /// Start with the physics toy on (key O toggles it): clicks drop balls and boxes (rapier3d) onto the terrain collider.
+    #[arg(long)]
+    pub physics: bool,
 }
 
 pub fn run(args: Args) -> anyhow::Result<()> {
@@ -88,5 +91,6 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             },
             dir: args.save_to,
         },
+        physics: args.physics,
     })
 }

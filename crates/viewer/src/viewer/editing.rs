@@ -5,6 +5,7 @@
 
 use super::Viewer;
 use crate::dig::pick;
+use crate::physics::Drop;
 use std::path::PathBuf;
 use std::sync::Arc;
 use strata_level::DirtyRect;
@@ -34,6 +35,22 @@ impl Viewer {
             start.elapsed().as_secs_f64() * 1e3
         ));
         Ok(())
+    }
+
+    /// Drop a body where picture point `at` (render pixels) shows terrain.
+    pub(super) fn drop_at(&mut self, at: (f32, f32), what: Drop) -> anyhow::Result<()> {
+        let camera = self.camera()?;
+        let line = self.physics.drop_at(&camera, at, what);
+        self.say(line);
+        Ok(())
+    }
+
+    /// The physics toy on or off.
+    pub(super) fn toggle_physics(&mut self) {
+        let line = self
+            .physics
+            .toggle(&self.level, f64::from(self.settings.mesh_quality));
+        self.say(line);
     }
 
     /// Save the edited world to `dir` (Ctrl+S: the default directory).
@@ -117,6 +134,11 @@ impl Viewer {
         self.unsaved = true;
         self.builds.record_edit(dirty);
         self.renderer.apply_edit(&self.level, dirty)?;
+        // The physics world's ground changes in the same call: exactly the
+        // dirty chunks' colliders are replaced.
+        if let Some(line) = self.physics.edited(&self.level, dirty) {
+            self.say(line);
+        }
         let repainted = self.map.update(&self.level, &self.colors, dirty);
         self.overlay.update_map(&self.map, &repainted);
         Ok(())

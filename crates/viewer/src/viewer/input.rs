@@ -3,6 +3,7 @@
 
 use super::{Viewer, scaled};
 use crate::fly::Motion;
+use crate::physics::Drop;
 use strata_render::methods;
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
 use winit::keyboard::{KeyCode, PhysicalKey};
@@ -59,12 +60,22 @@ impl Viewer {
                         self.looking = pressed && !self.overlay.wants_pointer();
                         self.grab_cursor(self.looking);
                     }
-                    MouseButton::Left if pressed && !used && !self.overlay.wants_pointer() => {
+                    MouseButton::Left | MouseButton::Middle
+                        if pressed && !used && !self.overlay.wants_pointer() =>
+                    {
                         if let Some(at) = self
                             .cursor
                             .and_then(|(x, y)| self.compositor.window_to_picture(x, y))
                         {
-                            self.dig_at(at)?;
+                            // Physics on: left click drops (Shift: a box),
+                            // middle click digs; off: both dig.
+                            match (*button, self.physics.on) {
+                                (MouseButton::Left, true) if self.shift => {
+                                    self.drop_at(at, Drop::Box)?
+                                }
+                                (MouseButton::Left, true) => self.drop_at(at, Drop::Sphere)?,
+                                _ => self.dig_at(at)?,
+                            }
                         }
                     }
                     _ => {}
@@ -155,6 +166,11 @@ impl Viewer {
                 KeyCode::KeyM => self.score()?,
                 KeyCode::KeyP => self.screenshot_after_frame = Some(self.next_screenshot_path()),
                 KeyCode::KeyU => self.undo()?,
+                KeyCode::KeyO => self.toggle_physics(),
+                KeyCode::KeyX => {
+                    let line = self.physics.clear();
+                    self.say(line);
+                }
                 KeyCode::KeyZ if self.ctrl => self.undo()?,
                 // A failed save is in the log; the session and its edits go on.
                 KeyCode::KeyS if self.ctrl => {

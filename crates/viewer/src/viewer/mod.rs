@@ -17,6 +17,7 @@ use crate::fly::FlyCamera;
 use crate::knobs::{Knob, relevant};
 use crate::minimap::Minimap;
 use crate::overlay::{self, Action, Building, Drawn, Editable, Overlay, Status};
+use crate::physics::PhysicsToy;
 use crate::present::{Compositor, WINDOW_FORMAT};
 use crate::save::Saver;
 use anyhow::{Context, bail};
@@ -71,6 +72,8 @@ pub struct Viewer {
     map: Minimap,
     views: Vec<ViewSpec>,
     digger: Digger,
+    /// The rigid-body toy (key O).
+    physics: PhysicsToy,
     fly: FlyCamera,
     /// Picture size over window size.
     render_scale: f32,
@@ -217,6 +220,7 @@ impl Viewer {
             adapter: _,
             out,
             save,
+            physics,
         } = options;
         let opened = Instant::now();
         let _ = size;
@@ -288,6 +292,7 @@ impl Viewer {
         let mut overlay = Overlay::new(&window, &gpu.device, WINDOW_FORMAT);
         overlay.set_map(&map);
         let digger = Digger::new(world.edit.as_ref().unwrap_or(&EditSite::fostral()));
+        let physics_toy = PhysicsToy::new(&level);
         let mut viewer = Viewer {
             window,
             surface,
@@ -303,6 +308,7 @@ impl Viewer {
             map,
             views,
             digger,
+            physics: physics_toy,
             fly: FlyCamera::from_camera(&camera),
             render_scale: scale,
             resize_to: None,
@@ -347,6 +353,9 @@ impl Viewer {
             opened.elapsed().as_secs_f64()
         ));
         viewer.request_method(&method)?;
+        if physics {
+            viewer.toggle_physics();
+        }
         Ok(viewer)
     }
 
@@ -603,6 +612,10 @@ impl Viewer {
         if !motion.is_still() {
             self.fly.fly(&motion, dt.min(0.1) as f32, &self.level);
         }
+        if let Some(line) = self.physics.poll(&self.level) {
+            self.say(line);
+        }
+        self.physics.advance(dt);
 
         if let Some(size) = self.resize_to
             && self.builds.running().is_empty()
@@ -620,6 +633,7 @@ impl Viewer {
         let camera = self.camera()?;
         let active = self.renderer.method_name();
         let mut timings = vec![(active.to_string(), self.renderer.render_frame(&camera)?)];
+        self.physics.draw(self.renderer.shared(), &camera);
         let split = self
             .split
             .clone()
@@ -631,6 +645,9 @@ impl Viewer {
             self.gpu.queue.submit([encoder.finish()]);
             self.renderer.activate(b)?;
             let drawn = self.renderer.render_frame(&camera);
+            if drawn.is_ok() {
+                self.physics.draw(self.renderer.shared(), &camera);
+            }
             self.renderer.activate(active)?;
             timings.push((b.clone(), drawn?));
         }

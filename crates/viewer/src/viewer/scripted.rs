@@ -22,6 +22,8 @@ enum Running {
     WaitMethod(String),
     /// Until no build runs (a changed knob's rebuild).
     WaitBuilds,
+    /// Until the physics toy's collider is fitted.
+    WaitPhysics,
     /// Until this many scores have finished (their read-backs arrive later).
     WaitScore(u32),
     /// Until the picture has this size; an error after `left` frames.
@@ -75,7 +77,10 @@ impl Player {
             self.running,
             Some((
                 _,
-                Running::WaitMethod(_) | Running::WaitBuilds | Running::WaitScore(_)
+                Running::WaitMethod(_)
+                    | Running::WaitBuilds
+                    | Running::WaitScore(_)
+                    | Running::WaitPhysics
             ))
         )
     }
@@ -126,6 +131,7 @@ impl Viewer {
                 Running::WaitBuilds => {
                     (!self.builds.running().is_empty()).then_some(Running::WaitBuilds)
                 }
+                Running::WaitPhysics => (!self.physics.is_ready()).then_some(Running::WaitPhysics),
                 Running::WaitMethod(name) => {
                     let drawn = self.renderer.method_name() == name
                         || (self.split.as_deref() == Some(name.as_str()) && self.is_current(&name));
@@ -143,6 +149,15 @@ impl Viewer {
         };
         self.run_command(line, command)
             .with_context(|| format!("script line {line}"))
+    }
+
+    /// The centre of the render pixel that fractions (`fx`, `fy`) of the
+    /// picture fall in.
+    fn picture_point(&self, fx: f32, fy: f32) -> (f32, f32) {
+        let (w, h) = self.render_size();
+        let px = (fx * w as f32).floor().min(w as f32 - 1.0) + 0.5;
+        let py = (fy * h as f32).floor().min(h as f32 - 1.0) + 0.5;
+        (px, py)
     }
 
     fn run_command(&mut self, line: usize, command: Command) -> anyhow::Result<()> {
@@ -178,12 +193,27 @@ impl Viewer {
             }
             Command::Frames(n) => running = Some(Running::Frames(n)),
             Command::Goto(x, y) => self.teleport(glam::Vec2::new(x, y)),
-            Command::Dig(fx, fy) => {
-                let (w, h) = self.render_size();
-                // The centre of the pixel the fraction falls in.
-                let px = (fx * w as f32).floor().min(w as f32 - 1.0) + 0.5;
-                let py = (fy * h as f32).floor().min(h as f32 - 1.0) + 0.5;
-                self.dig_at((px, py))?;
+            Command::Dig(fx, fy) => self.dig_at(self.picture_point(fx, fy))?,
+            Command::Physics(on) => {
+                if on != self.physics.on {
+                    self.toggle_physics();
+                }
+                if on {
+                    if cfg!(target_arch = "wasm32") {
+                        bail!("physics is native-only");
+                    }
+                    running = Some(Running::WaitPhysics);
+                }
+            }
+            Command::Drop(what, fx, fy) => {
+                if !self.physics.on {
+                    bail!("drop: the physics toy is off (`physics on` first)");
+                }
+                self.drop_at(self.picture_point(fx, fy), what)?;
+            }
+            Command::ClearBodies => {
+                let line = self.physics.clear();
+                self.say(line);
             }
             Command::Undo => self.undo()?,
             Command::Save(dir) => self.save(Some(dir))?,
