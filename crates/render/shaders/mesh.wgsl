@@ -9,7 +9,8 @@
 #include "shading.wgsl"
 
 struct MeshParams {
-    // x stride (chunk side + 1), y positions per kind ((side_x + 1) * (side_y + 1))
+    // x stride (chunk side + 1), y positions per kind ((side_x + 1) * (side_y + 1)),
+    // z 1: the gradient-normal diagnostic (`mesh_gradient_normal`)
     grid: vec4<u32>,
 }
 
@@ -102,12 +103,18 @@ fn fs_mesh(in: VertexOut) -> @location(0) vec4<f32> {
     } else {
         at = surface_along_ray(p, in.kind);
     }
-    let c = decode_column(i32(floor(at.x)), i32(floor(at.y)));
+    let column = vec2<i32>(floor(at));
+    let c = decode_column(column.x, column.y);
     var kind = SURFACE_FLOOR;
     if (in.kind != KIND_FLOOR) {
         // Slab triangles: tops and walls take the slab top's light, faces
         // looking down are the cave ceiling.
         kind = select(SURFACE_SLAB_TOP, SURFACE_CEILING, n.z < -0.5);
+    }
+    if (mesh.grid.z != 0u) {
+        // Diagnostic: the height-field normal the other methods shade with.
+        let here = select(c.high, c.mid, kind == SURFACE_CEILING);
+        n = surface_normal(column.x, column.y, kind, here);
     }
     return vec4<f32>(shade_with_normal(p, c, kind, n), 1.0);
 }
