@@ -1,7 +1,9 @@
 // The exact segment test of the CPU reference (`raycast.rs::column_hit`) for
 // one column, and the texel a point on a texel line belongs to: shared by the
 // exact march (`ray_exact_core.wgsl`) and the marched ray's final-interval
-// refinement (`ray_core.wgsl::refine_exact`). No bindings of its own.
+// refinement (`ray_core.wgsl::refine_exact`), and a short texel walk with it
+// (`first_entry`, the refinement's and the mesh's colour search). No bindings
+// of its own.
 #include "surface.wgsl"
 
 // The texel holding p + eps d: a point exactly on a texel line belongs to the
@@ -47,4 +49,60 @@ fn column_entry(c: Column, oz: f32, dz: f32, t0: f32, t1: f32) -> vec2<f32> {
         }
     }
     return vec2<f32>(best, slab);
+}
+
+struct SegmentHit {
+    hit: bool,
+    // ray parameter of the first solid point
+    t: f32,
+    // the column entered, absolute texel coordinates
+    column: vec2<i32>,
+    // whether `t` enters the slab [mid, high] rather than the floor
+    slab: bool,
+}
+
+// The first solid point of o + t d for t in [a, b]: a walk over the texels
+// the segment crosses, `column_entry` in each, at most `max_texels` of them
+// (no hit past that). Runs relative to the texel holding o + a d, so cell
+// boundaries stay exact far from the origin.
+fn first_entry(o: vec3<f32>, d: vec3<f32>, a: f32, b: f32, max_texels: u32) -> SegmentHit {
+    var r: SegmentHit;
+    r.hit = false;
+    r.t = b;
+    let q = o + d * a;
+    let base = vec2<i32>(floor(q.xy));
+    let lo = vec3<f32>(q.xy - vec2<f32>(base), q.z);
+    let span = b - a;
+    let pos = d.xy > vec2<f32>(0.0);
+    let step = select(vec2<i32>(-1), vec2<i32>(1), pos);
+    let far_side = select(vec2<i32>(0), vec2<i32>(1), pos);
+    let still = d.xy == vec2<f32>(0.0);
+    let inv = select(vec2<f32>(1.0) / d.xy, vec2<f32>(0.0), still);
+    var cell = texel_after(lo.xy, d.xy);
+    var s = 0.0;
+    for (var i = 0u; i < max_texels; i = i + 1u) {
+        let edge = vec2<f32>(cell + far_side);
+        let tb = select((edge - lo.xy) * inv, vec2<f32>(3.0e38), still);
+        let s_exit = min(tb.x, tb.y);
+        let column = base + cell;
+        let e = column_entry(decode_column(column.x, column.y), lo.z, d.z, s, min(s_exit, span));
+        if (e.x >= 0.0) {
+            r.hit = true;
+            r.t = a + e.x;
+            r.column = column;
+            r.slab = e.y != 0.0;
+            return r;
+        }
+        if (s_exit >= span) {
+            return r;
+        }
+        s = s_exit;
+        if (tb.x <= tb.y) {
+            cell.x = cell.x + step.x;
+        }
+        if (tb.y <= tb.x) {
+            cell.y = cell.y + step.y;
+        }
+    }
+    return r;
 }

@@ -90,47 +90,19 @@ const REFINE_MAX_TEXELS: u32 = 64u;
 // column it enters, not a point up to a bisection interval inside the solid
 // (whose height fed the shadow test and whose column, at a grazing floor hit
 // or a wall, could be the next one along the ray). Features the samples
-// stepped over stay skipped: the step budget is the method's. Runs relative
-// to the texel holding the start, so cell boundaries stay exact far out.
+// stepped over stay skipped: the step budget is the method's.
 fn refine_exact(o: vec3<f32>, d: vec3<f32>, a: f32, b: f32) -> MarchHit {
-    let q = o + d * a;
-    let base = vec2<i32>(floor(q.xy));
-    let lo = vec3<f32>(q.xy - vec2<f32>(base), q.z);
-    let span = b - a;
-    let pos = d.xy > vec2<f32>(0.0);
-    let step = select(vec2<i32>(-1), vec2<i32>(1), pos);
-    let far_side = select(vec2<i32>(0), vec2<i32>(1), pos);
-    let still = d.xy == vec2<f32>(0.0);
-    let inv = select(vec2<f32>(1.0) / d.xy, vec2<f32>(0.0), still);
-    var cell = texel_after(lo.xy, d.xy);
-    var s = 0.0;
-    for (var i = 0u; i < REFINE_MAX_TEXELS; i = i + 1u) {
-        let edge = vec2<f32>(cell + far_side);
-        let tb = select((edge - lo.xy) * inv, vec2<f32>(3.0e38), still);
-        let s_exit = min(tb.x, tb.y);
-        let column = base + cell;
-        let e = column_entry(decode_column(column.x, column.y), lo.z, d.z, s, min(s_exit, span));
-        if (e.x >= 0.0) {
-            var r: MarchHit;
-            r.hit = true;
-            r.t = a + e.x;
-            r.exact = true;
-            r.column = column;
-            return r;
-        }
-        if (s_exit >= span) {
-            break;
-        }
-        s = s_exit;
-        if (tb.x <= tb.y) {
-            cell.x = cell.x + step.x;
-        }
-        if (tb.y <= tb.x) {
-            cell.y = cell.y + step.y;
-        }
+    let e = first_entry(o, d, a, b, REFINE_MAX_TEXELS);
+    if (!e.hit) {
+        // Too long a walk, or f32 put b's solid point across a texel line.
+        return bisect(o, d, a, b, BISECTIONS);
     }
-    // Too long a walk, or f32 put b's solid point on the far side of a line.
-    return bisect(o, d, a, b, BISECTIONS);
+    var r: MarchHit;
+    r.hit = true;
+    r.t = e.t;
+    r.exact = true;
+    r.column = e.column;
+    return r;
 }
 
 // The paper's RAYMARCH: `steps` uniform samples over [t0, t1] until one is
