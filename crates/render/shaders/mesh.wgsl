@@ -55,14 +55,18 @@ fn vs_mesh(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) -> Ve
 // Where the eye's ray through `p` meets the height field's own surface near
 // `p`: the TIN lies up to its fit error above or below that surface, so the
 // point under `p` is not what the reference sees there (off-axis, the true
-// hit is texels away; a wall's ramp spans half of the low column, which from
-// above shows the low floor). The exact segment test (`first_entry`, shared
-// with ray and ray-exact) walks the ray over SURFACE_WINDOW units either side
-// of `p`; the first entry names the column and interval the pixel takes its
-// colour from. The mesh's geometry, depth and flat normal are unchanged.
-// The window covers the default fit's error (4 at q = 0.5) seen along rays
-// down to 40° from horizontal; a miss keeps the column under the TIN.
-const SURFACE_WINDOW: f32 = 6.0;
+// hit is texels away), and between samples a wall's ramp lies half over the
+// low column, up to the wall's height above its floor (from above, that
+// floor is what shows). The exact segment test (`first_entry`, shared with
+// ray and ray-exact) walks the ray from a few texels before `p` to several
+// past it; the first entry names the column and interval the pixel takes its
+// colour from. The walk costs one decode per texel crossed, so the window is
+// set in texels across (a near-vertical ray may run far: down a wall) and
+// capped along the ray. The mesh's geometry, depth and flat normal are
+// unchanged; a miss keeps the column under the TIN.
+const SURFACE_BACK_TEXELS: f32 = 3.0;
+const SURFACE_AHEAD_TEXELS: f32 = 8.0;
+const SURFACE_MAX_ALONG: f32 = 64.0;
 const SURFACE_MAX_TEXELS: u32 = 16u;
 
 struct ColourSource {
@@ -76,8 +80,11 @@ fn colour_source(p: vec3<f32>, n: vec3<f32>, vkind: u32) -> ColourSource {
     let eye = globals.eye.xyz;
     let dist = length(p - eye);
     let d = (p - eye) / dist;
-    let a = max(dist - SURFACE_WINDOW, 0.0);
-    let h = first_entry(eye, d, a, dist + SURFACE_WINDOW, SURFACE_MAX_TEXELS);
+    let across = max(length(d.xy), 1e-4);
+    let back = min(SURFACE_BACK_TEXELS / across, SURFACE_MAX_ALONG);
+    let ahead = min(SURFACE_AHEAD_TEXELS / across, SURFACE_MAX_ALONG);
+    let a = max(dist - back, 0.0);
+    let h = first_entry(eye, d, a, dist + ahead, SURFACE_MAX_TEXELS);
     var src: ColourSource;
     if (h.hit && h.t > a) {
         src.column = h.column;
@@ -90,9 +97,9 @@ fn colour_source(p: vec3<f32>, n: vec3<f32>, vkind: u32) -> ColourSource {
     // texel inwards (a steep ramp between two texel centres lies half over
     // the low column; its colour belongs to the high one, inside the solid).
     var at = p.xy;
-    let across = length(n.xy);
-    if (across > 0.7) {
-        at -= n.xy / across * 0.5;
+    let steep = length(n.xy);
+    if (steep > 0.7) {
+        at -= n.xy / steep * 0.5;
     }
     src.column = vec2<i32>(floor(at));
     src.kind = SURFACE_FLOOR;
