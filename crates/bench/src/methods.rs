@@ -65,11 +65,18 @@ pub fn settings_for(choice: &MethodChoice, shadows: bool) -> anyhow::Result<Meth
         }
         "mesh" => {
             // `Q`, `q=Q`, `Qo` (outline-constrained), then `/PX` (the LOD
-            // tolerance in pixels; `/`, as `,` separates methods).
-            let (q, px) = match text.split_once('/') {
-                Some((q, px)) => (q.trim(), Some(px.trim())),
-                None => (text.trim(), None),
-            };
+            // tolerance in pixels; `/`, as `,` separates methods) and
+            // `/gradient` (the gradient-normal diagnostic), in either order.
+            let mut parts = text.split('/');
+            let q = parts.next().unwrap_or_default().trim();
+            let mut px = None;
+            for part in parts.map(str::trim) {
+                if part == "gradient" {
+                    s.mesh_gradient_normal = true;
+                } else if px.replace(part).is_some() {
+                    bail!("{}: more than one LOD tolerance", ctx());
+                }
+            }
             let q = q.trim_start_matches("q=");
             let (q, outline) = match q.strip_suffix('o') {
                 Some(q) => (q, true),
@@ -122,10 +129,15 @@ pub fn describe(name: &str, s: &MethodSettings) -> String {
             format!("{name} density={x},{y},{z}")
         }
         "mesh" => format!(
-            "{name} q={}{} lod={}px",
+            "{name} q={}{} lod={}px{}",
             s.mesh_quality,
             if s.mesh_outline { " outline" } else { "" },
-            s.mesh_lod_pixels
+            s.mesh_lod_pixels,
+            if s.mesh_gradient_normal {
+                " gradient-normal"
+            } else {
+                ""
+            }
         ),
         _ => name.to_string(),
     }
@@ -189,7 +201,22 @@ mod tests {
             (0.5, true, 2.0)
         );
         assert_eq!(describe("mesh", &o), "mesh q=0.5 outline lod=2px");
-        for bad in ["0.5x", "0.5o,2", "0.5/px=0", "0.5/-1", "1.5o"] {
+        assert!(!o.mesh_gradient_normal);
+        for text in ["0.5/gradient/2", "0.5/2/gradient"] {
+            let g = settings_for(&choice("mesh", Some(text)), true).unwrap();
+            assert_eq!((g.mesh_lod_pixels, g.mesh_gradient_normal), (2.0, true));
+        }
+        let g = settings_for(&choice("mesh", Some("0.25/gradient")), true).unwrap();
+        assert_eq!(describe("mesh", &g), "mesh q=0.25 lod=1px gradient-normal");
+        for bad in [
+            "0.5x",
+            "0.5o,2",
+            "0.5/px=0",
+            "0.5/-1",
+            "1.5o",
+            "0.5/1/2",
+            "0.5/gradiant",
+        ] {
             assert!(
                 settings_for(&choice("mesh", Some(bad)), true).is_err(),
                 "{bad}"

@@ -7,9 +7,11 @@
 #include "frame.wgsl"
 #include "surface.wgsl"
 #include "shading.wgsl"
+#include "column_segment.wgsl"
 
 struct MeshParams {
-    // x stride (chunk side + 1), y positions per kind ((side_x + 1) * (side_y + 1))
+    // x stride (chunk side + 1), y positions per kind ((side_x + 1) * (side_y + 1)),
+    // z 1: the gradient-normal diagnostic (`mesh_gradient_normal`)
     grid: vec4<u32>,
 }
 
@@ -50,33 +52,63 @@ fn vs_mesh(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) -> Ve
     return out;
 }
 
-// Where the eye's ray through `p` meets the height field's own surface (the
-// interval of `kind`), near `p`: the TIN lies up to its fit error above or
-// below that surface, and off-axis rays (every pixel away from the image
-// centre) then reach it several texels away from where the true ray hits,
-// taking those texels' terrain type. Two fixed-point steps along the ray to
-// the column's altitude, the shift capped at 4 texels; the mesh's geometry,
-// depth and flat normal are unchanged.
-const PARALLAX_STEPS: u32 = 2u;
-const PARALLAX_MAX: f32 = 4.0;
+// Where the eye's ray through `p` meets the height field's own surface near
+// `p`: the TIN lies up to its fit error above or below that surface, so the
+// point under `p` is not what the reference sees there (off-axis, the true
+// hit is texels away), and between samples a wall's ramp lies half over the
+// low column, up to the wall's height above its floor (from above, that
+// floor is what shows). The exact segment test (`first_entry`, shared with
+// ray and ray-exact) walks the ray from a few texels before `p` to several
+// past it; the first entry names the column and interval the pixel takes its
+// colour from. The walk costs one decode per texel crossed, so the window is
+// set in texels across (a near-vertical ray may run far: down a wall) and
+// capped along the ray. The mesh's geometry, depth and flat normal are
+// unchanged; a miss keeps the column under the TIN.
+const SURFACE_BACK_TEXELS: f32 = 3.0;
+const SURFACE_AHEAD_TEXELS: f32 = 8.0;
+const SURFACE_MAX_ALONG: f32 = 64.0;
+const SURFACE_MAX_TEXELS: u32 = 16u;
 
-fn surface_along_ray(p: vec3<f32>, kind: u32) -> vec2<f32> {
-    let d = normalize(p - globals.eye.xyz);
-    if (abs(d.z) < 0.2) {
-        // Grazing rays: a height error moves the hit far; keep the mesh's.
-        return p.xy;
+struct ColourSource {
+    column: vec2<i32>,
+    kind: u32,
+}
+
+// The column and interval the pixel at TIN point `p` (flat normal `n`, of a
+// triangle of vertex kind `vkind`) is coloured from.
+fn colour_source(p: vec3<f32>, n: vec3<f32>, vkind: u32) -> ColourSource {
+    let eye = globals.eye.xyz;
+    let dist = length(p - eye);
+    let d = (p - eye) / dist;
+    let across = max(length(d.xy), 1e-4);
+    let back = min(SURFACE_BACK_TEXELS / across, SURFACE_MAX_ALONG);
+    let ahead = min(SURFACE_AHEAD_TEXELS / across, SURFACE_MAX_ALONG);
+    let a = max(dist - back, 0.0);
+    let h = first_entry(eye, d, a, dist + ahead, SURFACE_MAX_TEXELS);
+    var src: ColourSource;
+    if (h.hit && h.t > a) {
+        src.column = h.column;
+        let c = decode_column(h.column.x, h.column.y);
+        src.kind = surface_kind(c, eye.z + d.z * h.t, d.z);
+        return src;
     }
-    var q = p.xy;
-    for (var i = 0u; i < PARALLAX_STEPS; i = i + 1u) {
-        let c = decode_column(i32(floor(q.x)), i32(floor(q.y)));
-        var z = c.low;
-        if (kind != KIND_FLOOR && c.dual) {
-            z = select(c.mid, c.high, kind == KIND_TOP);
-        }
-        let t = clamp((z - p.z) / d.z, -PARALLAX_MAX, PARALLAX_MAX);
-        q = p.xy + d.xy * t;
+    // No surface entered in the window (the TIN bridges a gap, or the window
+    // starts inside the solid): the column under the TIN point, walls half a
+    // texel inwards (a steep ramp between two texel centres lies half over
+    // the low column; its colour belongs to the high one, inside the solid).
+    var at = p.xy;
+    let steep = length(n.xy);
+    if (steep > 0.7) {
+        at -= n.xy / steep * 0.5;
     }
-    return q;
+    src.column = vec2<i32>(floor(at));
+    src.kind = SURFACE_FLOOR;
+    if (vkind != KIND_FLOOR) {
+        // Slab triangles: tops and walls take the slab top's light, faces
+        // looking down are the cave ceiling.
+        src.kind = select(SURFACE_SLAB_TOP, SURFACE_CEILING, n.z < -0.5);
+    }
+    return src;
 }
 
 @fragment
@@ -90,24 +122,12 @@ fn fs_mesh(in: VertexOut) -> @location(0) vec4<f32> {
         // Whichever side is seen is the outside of the solid.
         n = -n;
     }
-    // A wall is a steep ramp between two texel centres, half over the low
-    // column; its colour and light belong to the high one, which lies inside
-    // the solid, against the outward normal. Half a texel inwards maps an
-    // axis-aligned ramp's span [i + 0.5, i + 1.5] onto column i + 1 (what a
-    // ray entering the wall meets). Gentler faces keep their own column.
-    var at = p.xy;
-    let across = length(n.xy);
-    if (across > 0.7) {
-        at -= n.xy / across * 0.5;
-    } else {
-        at = surface_along_ray(p, in.kind);
+    let src = colour_source(p, n, in.kind);
+    let c = decode_column(src.column.x, src.column.y);
+    if (mesh.grid.z != 0u) {
+        // Diagnostic: the height-field normal the other methods shade with.
+        let here = select(c.high, c.mid, src.kind == SURFACE_CEILING);
+        n = surface_normal(src.column.x, src.column.y, src.kind, here);
     }
-    let c = decode_column(i32(floor(at.x)), i32(floor(at.y)));
-    var kind = SURFACE_FLOOR;
-    if (in.kind != KIND_FLOOR) {
-        // Slab triangles: tops and walls take the slab top's light, faces
-        // looking down are the cave ceiling.
-        kind = select(SURFACE_SLAB_TOP, SURFACE_CEILING, n.z < -0.5);
-    }
-    return vec4<f32>(shade_with_normal(p, c, kind, n), 1.0);
+    return vec4<f32>(shade_with_normal(p, c, src.kind, n), 1.0);
 }

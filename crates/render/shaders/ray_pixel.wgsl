@@ -26,7 +26,12 @@ fn shade_hit(o: vec3<f32>, d: vec3<f32>, h: MarchHit) -> PixelSample {
         return out;
     }
     let p = o + d * h.t;
-    out.color = vec4<f32>(shade(p, d), 1.0);
+    if (h.exact) {
+        // On a column's side p lies on the texel line: name the column.
+        out.color = vec4<f32>(shade_column(p, h.column.x, h.column.y, d), 1.0);
+    } else {
+        out.color = vec4<f32>(shade(p, d), 1.0);
+    }
     out.depth = view_z_to_depth(h.t * globals.eye.w);
     return out;
 }

@@ -10,6 +10,10 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("frame.wgsl", include_str!("../shaders/frame.wgsl")),
     ("surface.wgsl", include_str!("../shaders/surface.wgsl")),
     ("shading.wgsl", include_str!("../shaders/shading.wgsl")),
+    (
+        "column_segment.wgsl",
+        include_str!("../shaders/column_segment.wgsl"),
+    ),
     ("ray_core.wgsl", include_str!("../shaders/ray_core.wgsl")),
     ("ray_pixel.wgsl", include_str!("../shaders/ray_pixel.wgsl")),
     (

@@ -127,6 +127,7 @@ pub fn relevant(name: &str, s: &MethodSettings) -> MethodSettings {
         } else {
             d.mesh_lod_pixels
         },
+        mesh_gradient_normal: name == "mesh" && s.mesh_gradient_normal,
         shadows: d.shadows,
     }
 }

@@ -81,6 +81,8 @@ pub struct Mesh {
     options: FitOptions,
     /// LOD tolerance in pixels (`mesh_lod_pixels`).
     lod_pixels: f32,
+    /// The gradient-normal diagnostic (`mesh_gradient_normal`).
+    gradient_normal: bool,
     /// This frame's visible copies, front to back (written by `prepare`).
     draws: Vec<Draw>,
 }
@@ -192,6 +194,7 @@ struct MeshSteps {
     tolerance: f64,
     options: FitOptions,
     lod_pixels: f32,
+    gradient_normal: bool,
     fit: Option<FitInSteps>,
 }
 
@@ -201,6 +204,7 @@ pub fn build_in_steps(settings: &MethodSettings) -> anyhow::Result<Box<dyn super
         tolerance: tolerance_of(settings)?,
         options: options_of(settings),
         lod_pixels: lod_pixels_of(settings)?,
+        gradient_normal: settings.mesh_gradient_normal,
         fit: None,
     }))
 }
@@ -227,7 +231,8 @@ impl super::BuildSteps for MeshSteps {
             .take()
             .and_then(FitInSteps::finish)
             .ok_or_else(|| anyhow::anyhow!("the mesh fit stopped before its last chunk"))?;
-        from_fit(shared, level, self.tolerance, self.lod_pixels, mesh).map(Some)
+        let shading = (self.lod_pixels, self.gradient_normal);
+        from_fit(shared, level, self.tolerance, shading, mesh).map(Some)
     }
 }
 
@@ -239,15 +244,33 @@ pub fn create(
     let tolerance = tolerance_of(settings)?;
     let lod_pixels = lod_pixels_of(settings)?;
     let mesh = fit_all(shared, level, tolerance, options_of(settings));
-    from_fit(shared, level, tolerance, lod_pixels, mesh)
+    from_fit(
+        shared,
+        level,
+        tolerance,
+        (lod_pixels, settings.mesh_gradient_normal),
+        mesh,
+    )
 }
 
-/// Upload a fitted mesh and make the method.
+/// The method's uniform (`MeshParams` in `mesh.wgsl`).
+fn mesh_params(layout: &ChunkLayout, gradient_normal: bool) -> [u32; 4] {
+    let stride = layout.size_x + 1;
+    [
+        stride,
+        stride * (layout.size_y + 1),
+        u32::from(gradient_normal),
+        0,
+    ]
+}
+
+/// Upload a fitted mesh and make the method; `shading` is the LOD tolerance
+/// in pixels and the gradient-normal diagnostic.
 fn from_fit(
     shared: &Shared,
     level: &Level,
     tolerance: f64,
-    lod_pixels: f32,
+    (lod_pixels, gradient_normal): (f32, bool),
     mesh: LevelMesh,
 ) -> anyhow::Result<Box<dyn Method>> {
     let options = mesh.options;
@@ -272,8 +295,7 @@ fn from_fit(
             },
         ],
     });
-    let stride = layout.size_x + 1;
-    let grid = [stride, stride * (layout.size_y + 1), 0, 0];
+    let grid = mesh_params(&layout, gradient_normal);
     let params = shared.uniform_buffer("mesh params", bytemuck::cast_slice(&grid));
     let draws_capacity = 256;
     let (draws_buffer, group) = draws_binding(shared, &group_layout, &params, draws_capacity);
@@ -297,6 +319,7 @@ fn from_fit(
         tolerance,
         options,
         lod_pixels,
+        gradient_normal,
         draws: Vec::new(),
     }))
 }
@@ -430,16 +453,23 @@ impl Method for Mesh {
 
     fn update_settings(
         &mut self,
-        _shared: &Shared,
+        shared: &Shared,
         settings: &MethodSettings,
     ) -> anyhow::Result<bool> {
-        // A new quality or outline is a new fit; the LOD tolerance is a
-        // per-frame choice, taken in place.
+        // A new quality or outline is a new fit; the LOD tolerance and the
+        // normal diagnostic are per-frame choices, taken in place.
         let q = f64::from(settings.mesh_quality);
         let same_fit = tolerance_for_quality(q) == Some(self.tolerance)
             && options_of(settings) == self.options;
         if same_fit {
             self.lod_pixels = lod_pixels_of(settings)?;
+            if settings.mesh_gradient_normal != self.gradient_normal {
+                self.gradient_normal = settings.mesh_gradient_normal;
+                let grid = mesh_params(&self.layout, self.gradient_normal);
+                shared
+                    .queue
+                    .write_buffer(&self.params, 0, bytemuck::cast_slice(&grid));
+            }
         }
         Ok(same_fit)
     }
@@ -458,8 +488,7 @@ impl Method for Mesh {
             let headroom = pool_headroom(&chunks);
             let (pool, slots) = IndexPool::build(&shared.device, &shared.queue, &chunks, headroom)?;
             (self.layout, self.pool, self.slots) = (layout, pool, slots);
-            let stride = layout.size_x + 1;
-            let grid = [stride, stride * (layout.size_y + 1), 0, 0];
+            let grid = mesh_params(&layout, self.gradient_normal);
             shared
                 .queue
                 .write_buffer(&self.params, 0, bytemuck::cast_slice(&grid));

@@ -105,6 +105,12 @@ pub struct MethodSettings {
     /// to the screen at the chunk's distance, is at most this many pixels.
     #[serde(default = "default_lod_pixels")]
     pub mesh_lod_pixels: f32,
+    /// `mesh`, a diagnostic: shade with the height-field gradient normal of
+    /// the column the pixel takes its colour from (as every other method
+    /// does) in place of the triangle's flat normal, to measure the flat
+    /// normal's share of the mesh's colour error (`mesh:0.5/gradient`).
+    #[serde(default)]
+    pub mesh_gradient_normal: bool,
     /// The shared shadow map (`--no-shadows` turns it off).
     pub shadows: bool,
 }
@@ -121,6 +127,7 @@ impl Default for MethodSettings {
             mesh_quality: 0.5,
             mesh_outline: false,
             mesh_lod_pixels: default_lod_pixels(),
+            mesh_gradient_normal: false,
             shadows: true,
         }
     }

@@ -92,6 +92,9 @@ pub struct MethodArgs {
     #[arg(long, value_name = "PX", value_parser = parse_lod_pixels,
           default_value_t = MethodSettings::default().mesh_lod_pixels)]
     pub mesh_lod_pixels: f32,
+    /// `mesh`, a diagnostic: shade with the height-field gradient normal instead of the flat one.
+    #[arg(long)]
+    pub mesh_gradient_normal: bool,
     /// Turn the shared shadow map off.
     #[arg(long)]
     pub no_shadows: bool,
@@ -109,6 +112,7 @@ impl MethodArgs {
             mesh_quality: self.mesh_quality,
             mesh_outline: self.mesh_outline,
             mesh_lod_pixels: self.mesh_lod_pixels,
+            mesh_gradient_normal: self.mesh_gradient_normal,
             shadows: !self.no_shadows,
         }
     }
