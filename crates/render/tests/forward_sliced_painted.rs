@@ -196,8 +196,9 @@ fn sliced_means(
 
 /// `sliced_refine` against the plain slicer on the synthetic level's 0°
 /// views: the exact crossing behind each kept slice writes depth, so the
-/// bands go and the see-through (pixels no slice covers) stays the plain
-/// slicer's.
+/// bands go, and the see-through can only drop (rays the slices do not
+/// sample are searched whole). Measured at 160x100: plain see-through
+/// 4.73 %, coherence 6.25 %, depth p95 164.8; refined 3.12 %, 0.00 %, 0.03.
 #[test]
 fn refined_slices_are_more_coherent_than_plain_ones() {
     let Some(gpu) = common::gpu() else { return };
@@ -218,17 +219,15 @@ fn refined_slices_are_more_coherent_than_plain_ones() {
         coh <= 1.0 && coh < 0.5 * plain_coh,
         "refined {coh} vs plain {plain_coh}"
     );
-    assert!(
-        see <= plain_see + 0.01,
-        "refined see-through {see} vs {plain_see}"
-    );
+    assert!(see <= plain_see, "refined see-through {see} vs {plain_see}");
     assert!(p95 <= 0.05, "refined depth p95 {p95}");
 }
 
 /// Issue 16's target on the generated world's 0° views at 320x200: the
-/// refined slicer's coherence mean at most 1 % (the plain slicer's is above),
-/// its see-through no worse than the plain slicer's, and its depth the
-/// exact surface's.
+/// refined slicer's coherence mean at most 1 %, its see-through no worse
+/// than the plain slicer's, its depth the exact surface's. Measured: plain
+/// see-through 0.61 %, coherence 14.31 %, depth p95 73.3 (it fails all
+/// three bounds); refined 0.00 %, 0.00 %, 0.00.
 #[test]
 fn refined_slices_meet_the_coherence_target_on_a_generated_world() {
     let Some(gpu) = common::gpu() else { return };
@@ -250,7 +249,7 @@ fn refined_slices_meet_the_coherence_target_on_a_generated_world() {
     );
     assert!(coh <= 1.0, "refined coherence {coh} %");
     assert!(
-        see <= plain_see + 0.01,
+        see <= plain_see && see <= 0.1,
         "refined see-through {see} vs {plain_see}"
     );
     assert!(p95 <= 0.05, "refined depth p95 {p95}");
