@@ -59,6 +59,10 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("forward.wgsl", include_str!("../shaders/forward.wgsl")),
     ("painted.wgsl", include_str!("../shaders/painted.wgsl")),
     ("sliced.wgsl", include_str!("../shaders/sliced.wgsl")),
+    (
+        "sliced_refine.wgsl",
+        include_str!("../shaders/sliced_refine.wgsl"),
+    ),
     ("mesh.wgsl", include_str!("../shaders/mesh.wgsl")),
     ("scattered.wgsl", include_str!("../shaders/scattered.wgsl")),
     (
@@ -110,6 +114,7 @@ pub const ENTRY_SHADERS: &[&str] = &[
     "voxel_build.wgsl",
     "painted.wgsl",
     "sliced.wgsl",
+    "sliced_refine.wgsl",
     "mesh.wgsl",
     "scattered.wgsl",
     "scattered_resolve.wgsl",

@@ -97,10 +97,26 @@ pub fn sweeps(quick: bool, size: (u32, u32), mesh_size: Option<(u32, u32)>) -> V
         },
         Sweep {
             method: "sliced",
-            knob: "slices",
+            // The refined slicer is a setting of the same method (its slices
+            // still decide coverage), so the rule weighs it against the
+            // paper's plain slicer at equal tuning.
+            knob: "slices [/refine]",
             settings: pick(
-                &["32", "64", "128", "256", "512", "1024"],
-                &["32", "512", "1024"],
+                &[
+                    "32",
+                    "64",
+                    "128",
+                    "256",
+                    "512",
+                    "1024",
+                    "32/refine",
+                    "64/refine",
+                    "128/refine",
+                    "256/refine",
+                    "512/refine",
+                    "1024/refine",
+                ],
+                &["32", "512", "1024", "32/refine", "512/refine"],
             ),
             paper: Some("512"),
             size,

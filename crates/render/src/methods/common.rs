@@ -77,6 +77,28 @@ pub(crate) fn forward_pipeline(
     ))
 }
 
+/// [`forward_pipeline`] drawing into one colour target of `format` (a
+/// method's private image) instead of the shared colour target.
+pub(crate) fn forward_pipeline_into(
+    shared: &Shared,
+    label: &str,
+    shader: &str,
+    layout: &wgpu::BindGroupLayout,
+    entries: (&str, &str),
+    format: wgpu::TextureFormat,
+) -> anyhow::Result<wgpu::RenderPipeline> {
+    let module = shared.shader(shader)?;
+    Ok(render_pipeline(
+        shared,
+        label,
+        &shared.pipeline_layout(label, &[layout]),
+        &module,
+        entries,
+        wgpu::CompareFunction::Less,
+        &[Some(format.into())],
+    ))
+}
+
 /// A full-screen march: one triangle (`vs_fullscreen`) whose fragment entry
 /// writes every pixel's colour and depth (`Always`: the march decides).
 pub(crate) fn fullscreen_pipeline(
@@ -188,6 +210,25 @@ pub(crate) fn begin_pass<'e>(
                 store: wgpu::StoreOp::Store,
             },
         })],
+        depth_stencil_attachment: Some(depth_attachment(shared)),
+        timestamp_writes: frame.timer.render(label),
+        occlusion_query_set: None,
+        multiview_mask: None,
+    })
+}
+
+/// [`begin_pass`] into `color` (a method's private image, cleared by the
+/// caller's load op) and the shared depth target, cleared to far.
+pub(crate) fn begin_pass_into<'e>(
+    shared: &Shared,
+    frame: &Frame<'_>,
+    encoder: &'e mut wgpu::CommandEncoder,
+    label: &str,
+    color: wgpu::RenderPassColorAttachment<'_>,
+) -> wgpu::RenderPass<'e> {
+    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
+        color_attachments: &[Some(color)],
         depth_stencil_attachment: Some(depth_attachment(shared)),
         timestamp_writes: frame.timer.render(label),
         occlusion_query_set: None,

@@ -59,6 +59,7 @@ pub mod scattered;
 mod scattered_grid;
 #[doc(hidden)]
 pub mod sliced;
+mod sliced_refine;
 #[doc(hidden)]
 pub mod voxel;
 #[doc(hidden)]
@@ -89,9 +90,10 @@ pub struct MethodSettings {
     pub voxel_steps: u32,
     /// `sliced`: horizontal slices (the paper's 512).
     pub slices: u32,
-    /// `sliced`: refine each kept fragment to the exact surface crossing
-    /// inside its slice interval (the surface writes depth and colour).
-    /// Off: the paper's plain slicer.
+    /// `sliced`: the slices decide coverage, then one full-screen pass puts
+    /// each covered pixel's exact surface crossing, searched along its ray
+    /// up to the nearest kept slice, in depth and colour. Off: the paper's
+    /// plain slicer.
     #[serde(default)]
     pub sliced_refine: bool,
     /// `scattered`: footprint grid density (x, y, z); the paper's (4, 4, 4).

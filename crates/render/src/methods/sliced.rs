@@ -2,10 +2,15 @@
 //! z = 256 - k·256/N (k = 1..N), one instanced draw; each fragment keeps its
 //! point where the decoded column is solid (floor column or slab) and
 //! discards it elsewhere. Depth-tested like any geometry.
+//!
+//! `sliced:N/refine` draws the same slices into a marks image instead and
+//! adds one full-screen pass that puts the exact surface crossing behind
+//! each pixel's nearest kept slice (`sliced_refine.rs`).
 
-use super::common::{begin_pass, forward_pipeline};
+use super::common::{begin_pass, begin_pass_into, forward_pipeline, forward_pipeline_into};
 use super::forward::{self, Z_MAX};
 use super::painted::footprint_binding;
+use super::sliced_refine::{MARK_FORMAT, Refine};
 use super::{Frame, Method, MethodSettings, RetainedBytes};
 use crate::frame::Shared;
 use strata_camera::Camera;
@@ -20,8 +25,8 @@ pub struct Sliced {
     group: wgpu::BindGroup,
     params: wgpu::Buffer,
     slices: u32,
-    /// The pipeline refines fragments to the exact crossing (`sliced_refine`).
-    refine: bool,
+    /// `sliced_refine`: `pipeline` marks the kept slices and this pass refines.
+    refine: Option<Refine>,
     /// Whether the footprint is empty this frame (nothing to draw).
     empty: bool,
 }
@@ -41,27 +46,32 @@ pub fn create(
 ) -> anyhow::Result<Box<dyn Method>> {
     let slices = checked_slices(settings)?;
     let (params, layout, group) = footprint_binding(shared, "sliced");
-    // Two fragment entry points rather than a branch: the refined one
-    // writes depth, which turns early depth testing off, and the plain
-    // slicer must keep it to stay the paper's.
-    let fragment = if settings.sliced_refine {
-        "fs_sliced_refined"
+    let (pipeline, refine) = if settings.sliced_refine {
+        let marks = forward_pipeline_into(
+            shared,
+            "sliced marks",
+            "sliced.wgsl",
+            &layout,
+            ("vs_sliced", "fs_slice_mark"),
+            MARK_FORMAT,
+        )?;
+        (marks, Some(Refine::new(shared, &params)?))
     } else {
-        "fs_sliced"
+        let plain = forward_pipeline(
+            shared,
+            "sliced",
+            "sliced.wgsl",
+            &layout,
+            ("vs_sliced", "fs_sliced"),
+        )?;
+        (plain, None)
     };
-    let pipeline = forward_pipeline(
-        shared,
-        "sliced",
-        "sliced.wgsl",
-        &layout,
-        ("vs_sliced", fragment),
-    )?;
     Ok(Box::new(Sliced {
         pipeline,
         group,
         params,
         slices,
-        refine: settings.sliced_refine,
+        refine,
         empty: true,
     }))
 }
@@ -83,12 +93,19 @@ impl Method for Sliced {
         settings: &MethodSettings,
     ) -> anyhow::Result<bool> {
         let slices = checked_slices(settings)?;
-        if settings.sliced_refine != self.refine {
+        if settings.sliced_refine != self.refine.is_some() {
             // Another pipeline: a rebuild.
             return Ok(false);
         }
         self.slices = slices;
         Ok(true)
+    }
+
+    fn resize(&mut self, shared: &Shared) -> anyhow::Result<()> {
+        if let Some(refine) = &mut self.refine {
+            refine.resize(shared, &self.params);
+        }
+        Ok(())
     }
 
     fn prepare(&mut self, shared: &Shared, camera: &Camera) -> anyhow::Result<()> {
@@ -104,22 +121,41 @@ impl Method for Sliced {
     }
 
     fn record(&self, shared: &Shared, frame: &Frame<'_>, encoder: &mut wgpu::CommandEncoder) {
-        let mut pass = begin_pass(shared, frame, encoder, "sliced");
-        if self.empty {
+        let Some(refine) = &self.refine else {
+            let mut pass = begin_pass(shared, frame, encoder, "sliced");
+            if !self.empty {
+                self.draw_slices(shared, &mut pass);
+            }
             return;
+        };
+        {
+            let mut pass =
+                begin_pass_into(shared, frame, encoder, "sliced", refine.marks_attachment());
+            if !self.empty {
+                self.draw_slices(shared, &mut pass);
+            }
         }
+        refine.record(shared, frame, encoder);
+    }
+
+    fn retained_bytes(&self) -> RetainedBytes {
+        // The 48-byte footprint uniform (the quads come from indices), and
+        // the refined slicer's marks image.
+        let refine = self.refine.as_ref().map(Refine::retained_bytes);
+        RetainedBytes {
+            gpu: forward::PARAMS_BYTES + refine.map_or(0, |r| r.gpu),
+            cpu: 0,
+        }
+    }
+}
+
+impl Sliced {
+    /// The slices, one instanced draw (nearest the eye's altitude first).
+    fn draw_slices(&self, shared: &Shared, pass: &mut wgpu::RenderPass<'_>) {
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &shared.frame_group, &[]);
         pass.set_bind_group(1, &self.group, &[]);
         pass.draw(0..6, 0..self.slices);
-    }
-
-    fn retained_bytes(&self) -> RetainedBytes {
-        // The 48-byte footprint uniform; the quads come from indices.
-        RetainedBytes {
-            gpu: forward::PARAMS_BYTES,
-            cpu: 0,
-        }
     }
 }
 

@@ -74,7 +74,7 @@ pub struct MethodArgs {
     #[arg(long, value_name = "N", value_parser = parse_positive,
           default_value_t = MethodSettings::default().slices)]
     pub slices: u32,
-    /// `sliced`: refine each kept fragment to the exact surface crossing in its slice interval.
+    /// `sliced`: per pixel, the exact surface crossing on the ray up to the nearest kept slice (a full-screen pass after the slices).
     #[arg(long)]
     pub sliced_refine: bool,
     /// `scattered`: grid density X,Y,Z in screen terms (4 → 1.25 samples per pixel across, 1 per pixel along, 1.25 per pixel of projected height), or one D for all three.
