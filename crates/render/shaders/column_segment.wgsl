@@ -11,7 +11,8 @@
 fn texel_after(p: vec2<f32>, d: vec2<f32>) -> vec2<i32> {
     let f = floor(p);
     let on_line = (f == p) & (d < vec2<f32>(0.0));
-    return vec2<i32>(f) - select(vec2<i32>(0), vec2<i32>(1), on_line);
+    // vec2<i32>(bool) rather than select: GLSL ES 3.00 (WebGL2) has no mix() on ints.
+    return vec2<i32>(f) - vec2<i32>(on_line);
 }
 
 // The first t in [t0, t1] at which o + t d is solid in column `c` (x; -1 when
@@ -74,8 +75,8 @@ fn first_entry(o: vec3<f32>, d: vec3<f32>, a: f32, b: f32, max_texels: u32) -> S
     let lo = vec3<f32>(q.xy - vec2<f32>(base), q.z);
     let span = b - a;
     let pos = d.xy > vec2<f32>(0.0);
-    let step = select(vec2<i32>(-1), vec2<i32>(1), pos);
-    let far_side = select(vec2<i32>(0), vec2<i32>(1), pos);
+    let step = 2 * vec2<i32>(pos) - vec2<i32>(1);
+    let far_side = vec2<i32>(pos);
     let still = d.xy == vec2<f32>(0.0);
     let inv = select(vec2<f32>(1.0) / d.xy, vec2<f32>(0.0), still);
     var cell = texel_after(lo.xy, d.xy);
