@@ -1,5 +1,12 @@
 //! The measurement harness behind `strata compare` and `strata merge`: typed
 //! results, statistics, the report and picture grid, and the protocol runner.
+//!
+//! Stability: this crate is the harness of the `strata` tools (compare, merge, tune), not a library API. Its public items
+//! serve the `strata` binary and the tests and may change between
+//! revisions; the embedding API is `strata-render` with the GPU-free crates
+//! (`strata-level`, `strata-camera`, `strata-mesh`, `strata-reference`,
+//! `strata-collide`, `strata-physics`, `strata-export`), which are documented
+//! item by item (`#![warn(missing_docs)]`).
 
 pub mod edits;
 pub mod figures;

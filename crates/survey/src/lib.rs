@@ -8,6 +8,13 @@
 //! Module map: [`plan`] (which worlds and qualities), [`run`] (load, measure,
 //! fit; one failed world keeps the others' rows), [`correlate`] (Pearson),
 //! [`report`] (`survey.md`, `survey.json`), [`plots`] (SVG figures).
+//!
+//! Stability: this crate is the `strata survey` tool, not a library API. Its public items
+//! serve the `strata` binary and the tests and may change between
+//! revisions; the embedding API is `strata-render` with the GPU-free crates
+//! (`strata-level`, `strata-camera`, `strata-mesh`, `strata-reference`,
+//! `strata-collide`, `strata-physics`, `strata-export`), which are documented
+//! item by item (`#![warn(missing_docs)]`).
 
 pub mod correlate;
 pub mod plan;

@@ -12,6 +12,13 @@
 //! `bodies` draws it),
 //! [`builds`] (background method builds), [`save`] (Ctrl+S), [`present`] (picture to window),
 //! [`overlay`] (egui), [`viewer`] (state and frame), and here the event loop.
+//!
+//! Stability: this crate is the `strata view` window and the web page, not a library API. Its public items
+//! serve the `strata` binary and the tests and may change between
+//! revisions; the embedding API is `strata-render` with the GPU-free crates
+//! (`strata-level`, `strata-camera`, `strata-mesh`, `strata-reference`,
+//! `strata-collide`, `strata-physics`, `strata-export`), which are documented
+//! item by item (`#![warn(missing_docs)]`).
 
 #[cfg(not(target_arch = "wasm32"))]
 pub mod bodies;
