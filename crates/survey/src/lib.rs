@@ -5,7 +5,7 @@
 //! log reduction against each predictor, the insertion causes against
 //! quality, and plots. No GPU.
 //!
-//! Module map: [`plan`] (which worlds and qualities), [`run`] (load, measure,
+//! Module map: [`plan`] (which worlds and qualities), [`run`](mod@run) (load, measure,
 //! fit; one failed world keeps the others' rows), [`correlate`] (Pearson),
 //! [`report`] (`survey.md`, `survey.json`), [`plots`] (SVG figures).
 //!

@@ -1,5 +1,5 @@
 //! What differs between a native window and a browser page, besides the
-//! event loop and the device request (in `lib.rs` and [`crate::web`]):
+//! event loop and the device request (in `lib.rs` and, on wasm32, `web.rs`):
 //! where a saved file goes, and the process's resident memory.
 
 use std::path::Path;

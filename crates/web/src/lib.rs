@@ -1,7 +1,7 @@
 //! The page's entry point for the browser build of the viewer (see
 //! `www/index.html`): read the URL's parameters, get the world (generated in
 //! the page a band of rows at a time under a progress bar, or fetched with
-//! `?level=URL`), then hand [`strata_viewer`] to the browser's event loop.
+//! `?level=URL`), then hand `strata_viewer` to the browser's event loop.
 //! Errors and panics are shown in the page.
 //!
 //! URL parameters: `backend=webgl2`, `method=NAME`, `view=NAME`, `voxel=X,Y,Z`,

@@ -21,7 +21,7 @@ use strata_render::gpu::{AdapterChoice, AdapterReport, Gpu, list_adapters};
 pub struct Args {
     #[command(flatten)]
     pub world: WorldArgs,
-    /// Output directory: results-<adapter>.json, report.md, grid.png, cells/.
+    /// Output directory: `results-<adapter>.json`, report.md, grid.png, cells/.
     #[arg(long, value_name = "DIR", default_value = "out/compare")]
     pub out: PathBuf,
     /// The CPU-machine smoke: 320x200, 4 timed frames (explicit --size/--frames win).

@@ -45,7 +45,7 @@ pub struct Args {
     /// Where screenshots (key P) go.
     #[arg(long, default_value = "out/view")]
     pub out: PathBuf,
-    /// Where Ctrl+S saves the edited world [default: OUT/<world>-edited, or the loaded world's directory with --overwrite].
+    /// Where Ctrl+S saves the edited world (default: `OUT/<world>-edited`, or the loaded world's directory with --overwrite).
     #[arg(long, value_name = "DIR")]
     pub save_to: Option<PathBuf>,
     /// Let a save (Ctrl+S, script `save`) write over the loaded world's own directory.

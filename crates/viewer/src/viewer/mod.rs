@@ -1,9 +1,9 @@
 //! The viewer's state and its frame: input to camera, script steps, finished
 //! builds, the method (or A/B pair) drawn through the harness's
 //! [`Renderer`], the overlay, and the swapchain. Input handling is in
-//! [`input`], script running in [`scripted`], the score and screenshot
-//! read-backs (finished a frame or more later) in [`readback`], digging,
-//! undo, saving and the memory report in [`editing`].
+//! `input`, script running in `scripted`, the score and screenshot
+//! read-backs (finished a frame or more later) in `readback`, digging,
+//! undo, saving and the memory report in `editing`.
 
 mod editing;
 mod input;
