@@ -65,16 +65,7 @@ pub(crate) fn forward_pipeline(
     layout: &wgpu::BindGroupLayout,
     entries: (&str, &str),
 ) -> anyhow::Result<wgpu::RenderPipeline> {
-    let module = shared.shader(shader)?;
-    Ok(render_pipeline(
-        shared,
-        label,
-        &shared.pipeline_layout(label, &[layout]),
-        &module,
-        entries,
-        wgpu::CompareFunction::Less,
-        &[Some(COLOR_FORMAT.into())],
-    ))
+    forward_pipeline_into(shared, label, shader, layout, entries, COLOR_FORMAT)
 }
 
 /// [`forward_pipeline`] drawing into one colour target of `format` (a
