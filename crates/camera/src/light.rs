@@ -34,6 +34,8 @@ pub struct ShadowFrame {
     pub texel: f32,
     /// Depth bias, world units: how far behind the blocker a point must be to be in shadow.
     pub bias: f32,
+    /// The texels a visible point can sample: the rest are never cast.
+    pub cover: ShadowCover,
 }
 
 impl ShadowFrame {
@@ -78,7 +80,7 @@ impl ShadowFrame {
         // Put the plane well above every altitude: 600 units up the light.
         let along = points.iter().map(|p| p.dot(light)).fold(f32::MAX, f32::min) - 600.0;
         let origin = u * (centre.x - 0.5 * side) + v * (centre.y - 0.5 * side) + light * along;
-        ShadowFrame {
+        let mut frame = ShadowFrame {
             enabled,
             light,
             origin,
@@ -88,6 +90,276 @@ impl ShadowFrame {
             // With the normal offset in `shading.wgsl`, a texel plus half a
             // unit (the march's bisection error) keeps lit surfaces lit.
             bias: texel + 0.5,
+            cover: ShadowCover::EVERY_TEXEL,
+        };
+        frame.cover = ShadowCover::of_view(camera, &frame);
+        frame
+    }
+
+    /// The map's texel coordinates of world point `p` (texel (i, j) spans
+    /// [i, i + 1) x [j, j + 1)).
+    pub fn texel_coords(&self, p: glam::DVec3) -> glam::DVec2 {
+        let rel = p - self.origin.as_dvec3();
+        let texel = f64::from(self.texel);
+        glam::DVec2::new(rel.dot(self.u.as_dvec3()), rel.dot(self.v.as_dvec3())) / texel
+    }
+
+    /// Whether texel (i, j) is cast this frame ([`ShadowFrame::cover`]).
+    pub fn casts(&self, i: u32, j: u32) -> bool {
+        self.cover.covers(i, j)
+    }
+}
+
+/// Most half-planes of a [`ShadowCover`] (the outline of the view's slice of
+/// space has at most a dozen edges; dropping one only covers more).
+pub const MAX_COVER_EDGES: usize = 16;
+
+/// Shadow texels kept beyond the outline of what the view sees: shading
+/// pushes a point 1.5 texels off the surface along its normal, then PCF reads
+/// the 2x2 texels around it (centres up to 1 texel away); the rest is slack
+/// for f32 rounding.
+pub const COVER_MARGIN_TEXELS: f32 = 4.0;
+
+/// The shadow texels a frame can sample: a convex region of the map, as
+/// half-planes in texel coordinates. Every point any method shades lies in
+/// the view frustum (near to far) and in the altitude slab [0, 255]; the light
+/// carries that convex slice of space onto the map as a convex polygon, and
+/// shading only reads texels within [`COVER_MARGIN_TEXELS`] of it. Texels
+/// outside are not cast (the GPU pass and the CPU twin store
+/// `SHADOW_MISS` there): at the horizon most of the square map lies outside
+/// the view's wedge.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShadowCover {
+    /// `(nx, ny, d)`: texel centre `c` is covered when `nx cx + ny cy + d <= 0`
+    /// for each of the first `count` planes (`n` unit length, outward).
+    pub planes: [[f32; 3]; MAX_COVER_EDGES],
+    /// How many of `planes` apply; 0 covers every texel.
+    pub count: u32,
+}
+
+impl ShadowCover {
+    /// No culling: every texel is cast.
+    pub const EVERY_TEXEL: ShadowCover = ShadowCover {
+        planes: [[0.0; 3]; MAX_COVER_EDGES],
+        count: 0,
+    };
+
+    /// No texel: the view sees nothing in the altitude slab.
+    pub const NO_TEXEL: ShadowCover = {
+        let mut planes = [[0.0; 3]; MAX_COVER_EDGES];
+        planes[0] = [0.0, 0.0, 1.0];
+        ShadowCover { planes, count: 1 }
+    };
+
+    /// The region of `frame`'s map that `camera`'s visible points can
+    /// sample: the light's projection of the frustum (near to far) cut to
+    /// the altitude slab [0, 255], widened by [`COVER_MARGIN_TEXELS`].
+    pub fn of_view(camera: &Camera, frame: &ShadowFrame) -> ShadowCover {
+        let outline: Vec<glam::DVec2> = view_slice_points(camera)
+            .into_iter()
+            .map(|p| frame.texel_coords(p))
+            .collect();
+        if outline.is_empty() {
+            return ShadowCover::NO_TEXEL;
         }
+        let hull = convex_hull(outline);
+        if hull.len() < 3 {
+            // A degenerate slice (a line or a point): keep it simple and
+            // cast everything rather than reason about a zero-area region.
+            return ShadowCover::EVERY_TEXEL;
+        }
+        let mut cover = ShadowCover::EVERY_TEXEL;
+        for (k, a) in hull.iter().enumerate() {
+            let b = hull[(k + 1) % hull.len()];
+            let e = b - *a;
+            // Counter-clockwise hull: the outside is to the right of a -> b.
+            let n = glam::DVec2::new(e.y, -e.x).normalize();
+            if (cover.count as usize) < MAX_COVER_EDGES {
+                let d = -n.dot(*a) - f64::from(COVER_MARGIN_TEXELS);
+                cover.planes[cover.count as usize] = [n.x as f32, n.y as f32, d as f32];
+                cover.count += 1;
+            }
+        }
+        cover
+    }
+
+    /// Whether texel (i, j)'s centre is covered, in f32 as `frame.wgsl`'s
+    /// `shadow_texel_cast` computes it.
+    pub fn covers(&self, i: u32, j: u32) -> bool {
+        let (x, y) = (i as f32 + 0.5, j as f32 + 0.5);
+        self.planes[..self.count as usize]
+            .iter()
+            .all(|[nx, ny, d]| nx * x + ny * y + d <= 0.0)
+    }
+
+    /// Share of `side` x `side` texels covered (for reports).
+    pub fn fraction(&self, side: u32) -> f64 {
+        let covered: u64 = (0..side)
+            .map(|j| (0..side).filter(|&i| self.covers(i, j)).count() as u64)
+            .sum();
+        covered as f64 / (f64::from(side) * f64::from(side))
+    }
+}
+
+/// The vertices of the frustum (view depth near to far) cut to the altitude
+/// slab [0, 255]: the frustum's corners inside the slab and its edges'
+/// crossings of z = 0 and z = 255 (a convex polytope's cut by two parallel
+/// planes has no other vertices). Empty when the slab is out of view.
+fn view_slice_points(camera: &Camera) -> Vec<glam::DVec3> {
+    const TOP: f64 = 255.0;
+    let eye = camera.position.as_dvec3();
+    let (w, h) = (camera.width as f32, camera.height as f32);
+    let focal = f64::from(camera.focal_px);
+    let corners = [(0.0, 0.0), (w, 0.0), (w, h), (0.0, h)];
+    let at = |depth: f32, (px, py): (f32, f32)| {
+        eye + camera.image_direction(px, py).as_dvec3() * (f64::from(depth) / focal)
+    };
+    let near: Vec<glam::DVec3> = corners.iter().map(|&c| at(camera.near, c)).collect();
+    let far: Vec<glam::DVec3> = corners.iter().map(|&c| at(camera.far, c)).collect();
+    let mut edges = Vec::with_capacity(12);
+    for k in 0..4 {
+        edges.push((near[k], near[(k + 1) % 4]));
+        edges.push((far[k], far[(k + 1) % 4]));
+        edges.push((near[k], far[k]));
+    }
+    let inside = |p: &glam::DVec3| (0.0..=TOP).contains(&p.z);
+    let mut points: Vec<glam::DVec3> = near.iter().chain(&far).copied().filter(inside).collect();
+    for (a, b) in edges {
+        for z in [0.0, TOP] {
+            let (da, db) = (a.z - z, b.z - z);
+            if (da <= 0.0 && db >= 0.0 || da >= 0.0 && db <= 0.0) && da != db {
+                points.push(a + (b - a) * (da / (da - db)));
+            }
+        }
+    }
+    points
+}
+
+/// Counter-clockwise convex hull (Andrew's monotone chain), collinear points dropped.
+fn convex_hull(mut points: Vec<glam::DVec2>) -> Vec<glam::DVec2> {
+    points.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
+    points.dedup();
+    if points.len() < 3 {
+        return points;
+    }
+    let cross = |o: glam::DVec2, a: glam::DVec2, b: glam::DVec2| (a - o).perp_dot(b - o);
+    let mut hull: Vec<glam::DVec2> = Vec::with_capacity(2 * points.len());
+    for pass in 0..2 {
+        let start = hull.len();
+        let ordered: Box<dyn Iterator<Item = &glam::DVec2>> = if pass == 0 {
+            Box::new(points.iter())
+        } else {
+            Box::new(points.iter().rev())
+        };
+        for &p in ordered {
+            while hull.len() >= start + 2
+                && cross(hull[hull.len() - 2], hull[hull.len() - 1], p) <= 0.0
+            {
+                hull.pop();
+            }
+            hull.push(p);
+        }
+        hull.pop();
+    }
+    hull
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn camera(pitch: f32, eye_z: f32, w: u32, h: u32) -> Camera {
+        Camera::new(Vec3::new(1000.0, 8000.0, eye_z), 37.0, pitch, w, h).unwrap()
+    }
+
+    /// Points any method can shade: pixel rays at view depths near..far,
+    /// inside the altitude slab.
+    fn visible_points(camera: &Camera) -> Vec<Vec3> {
+        let mut points = Vec::new();
+        let (w, h) = (camera.width as f32, camera.height as f32);
+        for j in 0..=16 {
+            for i in 0..=16 {
+                let d = camera.image_direction(w * i as f32 / 16.0, h * j as f32 / 16.0);
+                for k in 0..=64 {
+                    let depth = camera.near + (camera.far - camera.near) * k as f32 / 64.0;
+                    let p = camera.position + d * (depth / camera.focal_px);
+                    if (0.0..=255.0).contains(&p.z) {
+                        points.push(p);
+                    }
+                }
+            }
+        }
+        points
+    }
+
+    #[test]
+    fn every_texel_a_visible_point_samples_is_cast() {
+        for (pitch, eye_z) in [
+            (0.0, 60.0),
+            (-30.0, 200.0),
+            (-60.0, 300.0),
+            (-90.0, 400.0),
+            (20.0, 30.0),
+            (-10.0, 300.0),
+        ] {
+            let camera = camera(pitch, eye_z, 1280, 800);
+            let frame = ShadowFrame::fit(&camera, true);
+            let points = visible_points(&camera);
+            assert!(!points.is_empty());
+            for p in points {
+                // The 2x2 PCF taps around the point pushed 1.5 texels off
+                // the surface (any direction), as `shading.wgsl` reads them.
+                for (ox, oy) in [(-1.5f64, -1.5f64), (1.5, -1.5), (-1.5, 1.5), (1.5, 1.5)] {
+                    let uv = frame.texel_coords(p.as_dvec3()) + glam::DVec2::new(ox, oy) - 0.5;
+                    let base = uv.floor();
+                    for (di, dj) in [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)] {
+                        let (i, j) = (base.x + di, base.y + dj);
+                        if (0.0..f64::from(SHADOW_SIZE)).contains(&i)
+                            && (0.0..f64::from(SHADOW_SIZE)).contains(&j)
+                        {
+                            assert!(
+                                frame.casts(i as u32, j as u32),
+                                "pitch {pitch}: texel ({i}, {j}) of {p} is not cast"
+                            );
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn the_horizon_casts_a_fraction_of_the_map() {
+        let horizon = ShadowFrame::fit(&camera(0.0, 60.0, 1280, 800), true);
+        let fraction = horizon.cover.fraction(SHADOW_SIZE);
+        for (pitch, z) in [
+            (0.0, 60.0),
+            (0.0, 150.0),
+            (-30.0, 150.0),
+            (-30.0, 250.0),
+            (-60.0, 250.0),
+            (-60.0, 350.0),
+            (-90.0, 350.0),
+            (-90.0, 450.0),
+        ] {
+            let f = ShadowFrame::fit(&camera(pitch, z, 1280, 800), true);
+            eprintln!(
+                "pitch {pitch} eye {z}: {:.3}",
+                f.cover.fraction(SHADOW_SIZE)
+            );
+        }
+        assert!(
+            fraction > 0.05 && fraction < 0.9,
+            "horizon covers {fraction}"
+        );
+        let down = ShadowFrame::fit(&camera(-90.0, 400.0, 1280, 800), true);
+        assert!(down.cover.count >= 3 && down.cover.fraction(SHADOW_SIZE) < 1.0);
+    }
+
+    #[test]
+    fn a_view_of_only_sky_casts_nothing() {
+        let up = ShadowFrame::fit(&camera(60.0, 400.0, 320, 200), true);
+        assert_eq!(up.cover, ShadowCover::NO_TEXEL);
+        assert!(!up.casts(512, 512));
     }
 }

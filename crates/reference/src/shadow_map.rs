@@ -24,7 +24,8 @@ pub struct ShadowMap {
 }
 
 impl ShadowMap {
-    /// Cast every texel of `frame` with the exact tracer (parallel over rows).
+    /// Cast every texel of `frame` that its view can sample
+    /// ([`ShadowFrame::casts`]) with the exact tracer (parallel over rows).
     pub fn cast(tracer: &Tracer, frame: &ShadowFrame) -> Self {
         let side = SHADOW_SIZE;
         let mut depth = vec![SHADOW_MISS; (side * side) as usize];
@@ -34,6 +35,10 @@ impl ShadowMap {
             .enumerate()
             .for_each(|(j, row)| {
                 for (i, texel) in row.iter_mut().enumerate() {
+                    // Texels no visible point samples hold a miss, as on the GPU.
+                    if !frame.casts(i as u32, j as u32) {
+                        continue;
+                    }
                     // The texel centre as the GPU computes it (f32), then exact.
                     let o = frame.origin
                         + frame.u * ((i as f32 + 0.5) * frame.texel)

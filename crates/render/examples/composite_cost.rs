@@ -46,6 +46,8 @@ fn main() -> anyhow::Result<()> {
     };
     let colors = TerrainColors::test_ramps();
     let mut r = Renderer::new(&gpu, &level, &colors, &method, &settings, size.0, size.1)?;
+    // `record_copy_into` below copies from Strata's own depth target.
+    r.set_depth_attachment(true);
     let frame_ms: Vec<f64> = (0..frames.min(20))
         .map(|_| {
             r.render_frame(&camera)

@@ -26,6 +26,11 @@ struct Globals {
     // map width, map height (powers of two), log2 rows per texture layer,
     // added to the gap code before << 3 (1 original, 0 vange-rs)
     level: vec4<u32>,
+    // x how many of shadow_cover apply (0: every shadow texel is cast)
+    shadow_cover_count: vec4<u32>,
+    // the shadow texels this frame casts: half-planes (nx, ny, d, 0) in texel
+    // coordinates, inside when nx cx + ny cy + d <= 0 (`ShadowCover`)
+    shadow_cover: array<vec4<f32>, 16>,
 }
 
 struct ShadingParams {
@@ -42,6 +47,19 @@ struct ShadingParams {
 @group(0) @binding(2) var terrain: texture_2d_array<u32>;
 // Distance along the light from the shadow plane to the first solid point.
 @group(0) @binding(3) var shadow_map: texture_2d<f32>;
+
+// Whether the shadow pass casts texel `ij` this frame: only texels a visible
+// point can sample are (twin of `ShadowCover::covers`); the rest hold a miss.
+fn shadow_texel_cast(ij: vec2<u32>) -> bool {
+    let c = vec2<f32>(ij) + vec2<f32>(0.5);
+    for (var k = 0u; k < globals.shadow_cover_count.x; k = k + 1u) {
+        let plane = globals.shadow_cover[k];
+        if (plane.x * c.x + plane.y * c.y + plane.z > 0.0) {
+            return false;
+        }
+    }
+    return true;
+}
 
 // Unnormalised ray through the image point (px, py) in pixels from the top-left
 // (a pixel centre is i + 0.5): the twin of `Camera::image_direction`. Its

@@ -18,7 +18,10 @@ fn cs_exact_shadow(
     @builtin(local_invocation_index) li: u32,
 ) {
     let side = u32(globals.shadow_u.w);
-    if (id.x < side && id.y < side) {
+    if (id.x < side && id.y < side && !shadow_texel_cast(id.xy)) {
+        // No visible point samples this texel this frame.
+        textureStore(shadow_out, id.xy, vec4<f32>(SHADOW_MISS, 0.0, 0.0, 0.0));
+    } else if (id.x < side && id.y < side) {
         let texel = globals.shadow_origin.w;
         let o = globals.shadow_origin.xyz
             + globals.shadow_u.xyz * ((f32(id.x) + 0.5) * texel)

@@ -15,8 +15,12 @@ const SHADOW_MISS: f32 = 1e9;
 
 @group(1) @binding(0) var shadow_out: texture_storage_2d<r32float, write>;
 
-// Distance along the light to the first solid point from the map's texel `id`.
+// Distance along the light to the first solid point from the map's texel `id`
+// (a miss for texels no visible point samples: `shadow_texel_cast`).
 fn shadow_distance(id: vec2<u32>) -> f32 {
+    if (!shadow_texel_cast(id)) {
+        return SHADOW_MISS;
+    }
     let texel = globals.shadow_origin.w;
     let o = globals.shadow_origin.xyz
         + globals.shadow_u.xyz * ((f32(id.x) + 0.5) * texel)

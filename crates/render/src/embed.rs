@@ -481,7 +481,8 @@ impl Renderer {
         let recorded = (|| -> anyhow::Result<wgpu::CommandBuffer> {
             let pipeline = composite.pipeline(&device, key)?;
             let group = composite.group(self.shared());
-            let mut encoder = self.record_frame(camera)?;
+            // The composite reads the shared depth target: fill it.
+            let mut encoder = self.record_frame_with(camera, true)?;
             record_composite(&mut encoder, targets, key, &pipeline, &group, None);
             Ok(encoder.finish())
         })();
@@ -519,6 +520,12 @@ impl Renderer {
         timestamp_writes: Option<wgpu::RenderPassTimestampWrites<'_>>,
     ) -> anyhow::Result<()> {
         let key = key_of(targets, (self.shared().width, self.shared().height))?;
+        if !self.depth_target_current {
+            anyhow::bail!(
+                "the frame last drawn ({}) left its depth in the method's own image, not in the shared depth target this copy reads: draw it with `render_into`, or call `set_depth_attachment(true)` before `render_frame`",
+                self.method_name()
+            );
+        }
         let device = self.shared().device.clone();
         let mut composite = std::mem::take(&mut self.composite);
         let pipeline = composite.pipeline(&device, key);

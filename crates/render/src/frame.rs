@@ -7,6 +7,7 @@ use crate::caps::{Capabilities, Capability, ShadowPassKind};
 use crate::terrain::TerrainTexture;
 use bytemuck::{Pod, Zeroable};
 use strata_camera::Camera;
+use strata_camera::light::MAX_COVER_EDGES;
 use strata_level::{Level, World};
 
 /// Colour target format: 8-bit RGBA, written raw to `color.png`.
@@ -102,6 +103,13 @@ pub struct Globals {
     pub sky: [f32; 4],
     /// Level width, height, log2 of the rows per texture layer, mid rule (1: original).
     pub level: [u32; 4],
+    /// x: how many of `shadow_cover` apply (0: every shadow texel is cast).
+    pub shadow_cover_count: [u32; 4],
+    /// The shadow texels this frame casts ([`ShadowCover`]): half-planes
+    /// `(nx, ny, d, 0)` in texel coordinates.
+    ///
+    /// [`ShadowCover`]: strata_camera::light::ShadowCover
+    pub shadow_cover: [[f32; 4]; MAX_COVER_EDGES],
 }
 
 /// Twin of `ShadingParams` in `frame.wgsl`.
@@ -183,6 +191,8 @@ impl Globals {
                 layer_rows.trailing_zeros(),
                 mid_add,
             ],
+            shadow_cover_count: [shadow.cover.count, 0, 0, 0],
+            shadow_cover: shadow.cover.planes.map(|[nx, ny, d]| [nx, ny, d, 0.0]),
         }
     }
 }

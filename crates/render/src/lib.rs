@@ -30,7 +30,10 @@
 //! - Or Strata's own targets: after [`Renderer::render_frame`] the terrain's
 //!   colour and depth are in [`Renderer::shared`]`().color_view`
 //!   ([`COLOR_FORMAT`]) and `.depth_view` ([`DEPTH_FORMAT`], one sample);
-//!   draw into those the same way (`tests/compose.rs`).
+//!   draw into those the same way (`tests/compose.rs`). Call
+//!   [`Renderer::set_depth_attachment`]`(true)` first: by default the compute
+//!   marches keep the frame's depth in an image of their own and skip the
+//!   copy into `depth_view`.
 //! - Edits: [`Renderer::apply_edit`] updates the GPU data; a CPU follower
 //!   (`strata_collide::TerrainCollider`) registered with
 //!   [`Renderer::set_edit_listener`] changes in the same call.

@@ -52,6 +52,13 @@ pub struct Renderer {
     shadow_reuse: bool,
     /// The frame the shadow map holds, while no edit has changed it.
     shadow_drawn: Option<ShadowFrame>,
+    /// Cast only the shadow texels the view can sample (`ShadowCover`).
+    shadow_cull: bool,
+    /// Fill the shared depth target every frame, also for the methods that
+    /// keep depth in an image of their own ([`Renderer::set_depth_attachment`]).
+    depth_attachment: bool,
+    /// Whether the shared depth target holds the last frame's depth.
+    pub(crate) depth_target_current: bool,
     /// Depth read-back through a pass, where depth copies are missing.
     depth_reader: Option<DepthReader>,
     /// The newest frame's submission ([`Renderer::hold_busy`] bounds the queue by it).
@@ -129,6 +136,11 @@ impl Renderer {
             // `STRATA_SHADOW_REUSE=1` turns it on to measure a cached map.
             shadow_reuse: shadow_reuse_from_env(),
             shadow_drawn: None,
+            // `STRATA_SHADOW_CULL=0` casts the whole map, to measure the cull.
+            shadow_cull: !env_is_zero("STRATA_SHADOW_CULL"),
+            // `STRATA_DEPTH_ATTACHMENT=1` copies every frame, to measure it.
+            depth_attachment: env_is_one("STRATA_DEPTH_ATTACHMENT"),
+            depth_target_current: false,
             depth_reader,
             edit_listener: None,
             composite: Default::default(),
@@ -257,6 +269,27 @@ impl Renderer {
         self.shadow_reuse = on;
     }
 
+    /// Make every frame's depth land in the shared depth target
+    /// (`shared().depth_view`), for a caller that draws over Strata's own
+    /// targets with the depth test after [`Renderer::render_frame`] (the
+    /// viewer's physics bodies). Methods that rasterise write it anyway; the
+    /// compute marches (`ray-compute`, `voxel-compute`, `ray-exact`) write
+    /// depth into an image of their own and, with this off (the default),
+    /// skip the full-screen copy into the target: 0.076 ms of a frame at
+    /// 1280x800 on an H100. [`Renderer::read_depth`] and
+    /// [`Renderer::render_into`] see the frame's depth either way.
+    pub fn set_depth_attachment(&mut self, on: bool) {
+        self.depth_attachment = on;
+    }
+
+    /// Cast only the shadow texels this frame's view can sample (on by
+    /// default; `ShadowCover`): off casts all 1024², which gives the same
+    /// picture at more cost (a test checks it) and is kept for measuring.
+    #[doc(hidden)]
+    pub fn set_shadow_cull(&mut self, on: bool) {
+        self.shadow_cull = on;
+    }
+
     /// The shared frame, for building methods off the render thread:
     /// `methods::create(name, &handle, level, settings)`.
     pub fn shared_handle(&self) -> Arc<Shared> {
@@ -285,7 +318,10 @@ impl Renderer {
     }
 
     /// Render one frame into Strata's own targets ([`Shared::color_view`],
-    /// [`Shared::depth_view`]) and wait for it. GPU time is the sum of the
+    /// and [`Shared::depth_view`] for every method once
+    /// [`Renderer::set_depth_attachment`] is on, else the compute marches
+    /// keep depth in their own image: [`Renderer::read_depth`] reads it
+    /// either way) and wait for it. GPU time is the sum of the
     /// per-pass timestamp intervals; CPU time is submit until the GPU is done.
     /// `camera` must be of the renderer's size. To draw into your own
     /// targets instead, see [`Renderer::render_into`].
@@ -363,6 +399,17 @@ impl Renderer {
     /// Prepare one frame and record it into a new encoder (shadow map, the
     /// active method, timestamp resolve), not yet submitted.
     pub(crate) fn record_frame(&mut self, camera: &Camera) -> anyhow::Result<wgpu::CommandEncoder> {
+        let depth_attachment = self.depth_attachment;
+        self.record_frame_with(camera, depth_attachment)
+    }
+
+    /// [`Renderer::record_frame`], saying whether the shared depth target
+    /// must hold the frame's depth ([`Renderer::set_depth_attachment`]).
+    pub(crate) fn record_frame_with(
+        &mut self,
+        camera: &Camera,
+        depth_attachment: bool,
+    ) -> anyhow::Result<wgpu::CommandEncoder> {
         if camera.width != self.shared.width || camera.height != self.shared.height {
             anyhow::bail!(
                 "camera is {}x{} but the renderer was built for {}x{}",
@@ -373,7 +420,10 @@ impl Renderer {
             );
         }
         let shadows = self.settings().shadows;
-        let shadow = ShadowFrame::fit(camera, shadows);
+        let mut shadow = ShadowFrame::fit(camera, shadows);
+        if !self.shadow_cull {
+            shadow.cover = strata_camera::light::ShadowCover::EVERY_TEXEL;
+        }
         let globals = Globals::new(camera, &self.level_shape, &shadow);
         self.shared
             .queue
@@ -391,8 +441,10 @@ impl Renderer {
             camera,
             timer: &self.timer,
             index: self.frames,
+            depth_attachment,
         };
         let method = &self.methods[self.active].method;
+        self.depth_target_current = depth_attachment || method.depth_image().is_none();
         if shadows && !current {
             // The method may fill the map itself (the exact march does).
             if !method.record_shadow_map(&self.shared, &frame, &mut encoder) {
@@ -503,6 +555,10 @@ impl Renderer {
     /// near .. 1 far, 1 = sky; the crate's depth convention), row-major, top
     /// row first. Blocks until copied (example: [`Renderer::read_color`]).
     pub fn read_depth(&self) -> anyhow::Result<Vec<f32>> {
+        if let Some(image) = self.methods[self.active].method.depth_image() {
+            let raw = self.read_texture(image, wgpu::TextureAspect::All)?;
+            return Ok(bytemuck::cast_slice::<u8, f32>(&raw).to_vec());
+        }
         if let Some(reader) = &self.depth_reader {
             let s = &self.shared;
             return reader.read(&s.device, &s.queue, &self.errors, &s.depth);
@@ -514,6 +570,14 @@ impl Renderer {
     /// Start copying the depth target to the CPU without waiting (the
     /// browser's way: poll the result per frame; its bytes are `f32` depths).
     pub fn start_read_depth(&self) -> crate::gpu::TextureReadback {
+        if let Some(image) = self.methods[self.active].method.depth_image() {
+            return crate::gpu::TextureReadback::start(
+                &self.shared.device,
+                &self.shared.queue,
+                image,
+                wgpu::TextureAspect::All,
+            );
+        }
         if let Some(reader) = &self.depth_reader {
             let s = &self.shared;
             return reader.start(&s.device, &s.queue, &s.depth);
@@ -555,6 +619,34 @@ impl Renderer {
             texture,
             aspect,
         )
+    }
+}
+
+/// Whether environment variable `name` is `0` (a measuring switch; never in
+/// a browser).
+fn env_is_zero(name: &str) -> bool {
+    #[cfg(not(target_arch = "wasm32"))]
+    {
+        std::env::var(name).is_ok_and(|v| v == "0")
+    }
+    #[cfg(target_arch = "wasm32")]
+    {
+        let _ = name;
+        false
+    }
+}
+
+/// Whether environment variable `name` is `1` (a measuring switch; never in
+/// a browser).
+fn env_is_one(name: &str) -> bool {
+    #[cfg(not(target_arch = "wasm32"))]
+    {
+        std::env::var(name).is_ok_and(|v| v == "1")
+    }
+    #[cfg(target_arch = "wasm32")]
+    {
+        let _ = name;
+        false
     }
 }
 

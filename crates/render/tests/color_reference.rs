@@ -124,3 +124,58 @@ fn gpu_shadow_map_and_shading_match_the_cpu_colour_reference() {
     }
     gpu.errors.check().unwrap();
 }
+
+/// Casting only the shadow texels a view can sample (`ShadowCover`) changes
+/// no pixel of any method: every texel shading reads is inside the cover. At
+/// 160x100 the frustum is narrow (the focal length is fixed in pixels), so
+/// most of the map is culled and a cover that is too tight shows as lit
+/// pixels that should be shadowed.
+#[test]
+fn culling_the_shadow_map_to_the_view_changes_no_pixel_of_any_method() {
+    let Some(gpu) = common::gpu() else { return };
+    let level = common::synthetic_level();
+    let colors = TerrainColors::test_ramps();
+    let settings = MethodSettings::default();
+    let views = common::synthetic_views();
+    let mut culled_share = Vec::new();
+    for name in strata_render::methods::names() {
+        let mut renderer = match Renderer::new(&gpu, &level, &colors, name, &settings, W, H) {
+            Ok(r) => r,
+            Err(e) => {
+                // A method this adapter cannot run is refused by name.
+                eprintln!("{name}: not on this adapter ({e:#})");
+                continue;
+            }
+        };
+        for view in &views {
+            let camera = Camera::from_view(&level, view, W, H).unwrap();
+            renderer.set_shadow_cull(true);
+            renderer.render_frame(&camera).unwrap();
+            let culled = renderer.read_color().unwrap();
+            renderer.set_shadow_cull(false);
+            renderer.render_frame(&camera).unwrap();
+            let whole = renderer.read_color().unwrap();
+            let differ = culled
+                .chunks_exact(4)
+                .zip(whole.chunks_exact(4))
+                .filter(|(a, b)| a != b)
+                .count();
+            assert_eq!(
+                differ, 0,
+                "{name} {}: {differ} pixels change when the shadow map is culled",
+                view.name
+            );
+            if name == "ray" {
+                let frame = ShadowFrame::fit(&camera, true);
+                culled_share.push(1.0 - frame.cover.fraction(strata_camera::light::SHADOW_SIZE));
+            }
+        }
+    }
+    // The test means something only if the cull skips texels.
+    let most = culled_share.iter().cloned().fold(0.0, f64::max);
+    assert!(
+        most > 0.3,
+        "the cover culls at most {most} of the map on these views"
+    );
+    gpu.errors.check().unwrap();
+}

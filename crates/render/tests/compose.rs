@@ -173,6 +173,8 @@ fn callers_object_composes_by_depth_in_every_method() {
                 continue;
             }
         };
+        // The objects below are drawn over Strata's own depth target.
+        r.set_depth_attachment(true);
         r.render_frame(&camera).unwrap();
         let depth = r.read_depth().unwrap();
         let terrain = r.read_color().unwrap();

@@ -264,10 +264,15 @@ pub(crate) fn dispatch_per_pixel(
 }
 
 /// The compute variants' depth path: a compute shader cannot write a depth
-/// texture, so the march writes an R32Float storage image and a full-screen
-/// pass (`depth_blit.wgsl`) copies it into the shared depth target.
+/// texture, so the march writes an R32Float storage image (the frame's depth:
+/// [`Method::depth_image`], which `Renderer::read_depth` reads) and, on frames
+/// that need the shared depth target ([`Frame::depth_attachment`]), a
+/// full-screen pass (`depth_blit.wgsl`) copies it there.
+///
+/// [`Method::depth_image`]: super::Method::depth_image
 pub(crate) struct DepthCopy {
     label: String,
+    texture: wgpu::Texture,
     view: wgpu::TextureView,
     bytes: u64,
     blit: wgpu::RenderPipeline,
@@ -284,7 +289,7 @@ fn depth_image(
     shared: &Shared,
     label: &str,
     layout: &wgpu::BindGroupLayout,
-) -> (wgpu::TextureView, wgpu::BindGroup) {
+) -> (wgpu::Texture, wgpu::TextureView, wgpu::BindGroup) {
     let device = &shared.device;
     let depth = device.create_texture(&wgpu::TextureDescriptor {
         label: Some(label),
@@ -297,7 +302,10 @@ fn depth_image(
         sample_count: 1,
         dimension: wgpu::TextureDimension::D2,
         format: wgpu::TextureFormat::R32Float,
-        usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING,
+        // COPY_SRC: `Renderer::read_depth` reads the frame's depth from here.
+        usage: wgpu::TextureUsages::STORAGE_BINDING
+            | wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::COPY_SRC,
         view_formats: &[],
     });
     let view = depth.create_view(&Default::default());
@@ -309,7 +317,7 @@ fn depth_image(
             resource: wgpu::BindingResource::TextureView(&view),
         }],
     });
-    (view, group)
+    (depth, view, group)
 }
 
 impl DepthCopy {
@@ -326,7 +334,7 @@ impl DepthCopy {
             )],
         });
         let label = format!("{method} depth");
-        let (view, blit_group) = depth_image(shared, &label, &layout);
+        let (texture, view, blit_group) = depth_image(shared, &label, &layout);
         let module = shared.shader("depth_blit.wgsl")?;
         // No frame group: the copy reads only the storage image.
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -345,6 +353,7 @@ impl DepthCopy {
         );
         Ok(Self {
             label,
+            texture,
             view,
             bytes: u64::from(shared.width) * u64::from(shared.height) * 4,
             blit,
@@ -391,7 +400,7 @@ impl DepthCopy {
     /// A new storage image at the shared targets' new size; the caller
     /// rebinds [`DepthCopy::bindings`].
     pub(crate) fn resize(&mut self, shared: &Shared) {
-        (self.view, self.blit_group) = depth_image(shared, &self.label, &self.layout);
+        (self.texture, self.view, self.blit_group) = depth_image(shared, &self.label, &self.layout);
         self.bytes = u64::from(shared.width) * u64::from(shared.height) * 4;
     }
 
@@ -420,6 +429,11 @@ impl DepthCopy {
                 resource: wgpu::BindingResource::TextureView(&self.view),
             },
         ]
+    }
+
+    /// The storage image: this frame's depth-buffer values, every pixel.
+    pub(crate) fn texture(&self) -> &wgpu::Texture {
+        &self.texture
     }
 
     /// Bytes of the storage image (4 per pixel).
@@ -454,6 +468,9 @@ impl DepthCopy {
         scissor: bool,
         clear: bool,
     ) {
+        if !frame.depth_attachment {
+            return;
+        }
         let mut attachment = depth_attachment(shared);
         if !clear {
             attachment.depth_ops = Some(wgpu::Operations {
@@ -486,6 +503,9 @@ impl DepthCopy {
         label: &str,
         points: bool,
     ) {
+        if !frame.depth_attachment {
+            return;
+        }
         let mut attachment = depth_attachment(shared);
         attachment.depth_ops = Some(wgpu::Operations {
             load: wgpu::LoadOp::Load,

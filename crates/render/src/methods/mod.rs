@@ -157,6 +157,11 @@ pub struct Frame<'a> {
     pub timer: &'a PassTimer,
     /// Frames rendered before this one by this renderer.
     pub index: u64,
+    /// Whether the shared depth target must hold this frame's depth. Methods
+    /// that rasterise write it anyway; those whose depth lands in an image of
+    /// their own ([`Method::depth_image`]) copy it there only when this is
+    /// set (`Renderer::set_depth_attachment`, `render_into`).
+    pub depth_attachment: bool,
 }
 
 /// One way of drawing the terrain. `Send`, so a method can be built on a
@@ -219,6 +224,14 @@ pub trait Method: Send {
 
     /// GPU and CPU bytes owned beyond the shared resources.
     fn retained_bytes(&self) -> RetainedBytes;
+
+    /// Where this method leaves the frame's depth when it is not the shared
+    /// depth target: an `R32Float` texture (`COPY_SRC`) of depth-buffer
+    /// values, every pixel written each frame (the compute marches). `None`
+    /// (the default): the method draws depth into the shared target.
+    fn depth_image(&self) -> Option<&wgpu::Texture> {
+        None
+    }
 }
 
 /// Builds a method.

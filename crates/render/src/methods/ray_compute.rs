@@ -111,4 +111,8 @@ impl Method for RayCompute {
             cpu: 0,
         }
     }
+
+    fn depth_image(&self) -> Option<&wgpu::Texture> {
+        Some(self.depth.texture())
+    }
 }

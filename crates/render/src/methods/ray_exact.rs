@@ -644,6 +644,13 @@ impl Method for RayExact {
             cpu: 0,
         }
     }
+
+    fn depth_image(&self) -> Option<&wgpu::Texture> {
+        match &self.variant {
+            Variant::Compute { depth, .. } => Some(depth.texture()),
+            Variant::Fragment(_) => None,
+        }
+    }
 }
 
 impl Drop for RayExact {

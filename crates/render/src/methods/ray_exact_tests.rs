@@ -620,6 +620,7 @@ fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
                 camera: &camera,
                 timer: &timer,
                 index: index as u64,
+                depth_attachment: true,
             };
             let mut encoder = shared.device.create_command_encoder(&Default::default());
             assert!(m.record_shadow_map(&shared, &frame, &mut encoder));

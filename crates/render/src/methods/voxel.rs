@@ -305,6 +305,10 @@ impl Method for Voxel {
             cpu: 0,
         }
     }
+
+    fn depth_image(&self) -> Option<&wgpu::Texture> {
+        self.compute.as_ref().map(|c| c.depth.texture())
+    }
 }
 
 #[cfg(test)]

@@ -287,6 +287,8 @@ impl Viewer {
         )?;
         // A still camera (or the second side of an A/B pair) keeps its shadow map.
         renderer.set_shadow_reuse(true);
+        // The physics bodies draw over Strata's depth target with the depth test.
+        renderer.set_depth_attachment(true);
         let compositor = Compositor::new(renderer.shared(), window_size, config.format)?;
         let passes = PassTimer::new(&gpu.device, &gpu.queue, gpu.report.timestamps);
         let mut overlay = Overlay::new(&window, &gpu.device, WINDOW_FORMAT);
