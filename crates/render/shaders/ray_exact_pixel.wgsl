@@ -1,7 +1,10 @@
 // One pixel of `ray-exact` / `ray-exact-fragment`: the exact march of the
 // camera ray, relative to the eye's 256-texel tile, shaded with the shared
 // `shade_column` at the column the march found (a wall hit lies exactly on the
-// column's side, where `floor(p)` could name the neighbour).
+// column's side, where `floor(p)` could name the neighbour). The march and the
+// shading are separate functions so the deferred frame
+// (`ray_exact_deferred.wgsl`) can run them in two passes with the shadow map
+// cast in between, and get the same colour bit for bit.
 #include "frame.wgsl"
 #include "surface.wgsl"
 #include "shading.wgsl"
@@ -15,24 +18,43 @@ struct ExactPixel {
     capped: bool,
 }
 
-fn exact_pixel(px: f32, py: f32) -> ExactPixel {
+// The march of pixel (px, py): the hit (its `t` along `camera_ray`, column
+// absolute) or a miss.
+fn exact_pixel_hit(px: f32, py: f32) -> ExactHit {
     let eye = globals.eye.xyz;
     let d = camera_ray(px, py);
     let focal = globals.eye.w;
     let seg = exact_clip(eye, d, globals.forward.w / focal, globals.right.w / focal);
     let base = exact_base(eye.xy);
     let o = vec3<f32>(eye.xy - vec2<f32>(base), eye.z);
-    let h = exact_march(o, base, d, seg.x, seg.y);
+    return exact_march(o, base, d, seg.x, seg.y);
+}
+
+// Colour and depth of pixel (px, py) whose ray hit column `column` at `t`.
+fn exact_pixel_shade(px: f32, py: f32, t: f32, column: vec2<i32>) -> ExactPixel {
+    let d = camera_ray(px, py);
+    let p = globals.eye.xyz + d * t;
     var out: ExactPixel;
+    out.color = vec4<f32>(shade_column(p, column.x, column.y, d), 1.0);
+    out.depth = view_z_to_depth(t * globals.eye.w);
+    return out;
+}
+
+// The sky's colour and depth.
+fn exact_pixel_sky() -> ExactPixel {
+    var out: ExactPixel;
+    out.color = vec4<f32>(globals.sky.rgb, 1.0);
+    out.depth = 1.0;
+    return out;
+}
+
+fn exact_pixel(px: f32, py: f32) -> ExactPixel {
+    let h = exact_pixel_hit(px, py);
+    var out = exact_pixel_sky();
+    if (h.hit) {
+        out = exact_pixel_shade(px, py, h.t, h.column);
+    }
     out.iterations = h.iterations;
     out.capped = h.capped;
-    if (!h.hit) {
-        out.color = vec4<f32>(globals.sky.rgb, 1.0);
-        out.depth = 1.0;
-        return out;
-    }
-    let p = eye + d * h.t;
-    out.color = vec4<f32>(shade_column(p, h.column.x, h.column.y, d), 1.0);
-    out.depth = view_z_to_depth(h.t * focal);
     return out;
 }

@@ -450,7 +450,9 @@ impl Renderer {
             if !method.record_shadow_map(&self.shared, &frame, &mut encoder) {
                 self.shadow.record(&mut encoder, &self.timer);
             }
-            self.shadow_drawn = Some(shadow);
+            // A map cast only where this method's pixels sample it is not
+            // another method's to reuse.
+            self.shadow_drawn = (!method.shadow_map_is_partial()).then_some(shadow);
         }
         method.record(&self.shared, &frame, &mut encoder);
         self.timer.resolve(&mut encoder);

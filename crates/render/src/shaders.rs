@@ -87,6 +87,10 @@ pub const SOURCES: &[(&str, &str)] = &[
         include_str!("../shaders/ray_exact_shadow.wgsl"),
     ),
     (
+        "ray_exact_deferred.wgsl",
+        include_str!("../shaders/ray_exact_deferred.wgsl"),
+    ),
+    (
         "ray_exact_depth.wgsl",
         include_str!("../shaders/ray_exact_depth.wgsl"),
     ),
@@ -121,6 +125,7 @@ pub const ENTRY_SHADERS: &[&str] = &[
     "ray_exact.wgsl",
     "ray_exact_fragment.wgsl",
     "ray_exact_shadow.wgsl",
+    "ray_exact_deferred.wgsl",
     "ray_exact_depth.wgsl",
     "ray_exact_build.wgsl",
     "ray_exact_test.wgsl",

@@ -11,14 +11,32 @@ fn every_pass_is_timed() {
     let level = common::synthetic_level();
     let view = strata_level::ViewSpec::parse("v", "128,100:10:60", -30.0).unwrap();
     let camera = Camera::from_view(&level, &view, 160, 100).unwrap();
-    for (method, shadows, want) in [
-        ("ray", true, vec!["shadow", "ray"]),
-        ("ray", false, vec!["ray"]),
+    for (method, shadows, depth_attachment, want) in [
+        ("ray", true, false, vec!["shadow", "ray"]),
+        ("ray", false, false, vec!["ray"]),
+        // The compute march copies its depth image into the shared depth
+        // target only when asked.
         (
             "ray-compute",
             true,
+            false,
+            vec!["shadow", "ray-compute march"],
+        ),
+        (
+            "ray-compute",
+            true,
+            true,
             vec!["shadow", "ray-compute march", "ray-compute depth copy"],
         ),
+        // The exact march casts the shadow blocks its hits read between
+        // marching and shading.
+        (
+            "ray-exact",
+            true,
+            false,
+            vec!["ray-exact march", "shadow", "ray-exact shade"],
+        ),
+        ("ray-exact", false, false, vec!["ray-exact march"]),
     ] {
         let settings = MethodSettings {
             shadows,
@@ -34,6 +52,7 @@ fn every_pass_is_timed() {
             100,
         )
         .unwrap();
+        r.set_depth_attachment(depth_attachment);
         let m = r.measure(&camera, 1, 3).unwrap();
         for t in &m.timings {
             eprintln!("{method} shadows={shadows}: {t:?}");

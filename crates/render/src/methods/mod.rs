@@ -219,6 +219,13 @@ pub trait Method: Send {
         false
     }
 
+    /// Whether the shadow map this method fills ([`Method::record_shadow_map`])
+    /// holds only the texels its own pixels sample, so that no other method
+    /// (the viewer's other A/B side) may reuse it. Default: no.
+    fn shadow_map_is_partial(&self) -> bool {
+        false
+    }
+
     /// Record this frame's passes.
     fn record(&self, shared: &Shared, frame: &Frame<'_>, encoder: &mut wgpu::CommandEncoder);
 

@@ -9,15 +9,27 @@
 //! 16384-long wrapping map agrees with the f64 reference.
 //!
 //! `ray-exact` is a compute dispatch (colour into the shared target, depth
-//! into an R32Float image) plus the shared full-screen depth blit, which here
-//! *loads* the depth target instead of clearing it first: the blit writes
-//! every pixel (compare `Always`, sky = 1.0), so the image is the same, and on
-//! the H100 the clear alone cost 0.073 ms of the blit's 0.149. (The method
-//! contract asks the first pass to clear; this is the one deliberate
-//! exception, and `STRATA_EXACT_DEPTH=blit` restores the clear.)
-//! `ray-exact-fragment` is one full-screen fragment pass. Both fill the shared
-//! shadow map with the same march along the light
+//! into an R32Float image, which [`Method::depth_image`] hands to
+//! `Renderer::read_depth`); the shared full-screen depth blit copies it into
+//! the shared depth target only on frames that ask for it
+//! (`Renderer::set_depth_attachment`, `render_into`), and then *loads* the
+//! target instead of clearing it first: the blit writes every pixel (compare
+//! `Always`, sky = 1.0), so the image is the same, and on the H100 the clear
+//! alone cost 0.073 ms of the blit's 0.149. (`STRATA_EXACT_DEPTH=blit`
+//! restores the clear.) `ray-exact-fragment` is one full-screen fragment pass.
+//! Both fill the shared shadow map with the same march along the light
 //! ([`Method::record_shadow_map`]) instead of the renderer's 128-step march.
+//!
+//! On frames that cast the shadow map, `ray-exact` defers its shading
+//! (`ray_exact_deferred.wgsl`): the march writes each pixel's hit (`t` and
+//! column) and lists the 8x8-texel blocks of the map its shading will read;
+//! the shadow pass casts only those blocks (one workgroup each, an indirect
+//! dispatch); a third pass shades every hit exactly as the one-pass march
+//! does. On the default views the visible surface reads 2-17 % of the map
+//! where the view's cover ([`strata_camera::light::ShadowCover`]) holds
+//! 25-86 %. Such a map is the method's own ([`Method::shadow_map_is_partial`]):
+//! no other method reuses it. Frames that reuse a map, or have shadows off,
+//! march and shade in one pass.
 //!
 //! Measuring switches (environment, read at creation; H100 numbers in
 //! `bench/ray-exact.md`): `STRATA_EXACT_SHADOW=shared` keeps the renderer's
@@ -70,13 +82,81 @@ enum Variant {
         march: wgpu::ComputePipeline,
         depth: DepthCopy,
         mode: DepthMode,
+        /// The frame that casts the shadow map between march and shading
+        /// (with the exact shadow map).
+        deferred: Option<Deferred>,
     },
     Fragment(wgpu::RenderPipeline),
 }
 
+/// The compute variant's frame on frames that cast the shadow map
+/// (`ray_exact_deferred.wgsl`): march (hit `t` into the depth image, hit
+/// column into `hits`, the shadow blocks its shading reads stamped), then the
+/// exact shadow pass over the stamped blocks only, then shading. The other
+/// frames (map reused, shadows off) march and shade in one pass.
+struct Deferred {
+    march: wgpu::ComputePipeline,
+    shade: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+    group: wgpu::BindGroup,
+    /// R32Uint: each pixel's hit column relative to the eye's tile.
+    hits: wgpu::TextureView,
+}
+
+/// Side of the shadow map's stamped blocks, texels (`MARK_BLOCK` in
+/// `ray_exact_deferred.wgsl`).
+const MARK_BLOCK: u32 = 8;
+
+/// The deferred frame's record of the shadow blocks its pixels sample: a
+/// stamp per block, the list of blocks stamped this frame, and the shadow
+/// pass's indirect dispatch (one workgroup per listed block).
+struct ShadowMarks {
+    stamps: wgpu::Buffer,
+    list: wgpu::Buffer,
+    dispatch: wgpu::Buffer,
+}
+
+impl ShadowMarks {
+    fn new(device: &wgpu::Device, blocks: u32) -> Self {
+        let buffer = |label: &str, size: u64, usage: wgpu::BufferUsages| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage: wgpu::BufferUsages::STORAGE | usage,
+                mapped_at_creation: false,
+            })
+        };
+        let bytes = u64::from(blocks) * 4;
+        ShadowMarks {
+            stamps: buffer(
+                "ray-exact shadow stamps",
+                bytes,
+                wgpu::BufferUsages::empty(),
+            ),
+            list: buffer(
+                "ray-exact shadow blocks",
+                bytes,
+                wgpu::BufferUsages::empty(),
+            ),
+            dispatch: buffer(
+                "ray-exact shadow dispatch",
+                12,
+                wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
+            ),
+        }
+    }
+
+    fn bytes(&self) -> u64 {
+        self.stamps.size() + self.list.size() + self.dispatch.size()
+    }
+}
+
 /// The exact shadow-map pass.
 struct ExactShadow {
+    /// Every texel of the view's cover.
     pipeline: wgpu::ComputePipeline,
+    /// The deferred frame's listed blocks (indirect).
+    blocks: wgpu::ComputePipeline,
     frame_group: wgpu::BindGroup,
     group: wgpu::BindGroup,
 }
@@ -86,6 +166,13 @@ pub struct RayExact {
     pyramid: GpuMaxMip,
     params: wgpu::Buffer,
     stats: wgpu::Buffer,
+    /// The deferred frame's stamped shadow blocks and their list.
+    marks: ShadowMarks,
+    /// This frame's stamp (`ExactParams::config[2]`), never 0.
+    stamp: u32,
+    /// The renderer asked for the shadow map this frame; the deferred frame
+    /// casts it between march and shading.
+    shadow_due: Cell<bool>,
     layout: wgpu::BindGroupLayout,
     group: wgpu::BindGroup,
     variant: Variant,
@@ -141,7 +228,10 @@ impl ExactOptions {
         depth: DepthMode::BlitLoad,
         exact_shadow: true,
         climb: 1,
-        log_ratio: 1,
+        // Every other level (4^l tiles, as the CPU reference visits them):
+        // the same image in fewer descents. On the H100 with the deferred
+        // frame: 0.198 ms mean against 0.202 visiting every level.
+        log_ratio: 2,
     };
 }
 
@@ -342,7 +432,11 @@ pub fn build(shared: &Shared, level: &Level, options: ExactOptions) -> anyhow::R
     let device = &shared.device;
     let pyramid = GpuMaxMip::new(shared, level)?;
     let table = exact_params(&pyramid.layout);
+    // The deferred frame (compute, exact shadow map) lists shadow blocks.
+    let deferred_frame = compute && options.exact_shadow && shared.caps.compute;
     let params = shared.uniform_buffer("ray-exact params", bytemuck::bytes_of(&table));
+    let blocks = SHADOW_SIZE / MARK_BLOCK;
+    let marks = ShadowMarks::new(device, blocks * blocks);
     let stats = device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("ray-exact stats"),
         size: 16,
@@ -392,6 +486,13 @@ pub fn build(shared: &Shared, level: &Level, options: ExactOptions) -> anyhow::R
                 options,
             )?,
             mode: options.depth,
+            deferred: if deferred_frame {
+                Some(Deferred::new(
+                    shared, &params, &pyramid, &stats, &marks, &depth, options,
+                )?)
+            } else {
+                None
+            },
             depth,
         },
         None => Variant::Fragment(fullscreen_pipeline(
@@ -403,7 +504,9 @@ pub fn build(shared: &Shared, level: &Level, options: ExactOptions) -> anyhow::R
         )?),
     };
     let shadow = if shared.caps.compute && options.exact_shadow {
-        Some(exact_shadow(shared, &params, &pyramid, &stats, options)?)
+        Some(exact_shadow(
+            shared, &params, &pyramid, &stats, &marks, options,
+        )?)
     } else {
         None
     };
@@ -412,6 +515,9 @@ pub fn build(shared: &Shared, level: &Level, options: ExactOptions) -> anyhow::R
         pyramid,
         params,
         stats,
+        marks,
+        stamp: 0,
+        shadow_due: Cell::new(false),
         layout,
         group,
         variant,
@@ -434,6 +540,7 @@ fn exact_shadow(
     params: &wgpu::Buffer,
     pyramid: &GpuMaxMip,
     stats: &wgpu::Buffer,
+    marks: &ShadowMarks,
     options: ExactOptions,
 ) -> anyhow::Result<ExactShadow> {
     let device = &shared.device;
@@ -441,6 +548,11 @@ fn exact_shadow(
         crate::shadow::frame_without_shadow_map(shared, "ray-exact shadow frame");
     let mut entries = core_entries(wgpu::ShaderStages::COMPUTE);
     entries.push(storage_texture_entry(3, wgpu::TextureFormat::R32Float));
+    entries.push(buffer_entry(
+        4,
+        wgpu::ShaderStages::COMPUTE,
+        wgpu::BufferBindingType::Storage { read_only: true },
+    ));
     let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("ray-exact shadow"),
         entries: &entries,
@@ -449,6 +561,10 @@ fn exact_shadow(
     bindings.push(wgpu::BindGroupEntry {
         binding: 3,
         resource: wgpu::BindingResource::TextureView(&shared.shadow_view),
+    });
+    bindings.push(wgpu::BindGroupEntry {
+        binding: 4,
+        resource: marks.list.as_entire_binding(),
     });
     let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("ray-exact shadow"),
@@ -460,19 +576,145 @@ fn exact_shadow(
         bind_group_layouts: &[Some(&frame_layout), Some(&layout)],
         immediate_size: 0,
     });
-    let pipeline = exact_pipeline(
-        shared,
-        "ray-exact shadow",
-        "ray_exact_shadow.wgsl",
-        &pipeline_layout,
-        "cs_exact_shadow",
-        options,
-    )?;
+    let pipeline = |entry: &str| {
+        exact_pipeline(
+            shared,
+            "ray-exact shadow",
+            "ray_exact_shadow.wgsl",
+            &pipeline_layout,
+            entry,
+            options,
+        )
+    };
     Ok(ExactShadow {
-        pipeline,
+        pipeline: pipeline("cs_exact_shadow")?,
+        blocks: pipeline("cs_exact_shadow_blocks")?,
         frame_group,
         group,
     })
+}
+
+/// A read-write storage texture entry (compute).
+fn read_write_texture_entry(
+    binding: u32,
+    format: wgpu::TextureFormat,
+) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::StorageTexture {
+            access: wgpu::StorageTextureAccess::ReadWrite,
+            format,
+            view_dimension: wgpu::TextureViewDimension::D2,
+        },
+        count: None,
+    }
+}
+
+impl Deferred {
+    fn new(
+        shared: &Shared,
+        params: &wgpu::Buffer,
+        pyramid: &GpuMaxMip,
+        stats: &wgpu::Buffer,
+        marks: &ShadowMarks,
+        depth: &DepthCopy,
+        options: ExactOptions,
+    ) -> anyhow::Result<Self> {
+        let device = &shared.device;
+        let mut entries = core_entries(wgpu::ShaderStages::COMPUTE);
+        entries.extend([
+            storage_texture_entry(3, crate::frame::COLOR_FORMAT),
+            read_write_texture_entry(4, wgpu::TextureFormat::R32Float),
+            read_write_texture_entry(5, wgpu::TextureFormat::R32Uint),
+        ]);
+        for binding in 6..=8 {
+            entries.push(buffer_entry(
+                binding,
+                wgpu::ShaderStages::COMPUTE,
+                wgpu::BufferBindingType::Storage { read_only: false },
+            ));
+        }
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("ray-exact deferred"),
+            entries: &entries,
+        });
+        let pipeline_layout = shared.pipeline_layout("ray-exact deferred", &[&layout]);
+        let pipeline = |label: &str, entry: &str| {
+            exact_pipeline(
+                shared,
+                label,
+                "ray_exact_deferred.wgsl",
+                &pipeline_layout,
+                entry,
+                options,
+            )
+        };
+        let march = pipeline("ray-exact march", "cs_exact_march_hits")?;
+        let shade = pipeline("ray-exact shade", "cs_exact_shade")?;
+        let hits = hits_image(shared);
+        let group = Self::group(
+            shared,
+            &layout,
+            (params, pyramid, stats, marks),
+            depth,
+            &hits,
+        );
+        Ok(Deferred {
+            march,
+            shade,
+            layout,
+            group,
+            hits,
+        })
+    }
+
+    fn group(
+        shared: &Shared,
+        layout: &wgpu::BindGroupLayout,
+        (params, pyramid, stats, marks): (&wgpu::Buffer, &GpuMaxMip, &wgpu::Buffer, &ShadowMarks),
+        depth: &DepthCopy,
+        hits: &wgpu::TextureView,
+    ) -> wgpu::BindGroup {
+        let mut entries = core_bindings(params, pyramid, stats);
+        entries.extend(depth.bindings(shared, 3));
+        entries.push(wgpu::BindGroupEntry {
+            binding: 5,
+            resource: wgpu::BindingResource::TextureView(hits),
+        });
+        for (binding, buffer) in [(6, &marks.stamps), (7, &marks.list), (8, &marks.dispatch)] {
+            entries.push(wgpu::BindGroupEntry {
+                binding,
+                resource: buffer.as_entire_binding(),
+            });
+        }
+        shared.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("ray-exact deferred"),
+            layout,
+            entries: &entries,
+        })
+    }
+}
+
+/// The deferred frame's per-pixel hit columns: R32Uint at the targets' size.
+fn hits_image(shared: &Shared) -> wgpu::TextureView {
+    shared
+        .device
+        .create_texture(&wgpu::TextureDescriptor {
+            label: Some("ray-exact hits"),
+            size: wgpu::Extent3d {
+                width: shared.width,
+                height: shared.height,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::R32Uint,
+            usage: wgpu::TextureUsages::STORAGE_BINDING,
+            view_formats: &[],
+        })
+        .create_view(&Default::default())
 }
 
 impl RayExact {
@@ -509,6 +751,32 @@ impl RayExact {
             let _ = timer;
         }
         Ok(())
+    }
+
+    /// The exact shadow pass: every texel of the view's cover, or (`listed`,
+    /// the deferred frame) the blocks its march listed.
+    fn record_shadow_pass(
+        &self,
+        frame: &Frame<'_>,
+        encoder: &mut wgpu::CommandEncoder,
+        listed: bool,
+    ) {
+        let Some(shadow) = &self.shadow else {
+            return;
+        };
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("ray-exact shadow"),
+            timestamp_writes: frame.timer.compute("shadow"),
+        });
+        pass.set_bind_group(0, &shadow.frame_group, &[]);
+        pass.set_bind_group(1, &shadow.group, &[]);
+        if listed {
+            pass.set_pipeline(&shadow.blocks);
+            pass.dispatch_workgroups_indirect(&self.marks.dispatch, 0);
+        } else {
+            pass.set_pipeline(&shadow.pipeline);
+            pass.dispatch_workgroups(SHADOW_SIZE.div_ceil(8), SHADOW_SIZE.div_ceil(8), 1);
+        }
     }
 
     /// Record the queued pyramid update once per frame, before anything reads it.
@@ -550,8 +818,16 @@ impl Method for RayExact {
     }
 
     fn resize(&mut self, shared: &Shared) -> anyhow::Result<()> {
-        if let Variant::Compute { depth, .. } = &mut self.variant {
+        if let Variant::Compute {
+            depth, deferred, ..
+        } = &mut self.variant
+        {
             depth.resize(shared);
+            if let Some(d) = deferred {
+                d.hits = hits_image(shared);
+                let buffers = (&self.params, &self.pyramid, &self.stats, &self.marks);
+                d.group = Deferred::group(shared, &d.layout, buffers, depth, &d.hits);
+            }
             self.group = march_group(
                 shared,
                 &self.layout,
@@ -568,43 +844,81 @@ impl Method for RayExact {
         self.read_update_time()?;
         self.pyramid.prepare(shared);
         self.updated.set(false);
+        self.shadow_due.set(false);
+        // A new stamp each frame: last frame's marks no longer count.
+        self.stamp = self.stamp.wrapping_add(1).max(1);
+        shared
+            .queue
+            .write_buffer(&self.params, 8, bytemuck::bytes_of(&self.stamp));
+        // No block listed yet: the march lists them and the shadow pass
+        // dispatches one workgroup per listed block.
+        shared
+            .queue
+            .write_buffer(&self.marks.dispatch, 0, bytemuck::cast_slice(&[0u32, 1, 1]));
         Ok(())
     }
 
     fn record_shadow_map(
         &self,
-        shared: &Shared,
+        _shared: &Shared,
         frame: &Frame<'_>,
         encoder: &mut wgpu::CommandEncoder,
     ) -> bool {
-        let Some(shadow) = &self.shadow else {
+        if self.shadow.is_none() {
             return false;
-        };
-        let _ = shared;
+        }
         self.record_update(frame, encoder);
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("ray-exact shadow"),
-            timestamp_writes: frame.timer.compute("shadow"),
-        });
-        pass.set_pipeline(&shadow.pipeline);
-        pass.set_bind_group(0, &shadow.frame_group, &[]);
-        pass.set_bind_group(1, &shadow.group, &[]);
-        pass.dispatch_workgroups(SHADOW_SIZE.div_ceil(8), SHADOW_SIZE.div_ceil(8), 1);
+        if matches!(
+            &self.variant,
+            Variant::Compute {
+                deferred: Some(_),
+                ..
+            }
+        ) {
+            // Cast in `record`, between the march and the shading.
+            self.shadow_due.set(true);
+        } else {
+            self.record_shadow_pass(frame, encoder, false);
+        }
         true
+    }
+
+    fn shadow_map_is_partial(&self) -> bool {
+        matches!(
+            &self.variant,
+            Variant::Compute {
+                deferred: Some(_),
+                ..
+            }
+        )
     }
 
     fn record(&self, shared: &Shared, frame: &Frame<'_>, encoder: &mut wgpu::CommandEncoder) {
         self.record_update(frame, encoder);
         match &self.variant {
-            Variant::Compute { march, depth, mode } => {
-                dispatch_per_pixel(
-                    shared,
-                    frame,
-                    encoder,
-                    "ray-exact march",
-                    march,
-                    &self.group,
-                );
+            Variant::Compute {
+                march,
+                depth,
+                mode,
+                deferred,
+            } => {
+                match (deferred, self.shadow_due.replace(false)) {
+                    (Some(d), true) => {
+                        let label = "ray-exact march";
+                        dispatch_per_pixel(shared, frame, encoder, label, &d.march, &d.group);
+                        self.record_shadow_pass(frame, encoder, true);
+                        let label = "ray-exact shade";
+                        dispatch_per_pixel(shared, frame, encoder, label, &d.shade, &d.group);
+                    }
+                    _ => dispatch_per_pixel(
+                        shared,
+                        frame,
+                        encoder,
+                        "ray-exact march",
+                        march,
+                        &self.group,
+                    ),
+                }
                 let label = "ray-exact depth";
                 match mode {
                     DepthMode::Blit => {
@@ -633,8 +947,14 @@ impl Method for RayExact {
 
     fn retained_bytes(&self) -> RetainedBytes {
         let depth = match &self.variant {
-            Variant::Compute { depth, .. } => depth.bytes(),
-            Variant::Fragment(_) => 0,
+            Variant::Compute {
+                depth, deferred, ..
+            } => {
+                // The hit image: 4 bytes per pixel, as the depth image.
+                let hits = deferred.as_ref().map_or(0, |_| depth.bytes());
+                depth.bytes() + hits + self.marks.bytes()
+            }
+            Variant::Fragment(_) => self.marks.bytes(),
         };
         RetainedBytes {
             gpu: self.pyramid.gpu_bytes()

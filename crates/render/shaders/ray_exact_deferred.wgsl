@@ -1,0 +1,136 @@
+// `ray-exact`'s frame when it casts the shadow map: march, then cast only the
+// shadow texels its hits sample, then shade. (Casting the map first, as the
+// other methods' frames do, casts every texel the view's frustum could
+// sample: on the default views 25-86 % of the map, where the visible surface
+// samples 2-17 %.)
+//
+// 1. `cs_exact_march_hits`: the exact march per pixel; writes the hit's `t`
+//    into `depth_io`, its column (relative to the eye's 256-texel tile) into
+//    `hits`, and stamps the 8x8-texel blocks of the shadow map its shading
+//    can read in `shadow_marks`.
+// 2. `ray_exact_shadow.wgsl` casts the texels of stamped blocks.
+// 3. `cs_exact_shade`: shades each hit exactly as the one-pass march does
+//    (`exact_pixel_shade`: same `t`, same column) and replaces `t` by the
+//    depth-buffer value in `depth_io`.
+#include "frame.wgsl"
+#include "surface.wgsl"
+#include "shading.wgsl"
+#include "ray_core.wgsl"
+#include "ray_exact_core.wgsl"
+#include "ray_exact_pixel.wgsl"
+
+@group(1) @binding(3) var color_out: texture_storage_2d<rgba8unorm, write>;
+// The hit's t after the march, the depth-buffer value after the shading.
+@group(1) @binding(4) var depth_io: texture_storage_2d<r32float, read_write>;
+// The hit column relative to the eye's tile, x and y + 32768 in 16 bits
+// each; HIT_NONE for the sky.
+@group(1) @binding(5) var hits: texture_storage_2d<r32uint, read_write>;
+// One stamp per 8x8-texel block of the shadow map: `xparams.config.z` when a
+// pixel of this frame may sample the block.
+@group(1) @binding(6) var<storage, read_write> shadow_marks: array<atomic<u32>>;
+// The blocks stamped this frame, in the order they were first stamped.
+@group(1) @binding(7) var<storage, read_write> shadow_blocks: array<u32>;
+// The shadow pass's indirect dispatch: x the number of listed blocks (0 at
+// the frame's start), y and z 1.
+@group(1) @binding(8) var<storage, read_write> shadow_dispatch: array<atomic<u32>, 3>;
+
+const HIT_NONE: u32 = 0xffffffffu;
+const MARK_BLOCK: i32 = 8;
+
+var<workgroup> group_most: atomic<u32>;
+
+// Stamp the shadow-map blocks shading point `p` can read: `shadow_factor`
+// moves the point up to 1.5 texels along its normal, then reads the 2x2 texels
+// around it less half a texel, so every tap lies within 2 texels of p's own
+// map coordinates (2.5 here, for rounding).
+fn mark_shadow_blocks(p: vec3<f32>) {
+    let texel = globals.shadow_origin.w;
+    let rel = p - globals.shadow_origin.xyz;
+    let uv = vec2<f32>(dot(rel, globals.shadow_u.xyz), dot(rel, globals.shadow_v.xyz)) / texel;
+    let side = i32(globals.shadow_u.w);
+    let lo = vec2<i32>(floor(uv - vec2<f32>(2.5)));
+    let hi = vec2<i32>(floor(uv + vec2<f32>(2.5)));
+    if (any(hi < vec2<i32>(0)) || any(lo >= vec2<i32>(side))) {
+        // Off the map: shading reads nothing (taps outside are lit).
+        return;
+    }
+    let blocks = side / MARK_BLOCK;
+    let b0 = clamp(lo, vec2<i32>(0), vec2<i32>(side - 1)) / MARK_BLOCK;
+    let b1 = clamp(hi, vec2<i32>(0), vec2<i32>(side - 1)) / MARK_BLOCK;
+    for (var by = b0.y; by <= b1.y; by = by + 1) {
+        for (var bx = b0.x; bx <= b1.x; bx = bx + 1) {
+            // Most pixels of a block find it stamped: read before the
+            // exchange; the one exchange that changes the stamp lists it.
+            let i = u32(by * blocks + bx);
+            let stamp = xparams.config.z;
+            if (atomicLoad(&shadow_marks[i]) != stamp && atomicExchange(&shadow_marks[i], stamp) != stamp) {
+                shadow_blocks[atomicAdd(&shadow_dispatch[0], 1u)] = i;
+            }
+        }
+    }
+}
+
+// Casting the whole map (`ShadowCover` of every texel, how the tests check the
+// stamps are enough): list every block, pixel `flat` of `pixels` taking every
+// `pixels`-th.
+fn list_every_block(flat: u32, pixels: u32) {
+    let side = u32(globals.shadow_u.w) / 8u;
+    let count = side * side;
+    for (var k = flat; k < count; k = k + pixels) {
+        shadow_blocks[k] = k;
+    }
+    if (flat == 0u) {
+        atomicStore(&shadow_dispatch[0], count);
+    }
+}
+
+@compute @workgroup_size(8, 8, 1)
+fn cs_exact_march_hits(
+    @builtin(global_invocation_id) id: vec3<u32>,
+    @builtin(local_invocation_index) li: u32,
+) {
+    let size = vec2<u32>(globals.screen.xy);
+    if (all(id.xy < size)) {
+        let h = exact_pixel_hit(f32(id.x) + 0.5, f32(id.y) + 0.5);
+        var packed = HIT_NONE;
+        if (h.hit) {
+            let rel = h.column - exact_base(globals.eye.xy) + vec2<i32>(32768);
+            packed = u32(rel.x) | (u32(rel.y) << 16u);
+            textureStore(depth_io, id.xy, vec4<f32>(h.t, 0.0, 0.0, 0.0));
+            if (globals.light_dir.w != 0.0 && globals.shadow_cover_count.x != 0u) {
+                let d = camera_ray(f32(id.x) + 0.5, f32(id.y) + 0.5);
+                mark_shadow_blocks(globals.eye.xyz + d * h.t);
+            }
+        }
+        textureStore(hits, id.xy, vec4<u32>(packed, 0u, 0u, 0u));
+        if (globals.shadow_cover_count.x == 0u) {
+            list_every_block(id.y * size.x + id.x, size.x * size.y);
+        }
+        if (h.capped) {
+            atomicAdd(&xstats[0], 1u);
+        }
+        atomicMax(&group_most, h.iterations);
+    }
+    workgroupBarrier();
+    if (li == 0u) {
+        atomicMax(&xstats[1], atomicLoad(&group_most));
+    }
+}
+
+@compute @workgroup_size(8, 8, 1)
+fn cs_exact_shade(@builtin(global_invocation_id) id: vec3<u32>) {
+    let size = vec2<u32>(globals.screen.xy);
+    if (any(id.xy >= size)) {
+        return;
+    }
+    let packed = textureLoad(hits, id.xy).x;
+    var s = exact_pixel_sky();
+    if (packed != HIT_NONE) {
+        let rel = vec2<i32>(vec2<u32>(packed & 0xffffu, packed >> 16u)) - vec2<i32>(32768);
+        let column = exact_base(globals.eye.xy) + rel;
+        let t = textureLoad(depth_io, id.xy).x;
+        s = exact_pixel_shade(f32(id.x) + 0.5, f32(id.y) + 0.5, t, column);
+    }
+    textureStore(color_out, id.xy, s.color);
+    textureStore(depth_io, id.xy, vec4<f32>(s.depth, 0.0, 0.0, 0.0));
+}
