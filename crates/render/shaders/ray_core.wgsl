@@ -122,16 +122,32 @@ fn z_span_meets_solid(c: Column, z0: f32, z1: f32) -> bool {
     return lo <= c.low || (c.dual && lo <= c.high && c.mid <= hi);
 }
 
-// How far (in t) o + t d runs from p inside p's texel: backwards to the
-// texel's entry (x) and forwards to its exit (y); 3e38 along a ray with no
-// horizontal motion.
-fn texel_run(p: vec2<f32>, d: vec2<f32>) -> vec2<f32> {
-    let f = p - floor(p);
+// How far (in t) o + t d runs from a point inside the point's texel,
+// backwards to the texel's entry and forwards to its exit, as one multiply-add
+// per axis on the point's fraction of a texel: per axis, back = f s + back0
+// and forward = fwd0 - f s (3e38 on an axis the ray does not move along).
+struct TexelRun {
+    s: vec2<f32>,
+    back0: vec2<f32>,
+    fwd0: vec2<f32>,
+}
+
+fn texel_run_of(d: vec2<f32>) -> TexelRun {
     let pos = d > vec2<f32>(0.0);
     let still = d == vec2<f32>(0.0);
     let inv = select(vec2<f32>(1.0) / abs(d), vec2<f32>(0.0), still);
-    let back = select(select(vec2<f32>(1.0) - f, f, pos) * inv, vec2<f32>(3.0e38), still);
-    let fwd = select(select(f, vec2<f32>(1.0) - f, pos) * inv, vec2<f32>(3.0e38), still);
+    var r: TexelRun;
+    r.s = select(-inv, inv, pos);
+    r.back0 = select(select(inv, vec2<f32>(0.0), pos), vec2<f32>(3.0e38), still);
+    r.fwd0 = select(select(vec2<f32>(0.0), inv, pos), vec2<f32>(3.0e38), still);
+    return r;
+}
+
+// x: back to the entry of p's texel, y: on to its exit.
+fn texel_run(r: TexelRun, p: vec2<f32>) -> vec2<f32> {
+    let fs = (p - floor(p)) * r.s;
+    let back = fs + r.back0;
+    let fwd = r.fwd0 - fs;
     return vec2<f32>(min(back.x, back.y), min(fwd.x, fwd.y));
 }
 
@@ -178,25 +194,27 @@ fn march(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, steps: u32) -> MarchHit {
     let dt = (t1 - t0) / f32(n);
     var a = t0;
     // The previous sample's z and how far the ray runs on inside its texel.
+    let runs = texel_run_of(d.xy);
     var prev_z = p0.z;
-    var prev_exit = texel_run(p0.xy, d.xy).y;
+    var prev_exit = texel_run(runs, p0.xy).y;
     for (var i = 1u; i <= n; i = i + 1u) {
         let t = t0 + dt * f32(i);
         let p = o + d * t;
         let c = decode_column(i32(floor(p.x)), i32(floor(p.y)));
-        let solid = column_is_solid(c, p.z);
-        let run = texel_run(p.xy, d.xy);
-        var flag = solid;
+        let run = texel_run(runs, p.xy);
+        var flag: bool;
         if (SEGMENT_STEP_TEST) {
-            // The step's piece in this column: from its entry (or sample i - 1) to p;
-            // and in the previous column: from sample i - 1 to its exit (or p).
+            // The step's piece in this column: from its entry (or sample i - 1)
+            // to p, which holds the point test; and in the previous column:
+            // from sample i - 1 to its exit (or p).
             let z_in = p.z - d.z * min(run.x, dt);
             let z_out = prev_z + d.z * min(prev_exit, dt);
-            flag = flag || z_span_meets_solid(c, z_in, p.z)
-                || z_span_meets_solid(prev, prev_z, z_out);
+            flag = z_span_meets_solid(c, z_in, p.z) || z_span_meets_solid(prev, prev_z, z_out);
+        } else {
+            flag = column_is_solid(c, p.z);
         }
         if (flag) {
-            let r = refine_exact(o, d, a, t, solid);
+            let r = refine_exact(o, d, a, t, column_is_solid(c, p.z));
             if (r.hit) {
                 return r;
             }
