@@ -10,6 +10,7 @@
 #include "ray_core.wgsl"
 #include "fullscreen.wgsl"
 
+// The camera ray's march and step test (`ray_core.wgsl::march`), 128 steps.
 const SHADOW_STEPS: u32 = 128u;
 const SHADOW_MISS: f32 = 1e9;
 

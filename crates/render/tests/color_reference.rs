@@ -87,11 +87,14 @@ fn gpu_shadow_map_and_shading_match_the_cpu_colour_reference() {
             view.name, frame.bias
         );
         // The 128-step march (2.4-unit steps along the light) skips thin
-        // casters and terrace lips the exact tracer finds (seen: up to 2.8 %
-        // of texels, all of them longer on the GPU); a wrong frame, axis or
-        // texel centre would put most texels off, or some early.
+        // casters and terrace lips in the columns strictly between two
+        // samples, which the exact tracer finds (seen: 1.43 to 1.63 % of
+        // texels with the segment step test, 1.94 to 2.17 % with the paper's
+        // point test, which this bound fails; all of them longer on the GPU);
+        // a wrong frame, axis or texel centre would put most texels off, or
+        // some early.
         assert!(
-            off_pct < 5.0,
+            off_pct < 1.8,
             "{}: {off_pct} % of shadow texels off",
             view.name
         );
