@@ -69,13 +69,17 @@ fn gpu_shadow_map_and_shading_match_the_cpu_colour_reference() {
         let frame = ShadowFrame::fit(&camera, true);
         let cpu = ShadowMap::cast(&tracer, &frame);
         // A texel agrees when the march's depth is within the map's own bias
-        // (a texel plus the bisection's half unit) of the exact depth.
-        let off = gpu_map
+        // (a texel plus the bisection's half unit) of the exact depth. Both
+        // hold a miss outside the view's cover: count the texels cast.
+        let side = cpu.side as usize;
+        let cast: Vec<usize> = (0..gpu_map.len())
+            .filter(|&k| frame.casts((k % side) as u32, (k / side) as u32))
+            .collect();
+        let off = cast
             .iter()
-            .zip(&cpu.depth)
-            .filter(|(g, c)| (*g - *c).abs() > frame.bias)
+            .filter(|&&k| (gpu_map[k] - cpu.depth[k]).abs() > frame.bias)
             .count();
-        let off_pct = 100.0 * off as f64 / gpu_map.len() as f64;
+        let off_pct = 100.0 * off as f64 / cast.len().max(1) as f64;
         // The march can only find a caster late or miss it, never early.
         let early = gpu_map
             .iter()
@@ -83,18 +87,19 @@ fn gpu_shadow_map_and_shading_match_the_cpu_colour_reference() {
             .filter(|(g, c)| *c - *g > frame.bias)
             .count();
         eprintln!(
-            "{}: marched shadow map vs exact CPU twin: {off_pct:.3} % of texels off by more than the bias {:.2}",
-            view.name, frame.bias
+            "{}: marched shadow map vs exact CPU twin: {off_pct:.3} % of the {} texels cast off by more than the bias {:.2}",
+            view.name,
+            cast.len(),
+            frame.bias
         );
         // The 128-step march (2.4-unit steps along the light) skips thin
         // casters and terrace lips in the columns strictly between two
-        // samples, which the exact tracer finds (seen: 1.43 to 1.63 % of
-        // texels with the segment step test, 1.94 to 2.17 % with the paper's
-        // point test, which this bound fails; all of them longer on the GPU);
-        // a wrong frame, axis or texel centre would put most texels off, or
-        // some early.
+        // samples, which the exact tracer finds (seen with the segment step
+        // test, over the texels cast: 1.57 to 2.36 %, all of them longer on
+        // the GPU); a wrong frame, axis or texel centre would put most texels
+        // off, or some early.
         assert!(
-            off_pct < 1.8,
+            off_pct < 3.0,
             "{}: {off_pct} % of shadow texels off",
             view.name
         );

@@ -80,11 +80,12 @@ pub struct ExactStats {
 enum Variant {
     Compute {
         march: wgpu::ComputePipeline,
-        depth: DepthCopy,
+        /// Boxed: the variants stay of like size.
+        depth: Box<DepthCopy>,
         mode: DepthMode,
         /// The frame that casts the shadow map between march and shading
         /// (with the exact shadow map).
-        deferred: Option<Deferred>,
+        deferred: Option<Box<Deferred>>,
     },
     Fragment(wgpu::RenderPipeline),
 }
@@ -487,13 +488,13 @@ pub fn build(shared: &Shared, level: &Level, options: ExactOptions) -> anyhow::R
             )?,
             mode: options.depth,
             deferred: if deferred_frame {
-                Some(Deferred::new(
+                Some(Box::new(Deferred::new(
                     shared, &params, &pyramid, &stats, &marks, &depth, options,
-                )?)
+                )?))
             } else {
                 None
             },
-            depth,
+            depth: Box::new(depth),
         },
         None => Variant::Fragment(fullscreen_pipeline(
             shared,
