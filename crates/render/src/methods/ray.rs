@@ -1,5 +1,9 @@
 //! `ray`: the paper's height-field march (§3.1) as one full-screen fragment
-//! pass over the shared WGSL core (`ray_core.wgsl::ray_pixel`).
+//! pass over the shared WGSL core (`ray_core.wgsl::ray_pixel`). A ray takes
+//! `ray_steps` uniform samples, one column decode each; a step is flagged for
+//! the exact walk when the ray's piece of it in the column under either of
+//! its samples meets that column's floor or slab (`ray_core.wgsl::march`),
+//! where the paper tests only the sample point.
 
 use super::common::{draw_fullscreen, fullscreen_pipeline, uniform_binding};
 use super::{Frame, Method, MethodSettings, RetainedBytes};
