@@ -10,6 +10,9 @@
 //! vertices by the class of their sample (single or dual, on the outline or
 //! not); then the census of the outline itself.
 
+// Parallel per-class and per-cause tables, indexed together.
+#![allow(clippy::needless_range_loop)]
+
 use rayon::prelude::*;
 use strata_level::Level;
 use strata_level::generate::{GenerateParams, Knobs, generate_with};
@@ -244,6 +247,11 @@ fn main() {
                 metas[i + 1] &= !strata_level::model::META_DOUBLE_LEVEL;
             }
         }
-        census(&floor, tol, FitOptions::default(), "floor alone (low of every column, plain fit)");
+        census(
+            &floor,
+            tol,
+            FitOptions::default(),
+            "floor alone (low of every column, plain fit)",
+        );
     }
 }
