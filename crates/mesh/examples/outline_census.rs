@@ -67,7 +67,7 @@ fn census(level: &Level, tol: f64, options: FitOptions, name: &str) {
     rayon::broadcast(|_| ());
     let cpu0 = process_cpu_seconds().unwrap_or(0.0);
     let t0 = std::time::Instant::now();
-    let per: Vec<([u64; 4], [u64; 4])> = (0..layout.count())
+    let per: Vec<([u64; 4], [u64; 4], u64)> = (0..layout.count())
         .into_par_iter()
         .map_init(
             || (ChunkFitter::default(), ChunkSamples::default()),
@@ -85,7 +85,15 @@ fn census(level: &Level, tol: f64, options: FitOptions, name: &str) {
                         samples[class(s, x, y)] += 1;
                     }
                 }
-                (verts, samples)
+                let tr = f.triangulation();
+                let mut bad = tr.delaunay_violations() as u64;
+                if !tr.is_consistent() {
+                    bad += 1 << 32;
+                }
+                if options.outline {
+                    bad += f.floor_triangulation().delaunay_violations() as u64;
+                }
+                (verts, samples, bad)
             },
         )
         .collect();
@@ -93,7 +101,8 @@ fn census(level: &Level, tol: f64, options: FitOptions, name: &str) {
     let cpu = process_cpu_seconds().unwrap_or(0.0) - cpu0;
     let mut verts = [0u64; 4];
     let mut samples = [0u64; 4];
-    for (v, s) in &per {
+    let bad: u64 = per.iter().map(|p| p.2).sum();
+    for (v, s, _) in &per {
         for k in 0..4 {
             verts[k] += v[k];
             samples[k] += s[k];
@@ -145,6 +154,9 @@ fn census(level: &Level, tol: f64, options: FitOptions, name: &str) {
         );
     }
     println!("  samples by class (chunk-local, each texel once): {samples:?}");
+    println!(
+        "  non-Delaunay edges off the constraints (both triangulations), + 2^32 per inconsistent one: {bad}"
+    );
 }
 
 /// The outline itself on the texel grid: runs of dual samples per row and

@@ -390,10 +390,13 @@ fn scan_slab_generic(
         return (0, i64::from(den), 0);
     }
     let bbox = [x0, y0, x1, y1];
-    let (best, at) = if slab && duals_in as i32 == (x1 - x0 + 1) * (y1 - y0 + 1) {
+    let area = (x1 - x0 + 1) * (y1 - y0 + 1);
+    let covered = [0, 1, 2].map(|k| duals[(k + 1) % 3] && duals[(k + 2) % 3]);
+    let (best, at) = if area <= SMALL {
+        scan_slab_small(pts, zs, den, slab, covered, bbox, chunk)
+    } else if slab && duals_in as i32 == area {
         scan_rows::<2>(pts, zs, den, bbox, chunk)
     } else {
-        let covered = [0, 1, 2].map(|k| duals[(k + 1) % 3] && duals[(k + 2) % 3]);
         scan_slab_spans(pts, zs, den, slab, covered, bbox, chunk)
     };
     (i64::from(best), i64::from(den), at)
@@ -423,6 +426,48 @@ pub fn slab_error(
     } else {
         (i32::from(s.z[2]) - i32::from(s.z[0])) * den
     }
+}
+
+/// [`scan_slab`] over a small bounding box, sample by sample.
+#[inline(always)]
+fn scan_slab_small(
+    pts: [Pt; 3],
+    zs: [[u8; 3]; 3],
+    den: i32,
+    slab: bool,
+    covered: [bool; 3],
+    bbox: [i32; 4],
+    chunk: &ChunkSamples,
+) -> (i32, u32) {
+    let [a, b, c] = pts;
+    let [x0, y0, x1, y1] = bbox;
+    let stride = chunk.stride();
+    let (dx, dy) = edge_steps(pts);
+    let mut w_row = barycentric(a, b, c, [x0, y0]);
+    let mut best = (0i32, 0u32);
+    for y in y0..=y1 {
+        let mut w = w_row;
+        let row = y as usize * stride;
+        for x in x0..=x1 {
+            if (w[0] | w[1] | w[2]) >= 0 {
+                let i = row + x as usize;
+                let s = &chunk.samples[i];
+                if slab || s.dual() {
+                    let e = slab_error(w, den, zs, s, slab, covered);
+                    if e > best.0 {
+                        best = (e, i as u32);
+                    }
+                }
+            }
+            for k in 0..3 {
+                w[k] += dx[k];
+            }
+        }
+        for k in 0..3 {
+            w_row[k] += dy[k];
+        }
+    }
+    best
 }
 
 /// [`scan_slab`] where both classes are in the bounding box: row by row over

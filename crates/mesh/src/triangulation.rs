@@ -302,13 +302,21 @@ impl Triangulation {
     /// circumcircle, which lowers the lifted triangulation: it terminates,
     /// and leaves every edge but the constraints locally Delaunay.
     fn legalize_constrained(&mut self) {
-        // Every edge of the new fan: besides those opposite the new point,
-        // a split edge's halves face new vertices across a constraint that
-        // may not have been Delaunay.
+        // The edges opposite the new point, and where it split an edge,
+        // that edge's two halves: they face new vertices across what may
+        // have been a constraint, so not a Delaunay edge. (A new edge to a
+        // vertex of the split triangle is locally Delaunay: the circle
+        // through it and the third vertex on one side lies inside the old
+        // triangle's circumcircle there.)
         self.edge_stack.clear();
-        for t in self.stack.drain(..) {
-            self.edge_stack.extend([(t, 0u8), (t, 1), (t, 2)]);
+        self.edge_stack.extend(self.stack.iter().map(|&t| (t, 0u8)));
+        if self.stack.len() == 4 {
+            // Closed fan (p,c,a), (p,a,d), (p,d,b), (p,b,c): the halves p-a
+            // and p-b are edge 1 of the first and the third.
+            self.edge_stack
+                .extend([(self.stack[0], 1), (self.stack[2], 1)]);
         }
+        self.stack.clear();
         while let Some((t, i)) = self.edge_stack.pop() {
             let i = usize::from(i);
             let tri = self.tris[t as usize];
