@@ -116,14 +116,19 @@ fn scan_generic(pts: [Pt; 3], zs: [[u8; 3]; 3], chunk: &ChunkSamples) -> (i64, i
         Ok(setup) => setup,
         Err(nothing) => return nothing,
     };
-    if (x1 - x0 + 1) * (y1 - y0 + 1) <= SMALL {
-        let (best, at) = scan_small(pts, zs, den, [x0, y0, x1, y1], chunk);
-        return (i64::from(best), i64::from(den), at);
-    }
     // Where the vertices and every sample are single, mid = high = low and
     // the three fields have identical errors: scan one.
     let single =
         zs.iter().all(|z| z[0] == z[1] && z[1] == z[2]) && chunk.duals_in(x0, y0, x1, y1) == 0;
+    if (x1 - x0 + 1) * (y1 - y0 + 1) <= SMALL {
+        let bbox = [x0, y0, x1, y1];
+        let (best, at) = if single {
+            scan_small::<1>(pts, zs, den, bbox, chunk)
+        } else {
+            scan_small::<3>(pts, zs, den, bbox, chunk)
+        };
+        return (i64::from(best), i64::from(den), at);
+    }
     let (best, at) = if single {
         scan_rows::<1>(pts, zs, den, [x0, y0, x1, y1], chunk)
     } else {
@@ -152,8 +157,9 @@ fn edge_steps(pts: [Pt; 3]) -> ([i32; 3], [i32; 3]) {
     (dx, dy)
 }
 
+/// A small bounding box sample by sample; `F` as in [`row_max`].
 #[inline(always)]
-fn scan_small(
+fn scan_small<const F: usize>(
     pts: [Pt; 3],
     zs: [[u8; 3]; 3],
     den: i32,
@@ -186,10 +192,17 @@ fn scan_small(
             if (w[0] | w[1] | w[2]) >= 0 {
                 let i = row + x as usize;
                 let s = chunk.samples[i].z;
-                let e = (n[0] - i32::from(s[0]) * den)
-                    .abs()
-                    .max((n[1] - i32::from(s[1]) * den).abs())
-                    .max((n[2] - i32::from(s[2]) * den).abs());
+                let e0 = || (n[0] - i32::from(s[0]) * den).abs();
+                let e12 = || {
+                    (n[1] - i32::from(s[1]) * den)
+                        .abs()
+                        .max((n[2] - i32::from(s[2]) * den).abs())
+                };
+                let e = match F {
+                    1 => e0(),
+                    2 => e12(),
+                    _ => e0().max(e12()),
+                };
                 if e > best.0 {
                     best = (e, i as u32);
                 }
@@ -392,7 +405,9 @@ fn scan_slab_generic(
     let bbox = [x0, y0, x1, y1];
     let area = (x1 - x0 + 1) * (y1 - y0 + 1);
     let covered = [0, 1, 2].map(|k| duals[(k + 1) % 3] && duals[(k + 2) % 3]);
-    let (best, at) = if area <= SMALL {
+    let (best, at) = if slab && duals_in as i32 == area && area <= SMALL {
+        scan_small::<2>(pts, zs, den, bbox, chunk)
+    } else if area <= SMALL {
         scan_slab_small(pts, zs, den, slab, covered, bbox, chunk)
     } else if slab && duals_in as i32 == area {
         scan_rows::<2>(pts, zs, den, bbox, chunk)
