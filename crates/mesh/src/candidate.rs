@@ -443,7 +443,9 @@ pub fn slab_error(
     }
 }
 
-/// [`scan_slab`] over a small bounding box, sample by sample.
+/// [`scan_slab`] over a small bounding box, sample by sample: the slab's
+/// interpolants stepped per sample under a slab triangle, the missing slab
+/// of uncovered dual samples under any other.
 #[inline(always)]
 fn scan_slab_small(
     pts: [Pt; 3],
@@ -458,29 +460,56 @@ fn scan_slab_small(
     let [x0, y0, x1, y1] = bbox;
     let stride = chunk.stride();
     let (dx, dy) = edge_steps(pts);
+    let z = |f: usize| {
+        [
+            i32::from(zs[0][f]),
+            i32::from(zs[1][f]),
+            i32::from(zs[2][f]),
+        ]
+    };
+    let (z1, z2) = (z(1), z(2));
+    let dot = |w: [i32; 3], z: [i32; 3]| w[0] * z[0] + w[1] * z[1] + w[2] * z[2];
+    let (dn1, dn2) = (dot(dx, z1), dot(dx, z2));
+    let (en1, en2) = (dot(dy, z1), dot(dy, z2));
     let mut w_row = barycentric(a, b, c, [x0, y0]);
+    let mut n_row = [dot(w_row, z1), dot(w_row, z2)];
     let mut best = (0i32, 0u32);
     for y in y0..=y1 {
-        let mut w = w_row;
+        let (mut w, mut n) = (w_row, n_row);
         let row = y as usize * stride;
         for x in x0..=x1 {
             if (w[0] | w[1] | w[2]) >= 0 {
                 let i = row + x as usize;
                 let s = &chunk.samples[i];
-                if slab || s.dual() {
-                    let e = slab_error(w, den, zs, s, slab, covered);
-                    if e > best.0 {
-                        best = (e, i as u32);
+                let e = if slab {
+                    (n[0] - i32::from(s.z[1]) * den)
+                        .abs()
+                        .max((n[1] - i32::from(s.z[2]) * den).abs())
+                } else if s.dual() {
+                    let zeros = w.iter().filter(|&&v| v == 0).count();
+                    if zeros >= 2 || (0..3).any(|k| w[k] == 0 && covered[k]) {
+                        0
+                    } else {
+                        (i32::from(s.z[2]) - i32::from(s.z[0])) * den
                     }
+                } else {
+                    0
+                };
+                if e > best.0 {
+                    best = (e, i as u32);
                 }
             }
             for k in 0..3 {
                 w[k] += dx[k];
             }
+            n[0] += dn1;
+            n[1] += dn2;
         }
         for k in 0..3 {
             w_row[k] += dy[k];
         }
+        n_row[0] += en1;
+        n_row[1] += en2;
     }
     best
 }
