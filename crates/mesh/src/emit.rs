@@ -23,6 +23,10 @@
 //! samples (exact local refit). Winding: counter-clockwise seen from outside
 //! the solid, in the right-handed (x, y, z-up) grid frame.
 //!
+//! The outline fit emits the floor of one triangulation and the slab of
+//! another into the same LODs ([`Parts`]); the rules above apply to each
+//! (walls close the slab triangulation's slab triangles).
+//!
 //! LODs share triangles (greedy insertion leaves untouched regions alone),
 //! so the three lists are stored once, in blocks by LOD membership:
 //! `[2 only][1,2][0,1,2][0,1][0 only][1 only]`. LOD 2 and LOD 0 are one range
