@@ -67,7 +67,7 @@ fn census(level: &Level, tol: f64, options: FitOptions, name: &str) {
     rayon::broadcast(|_| ());
     let cpu0 = process_cpu_seconds().unwrap_or(0.0);
     let t0 = std::time::Instant::now();
-    let per: Vec<([u64; 4], [u64; 4], u64)> = (0..layout.count())
+    let per: Vec<([u64; 4], [u64; 4], u64, [u64; 3])> = (0..layout.count())
         .into_par_iter()
         .map_init(
             || (ChunkFitter::default(), ChunkSamples::default()),
@@ -76,8 +76,13 @@ fn census(level: &Level, tol: f64, options: FitOptions, name: &str) {
                 f.fit_with(level, &layout, cx, cy, tol, options);
                 s.load(level, &layout, cx, cy);
                 let mut verts = [0u64; 4];
+                let mut ends = [0u64; 2];
                 for p in &f.triangulation().pts {
-                    verts[class(s, p[0], p[1])] += 1;
+                    let k = class(s, p[0], p[1]);
+                    verts[k] += 1;
+                    if k == 2 {
+                        ends[usize::from(run_end(s, p[0], p[1]))] += 1;
+                    }
                 }
                 let mut samples = [0u64; 4];
                 for y in 0..s.size_y as i32 {
@@ -93,7 +98,15 @@ fn census(level: &Level, tol: f64, options: FitOptions, name: &str) {
                 if options.outline {
                     bad += f.floor_triangulation().delaunay_violations() as u64;
                 }
-                (verts, samples, bad)
+                let mut all_ends = 0u64;
+                for y in 0..s.size_y as i32 {
+                    for x in 0..s.size_x as i32 {
+                        if class(s, x, y) == 2 && run_end(s, x, y) {
+                            all_ends += 1;
+                        }
+                    }
+                }
+                (verts, samples, bad, [ends[0], ends[1], all_ends])
             },
         )
         .collect();
@@ -102,7 +115,13 @@ fn census(level: &Level, tol: f64, options: FitOptions, name: &str) {
     let mut verts = [0u64; 4];
     let mut samples = [0u64; 4];
     let bad: u64 = per.iter().map(|p| p.2).sum();
-    for (v, s, _) in &per {
+    let mut ends = [0u64; 3];
+    for p in &per {
+        for k in 0..3 {
+            ends[k] += p.3[k];
+        }
+    }
+    for (v, s, _, _) in &per {
         for k in 0..4 {
             verts[k] += v[k];
             samples[k] += s[k];
@@ -155,8 +174,19 @@ fn census(level: &Level, tol: f64, options: FitOptions, name: &str) {
     }
     println!("  samples by class (chunk-local, each texel once): {samples:?}");
     println!(
+        "  dual-outline vertices at a row-run end (a single left or right neighbour) {} of {} such samples; elsewhere on the outline {}",
+        ends[1], ends[2], ends[0]
+    );
+    println!(
         "  non-Delaunay edges off the constraints (both triangulations), + 2^32 per inconsistent one: {bad}"
     );
+}
+
+/// Whether dual sample `(x, y)` ends a row run (a single sample, in the
+/// chunk, left or right of it).
+fn run_end(s: &ChunkSamples, x: i32, y: i32) -> bool {
+    let single = |u: i32| (0..=s.size_x as i32).contains(&u) && s.at(u, y).flags & DUAL == 0;
+    single(x - 1) || single(x + 1)
 }
 
 /// The outline itself on the texel grid: runs of dual samples per row and
