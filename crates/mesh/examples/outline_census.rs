@@ -62,12 +62,16 @@ fn class(s: &ChunkSamples, x: i32, y: i32) -> usize {
     }
 }
 
+/// One chunk's vertices and samples by class, its non-Delaunay edges, and
+/// its dual-outline vertices off / at a row-run end and all run ends.
+type ChunkCensus = ([u64; 4], [u64; 4], u64, [u64; 3]);
+
 fn census(level: &Level, tol: f64, options: FitOptions, name: &str) {
     let layout = ChunkLayout::of(level);
     rayon::broadcast(|_| ());
     let cpu0 = process_cpu_seconds().unwrap_or(0.0);
     let t0 = std::time::Instant::now();
-    let per: Vec<([u64; 4], [u64; 4], u64, [u64; 3])> = (0..layout.count())
+    let per: Vec<ChunkCensus> = (0..layout.count())
         .into_par_iter()
         .map_init(
             || (ChunkFitter::default(), ChunkSamples::default()),
