@@ -254,6 +254,66 @@ fn outline(level: &Level) {
     );
 }
 
+/// What a per-chunk choice between the two fits could reach: each chunk
+/// fitted both ways, the one drawing fewer finest triangles kept (an upper
+/// bound on the gain: it ignores that neighbours choosing differently would
+/// need a common border vertex set).
+fn best_of_both(level: &Level, tol: f64) {
+    let layout = ChunkLayout::of(level);
+    let per: Vec<[u64; 5]> = (0..layout.count())
+        .into_par_iter()
+        .map_init(ChunkFitter::default, |f, i| {
+            let (cx, cy) = layout.coords(i);
+            let p = f.fit_with(level, &layout, cx, cy, tol, FitOptions::default());
+            let o = f.fit_with(level, &layout, cx, cy, tol, FitOptions { outline: true });
+            let (p, o) = (p.stats.lods[0], o.stats.lods[0]);
+            // The chunk's raggedness: the share of its dual samples on the
+            // outline, in percent (a cheap statistic to choose by).
+            let s = f.samples();
+            let (mut dual, mut edge) = (0u64, 0u64);
+            for y in 0..=s.size_y as i32 {
+                for x in 0..=s.size_x as i32 {
+                    let k = class(s, x, y);
+                    dual += u64::from(k >= 2);
+                    edge += u64::from(k == 2);
+                }
+            }
+            let ragged = (100 * edge).checked_div(dual).unwrap_or(0);
+            if o.emitted() < p.emitted() {
+                let planar = u64::from(o.planar + o.slab / 2);
+                [planar, u64::from(o.emitted()), 1, ragged, dual]
+            } else {
+                [u64::from(p.planar), u64::from(p.emitted()), 0, ragged, dual]
+            }
+        })
+        .collect();
+    let mut t = [0u64; 5];
+    for c in &per {
+        for k in 0..3 {
+            t[k] += c[k];
+        }
+    }
+    // How well "outline where at least R % of the dual samples are on the
+    // outline" reproduces the choice, for chunks with a slab.
+    for r in [50, 60, 70, 80, 90] {
+        let agree = per
+            .iter()
+            .filter(|c| c[4] > 0)
+            .filter(|c| (c[3] >= r) == (c[2] == 1))
+            .count();
+        let with = per.iter().filter(|c| c[4] > 0).count();
+        println!("  rule ragged >= {r} %: agrees in {agree} of {with} chunks with a slab");
+    }
+    println!("== best of both per chunk (tol {tol})");
+    println!(
+        "  LOD 0: planar {:>10}  drawn {:>10}; outline chosen in {} of {} chunks",
+        t[0],
+        t[1],
+        t[2],
+        layout.count()
+    );
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let tol: f64 = args
@@ -281,6 +341,9 @@ fn main() {
     }
     if only.is_empty() || only == "outline" {
         census(&level, tol, FitOptions { outline: true }, "outline");
+    }
+    if only.is_empty() || only == "best" {
+        best_of_both(&level, tol);
     }
     if only.is_empty() || only == "floor" {
         // The floor alone: every dual pair made single at its `low`.
