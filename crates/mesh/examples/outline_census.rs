@@ -336,6 +336,29 @@ fn main() {
     );
     outline(&level);
     let only = std::env::var("CENSUS_ONLY").unwrap_or_default();
+    if only == "probe" {
+        // Lines `TAG X Y ...` on stdin: count TAGs by the column's class
+        // (chunk-local 8-neighbourhood as in `class`).
+        use std::io::BufRead;
+        let layout = ChunkLayout::of(&level);
+        let mut s = ChunkSamples::default();
+        let mut counts = std::collections::BTreeMap::<(String, usize), u64>::new();
+        for line in std::io::stdin().lock().lines().map_while(Result::ok) {
+            let f: Vec<&str> = line.split_whitespace().collect();
+            let (Some(tag), Some(x), Some(y)) = (f.first(), f.get(1), f.get(2)) else {
+                continue;
+            };
+            let (Ok(x), Ok(y)) = (x.parse::<u32>(), y.parse::<u32>()) else {
+                continue;
+            };
+            let (cx, cy) = (x / layout.size_x, y / layout.size_y);
+            s.load(&level, &layout, cx, cy);
+            let k = class(&s, (x % layout.size_x) as i32, (y % layout.size_y) as i32);
+            *counts.entry((tag.to_string(), k)).or_default() += 1;
+        }
+        println!("(tag, class 0 single 1 single-outline 2 dual-outline 3 dual): {counts:?}");
+        return;
+    }
     if only.is_empty() || only == "plain" {
         census(&level, tol, FitOptions::default(), "plain");
     }
