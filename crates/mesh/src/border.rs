@@ -49,15 +49,16 @@ pub fn fit_border(edge: &[Sample], tol: f64, out: &mut Vec<u32>) {
     out.sort_unstable();
 }
 
-/// [`fit_border`] for the outline-constrained fit: a segment between two
-/// dual samples is a slab edge, measured on all three fields; any other
-/// segment draws the floor only and is measured on `low`, plus the whole
-/// missing slab (`high - low`) of a dual sample on it. The same rules as
-/// [`crate::candidate::outline_error`], and like [`fit_border`] a pure
-/// function of the edge's samples.
-pub fn fit_border_outline(edge: &[Sample], tol: f64, out: &mut Vec<u32>) {
+/// [`fit_border`] for the outline fit's slab triangulation: a segment
+/// between two dual samples is a slab edge, measured on `mid` and `high`
+/// (a single sample on it by how far the slab is from its surface); any
+/// other segment draws nothing of the slab, so only a dual sample on it
+/// counts, by its whole missing slab (`high - low`). The rules of
+/// [`crate::candidate::slab_error`]; a pure function of the edge's samples.
+/// An edge without dual samples keeps no vertex.
+pub fn fit_border_slab(edge: &[Sample], tol: f64, out: &mut Vec<u32>) {
     out.clear();
-    if edge.len() < 3 {
+    if edge.len() < 3 || !edge.iter().any(Sample::dual) {
         return;
     }
     let mut stack = vec![(0usize, edge.len() - 1)];
@@ -65,20 +66,22 @@ pub fn fit_border_outline(edge: &[Sample], tol: f64, out: &mut Vec<u32>) {
         let len = (j - i) as i64;
         let (zi, zj) = (edge[i].z, edge[j].z);
         let slab = edge[i].dual() && edge[j].dual();
-        let fields = if slab { 3 } else { 1 };
         let mut best = (0i64, 0usize);
         for (k, s) in edge.iter().enumerate().take(j).skip(i + 1) {
             let (a, b) = ((j - k) as i64, (k - i) as i64);
-            let mut e = (0..fields)
-                .map(|f| {
-                    let interp = i64::from(zi[f]) * a + i64::from(zj[f]) * b;
-                    (interp - i64::from(s.z[f]) * len).abs()
-                })
-                .max()
-                .unwrap_or(0);
-            if s.dual() && !slab {
-                e = e.max((i64::from(s.z[2]) - i64::from(s.z[0])) * len);
-            }
+            let e = if slab {
+                (1..3)
+                    .map(|f| {
+                        let interp = i64::from(zi[f]) * a + i64::from(zj[f]) * b;
+                        (interp - i64::from(s.z[f]) * len).abs()
+                    })
+                    .max()
+                    .unwrap_or(0)
+            } else if s.dual() {
+                (i64::from(s.z[2]) - i64::from(s.z[0])) * len
+            } else {
+                0
+            };
             if e > best.0 {
                 best = (e, k);
             }

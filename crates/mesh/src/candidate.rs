@@ -116,14 +116,19 @@ fn scan_generic(pts: [Pt; 3], zs: [[u8; 3]; 3], chunk: &ChunkSamples) -> (i64, i
         Ok(setup) => setup,
         Err(nothing) => return nothing,
     };
-    if (x1 - x0 + 1) * (y1 - y0 + 1) <= SMALL {
-        let (best, at) = scan_small(pts, zs, den, [x0, y0, x1, y1], chunk);
-        return (i64::from(best), i64::from(den), at);
-    }
     // Where the vertices and every sample are single, mid = high = low and
     // the three fields have identical errors: scan one.
     let single =
         zs.iter().all(|z| z[0] == z[1] && z[1] == z[2]) && chunk.duals_in(x0, y0, x1, y1) == 0;
+    if (x1 - x0 + 1) * (y1 - y0 + 1) <= SMALL {
+        let bbox = [x0, y0, x1, y1];
+        let (best, at) = if single {
+            scan_small::<1>(pts, zs, den, bbox, chunk)
+        } else {
+            scan_small::<3>(pts, zs, den, bbox, chunk)
+        };
+        return (i64::from(best), i64::from(den), at);
+    }
     let (best, at) = if single {
         scan_rows::<1>(pts, zs, den, [x0, y0, x1, y1], chunk)
     } else {
@@ -152,8 +157,9 @@ fn edge_steps(pts: [Pt; 3]) -> ([i32; 3], [i32; 3]) {
     (dx, dy)
 }
 
+/// A small bounding box sample by sample; `F` as in [`row_max`].
 #[inline(always)]
-fn scan_small(
+fn scan_small<const F: usize>(
     pts: [Pt; 3],
     zs: [[u8; 3]; 3],
     den: i32,
@@ -186,10 +192,17 @@ fn scan_small(
             if (w[0] | w[1] | w[2]) >= 0 {
                 let i = row + x as usize;
                 let s = chunk.samples[i].z;
-                let e = (n[0] - i32::from(s[0]) * den)
-                    .abs()
-                    .max((n[1] - i32::from(s[1]) * den).abs())
-                    .max((n[2] - i32::from(s[2]) * den).abs());
+                let e0 = || (n[0] - i32::from(s[0]) * den).abs();
+                let e12 = || {
+                    (n[1] - i32::from(s[1]) * den)
+                        .abs()
+                        .max((n[2] - i32::from(s[2]) * den).abs())
+                };
+                let e = match F {
+                    1 => e0(),
+                    2 => e12(),
+                    _ => e0().max(e12()),
+                };
                 if e > best.0 {
                     best = (e, i as u32);
                 }
@@ -293,16 +306,21 @@ fn scan_rows<const F: usize>(
 #[inline(always)]
 fn err_at<const F: usize>(rows: [&[u8]; 3], n: [i32; 3], dn: [i32; 3], den: i32, k: usize) -> i32 {
     let kk = k as i32;
-    let mut e = (n[0] + kk * dn[0] - i32::from(rows[0][k]) * den).abs();
-    if F == 3 {
-        e = e
-            .max((n[1] + kk * dn[1] - i32::from(rows[1][k]) * den).abs())
-            .max((n[2] + kk * dn[2] - i32::from(rows[2][k]) * den).abs());
+    let e0 = || (n[0] + kk * dn[0] - i32::from(rows[0][k]) * den).abs();
+    let e12 = || {
+        (n[1] + kk * dn[1] - i32::from(rows[1][k]) * den)
+            .abs()
+            .max((n[2] + kk * dn[2] - i32::from(rows[2][k]) * den).abs())
+    };
+    match F {
+        1 => e0(),
+        2 => e12(),
+        _ => e0().max(e12()),
     }
-    e
 }
 
-/// Largest error of a row span: branch-free so that it vectorises.
+/// Largest error of a row span: branch-free so that it vectorises. `F`: 1
+/// measures `low`, 2 `mid` and `high`, 3 all three.
 #[inline(always)]
 fn row_max<const F: usize>(rows: [&[u8]; 3], n: [i32; 3], dn: [i32; 3], den: i32) -> i32 {
     let len = rows[0].len();
@@ -312,6 +330,13 @@ fn row_max<const F: usize>(rows: [&[u8]; 3], n: [i32; 3], dn: [i32; 3], den: i32
         for (k, &z) in r0.iter().enumerate() {
             let kk = k as i32;
             m = m.max((n[0] + kk * dn[0] - i32::from(z) * den).abs());
+        }
+    } else if F == 2 {
+        for k in 0..len {
+            let kk = k as i32;
+            let e1 = (n[1] + kk * dn[1] - i32::from(r1[k]) * den).abs();
+            let e2 = (n[2] + kk * dn[2] - i32::from(r2[k]) * den).abs();
+            m = m.max(e1.max(e2));
         }
     } else {
         for k in 0..len {
@@ -325,16 +350,44 @@ fn row_max<const F: usize>(rows: [&[u8]; 3], n: [i32; 3], dn: [i32; 3], den: i32
     m
 }
 
-/// [`scan`] for the outline-constrained fit. A slab triangle (`duals` all
-/// true) should hold only dual samples, and is measured on all three
-/// fields; any other triangle draws the floor only, so it is measured on
-/// `low`, and should hold no dual sample except on an edge between two dual
-/// vertices (the slab triangle across draws it). A sample on the wrong side
-/// of the outline is measured by what drawing it wrong costs: a single
-/// sample under a slab by the slab's interpolated fields, a dual sample
-/// without one by its missing slab (`high - low`) as well. So a fit within
-/// tolerance never straddles the outline by more than the tolerance.
-pub fn scan_outline(
+/// [`scan`] for the slab triangulation of the outline fit, whose slab
+/// triangles (`duals` all true) draw only the slab (`mid`, `high`): the
+/// floor has its own triangulation. A slab triangle is measured on `mid`
+/// and `high` at every sample it covers (a single sample under it by how
+/// far the drawn slab is from its one surface); any other triangle draws
+/// nothing of this triangulation, so only its dual samples count, by the
+/// whole slab they miss (`high - low`), unless they are vertices or lie on
+/// an edge between two dual vertices (the slab triangle across draws them).
+/// Single samples outside slab triangles cost nothing here: the floor
+/// triangulation draws them. Same answer as a per-sample loop over
+/// [`slab_error`] (ties: the first sample in row-major order).
+pub fn scan_slab(
+    pts: [Pt; 3],
+    zs: [[u8; 3]; 3],
+    duals: [bool; 3],
+    chunk: &ChunkSamples,
+) -> (i64, i64, u32) {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU supports AVX2 (checked just above).
+        return unsafe { scan_slab_avx2(pts, zs, duals, chunk) };
+    }
+    scan_slab_generic(pts, zs, duals, chunk)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn scan_slab_avx2(
+    pts: [Pt; 3],
+    zs: [[u8; 3]; 3],
+    duals: [bool; 3],
+    chunk: &ChunkSamples,
+) -> (i64, i64, u32) {
+    scan_slab_generic(pts, zs, duals, chunk)
+}
+
+#[inline(always)]
+fn scan_slab_generic(
     pts: [Pt; 3],
     zs: [[u8; 3]; 3],
     duals: [bool; 3],
@@ -346,25 +399,28 @@ pub fn scan_outline(
     };
     let slab = duals.iter().all(|&d| d);
     let duals_in = chunk.duals_in(x0, y0, x1, y1);
+    if !slab && duals_in == 0 {
+        return (0, i64::from(den), 0);
+    }
     let bbox = [x0, y0, x1, y1];
-    // Nothing can be on the wrong side: the vectorised kernels.
-    let (best, at) = if !slab && duals_in == 0 {
-        scan_rows::<1>(pts, zs, den, bbox, chunk)
-    } else if slab && duals_in as i32 == (x1 - x0 + 1) * (y1 - y0 + 1) {
-        scan_rows::<3>(pts, zs, den, bbox, chunk)
+    let area = (x1 - x0 + 1) * (y1 - y0 + 1);
+    let covered = [0, 1, 2].map(|k| duals[(k + 1) % 3] && duals[(k + 2) % 3]);
+    let (best, at) = if slab && duals_in as i32 == area && area <= SMALL {
+        scan_small::<2>(pts, zs, den, bbox, chunk)
+    } else if area <= SMALL {
+        scan_slab_small(pts, zs, den, slab, covered, bbox, chunk)
+    } else if slab && duals_in as i32 == area {
+        scan_rows::<2>(pts, zs, den, bbox, chunk)
     } else {
-        // Edge k (opposite vertex k) joins two dual vertices.
-        let covered = [0, 1, 2].map(|k| duals[(k + 1) % 3] && duals[(k + 2) % 3]);
-        scan_classes(pts, zs, den, slab, covered, bbox, chunk)
+        scan_slab_spans(pts, zs, den, slab, covered, bbox, chunk)
     };
     (i64::from(best), i64::from(den), at)
 }
 
-/// The error numerator of sample `s` (barycentric numerators `w`) in an
-/// outline fit's triangle; `covered[k]`: a dual sample on edge `k` is drawn
-/// by the slab across.
+/// The error numerator of sample `s` (barycentric numerators `w`) in a
+/// triangle of the outline fit's slab triangulation (see [`scan_slab`]).
 #[inline]
-pub fn outline_error(
+pub fn slab_error(
     w: [i32; 3],
     den: i32,
     zs: [[u8; 3]; 3],
@@ -372,26 +428,98 @@ pub fn outline_error(
     slab: bool,
     covered: [bool; 3],
 ) -> i32 {
-    let e = errors(w, den, zs, s.z);
-    match (slab, s.dual()) {
-        (true, true) => e[0].max(e[1]).max(e[2]),
-        // A slab drawn over a single sample: its fields say by how much.
-        (true, false) => e[0].max(e[1]).max(e[2]),
-        (false, false) => e[0],
-        (false, true) => {
-            let vertex = w.iter().filter(|&&v| v == 0).count() >= 2;
-            if vertex || (0..3).any(|k| w[k] == 0 && covered[k]) {
-                e[0]
-            } else {
-                // No slab drawn here: all of it is missing.
-                e[0].max((i32::from(s.z[2]) - i32::from(s.z[0])) * den)
-            }
-        }
+    if slab {
+        let e = errors(w, den, zs, s.z);
+        return e[1].max(e[2]);
+    }
+    if !s.dual() {
+        return 0;
+    }
+    let vertex = w.iter().filter(|&&v| v == 0).count() >= 2;
+    if vertex || (0..3).any(|k| w[k] == 0 && covered[k]) {
+        0
+    } else {
+        (i32::from(s.z[2]) - i32::from(s.z[0])) * den
     }
 }
 
-/// The per-sample loop of [`scan_outline`] where both classes are present.
-fn scan_classes(
+/// [`scan_slab`] over a small bounding box, sample by sample: the slab's
+/// interpolants stepped per sample under a slab triangle, the missing slab
+/// of uncovered dual samples under any other.
+#[inline(always)]
+fn scan_slab_small(
+    pts: [Pt; 3],
+    zs: [[u8; 3]; 3],
+    den: i32,
+    slab: bool,
+    covered: [bool; 3],
+    bbox: [i32; 4],
+    chunk: &ChunkSamples,
+) -> (i32, u32) {
+    let [a, b, c] = pts;
+    let [x0, y0, x1, y1] = bbox;
+    let stride = chunk.stride();
+    let (dx, dy) = edge_steps(pts);
+    let z = |f: usize| {
+        [
+            i32::from(zs[0][f]),
+            i32::from(zs[1][f]),
+            i32::from(zs[2][f]),
+        ]
+    };
+    let (z1, z2) = (z(1), z(2));
+    let dot = |w: [i32; 3], z: [i32; 3]| w[0] * z[0] + w[1] * z[1] + w[2] * z[2];
+    let (dn1, dn2) = (dot(dx, z1), dot(dx, z2));
+    let (en1, en2) = (dot(dy, z1), dot(dy, z2));
+    let mut w_row = barycentric(a, b, c, [x0, y0]);
+    let mut n_row = [dot(w_row, z1), dot(w_row, z2)];
+    let mut best = (0i32, 0u32);
+    for y in y0..=y1 {
+        let (mut w, mut n) = (w_row, n_row);
+        let row = y as usize * stride;
+        for x in x0..=x1 {
+            if (w[0] | w[1] | w[2]) >= 0 {
+                let i = row + x as usize;
+                let s = &chunk.samples[i];
+                let e = if slab {
+                    (n[0] - i32::from(s.z[1]) * den)
+                        .abs()
+                        .max((n[1] - i32::from(s.z[2]) * den).abs())
+                } else if s.dual() {
+                    let zeros = w.iter().filter(|&&v| v == 0).count();
+                    if zeros >= 2 || (0..3).any(|k| w[k] == 0 && covered[k]) {
+                        0
+                    } else {
+                        (i32::from(s.z[2]) - i32::from(s.z[0])) * den
+                    }
+                } else {
+                    0
+                };
+                if e > best.0 {
+                    best = (e, i as u32);
+                }
+            }
+            for k in 0..3 {
+                w[k] += dx[k];
+            }
+            n[0] += dn1;
+            n[1] += dn2;
+        }
+        for k in 0..3 {
+            w_row[k] += dy[k];
+        }
+        n_row[0] += en1;
+        n_row[1] += en2;
+    }
+    best
+}
+
+/// [`scan_slab`] where both classes are in the bounding box: row by row over
+/// the triangle's exact span; a span of one class takes the vectorised
+/// kernel (all dual under a slab triangle) or is skipped (no dual outside
+/// one), the others go sample by sample.
+#[inline(always)]
+fn scan_slab_spans(
     pts: [Pt; 3],
     zs: [[u8; 3]; 3],
     den: i32,
@@ -405,23 +533,78 @@ fn scan_classes(
     let stride = chunk.stride();
     let (dx, dy) = edge_steps(pts);
     let mut w_row = barycentric(a, b, c, [x0, y0]);
+    let inv = dx.map(|d| {
+        if d == 0 {
+            0.0
+        } else {
+            1.0 / f64::from(d.abs())
+        }
+    });
+    let mut dn = [0i32; 3];
+    for (f, d) in dn.iter_mut().enumerate() {
+        *d = (0..3).map(|i| dx[i] * i32::from(zs[i][f])).sum();
+    }
     let mut best = (0i32, 0u32);
     for y in y0..=y1 {
-        let mut w = w_row;
-        for x in x0..=x1 {
-            if (w[0] | w[1] | w[2]) >= 0 {
-                let i = y as usize * stride + x as usize;
-                let e = outline_error(w, den, zs, &chunk.samples[i], slab, covered);
-                if e > best.0 {
-                    best = (e, i as u32);
+        // The exact span of x inside the triangle (as in `scan_rows`).
+        let (mut lo, mut hi) = (x0, x1);
+        for i in 0..3 {
+            let (w, d) = (w_row[i], dx[i]);
+            if w >= 0 {
+                if d < 0 {
+                    hi = hi.min(x0 + (f64::from(w) * inv[i] + NUDGE).floor() as i32);
                 }
-            }
-            for k in 0..3 {
-                w[k] += dx[k];
+            } else if d > 0 {
+                lo = lo.max(x0 + (f64::from(-w) * inv[i] - NUDGE).ceil() as i32);
+            } else {
+                hi = -1;
             }
         }
-        for k in 0..3 {
-            w_row[k] += dy[k];
+        if lo <= hi {
+            let duals = chunk.duals_in(lo, y, hi, y) as i32;
+            let off = lo - x0;
+            let w = [
+                w_row[0] + dx[0] * off,
+                w_row[1] + dx[1] * off,
+                w_row[2] + dx[2] * off,
+            ];
+            let start = y as usize * stride + lo as usize;
+            let len = (hi - lo + 1) as usize;
+            if slab && duals == hi - lo + 1 {
+                let mut n = [0i32; 3];
+                for (f, nf) in n.iter_mut().enumerate() {
+                    *nf = (0..3).map(|i| w[i] * i32::from(zs[i][f])).sum();
+                }
+                let rows = [
+                    &chunk.planes[0][start..start + len],
+                    &chunk.planes[1][start..start + len],
+                    &chunk.planes[2][start..start + len],
+                ];
+                let m = row_max::<2>(rows, n, dn, den);
+                if m > best.0 {
+                    let k = (0..len)
+                        .find(|&k| err_at::<2>(rows, n, dn, den, k) == m)
+                        .unwrap_or(0);
+                    best = (m, (start + k) as u32);
+                }
+            } else if slab || duals > 0 {
+                let mut w = w;
+                for k in 0..len {
+                    let s = &chunk.samples[start + k];
+                    if slab || s.dual() {
+                        let e = slab_error(w, den, zs, s, slab, covered);
+                        if e > best.0 {
+                            best = (e, (start + k) as u32);
+                        }
+                    }
+                    for i in 0..3 {
+                        w[i] += dx[i];
+                    }
+                }
+            }
+        }
+        for i in 0..3 {
+            w_row[i] += dy[i];
         }
     }
     best

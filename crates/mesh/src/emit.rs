@@ -23,6 +23,10 @@
 //! samples (exact local refit). Winding: counter-clockwise seen from outside
 //! the solid, in the right-handed (x, y, z-up) grid frame.
 //!
+//! The outline fit emits the floor of one triangulation and the slab of
+//! another into the same LODs ([`Parts`]); the rules above apply to each
+//! (walls close the slab triangulation's slab triangles).
+//!
 //! LODs share triangles (greedy insertion leaves untouched regions alone),
 //! so the three lists are stored once, in blocks by LOD membership:
 //! `[2 only][1,2][0,1,2][0,1][0 only][1 only]`. LOD 2 and LOD 0 are one range
@@ -116,6 +120,17 @@ impl ChunkMesh {
     }
 }
 
+/// Which parts of a triangulation [`Emitter::emit_lod_parts`] adds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Parts {
+    /// The floor of every triangle and the slab of the slab triangles.
+    Both,
+    /// The floor of every triangle only.
+    Floor,
+    /// The slab (top, ceiling, walls) of the slab triangles only.
+    Slab,
+}
+
 /// Emission scratch, reused across chunks.
 #[derive(Default)]
 pub struct Emitter {
@@ -154,13 +169,29 @@ impl Emitter {
         self.stats = [LodStats::default(); LODS];
     }
 
-    /// Emit LOD `lod` from the current state of the triangulation.
+    /// Emit LOD `lod` from the current state of the triangulation: the
+    /// floor of every triangle and the slab (top, ceiling, walls) of every
+    /// slab triangle.
     pub fn emit_lod(
         &mut self,
         lod: usize,
         tr: &Triangulation,
         vsample: &[u32],
         samples: &ChunkSamples,
+    ) {
+        self.emit_lod_parts(lod, tr, vsample, samples, Parts::Both);
+    }
+
+    /// [`emit_lod`](Self::emit_lod), adding only `parts` of the
+    /// triangulation to the LOD (the outline fit emits its floor and its
+    /// slab from two triangulations into the same LOD).
+    pub fn emit_lod_parts(
+        &mut self,
+        lod: usize,
+        tr: &Triangulation,
+        vsample: &[u32],
+        samples: &ChunkSamples,
+        parts: Parts,
     ) {
         let positions = self.positions;
         let sample = |v: u32| &samples.samples[vsample[v as usize] as usize];
@@ -172,9 +203,11 @@ impl Emitter {
         for t in 0..tr.tris.len() as u32 {
             let tri = tr.tris[t as usize];
             let [a, b, c] = tri.v;
-            out.push(key([a, b, c].map(|v| idx(v, KIND_FLOOR))));
-            st.planar += 1;
-            if !slab(t) {
+            if parts != Parts::Slab {
+                out.push(key([a, b, c].map(|v| idx(v, KIND_FLOOR))));
+                st.planar += 1;
+            }
+            if parts == Parts::Floor || !slab(t) {
                 continue;
             }
             out.push(key([a, b, c].map(|v| idx(v, KIND_TOP))));
@@ -206,11 +239,17 @@ impl Emitter {
                 }
             }
         }
-        self.stats[lod] = st;
+        let acc = &mut self.stats[lod];
+        acc.planar += st.planar;
+        acc.slab += st.slab;
+        acc.wall += st.wall;
+        acc.border_walls += st.border_walls;
     }
 
-    /// Lay the three LODs out by membership blocks and move them into `mesh`.
-    pub fn finish(&mut self, mesh: &mut ChunkMesh, tr: &Triangulation) {
+    /// Lay the three LODs out by membership blocks and move them into
+    /// `mesh`; `vertices`: the finest LOD's vertex count (of every
+    /// triangulation emitted).
+    pub fn finish(&mut self, mesh: &mut ChunkMesh, vertices: u32) {
         for l in &mut self.lists {
             radix_sort(l, &mut self.scratch);
         }
@@ -263,7 +302,7 @@ impl Emitter {
         mesh.stats.hash = content_hash(&indices, &mesh.lods);
         mesh.indices = indices;
         mesh.stats.lods = self.stats;
-        mesh.stats.planar_vertices = tr.pts.len() as u32;
+        mesh.stats.planar_vertices = vertices;
     }
 }
 

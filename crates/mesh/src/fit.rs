@@ -8,9 +8,9 @@ use std::collections::BinaryHeap;
 
 use strata_level::Level;
 
-use crate::border::{exceeds, fit_border, fit_border_outline};
-use crate::candidate::{Candidate, barycentric, errors, scan, scan_outline};
-use crate::emit::{ChunkMesh, Emitter};
+use crate::border::{exceeds, fit_border, fit_border_slab};
+use crate::candidate::{Candidate, barycentric, errors, scan, scan_slab};
+use crate::emit::{ChunkMesh, Emitter, Parts};
 use crate::predicates::Pt;
 use crate::samples::{ChunkLayout, ChunkSamples, DUAL_INTERIOR, Sample};
 use crate::triangulation::Triangulation;
@@ -44,18 +44,41 @@ pub const CAUSES: usize = 4;
 /// How a fit runs, besides its tolerance.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize)]
 pub struct FitOptions {
-    /// Constrain the triangulation to the single/double region outline
-    /// (issue 17): no triangle holds samples of both classes, so the slab is
-    /// never interpolated across the outline, and triangles without a slab
-    /// are measured on the floor alone (the only field they draw).
+    /// The outline fit (issue 17): the floor and the slab get a
+    /// triangulation each. The floor's is fitted on `low` alone, everywhere
+    /// (single samples and the floor under a slab alike: the field that is
+    /// drawn as the ground). The slab's is constrained to the single/double
+    /// region outline: only its slab triangles (three dual vertices) are
+    /// drawn, as slab top, cave ceiling and walls, and they are measured on
+    /// `mid` and `high` over every sample they cover, while a dual sample
+    /// that no slab triangle draws costs its whole slab. So the slab is
+    /// never interpolated across the outline, single samples never drive
+    /// the slab's error and the slab never drives the floor's.
     pub outline: bool,
+}
+
+/// Which triangulation a greedy run builds.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+enum Pass {
+    /// The plain fit: one triangulation for all three fields.
+    #[default]
+    Coupled,
+    /// The outline fit's floor (on samples made single at `low`).
+    Floor,
+    /// The outline fit's slab, constrained to the outline.
+    Slab,
 }
 
 /// Reusable scratch for fitting chunks one after another on one thread.
 #[derive(Default)]
 pub struct ChunkFitter {
     samples: ChunkSamples,
+    /// The floor view of `samples` (outline fit).
+    floor_samples: ChunkSamples,
     tr: Triangulation,
+    /// The outline fit's floor triangulation (the last one fitted).
+    floor_tr: Triangulation,
+    pass: Pass,
     heap: BinaryHeap<Candidate>,
     stamps: Vec<u32>,
     seen: Vec<u32>,
@@ -90,10 +113,45 @@ impl ChunkFitter {
         options: FitOptions,
     ) -> ChunkMesh {
         self.samples.load(level, layout, cx, cy);
-        let (sx, sy) = (layout.size_x as i32, layout.size_y as i32);
+        self.emitter.begin(self.samples.size_x, self.samples.size_y);
+        let mut causes = [0u32; CAUSES];
+        let vertices = if options.outline {
+            // The floor first, on the floor view of the samples.
+            self.floor_samples.floor_of(&self.samples);
+            std::mem::swap(&mut self.samples, &mut self.floor_samples);
+            self.greedy(tol, Pass::Floor, &mut causes);
+            std::mem::swap(&mut self.samples, &mut self.floor_samples);
+            std::mem::swap(&mut self.tr, &mut self.floor_tr);
+            let floor = self.floor_tr.pts.len();
+            // The slab, where the chunk has one.
+            let (sx, sy) = (self.samples.size_x as i32, self.samples.size_y as i32);
+            if self.samples.duals_in(0, 0, sx, sy) > 0 {
+                self.greedy(tol, Pass::Slab, &mut causes);
+                floor + self.tr.pts.len()
+            } else {
+                self.tr.reset(sx, sy);
+                self.tr.outline = true;
+                floor
+            }
+        } else {
+            self.greedy(tol, Pass::Coupled, &mut causes);
+            self.tr.pts.len()
+        };
+        let mut mesh = ChunkMesh::default();
+        self.emitter.finish(&mut mesh, vertices as u32);
+        mesh.stats.causes = causes;
+        mesh
+    }
+
+    /// One greedy fit of `self.samples` into `self.tr` (border vertices,
+    /// then the worst sample until within `tol`), emitting each LOD's part
+    /// of the pass as the worst error drops under its tolerance.
+    fn greedy(&mut self, tol: f64, pass: Pass, causes: &mut [u32; CAUSES]) {
+        self.pass = pass;
+        let (sx, sy) = (self.samples.size_x as i32, self.samples.size_y as i32);
         let stride = self.samples.stride();
         self.tr.reset(sx, sy);
-        self.tr.outline = options.outline;
+        self.tr.outline = pass == Pass::Slab;
         self.vsample.clear();
         for v in 0..self.tr.pts.len() {
             let p = self.tr.pts[v];
@@ -101,7 +159,6 @@ impl ChunkFitter {
             self.vsample.push(i as u32);
             self.tr.vdual[v] = self.samples.samples[i].dual();
         }
-        let mut causes = [0u32; CAUSES];
 
         // Borders: the four edges, each fitted in 1D from its own samples.
         let edges: [(Pt, Pt, i32); 4] = [
@@ -116,8 +173,8 @@ impl ChunkFitter {
                 let p = [start[0] + step[0] * k, start[1] + step[1] * k];
                 self.edge.push(*self.samples.at(p[0], p[1]));
             }
-            if options.outline {
-                fit_border_outline(&self.edge, tol, &mut self.border);
+            if pass == Pass::Slab {
+                fit_border_slab(&self.edge, tol, &mut self.border);
             } else {
                 fit_border(&self.edge, tol, &mut self.border);
             }
@@ -145,9 +202,12 @@ impl ChunkFitter {
             self.push_candidate(t, tol);
         }
 
+        let parts = match pass {
+            Pass::Coupled => Parts::Both,
+            Pass::Floor => Parts::Floor,
+            Pass::Slab => Parts::Slab,
+        };
         let lod_tols: [f64; LODS] = [tol, tol * 2.0, tol * 4.0];
-        let mut mesh = ChunkMesh::default();
-        self.emitter.begin(self.samples.size_x, self.samples.size_y);
         let mut next_lod = LODS; // coarsest first: LOD 2, then 1, then 0
         let mut epoch = 0u32;
         loop {
@@ -160,8 +220,13 @@ impl ChunkFitter {
             let top = self.heap.peek().copied();
             while next_lod > 0 && top.is_none_or(|c| c.error() <= lod_tols[next_lod - 1]) {
                 next_lod -= 1;
-                self.emitter
-                    .emit_lod(next_lod, &self.tr, &self.vsample, &self.samples);
+                self.emitter.emit_lod_parts(
+                    next_lod,
+                    &self.tr,
+                    &self.vsample,
+                    &self.samples,
+                    parts,
+                );
             }
             let Some(c) = top else { break };
             if next_lod == 0 {
@@ -192,9 +257,6 @@ impl ChunkFitter {
                 self.push_candidate(t, tol);
             }
         }
-        self.emitter.finish(&mut mesh, &self.tr);
-        mesh.stats.causes = causes;
-        mesh
     }
 
     fn push_candidate(&mut self, t: u32, tol: f64) {
@@ -203,9 +265,9 @@ impl ChunkFitter {
         let zs = tri
             .v
             .map(|v| self.samples.samples[self.vsample[v as usize] as usize].z);
-        let (num, den, sample) = if self.tr.outline {
+        let (num, den, sample) = if self.pass == Pass::Slab {
             let duals = tri.v.map(|v| self.tr.vdual[v as usize]);
-            scan_outline(pts, zs, duals, &self.samples)
+            scan_slab(pts, zs, duals, &self.samples)
         } else {
             scan(pts, zs, &self.samples)
         };
@@ -218,28 +280,30 @@ impl ChunkFitter {
     /// The cause of inserting grid point `p` of triangle `t`.
     fn cause(&self, t: u32, p: Pt) -> Cause {
         let tri = self.tr.tris[t as usize];
+        let s = self.samples.at(p[0], p[1]);
+        let all_dual = tri
+            .v
+            .iter()
+            .all(|&v| self.samples.samples[self.vsample[v as usize] as usize].dual());
+        match self.pass {
+            Pass::Floor => return Cause::Floor,
+            // The slab's own relief, or the outline: a single sample under
+            // a slab triangle, a dual sample that no slab triangle draws.
+            Pass::Slab => {
+                return if all_dual && s.dual() {
+                    Cause::SlabInterior
+                } else {
+                    Cause::Boundary
+                };
+            }
+            Pass::Coupled => {}
+        }
         let [a, b, c] = tri.v.map(|v| self.tr.pt(v));
         let zs = tri
             .v
             .map(|v| self.samples.samples[self.vsample[v as usize] as usize].z);
         let den = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
-        let s = self.samples.at(p[0], p[1]);
         let e = errors(barycentric(a, b, c, p), den, zs, s.z);
-        let all_dual = tri
-            .v
-            .iter()
-            .all(|&v| self.samples.samples[self.vsample[v as usize] as usize].dual());
-        if self.tr.outline {
-            // The sample is on the wrong side of the outline, or the floor
-            // is worst, or (slab triangles only) the slab's own relief.
-            return if s.dual() != all_dual {
-                Cause::Boundary
-            } else if !all_dual || (e[0] >= e[1] && e[0] >= e[2]) {
-                Cause::Floor
-            } else {
-                Cause::SlabInterior
-            };
-        }
         if e[0] >= e[1] && e[0] >= e[2] {
             Cause::Floor
         } else if all_dual && s.flags & DUAL_INTERIOR != 0 {
@@ -249,7 +313,14 @@ impl ChunkFitter {
         }
     }
 
-    /// The working triangulation of the last fit (tests inspect it).
+    /// The outline fit's floor triangulation, of the last chunk fitted with
+    /// the outline option (tests inspect it).
+    pub fn floor_triangulation(&self) -> &Triangulation {
+        &self.floor_tr
+    }
+
+    /// The working triangulation of the last fit (tests inspect it): with
+    /// the outline option, the slab's.
     pub fn triangulation(&self) -> &Triangulation {
         &self.tr
     }

@@ -2,7 +2,9 @@
 //! altitude fields (`low`, `mid`, `high`) sharing one planar Delaunay
 //! triangulation per 128x128 chunk, three LODs per chunk with crack-free
 //! shared borders, compact emission for the GPU, and an exact local refit.
-//! No GPU dependency.
+//! The outline fit ([`FitOptions::outline`], issue 17) gives the floor and
+//! the slab a triangulation each instead, the slab's constrained to the
+//! single/double outline. No GPU dependency.
 //!
 //! # Using it (the drawing side)
 //! - [`LevelMesh::fit`]`(level, tolerance_for_quality(q))` gives one

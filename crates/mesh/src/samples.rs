@@ -116,6 +116,26 @@ impl ChunkSamples {
         &self.samples[y as usize * self.stride() + x as usize]
     }
 
+    /// Make `self` the floor of `src`: every sample single at its `low`
+    /// (`mid = high = low`), types kept; what the outline fit's floor
+    /// triangulation is fitted on.
+    pub fn floor_of(&mut self, src: &ChunkSamples) {
+        self.size_x = src.size_x;
+        self.size_y = src.size_y;
+        self.samples.clear();
+        self.samples.extend(src.samples.iter().map(|s| Sample {
+            z: [s.z[0]; 3],
+            flags: 0,
+            ..*s
+        }));
+        for plane in &mut self.planes {
+            plane.clear();
+            plane.extend_from_slice(&src.planes[0]);
+        }
+        self.dual_sum.clear();
+        self.dual_sum.resize(src.dual_sum.len(), 0);
+    }
+
     /// Decode chunk `(cx, cy)` of `level` into `self`, reusing the buffer.
     pub fn load(&mut self, level: &Level, layout: &ChunkLayout, cx: u32, cy: u32) {
         self.size_x = layout.size_x;

@@ -40,6 +40,8 @@ pub struct Triangulation {
     /// Triangles created or rewritten by the last insertion (may repeat).
     pub touched: Vec<u32>,
     stack: Vec<u32>,
+    /// Edges (triangle, edge index) to check, with the outline constraints.
+    edge_stack: Vec<(u32, u8)>,
 }
 
 #[inline]
@@ -246,6 +248,10 @@ impl Triangulation {
     /// Lawson flips from the edges opposite the new point: every triangle on
     /// the stack has the new point at `v[0]`, its suspect edge opposite it.
     fn legalize(&mut self) {
+        if self.outline {
+            self.legalize_constrained();
+            return;
+        }
         while let Some(t) = self.stack.pop() {
             let tri = self.tris[t as usize];
             let u = tri.n[0];
@@ -281,6 +287,68 @@ impl Triangulation {
             self.relink(n_bp, p, b, u);
             self.stack.push(t);
             self.stack.push(u);
+            self.touched.push(t);
+            self.touched.push(u);
+        }
+    }
+
+    /// [`legalize`](Self::legalize) with the outline constraints. Whether an
+    /// edge is a constraint depends on the vertices opposite it, which a
+    /// flip changes for all four outer edges of its quad; so every one of
+    /// them is checked again, not only the two opposite the new point (the
+    /// plain rule relies on every edge being Delaunay, which constraints
+    /// are not). Each
+    /// flip removes an edge whose opposite vertex lies strictly inside the
+    /// circumcircle, which lowers the lifted triangulation: it terminates,
+    /// and leaves every edge but the constraints locally Delaunay.
+    fn legalize_constrained(&mut self) {
+        // The edges opposite the new point, and where it split an edge,
+        // that edge's two halves: they face new vertices across what may
+        // have been a constraint, so not a Delaunay edge. (A new edge to a
+        // vertex of the split triangle is locally Delaunay: the circle
+        // through it and the third vertex on one side lies inside the old
+        // triangle's circumcircle there.)
+        self.edge_stack.clear();
+        self.edge_stack.extend(self.stack.iter().map(|&t| (t, 0u8)));
+        if self.stack.len() == 4 {
+            // Closed fan (p,c,a), (p,a,d), (p,d,b), (p,b,c): the halves p-a
+            // and p-b are edge 1 of the first and the third.
+            self.edge_stack
+                .extend([(self.stack[0], 1), (self.stack[2], 1)]);
+        }
+        self.stack.clear();
+        while let Some((t, i)) = self.edge_stack.pop() {
+            let i = usize::from(i);
+            let tri = self.tris[t as usize];
+            let u = tri.n[i];
+            if u == NONE {
+                continue;
+            }
+            let ut = self.tris[u as usize];
+            let Some(j) = (0..3).find(|&j| ut.n[j] == t) else {
+                continue;
+            };
+            let (p, a, b) = (tri.v[i], tri.v[next(i)], tri.v[prev(i)]);
+            let d = ut.v[j];
+            if self.is_outline_edge(p, a, b, d)
+                || incircle_small(self.pt(p), self.pt(a), self.pt(b), self.pt(d)) <= 0
+            {
+                continue;
+            }
+            let (n_ad, n_db) = (ut.n[next(j)], ut.n[prev(j)]);
+            let (n_bp, n_pa) = (tri.n[next(i)], tri.n[prev(i)]);
+            self.tris[t as usize] = Tri {
+                v: [p, a, d],
+                n: [n_ad, u, n_pa],
+            };
+            self.tris[u as usize] = Tri {
+                v: [p, d, b],
+                n: [n_db, n_bp, t],
+            };
+            self.relink(n_ad, d, a, t);
+            self.relink(n_bp, p, b, u);
+            // a-d, d-b, p-a, b-p.
+            self.edge_stack.extend([(t, 0), (u, 0), (t, 2), (u, 1)]);
             self.touched.push(t);
             self.touched.push(u);
         }

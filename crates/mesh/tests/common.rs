@@ -3,7 +3,7 @@
 
 use strata_level::model::META_DOUBLE_LEVEL;
 use strata_level::{DirtyRect, Level};
-use strata_mesh::emit::KIND_FLOOR;
+use strata_mesh::emit::{KIND_CEILING, KIND_FLOOR, KIND_TOP};
 use strata_mesh::{ChunkMesh, decode};
 
 /// Floor triangles of one LOD as local grid points (128-chunks).
@@ -16,6 +16,25 @@ pub fn floor_triangles(mesh: &ChunkMesh, lod: usize) -> Vec<[[i32; 2]; 3]> {
                 .then(|| vs.map(|v| [v.0 as i32, v.1 as i32]))
         })
         .collect()
+}
+
+/// A triangle as local grid points.
+pub type GridTriangle = [[i32; 2]; 3];
+
+/// Slab top and cave ceiling triangles of one LOD as local grid points
+/// (128-chunks), as drawn (the ceiling's winding reversed).
+pub fn slab_triangles(mesh: &ChunkMesh, lod: usize) -> (Vec<GridTriangle>, Vec<GridTriangle>) {
+    let (mut tops, mut ceilings) = (Vec::new(), Vec::new());
+    for t in mesh.lod_triangles(lod) {
+        let vs = t.map(|i| decode(i, 129, 129 * 129));
+        let pts = vs.map(|v| [v.0 as i32, v.1 as i32]);
+        if vs.iter().all(|v| v.2 == KIND_TOP) {
+            tops.push(pts);
+        } else if vs.iter().all(|v| v.2 == KIND_CEILING) {
+            ceilings.push(pts);
+        }
+    }
+    (tops, ceilings)
 }
 
 /// A crater like the paper's: altitude lowered by `depth (1 - d²/r²)`, the
@@ -73,8 +92,14 @@ pub fn side_edges(
     axis: usize,
     at: i32,
 ) -> Vec<(i32, i32)> {
+    side_edges_of(&floor_triangles(chunk, lod), axis, at)
+}
+
+/// Edges of `triangles` on one side of the chunk (`axis` 0: x = `at`), as
+/// sorted (from, to) positions along that side.
+pub fn side_edges_of(triangles: &[[[i32; 2]; 3]], axis: usize, at: i32) -> Vec<(i32, i32)> {
     let mut out = Vec::new();
-    for t in floor_triangles(chunk, lod) {
+    for &t in triangles {
         for k in 0..3 {
             let (p, q) = (t[k], t[(k + 1) % 3]);
             if p[axis] == at && q[axis] == at {

@@ -18,16 +18,18 @@ use crate::plan::{Plan, WorldSpec};
 pub struct FitRow {
     pub quality: f64,
     pub max_error: f64,
-    /// Finest-LOD planar triangles (the paper's "tris").
+    /// Finest-LOD planar triangles (the paper's "tris"): distinct planar
+    /// footprints drawn, i.e. the floor's triangles plus, in the outline fit
+    /// (whose slab has its own triangulation), the slab tops'.
     pub triangles: u64,
-    /// Planar triangles per LOD, finest first.
+    /// Planar triangles per LOD (as `triangles`), finest first.
     pub lod_triangles: [u64; LODS],
     /// Everything the finest LOD draws (floor, slab top and ceiling, walls).
     pub emitted_triangles: u64,
     /// Full grid (2 per texel) over finest triangles.
     pub reduction: f64,
-    /// Share of finest planar triangles that carry a slab (top and ceiling),
-    /// percent: where the fit's budget went.
+    /// Share of finest planar triangles (as `triangles`) that carry a slab
+    /// (top and ceiling), percent: where the fit's budget went.
     pub slab_share: f64,
     /// Insertions: floor, slab interior, single/double boundary, chunk border.
     pub causes: [u64; CAUSES],
@@ -180,16 +182,22 @@ fn fit(level: &Level, q: f64, threads: usize, outline: bool) -> Result<(FitRow, 
         .map_err(|e| format!("worker threads: {e}"))?;
     let s = mesh.stats();
     let full = 2 * u64::from(level.width()) * u64::from(level.height());
-    Ok((row_of(q, &s, full, timing.wall_seconds), timing.threads))
+    Ok((
+        row_of(q, &s, full, timing.wall_seconds, outline),
+        timing.threads,
+    ))
 }
 
-fn row_of(quality: f64, s: &MeshStats, full: u64, fit_seconds: f64) -> FitRow {
-    let tris = s.lods[0].planar;
+fn row_of(quality: f64, s: &MeshStats, full: u64, fit_seconds: f64, outline: bool) -> FitRow {
+    // The outline fit draws its slab tops on triangles of their own.
+    let footprints =
+        |l: &strata_mesh::level_mesh::LodTotals| l.planar + if outline { l.slab / 2 } else { 0 };
+    let tris = footprints(&s.lods[0]);
     FitRow {
         quality,
         max_error: s.tolerance,
         triangles: tris,
-        lod_triangles: s.lods.map(|l| l.planar),
+        lod_triangles: s.lods.each_ref().map(footprints),
         emitted_triangles: s.lods[0].emitted,
         reduction: full as f64 / tris.max(1) as f64,
         // Each planar triangle with a slab emits two slab triangles.
