@@ -165,16 +165,46 @@ fn texel_run(r: TexelRun, p: vec2<f32>) -> vec2<f32> {
 // is not solid, the march goes on. Either way a ray takes at most `steps`
 // samples, one column decode each, and the columns strictly between two
 // samples stay untested: the step budget is the method's. The shared shadow
-// map (`shadow.wgsl`) runs the same march, so its texels come nearer to its
-// CPU twin's (cast by the exact tracer) and are never early.
+// map (`shadow.wgsl`) keeps the point test (`march_points`).
 // Measured (default world, twelve views, 1280x800, lavapipe = the H100's
-// images): ray mean ꟻLIP 0.0561 with the point test, 0.0460 with this one.
+// images): ray mean ꟻLIP 0.0561 with the point test, 0.0499 with this one
+// (0.0460 with the shadow map on it too, `bench/ray-flip/`). Its price on the
+// H100: `ray` 4.0 -> 7.1 ms, `ray-compute`'s march 0.135 -> 0.229 ms.
 const SEGMENT_STEP_TEST: bool = true;
 
 // Twin of `methods::ray::MAX_RAY_STEPS`.
 const MAX_MARCH_STEPS: u32 = 16384u;
 
-fn march(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, steps: u32) -> MarchHit {
+// The paper's point test: `steps` samples until one is solid, then the exact
+// entry inside the step that ends there. The shared shadow map marches this
+// way: the segment test made its pass 75 % dearer on the H100 (0.103 -> 0.180
+// ms at 1280x800, every method but `ray-exact` pays it) for 0.0040 of ray's
+// mean ꟻLIP.
+fn march_points(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, steps: u32) -> MarchHit {
+    var result: MarchHit;
+    result.hit = false;
+    result.t = t1;
+    if (t1 <= t0) {
+        return result;
+    }
+    if (is_solid(o + d * t0)) {
+        result.hit = true;
+        result.t = t0;
+        return result;
+    }
+    let s = first_solid_sample(o, d, t0, t1, min(steps, MAX_MARCH_STEPS));
+    if (s.x == 0.0) {
+        return result;
+    }
+    return refine_exact(o, d, s.y, s.z, true);
+}
+
+// `segment`: the step test above (`ray`, `ray-compute`), else the point test
+// (`march_points`: the shadow map).
+fn march(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, steps: u32, segment: bool) -> MarchHit {
+    if (!segment) {
+        return march_points(o, d, t0, t1, steps);
+    }
     var result: MarchHit;
     result.hit = false;
     result.t = t1;
@@ -202,18 +232,12 @@ fn march(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, steps: u32) -> MarchHit {
         let p = o + d * t;
         let c = decode_column(i32(floor(p.x)), i32(floor(p.y)));
         let run = texel_run(runs, p.xy);
-        var flag: bool;
-        if (SEGMENT_STEP_TEST) {
-            // The step's piece in this column: from its entry (or sample i - 1)
-            // to p, which holds the point test; and in the previous column:
-            // from sample i - 1 to its exit (or p).
-            let z_in = p.z - d.z * min(run.x, dt);
-            let z_out = prev_z + d.z * min(prev_exit, dt);
-            flag = z_span_meets_solid(c, z_in, p.z) || z_span_meets_solid(prev, prev_z, z_out);
-        } else {
-            flag = column_is_solid(c, p.z);
-        }
-        if (flag) {
+        // The step's piece in this column: from its entry (or sample i - 1)
+        // to p, which holds the point test; and in the previous column: from
+        // sample i - 1 to its exit (or p).
+        let z_in = p.z - d.z * min(run.x, dt);
+        let z_out = prev_z + d.z * min(prev_exit, dt);
+        if (z_span_meets_solid(c, z_in, p.z) || z_span_meets_solid(prev, prev_z, z_out)) {
             let r = refine_exact(o, d, a, t, column_is_solid(c, p.z));
             if (r.hit) {
                 return r;

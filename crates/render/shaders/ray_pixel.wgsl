@@ -41,5 +41,5 @@ fn ray_pixel(px: f32, py: f32, steps: u32) -> PixelSample {
     let o = globals.eye.xyz;
     let d = camera_ray(px, py);
     let seg = camera_segment(o, d);
-    return shade_hit(o, d, march(o, d, seg.x, seg.y, steps));
+    return shade_hit(o, d, march(o, d, seg.x, seg.y, steps, SEGMENT_STEP_TEST));
 }

@@ -10,7 +10,8 @@
 #include "ray_core.wgsl"
 #include "fullscreen.wgsl"
 
-// The camera ray's march and step test (`ray_core.wgsl::march`), 128 steps.
+// The camera ray's march with the paper's point test
+// (`ray_core.wgsl::march_points`), 128 steps.
 const SHADOW_STEPS: u32 = 128u;
 const SHADOW_MISS: f32 = 1e9;
 
@@ -28,7 +29,7 @@ fn shadow_distance(id: vec2<u32>) -> f32 {
         + globals.shadow_v.xyz * ((f32(id.y) + 0.5) * texel);
     let d = globals.light_dir.xyz;
     let seg = clip_to_altitudes(o, d, 0.0, 1e6);
-    let h = march(o, d, seg.x, seg.y, SHADOW_STEPS);
+    let h = march(o, d, seg.x, seg.y, SHADOW_STEPS, false);
     return select(SHADOW_MISS, h.t, h.hit);
 }
 

@@ -74,17 +74,18 @@ fn marched_ray_colour_is_near_the_cpu_reference_on_a_generated_world() {
     }
     let mean = total / views.len() as f32;
     eprintln!("ray: mean FLIP over the four pitches {mean:.4}");
-    // Measured on lavapipe: 0.0245 (0.037 / 0.016 / 0.031 / 0.015 by pitch)
-    // with the segment step test (`ray_core.wgsl::march`: a step is flagged
-    // when the ray's piece of it in the column under either of its samples
-    // meets that column's floor or slab); 0.0409 (0.041 / 0.023 / 0.063 /
-    // 0.037) with the paper's point test at each sample, and 0.0503 (0.050 /
-    // 0.043 / 0.070 / 0.038) with that and the paper's four bisections, whose
-    // hit lay up to 1/16 of a step inside the solid (in the next column along
-    // a grazing ray; its height fed the shadow test). What remains is the
-    // columns strictly between two samples, in the image and in the marched
-    // shadow map. The bound fails the point test.
-    assert!(mean < 0.028, "ray mean FLIP {mean}");
+    // Measured on lavapipe: 0.0341 (0.038 / 0.023 / 0.051 / 0.025 by pitch)
+    // with the segment step test for the camera ray (`ray_core.wgsl::march`:
+    // a step is flagged when the ray's piece of it in the column under
+    // either of its samples meets that column's floor or slab) and the
+    // paper's point test for the shared shadow map; 0.0245 with the segment
+    // test in both (not kept: the shadow pass cost 75 % more on the H100);
+    // 0.0409 (0.041 / 0.023 / 0.063 / 0.037) with the point test in both,
+    // and 0.0503 with that and the paper's four bisections, whose hit lay up
+    // to 1/16 of a step inside the solid. What remains is the columns
+    // strictly between two samples, in the image and in the marched shadow
+    // map. The bound fails the point test.
+    assert!(mean < 0.038, "ray mean FLIP {mean}");
     gpu.errors.check().unwrap();
 }
 

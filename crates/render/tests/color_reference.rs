@@ -92,14 +92,14 @@ fn gpu_shadow_map_and_shading_match_the_cpu_colour_reference() {
             cast.len(),
             frame.bias
         );
-        // The 128-step march (2.4-unit steps along the light) skips thin
-        // casters and terrace lips in the columns strictly between two
-        // samples, which the exact tracer finds (seen with the segment step
-        // test, over the texels cast: 1.57 to 2.36 %, all of them longer on
-        // the GPU); a wrong frame, axis or texel centre would put most texels
-        // off, or some early.
+        // The 128-step march (2.4-unit steps along the light, the paper's
+        // point test) skips thin casters and terrace lips the exact tracer
+        // finds (seen over the texels cast: 2.07 to 3.31 %; 1.57 to 2.36 %
+        // with the camera ray's segment step test, not used for the map; all
+        // of them longer on the GPU); a wrong frame, axis or texel centre
+        // would put most texels off, or some early.
         assert!(
-            off_pct < 3.0,
+            off_pct < 4.5,
             "{}: {off_pct} % of shadow texels off",
             view.name
         );
