@@ -46,6 +46,7 @@
 
 #![warn(missing_docs)]
 
+pub mod frustum;
 pub mod light;
 
 use glam::{Mat4, Vec3, Vec4};

@@ -155,14 +155,17 @@ impl ShadowCover {
     /// sample: the light's projection of the frustum (near to far) cut to
     /// the altitude slab [0, 255], widened by [`COVER_MARGIN_TEXELS`].
     pub fn of_view(camera: &Camera, frame: &ShadowFrame) -> ShadowCover {
-        let outline: Vec<glam::DVec2> = view_slice_points(camera)
+        let outline: Vec<[f32; 2]> = crate::frustum::slab_points(camera, camera.far, 255.0)
             .into_iter()
-            .map(|p| frame.texel_coords(p))
+            .map(|p| frame.texel_coords(p.as_dvec3()).as_vec2().to_array())
             .collect();
         if outline.is_empty() {
             return ShadowCover::NO_TEXEL;
         }
-        let hull = convex_hull(outline);
+        let hull: Vec<glam::DVec2> = crate::frustum::convex_hull(outline)
+            .into_iter()
+            .map(|p| glam::Vec2::from(p).as_dvec2())
+            .collect();
         if hull.len() < 3 {
             // A degenerate slice (a line or a point): keep it simple and
             // cast everything rather than reason about a zero-area region.
@@ -199,69 +202,6 @@ impl ShadowCover {
             .sum();
         covered as f64 / (f64::from(side) * f64::from(side))
     }
-}
-
-/// The vertices of the frustum (view depth near to far) cut to the altitude
-/// slab [0, 255]: the frustum's corners inside the slab and its edges'
-/// crossings of z = 0 and z = 255 (a convex polytope's cut by two parallel
-/// planes has no other vertices). Empty when the slab is out of view.
-fn view_slice_points(camera: &Camera) -> Vec<glam::DVec3> {
-    const TOP: f64 = 255.0;
-    let eye = camera.position.as_dvec3();
-    let (w, h) = (camera.width as f32, camera.height as f32);
-    let focal = f64::from(camera.focal_px);
-    let corners = [(0.0, 0.0), (w, 0.0), (w, h), (0.0, h)];
-    let at = |depth: f32, (px, py): (f32, f32)| {
-        eye + camera.image_direction(px, py).as_dvec3() * (f64::from(depth) / focal)
-    };
-    let near: Vec<glam::DVec3> = corners.iter().map(|&c| at(camera.near, c)).collect();
-    let far: Vec<glam::DVec3> = corners.iter().map(|&c| at(camera.far, c)).collect();
-    let mut edges = Vec::with_capacity(12);
-    for k in 0..4 {
-        edges.push((near[k], near[(k + 1) % 4]));
-        edges.push((far[k], far[(k + 1) % 4]));
-        edges.push((near[k], far[k]));
-    }
-    let inside = |p: &glam::DVec3| (0.0..=TOP).contains(&p.z);
-    let mut points: Vec<glam::DVec3> = near.iter().chain(&far).copied().filter(inside).collect();
-    for (a, b) in edges {
-        for z in [0.0, TOP] {
-            let (da, db) = (a.z - z, b.z - z);
-            if (da <= 0.0 && db >= 0.0 || da >= 0.0 && db <= 0.0) && da != db {
-                points.push(a + (b - a) * (da / (da - db)));
-            }
-        }
-    }
-    points
-}
-
-/// Counter-clockwise convex hull (Andrew's monotone chain), collinear points dropped.
-fn convex_hull(mut points: Vec<glam::DVec2>) -> Vec<glam::DVec2> {
-    points.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
-    points.dedup();
-    if points.len() < 3 {
-        return points;
-    }
-    let cross = |o: glam::DVec2, a: glam::DVec2, b: glam::DVec2| (a - o).perp_dot(b - o);
-    let mut hull: Vec<glam::DVec2> = Vec::with_capacity(2 * points.len());
-    for pass in 0..2 {
-        let start = hull.len();
-        let ordered: Box<dyn Iterator<Item = &glam::DVec2>> = if pass == 0 {
-            Box::new(points.iter())
-        } else {
-            Box::new(points.iter().rev())
-        };
-        for &p in ordered {
-            while hull.len() >= start + 2
-                && cross(hull[hull.len() - 2], hull[hull.len() - 1], p) <= 0.0
-            {
-                hull.pop();
-            }
-            hull.push(p);
-        }
-        hull.pop();
-    }
-    hull
 }
 
 #[cfg(test)]

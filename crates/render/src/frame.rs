@@ -391,11 +391,21 @@ pub fn storage_texture_entry(
     binding: u32,
     format: wgpu::TextureFormat,
 ) -> wgpu::BindGroupLayoutEntry {
+    storage_texture_entry_with(binding, format, wgpu::StorageTextureAccess::WriteOnly)
+}
+
+/// [`storage_texture_entry`] with the given access (the R32 formats allow
+/// `ReadWrite` everywhere WebGPU runs).
+pub fn storage_texture_entry_with(
+    binding: u32,
+    format: wgpu::TextureFormat,
+    access: wgpu::StorageTextureAccess,
+) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
         visibility: wgpu::ShaderStages::COMPUTE,
         ty: wgpu::BindingType::StorageTexture {
-            access: wgpu::StorageTextureAccess::WriteOnly,
+            access,
             format,
             view_dimension: wgpu::TextureViewDimension::D2,
         },

@@ -49,41 +49,9 @@ pub fn footprint_bounds(camera: &Camera, far: f32) -> Option<([f32; 2], [f32; 2]
 }
 
 /// Points whose convex hull is the part of the frustum (near to `far`) with
-/// altitude in `0..=Z_MAX` (empty when the frustum misses that range). Shared
-/// by the footprint bounds here and `scattered`'s camera-aligned grid.
+/// altitude in `0..=Z_MAX` (empty when the frustum misses that range).
 pub fn frustum_slab_points(camera: &Camera, far: f32) -> Vec<Vec3> {
-    let (w, h) = (camera.width as f32, camera.height as f32);
-    let image = [(0.0, 0.0), (w, 0.0), (w, h), (0.0, h)];
-    // Corners at view depth `d`: the image direction's forward part is the focal length.
-    let corners = |d: f32| {
-        image.map(|(px, py)| {
-            camera.position + camera.image_direction(px, py) * (d / camera.focal_px)
-        })
-    };
-    let near = corners(camera.near);
-    let far = corners(far);
-    let mut points: Vec<Vec3> = near
-        .iter()
-        .chain(&far)
-        .copied()
-        .filter(|p| (0.0..=Z_MAX).contains(&p.z))
-        .collect();
-    // A convex body cut by a slab: its vertices are the body's vertices inside
-    // the slab and the crossings of its edges with the slab's two planes.
-    let mut edges = Vec::with_capacity(12);
-    for i in 0..4 {
-        let j = (i + 1) % 4;
-        edges.extend([(near[i], near[j]), (far[i], far[j]), (near[i], far[i])]);
-    }
-    for (a, b) in edges {
-        for z in [0.0, Z_MAX] {
-            if (a.z - z) * (b.z - z) < 0.0 {
-                let t = (z - a.z) / (b.z - a.z);
-                points.push(a.lerp(b, t));
-            }
-        }
-    }
-    points
+    strata_camera::frustum::slab_points(camera, far, Z_MAX)
 }
 
 /// Samples in the bound of the frustum cut at `far`: the bound's corners.

@@ -90,68 +90,6 @@ enum Variant {
     Fragment(wgpu::RenderPipeline),
 }
 
-/// The compute variant's frame on frames that cast the shadow map
-/// (`ray_exact_deferred.wgsl`): march (hit `t` into the depth image, hit
-/// column into `hits`, the shadow blocks its shading reads stamped), then the
-/// exact shadow pass over the stamped blocks only, then shading. The other
-/// frames (map reused, shadows off) march and shade in one pass.
-struct Deferred {
-    march: wgpu::ComputePipeline,
-    shade: wgpu::ComputePipeline,
-    layout: wgpu::BindGroupLayout,
-    group: wgpu::BindGroup,
-    /// R32Uint: each pixel's hit column relative to the eye's tile.
-    hits: wgpu::TextureView,
-}
-
-/// Side of the shadow map's stamped blocks, texels (`MARK_BLOCK` in
-/// `ray_exact_deferred.wgsl`).
-const MARK_BLOCK: u32 = 8;
-
-/// The deferred frame's record of the shadow blocks its pixels sample: a
-/// stamp per block, the list of blocks stamped this frame, and the shadow
-/// pass's indirect dispatch (one workgroup per listed block).
-struct ShadowMarks {
-    stamps: wgpu::Buffer,
-    list: wgpu::Buffer,
-    dispatch: wgpu::Buffer,
-}
-
-impl ShadowMarks {
-    fn new(device: &wgpu::Device, blocks: u32) -> Self {
-        let buffer = |label: &str, size: u64, usage: wgpu::BufferUsages| {
-            device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size,
-                usage: wgpu::BufferUsages::STORAGE | usage,
-                mapped_at_creation: false,
-            })
-        };
-        let bytes = u64::from(blocks) * 4;
-        ShadowMarks {
-            stamps: buffer(
-                "ray-exact shadow stamps",
-                bytes,
-                wgpu::BufferUsages::empty(),
-            ),
-            list: buffer(
-                "ray-exact shadow blocks",
-                bytes,
-                wgpu::BufferUsages::empty(),
-            ),
-            dispatch: buffer(
-                "ray-exact shadow dispatch",
-                12,
-                wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
-            ),
-        }
-    }
-
-    fn bytes(&self) -> u64 {
-        self.stamps.size() + self.list.size() + self.dispatch.size()
-    }
-}
-
 /// The exact shadow-map pass.
 struct ExactShadow {
     /// Every texel of the view's cover.
@@ -595,129 +533,6 @@ fn exact_shadow(
     })
 }
 
-/// A read-write storage texture entry (compute).
-fn read_write_texture_entry(
-    binding: u32,
-    format: wgpu::TextureFormat,
-) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::StorageTexture {
-            access: wgpu::StorageTextureAccess::ReadWrite,
-            format,
-            view_dimension: wgpu::TextureViewDimension::D2,
-        },
-        count: None,
-    }
-}
-
-impl Deferred {
-    fn new(
-        shared: &Shared,
-        params: &wgpu::Buffer,
-        pyramid: &GpuMaxMip,
-        stats: &wgpu::Buffer,
-        marks: &ShadowMarks,
-        depth: &DepthCopy,
-        options: ExactOptions,
-    ) -> anyhow::Result<Self> {
-        let device = &shared.device;
-        let mut entries = core_entries(wgpu::ShaderStages::COMPUTE);
-        entries.extend([
-            storage_texture_entry(3, crate::frame::COLOR_FORMAT),
-            read_write_texture_entry(4, wgpu::TextureFormat::R32Float),
-            read_write_texture_entry(5, wgpu::TextureFormat::R32Uint),
-        ]);
-        for binding in 6..=8 {
-            entries.push(buffer_entry(
-                binding,
-                wgpu::ShaderStages::COMPUTE,
-                wgpu::BufferBindingType::Storage { read_only: false },
-            ));
-        }
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("ray-exact deferred"),
-            entries: &entries,
-        });
-        let pipeline_layout = shared.pipeline_layout("ray-exact deferred", &[&layout]);
-        let pipeline = |label: &str, entry: &str| {
-            exact_pipeline(
-                shared,
-                label,
-                "ray_exact_deferred.wgsl",
-                &pipeline_layout,
-                entry,
-                options,
-            )
-        };
-        let march = pipeline("ray-exact march", "cs_exact_march_hits")?;
-        let shade = pipeline("ray-exact shade", "cs_exact_shade")?;
-        let hits = hits_image(shared);
-        let group = Self::group(
-            shared,
-            &layout,
-            (params, pyramid, stats, marks),
-            depth,
-            &hits,
-        );
-        Ok(Deferred {
-            march,
-            shade,
-            layout,
-            group,
-            hits,
-        })
-    }
-
-    fn group(
-        shared: &Shared,
-        layout: &wgpu::BindGroupLayout,
-        (params, pyramid, stats, marks): (&wgpu::Buffer, &GpuMaxMip, &wgpu::Buffer, &ShadowMarks),
-        depth: &DepthCopy,
-        hits: &wgpu::TextureView,
-    ) -> wgpu::BindGroup {
-        let mut entries = core_bindings(params, pyramid, stats);
-        entries.extend(depth.bindings(shared, 3));
-        entries.push(wgpu::BindGroupEntry {
-            binding: 5,
-            resource: wgpu::BindingResource::TextureView(hits),
-        });
-        for (binding, buffer) in [(6, &marks.stamps), (7, &marks.list), (8, &marks.dispatch)] {
-            entries.push(wgpu::BindGroupEntry {
-                binding,
-                resource: buffer.as_entire_binding(),
-            });
-        }
-        shared.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("ray-exact deferred"),
-            layout,
-            entries: &entries,
-        })
-    }
-}
-
-/// The deferred frame's per-pixel hit columns: R32Uint at the targets' size.
-fn hits_image(shared: &Shared) -> wgpu::TextureView {
-    shared
-        .device
-        .create_texture(&wgpu::TextureDescriptor {
-            label: Some("ray-exact hits"),
-            size: wgpu::Extent3d {
-                width: shared.width,
-                height: shared.height,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::R32Uint,
-            usage: wgpu::TextureUsages::STORAGE_BINDING,
-            view_formats: &[],
-        })
-        .create_view(&Default::default())
-}
-
 impl RayExact {
     /// The GPU pyramid (tests compare it with `strata_maxmip`).
     pub fn pyramid(&self) -> &GpuMaxMip {
@@ -993,6 +808,10 @@ impl Drop for RayExact {
         }
     }
 }
+
+#[path = "ray_exact_deferred.rs"]
+mod deferred;
+use deferred::{Deferred, MARK_BLOCK, ShadowMarks, hits_image};
 
 #[cfg(test)]
 #[path = "ray_exact_tests.rs"]

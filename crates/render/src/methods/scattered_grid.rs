@@ -79,67 +79,11 @@ impl ScatterParams {
     }
 }
 
-/// Convex hull, counter-clockwise, without collinear points (monotone chain).
-fn convex_hull(mut pts: Vec<[f32; 2]>) -> Vec<[f32; 2]> {
-    pts.sort_by(|p, q| p[0].total_cmp(&q[0]).then(p[1].total_cmp(&q[1])));
-    pts.dedup();
-    if pts.len() < 3 {
-        return pts;
-    }
-    let turn = |o: [f32; 2], a: [f32; 2], b: [f32; 2]| {
-        (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
-    };
-    let mut hull: Vec<[f32; 2]> = Vec::with_capacity(2 * pts.len());
-    for pass in [false, true] {
-        let start = hull.len();
-        let iter: Box<dyn Iterator<Item = &[f32; 2]>> = if pass {
-            Box::new(pts.iter().rev())
-        } else {
-            Box::new(pts.iter())
-        };
-        for &p in iter {
-            while hull.len() >= start + 2
-                && turn(hull[hull.len() - 2], hull[hull.len() - 1], p) <= 0.0
-            {
-                hull.pop();
-            }
-            hull.push(p);
-        }
-        hull.pop();
-    }
-    hull
-}
-
 /// Points whose convex hull is the part of the frustum (near to far) with
-/// altitude in `0..=top` (as `forward::frustum_slab_points`, which cuts at
-/// `Z_MAX`): no terrain in view lies outside it when no column top in view is
-/// above `top`.
+/// altitude in `0..=top`: no terrain in view lies outside it when no column
+/// top in view is above `top`.
 pub fn slab_points(camera: &Camera, top: f32) -> Vec<Vec3> {
-    let (w, h) = (camera.width as f32, camera.height as f32);
-    let image = [(0.0, 0.0), (w, 0.0), (w, h), (0.0, h)];
-    let corners = |d: f32| {
-        image.map(|(px, py)| {
-            camera.position + camera.image_direction(px, py) * (d / camera.focal_px)
-        })
-    };
-    let (near, far) = (corners(camera.near), corners(camera.far));
-    let mut points: Vec<Vec3> = near
-        .iter()
-        .chain(&far)
-        .copied()
-        .filter(|p| (0.0..=top).contains(&p.z))
-        .collect();
-    for i in 0..4 {
-        let j = (i + 1) % 4;
-        for (a, b) in [(near[i], near[j]), (far[i], far[j]), (near[i], far[i])] {
-            for z in [0.0, top] {
-                if (a.z - z) * (b.z - z) < 0.0 {
-                    points.push(a.lerp(b, (z - a.z) / (b.z - a.z)));
-                }
-            }
-        }
-    }
-    points
+    strata_camera::frustum::slab_points(camera, camera.far, top)
 }
 
 /// The grid for `camera` at `density` (X, Y, Z, each already within
@@ -188,7 +132,7 @@ pub fn scatter_grid(
             [r.dot(b.flat), r.dot(b.right)]
         })
         .collect();
-    let mut hull = convex_hull(pts);
+    let mut hull = strata_camera::frustum::convex_hull(pts);
     if hull.len() < 3 {
         return (params, None);
     }
@@ -396,15 +340,6 @@ mod tests {
     use super::*;
 
     #[test]
-    fn slab_points_match_the_forward_footprint_at_z_max() {
-        use super::super::forward::frustum_slab_points;
-        for pitch in [0.0, -45.0, -90.0] {
-            let cam = Camera::new(Vec3::new(30.0, 50.0, 120.0), 20.0, pitch, 160, 100).unwrap();
-            assert_eq!(slab_points(&cam, Z_MAX), frustum_slab_points(&cam, cam.far));
-        }
-    }
-
-    #[test]
     fn a_low_terrain_shrinks_the_footprint_and_widens_the_rows() {
         // Looking steeply down from 150: terrain no higher than 50 is at least
         // 100 away, so rows near the eye are not needed.
@@ -423,20 +358,6 @@ mod tests {
             low.samples(),
             all.samples()
         );
-    }
-
-    #[test]
-    fn hull_drops_inner_and_collinear_points() {
-        let pts = vec![
-            [0.0, 0.0],
-            [2.0, 0.0],
-            [1.0, 0.0],
-            [2.0, 2.0],
-            [0.0, 2.0],
-            [1.0, 1.0],
-        ];
-        let h = convex_hull(pts);
-        assert_eq!(h.len(), 4, "{h:?}");
     }
 
     #[test]
