@@ -304,7 +304,9 @@ mod tests {
                 heights[y * 64 + x] = 80;
             }
         }
-        let cam = Camera::new(Vec3::new(32.0, 0.0, 120.0), 0.0, -45.0, 16, 16).unwrap();
+        // Looking down on both test points: the map is cast only where the
+        // view can read it (`ShadowCover`).
+        let cam = Camera::new(Vec3::new(32.0, 32.0, 120.0), 0.0, -90.0, 256, 256).unwrap();
         let tracer = Tracer::new(&level);
         let ramps = ramps();
         let shader = Shader::new(&tracer, &ramps, &cam, true);

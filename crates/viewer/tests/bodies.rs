@@ -90,6 +90,8 @@ fn bodies_show_in_the_open_and_hide_under_a_slab_in_every_method() {
                 continue;
             }
         };
+        // The bodies draw over Strata's own depth target.
+        r.set_depth_attachment(true);
         r.render_frame(&camera).unwrap();
         let terrain = r.read_color().unwrap();
         painter.draw(
