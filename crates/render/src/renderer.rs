@@ -134,12 +134,12 @@ impl Renderer {
             setup_ms: 0.0,
             // Off by default (the protocol pays for every frame's map);
             // `STRATA_SHADOW_REUSE=1` turns it on to measure a cached map.
-            shadow_reuse: shadow_reuse_from_env(),
+            shadow_reuse: env_is("STRATA_SHADOW_REUSE", "1"),
             shadow_drawn: None,
             // `STRATA_SHADOW_CULL=0` casts the whole map, to measure the cull.
-            shadow_cull: !env_is_zero("STRATA_SHADOW_CULL"),
+            shadow_cull: !env_is("STRATA_SHADOW_CULL", "0"),
             // `STRATA_DEPTH_ATTACHMENT=1` copies every frame, to measure it.
-            depth_attachment: env_is_one("STRATA_DEPTH_ATTACHMENT"),
+            depth_attachment: env_is("STRATA_DEPTH_ATTACHMENT", "1"),
             depth_target_current: false,
             depth_reader,
             edit_listener: None,
@@ -624,43 +624,16 @@ impl Renderer {
     }
 }
 
-/// Whether environment variable `name` is `0` (a measuring switch; never in
-/// a browser).
-fn env_is_zero(name: &str) -> bool {
+/// Whether environment variable `name` is `value`: the measuring switches
+/// (`STRATA_SHADOW_REUSE`, `STRATA_EXACT_*`, ...), never set in a browser.
+pub(crate) fn env_is(name: &str, value: &str) -> bool {
     #[cfg(not(target_arch = "wasm32"))]
     {
-        std::env::var(name).is_ok_and(|v| v == "0")
+        std::env::var(name).is_ok_and(|v| v == value)
     }
     #[cfg(target_arch = "wasm32")]
     {
-        let _ = name;
-        false
-    }
-}
-
-/// Whether environment variable `name` is `1` (a measuring switch; never in
-/// a browser).
-fn env_is_one(name: &str) -> bool {
-    #[cfg(not(target_arch = "wasm32"))]
-    {
-        std::env::var(name).is_ok_and(|v| v == "1")
-    }
-    #[cfg(target_arch = "wasm32")]
-    {
-        let _ = name;
-        false
-    }
-}
-
-/// `STRATA_SHADOW_REUSE=1`: start with [`Renderer::set_shadow_reuse`] on
-/// (a measuring switch; never on in a browser).
-fn shadow_reuse_from_env() -> bool {
-    #[cfg(not(target_arch = "wasm32"))]
-    {
-        std::env::var("STRATA_SHADOW_REUSE").is_ok_and(|v| v == "1")
-    }
-    #[cfg(target_arch = "wasm32")]
-    {
+        let _ = (name, value);
         false
     }
 }

@@ -47,6 +47,7 @@ use super::common::{DepthCopy, dispatch_per_pixel, fullscreen_pipeline};
 use super::ray_exact_build::{GpuMaxMip, read_buffer};
 use super::{Frame, Method, MethodSettings, RetainedBytes};
 use crate::frame::{SHADOW_SIZE, Shared, storage_texture_entry};
+use crate::renderer::env_is;
 use serde::Serialize;
 use std::cell::Cell;
 use strata_camera::Camera;
@@ -238,18 +239,6 @@ pub fn create_fragment(
         level,
         ExactOptions::from_env(false),
     )?))
-}
-
-fn env_is(name: &str, value: &str) -> bool {
-    #[cfg(not(target_arch = "wasm32"))]
-    {
-        std::env::var(name).is_ok_and(|v| v == value)
-    }
-    #[cfg(target_arch = "wasm32")]
-    {
-        let _ = (name, value);
-        false
-    }
 }
 
 fn buffer_entry(
