@@ -224,6 +224,47 @@ fn scan_small<const F: usize>(
     best
 }
 
+/// 1 / |d| per edge step (0 where d is 0), for [`row_span`].
+#[inline(always)]
+fn reciprocals(dx: [i32; 3]) -> [f64; 3] {
+    dx.map(|d| {
+        if d == 0 {
+            0.0
+        } else {
+            1.0 / f64::from(d.abs())
+        }
+    })
+}
+
+/// How much each field's interpolant numerator changes per step in x.
+#[inline(always)]
+fn numerator_steps(dx: [i32; 3], zs: [[u8; 3]; 3]) -> [i32; 3] {
+    std::array::from_fn(|f| (0..3).map(|i| dx[i] * i32::from(zs[i][f])).sum())
+}
+
+/// The span `lo..=hi` of x in `x0..=x1` where all three barycentric weights
+/// of the row (`w_row` at x0, `dx` per step) are >= 0: exact integer bounds
+/// (empty when `lo > hi`). Quotients via reciprocals: |d| <= 2^8 and
+/// |w| < 2^20, so a non-integer quotient is >= 2^-8 from an integer while the
+/// float error is < 2^-30; the 2^-12 nudge makes ceil/floor exact.
+#[inline(always)]
+fn row_span(w_row: [i32; 3], dx: [i32; 3], inv: [f64; 3], x0: i32, x1: i32) -> (i32, i32) {
+    let (mut lo, mut hi) = (x0, x1);
+    for i in 0..3 {
+        let (w, d) = (w_row[i], dx[i]);
+        if w >= 0 {
+            if d < 0 {
+                hi = hi.min(x0 + (f64::from(w) * inv[i] + NUDGE).floor() as i32);
+            }
+        } else if d > 0 {
+            lo = lo.max(x0 + (f64::from(-w) * inv[i] - NUDGE).ceil() as i32);
+        } else {
+            hi = -1;
+        }
+    }
+    (lo, hi)
+}
+
 #[inline(always)]
 fn scan_rows<const F: usize>(
     pts: [Pt; 3],
@@ -238,37 +279,12 @@ fn scan_rows<const F: usize>(
     // w_i(x, y) = w_i(x0, y0) + dx[i] (x - x0) + dy[i] (y - y0).
     let (dx, dy) = edge_steps(pts);
     let mut w_row = barycentric(a, b, c, [x0, y0]);
-    let inv = dx.map(|d| {
-        if d == 0 {
-            0.0
-        } else {
-            1.0 / f64::from(d.abs())
-        }
-    });
+    let inv = reciprocals(dx);
     // Interpolant numerators change by a constant per step in x.
-    let mut dn = [0i32; 3];
-    for (f, d) in dn.iter_mut().enumerate() {
-        *d = (0..3).map(|i| dx[i] * i32::from(zs[i][f])).sum();
-    }
+    let dn = numerator_steps(dx, zs);
     let mut best = (0i32, 0u32);
     for y in y0..=y1 {
-        // The span of x where all three w_i >= 0 (exact integer bounds).
-        // Quotients via reciprocals: |d| <= 2^8 and |w| < 2^20, so a
-        // non-integer quotient is >= 2^-8 from an integer while the float
-        // error is < 2^-30; the 2^-12 nudge makes ceil/floor exact.
-        let (mut lo, mut hi) = (x0, x1);
-        for i in 0..3 {
-            let (w, d) = (w_row[i], dx[i]);
-            if w >= 0 {
-                if d < 0 {
-                    hi = hi.min(x0 + (f64::from(w) * inv[i] + NUDGE).floor() as i32);
-                }
-            } else if d > 0 {
-                lo = lo.max(x0 + (f64::from(-w) * inv[i] - NUDGE).ceil() as i32);
-            } else {
-                hi = -1;
-            }
-        }
+        let (lo, hi) = row_span(w_row, dx, inv, x0, x1);
         if lo <= hi {
             let off = lo - x0;
             let w = [
@@ -533,33 +549,11 @@ fn scan_slab_spans(
     let stride = chunk.stride();
     let (dx, dy) = edge_steps(pts);
     let mut w_row = barycentric(a, b, c, [x0, y0]);
-    let inv = dx.map(|d| {
-        if d == 0 {
-            0.0
-        } else {
-            1.0 / f64::from(d.abs())
-        }
-    });
-    let mut dn = [0i32; 3];
-    for (f, d) in dn.iter_mut().enumerate() {
-        *d = (0..3).map(|i| dx[i] * i32::from(zs[i][f])).sum();
-    }
+    let inv = reciprocals(dx);
+    let dn = numerator_steps(dx, zs);
     let mut best = (0i32, 0u32);
     for y in y0..=y1 {
-        // The exact span of x inside the triangle (as in `scan_rows`).
-        let (mut lo, mut hi) = (x0, x1);
-        for i in 0..3 {
-            let (w, d) = (w_row[i], dx[i]);
-            if w >= 0 {
-                if d < 0 {
-                    hi = hi.min(x0 + (f64::from(w) * inv[i] + NUDGE).floor() as i32);
-                }
-            } else if d > 0 {
-                lo = lo.max(x0 + (f64::from(-w) * inv[i] - NUDGE).ceil() as i32);
-            } else {
-                hi = -1;
-            }
-        }
+        let (lo, hi) = row_span(w_row, dx, inv, x0, x1);
         if lo <= hi {
             let duals = chunk.duals_in(lo, y, hi, y) as i32;
             let off = lo - x0;

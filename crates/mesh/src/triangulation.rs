@@ -273,18 +273,7 @@ impl Triangulation {
             if incircle_small(self.pt(p), self.pt(a), self.pt(b), self.pt(d)) <= 0 {
                 continue;
             }
-            let (n_ad, n_db) = (ut.n[next(j)], ut.n[prev(j)]);
-            let (n_bp, n_pa) = (tri.n[1], tri.n[2]);
-            self.tris[t as usize] = Tri {
-                v: [p, a, d],
-                n: [n_ad, u, n_pa],
-            };
-            self.tris[u as usize] = Tri {
-                v: [p, d, b],
-                n: [n_db, n_bp, t],
-            };
-            self.relink(n_ad, d, a, t);
-            self.relink(n_bp, p, b, u);
+            self.flip(t, 0, u, j);
             self.stack.push(t);
             self.stack.push(u);
             self.touched.push(t);
@@ -335,23 +324,33 @@ impl Triangulation {
             {
                 continue;
             }
-            let (n_ad, n_db) = (ut.n[next(j)], ut.n[prev(j)]);
-            let (n_bp, n_pa) = (tri.n[next(i)], tri.n[prev(i)]);
-            self.tris[t as usize] = Tri {
-                v: [p, a, d],
-                n: [n_ad, u, n_pa],
-            };
-            self.tris[u as usize] = Tri {
-                v: [p, d, b],
-                n: [n_db, n_bp, t],
-            };
-            self.relink(n_ad, d, a, t);
-            self.relink(n_bp, p, b, u);
+            self.flip(t, i, u, j);
             // a-d, d-b, p-a, b-p.
             self.edge_stack.extend([(t, 0), (u, 0), (t, 2), (u, 1)]);
             self.touched.push(t);
             self.touched.push(u);
         }
+    }
+
+    /// Flip the edge a-b between triangle `t` (p, a, b, with p its vertex
+    /// `i`) and its neighbour `u` across it (d, its vertex `j`): `t` becomes
+    /// (p, a, d) and `u` (p, d, b), neighbours relinked.
+    fn flip(&mut self, t: u32, i: usize, u: u32, j: usize) {
+        let (tri, ut) = (self.tris[t as usize], self.tris[u as usize]);
+        let (p, a, b) = (tri.v[i], tri.v[next(i)], tri.v[prev(i)]);
+        let d = ut.v[j];
+        let (n_ad, n_db) = (ut.n[next(j)], ut.n[prev(j)]);
+        let (n_bp, n_pa) = (tri.n[next(i)], tri.n[prev(i)]);
+        self.tris[t as usize] = Tri {
+            v: [p, a, d],
+            n: [n_ad, u, n_pa],
+        };
+        self.tris[u as usize] = Tri {
+            v: [p, d, b],
+            n: [n_db, n_bp, t],
+        };
+        self.relink(n_ad, d, a, t);
+        self.relink(n_bp, p, b, u);
     }
 
     /// With [`outline`](Self::outline) on: does edge `a`-`b`, with `p` and
