@@ -367,28 +367,31 @@ fn row_max<const F: usize>(rows: [&[u8]; 3], n: [i32; 3], dn: [i32; 3], den: i32
 }
 
 /// [`scan`] for the slab triangulation of the outline fit, whose slab
-/// triangles (`duals` all true) draw only the slab (`mid`, `high`): the
+/// triangles (`slab`: see
+/// [`crate::triangulation::Triangulation::is_slab`]) draw only the slab (`mid`, `high`): the
 /// floor has its own triangulation. A slab triangle is measured on `mid`
 /// and `high` at every sample it covers (a single sample under it by how
 /// far the drawn slab is from its one surface); any other triangle draws
 /// nothing of this triangulation, so only its dual samples count, by the
 /// whole slab they miss (`high - low`), unless they are vertices or lie on
-/// an edge between two dual vertices (the slab triangle across draws them).
+/// a slab edge (`covered[k]` for the edge opposite vertex `k`: the slab
+/// triangle across draws them).
 /// Single samples outside slab triangles cost nothing here: the floor
 /// triangulation draws them. Same answer as a per-sample loop over
 /// [`slab_error`] (ties: the first sample in row-major order).
 pub fn scan_slab(
     pts: [Pt; 3],
     zs: [[u8; 3]; 3],
-    duals: [bool; 3],
+    slab: bool,
+    covered: [bool; 3],
     chunk: &ChunkSamples,
 ) -> (i64, i64, u32) {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: the CPU supports AVX2 (checked just above).
-        return unsafe { scan_slab_avx2(pts, zs, duals, chunk) };
+        return unsafe { scan_slab_avx2(pts, zs, slab, covered, chunk) };
     }
-    scan_slab_generic(pts, zs, duals, chunk)
+    scan_slab_generic(pts, zs, slab, covered, chunk)
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -396,31 +399,31 @@ pub fn scan_slab(
 fn scan_slab_avx2(
     pts: [Pt; 3],
     zs: [[u8; 3]; 3],
-    duals: [bool; 3],
+    slab: bool,
+    covered: [bool; 3],
     chunk: &ChunkSamples,
 ) -> (i64, i64, u32) {
-    scan_slab_generic(pts, zs, duals, chunk)
+    scan_slab_generic(pts, zs, slab, covered, chunk)
 }
 
 #[inline(always)]
 fn scan_slab_generic(
     pts: [Pt; 3],
     zs: [[u8; 3]; 3],
-    duals: [bool; 3],
+    slab: bool,
+    covered: [bool; 3],
     chunk: &ChunkSamples,
 ) -> (i64, i64, u32) {
     let (den, [x0, y0, x1, y1]) = match scan_setup(pts, chunk) {
         Ok(setup) => setup,
         Err(nothing) => return nothing,
     };
-    let slab = duals.iter().all(|&d| d);
     let duals_in = chunk.duals_in(x0, y0, x1, y1);
     if !slab && duals_in == 0 {
         return (0, i64::from(den), 0);
     }
     let bbox = [x0, y0, x1, y1];
     let area = (x1 - x0 + 1) * (y1 - y0 + 1);
-    let covered = [0, 1, 2].map(|k| duals[(k + 1) % 3] && duals[(k + 2) % 3]);
     let (best, at) = if slab && duals_in as i32 == area && area <= SMALL {
         scan_small::<2>(pts, zs, den, bbox, chunk)
     } else if area <= SMALL {

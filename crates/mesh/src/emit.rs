@@ -25,7 +25,10 @@
 //!
 //! The outline fit emits the floor of one triangulation and the slab of
 //! another into the same LODs ([`Parts`]); the rules above apply to each
-//! (walls close the slab triangulation's slab triangles).
+//! (walls close the slab triangulation's slab triangles). There a slab
+//! triangle also keeps within half a texel of the slab columns
+//! ([`Triangulation::is_slab`]): three dual vertices on two rims of a gap
+//! do not make one.
 //!
 //! LODs share triangles (greedy insertion leaves untouched regions alone),
 //! so the three lists are stored once, in blocks by LOD membership:
@@ -141,6 +144,8 @@ pub struct Emitter {
     blocks: [Vec<u64>; 8],
     scratch: Vec<u64>,
     stats: [LodStats; LODS],
+    /// Per triangle of the LOD being emitted: a slab triangle?
+    slab: Vec<bool>,
 }
 
 #[inline]
@@ -195,7 +200,13 @@ impl Emitter {
     ) {
         let positions = self.positions;
         let sample = |v: u32| &samples.samples[vsample[v as usize] as usize];
-        let slab = |t: u32| tr.tris[t as usize].v.iter().all(|&v| sample(v).dual());
+        self.slab.clear();
+        if parts != Parts::Floor {
+            self.slab
+                .extend((0..tr.tris.len() as u32).map(|t| tr.is_slab(t)));
+        }
+        let slab_of = &self.slab;
+        let slab = |t: u32| slab_of[t as usize];
         // A vertex's sample index is its grid position `y * stride + x`.
         let idx = |v: u32, kind: u16| (u32::from(kind) * positions + vsample[v as usize]) as u16;
         let out = &mut self.lists[lod];

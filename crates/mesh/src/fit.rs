@@ -48,7 +48,9 @@ pub struct FitOptions {
     /// triangulation each. The floor's is fitted on `low` alone, everywhere
     /// (single samples and the floor under a slab alike: the field that is
     /// drawn as the ground). The slab's is constrained to the single/double
-    /// region outline: only its slab triangles (three dual vertices) are
+    /// region outline: only its slab triangles (three dual vertices, no
+    /// edge across a gap between slab columns:
+    /// [`Triangulation::is_slab`](crate::triangulation::Triangulation::is_slab)) are
     /// drawn, as slab top, cave ceiling and walls, and they are measured on
     /// `mid` and `high` over every sample they cover, while a dual sample
     /// that no slab triangle draws costs its whole slab. So the slab is
@@ -152,13 +154,18 @@ impl ChunkFitter {
         let stride = self.samples.stride();
         self.tr.reset(sx, sy);
         self.tr.outline = pass == Pass::Slab;
+        if self.tr.outline {
+            self.tr.gaps.load(&self.samples);
+        }
         self.vsample.clear();
-        for v in 0..self.tr.pts.len() {
+        let mut corners = [false; 4];
+        for (v, dual) in corners.iter_mut().enumerate() {
             let p = self.tr.pts[v];
             let i = p[1] as usize * stride + p[0] as usize;
             self.vsample.push(i as u32);
-            self.tr.vdual[v] = self.samples.samples[i].dual();
+            *dual = self.samples.samples[i].dual();
         }
+        self.tr.classify_corners(corners);
 
         // Borders: the four edges, each fitted in 1D from its own samples.
         let edges: [(Pt, Pt, i32); 4] = [
@@ -266,8 +273,8 @@ impl ChunkFitter {
             .v
             .map(|v| self.samples.samples[self.vsample[v as usize] as usize].z);
         let (num, den, sample) = if self.pass == Pass::Slab {
-            let duals = tri.v.map(|v| self.tr.vdual[v as usize]);
-            scan_slab(pts, zs, duals, &self.samples)
+            let covered = self.tr.slab_edges(t);
+            scan_slab(pts, zs, self.tr.is_slab(t), covered, &self.samples)
         } else {
             scan(pts, zs, &self.samples)
         };
@@ -290,7 +297,7 @@ impl ChunkFitter {
             // The slab's own relief, or the outline: a single sample under
             // a slab triangle, a dual sample that no slab triangle draws.
             Pass::Slab => {
-                return if all_dual && s.dual() {
+                return if self.tr.is_slab(t) && s.dual() {
                     Cause::SlabInterior
                 } else {
                     Cause::Boundary

@@ -4,6 +4,8 @@
 use strata_level::Level;
 use strata_level::model::decode_column;
 
+use crate::predicates::Pt;
+
 /// Flag bit of [`Sample::flags`]: the column is dual (has a slab).
 pub const DUAL: u8 = 1;
 /// Flag bit: the column and its eight neighbours inside the chunk are all dual.
@@ -190,5 +192,97 @@ impl ChunkSamples {
                 }
             }
         }
+    }
+}
+
+/// The gaps of a chunk's slab: its unit squares `[x, x+1] x [y, y+1]` with
+/// no dual sample at any corner. A point over such a square is at least half
+/// a texel from every slab column, so the outline fit draws no slab there
+/// ([`crate::triangulation::Triangulation::slab_edge`]).
+#[derive(Clone, Debug, Default)]
+pub struct GapSquares {
+    /// Squares per row (`size_x`).
+    width: i32,
+    /// Summed-area table of `gap`, stride `width + 1`.
+    sum: Vec<u32>,
+}
+
+impl GapSquares {
+    /// The gaps of `chunk`.
+    pub fn load(&mut self, chunk: &ChunkSamples) {
+        let (w, h) = (chunk.size_x as i32, chunk.size_y as i32);
+        self.width = w;
+        let sw = w as usize + 1;
+        self.sum.clear();
+        self.sum.resize(sw * (h as usize + 1), 0);
+        for y in 0..h {
+            let mut run = 0;
+            for x in 0..w {
+                run += u32::from(chunk.duals_in(x, y, x + 1, y + 1) == 0);
+                let (x, y) = (x as usize, y as usize);
+                self.sum[(y + 1) * sw + x + 1] = self.sum[y * sw + x + 1] + run;
+            }
+        }
+    }
+
+    /// Whether any square of `[x0, x1) x [y0, y1)` is a gap.
+    #[inline]
+    fn any_in(&self, x0: i32, y0: i32, x1: i32, y1: i32) -> bool {
+        let sw = self.width as usize + 1;
+        let at = |x: i32, y: i32| self.sum[y as usize * sw + x as usize];
+        at(x1, y1) + at(x0, y0) != at(x0, y1) + at(x1, y0)
+    }
+
+    /// Does segment `a`-`b` between two dual samples of the chunk pass over
+    /// no gap? Exactly: no gap square's open interior meets the open
+    /// segment.
+    pub fn clear(&self, a: Pt, b: Pt) -> bool {
+        let (dx, dy) = ((b[0] - a[0]).abs(), (b[1] - a[1]).abs());
+        // On a grid line it meets no square's interior (its samples are
+        // the error scan's). Within two texels each way, every square it
+        // crosses has an end for a corner (the ends are dual: see
+        // `Triangulation::slab_edge`). With no gap in its bounding box, it
+        // crosses none.
+        if dx == 0
+            || dy == 0
+            || (dx <= 2 && dy <= 2)
+            || !self.any_in(
+                a[0].min(b[0]),
+                a[1].min(b[1]),
+                a[0].max(b[0]),
+                a[1].max(b[1]),
+            )
+        {
+            return true;
+        }
+        // Along the axis it advances less on, one strip at a time: a range
+        // query per strip.
+        if dx <= dy {
+            Self::strips(a, b, |i, first, last| {
+                !self.any_in(i, first, i + 1, last + 1)
+            })
+        } else {
+            let t = |p: Pt| [p[1], p[0]];
+            Self::strips(t(a), t(b), |i, first, last| {
+                !self.any_in(first, i, last + 1, i + 1)
+            })
+        }
+    }
+
+    /// For each column `i` of squares between `a` and `b` (`a[0] != b[0]`,
+    /// `a[1] != b[1]`): the rows `first..=last` of the squares the segment
+    /// crosses there, while `clear(i, first, last)` holds.
+    fn strips(a: Pt, b: Pt, mut clear: impl FnMut(i32, i32, i32) -> bool) -> bool {
+        let (a, b) = if a[0] <= b[0] { (a, b) } else { (b, a) };
+        let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+        // Over x in (i, i+1) the segment's y spans the open interval
+        // between y(i) and y(i+1), here times dx.
+        let y_dx = |x: i32| a[1] * dx + (x - a[0]) * dy;
+        (a[0]..b[0]).all(|i| {
+            let (y0, y1) = (y_dx(i), y_dx(i + 1));
+            let first = y0.min(y1).div_euclid(dx);
+            let last = (y0.max(y1) + dx - 1).div_euclid(dx) - 1;
+            clear(i, first, last)
+        })
     }
 }

@@ -8,6 +8,7 @@
 //! insertion once the buffers have grown.
 
 use crate::predicates::{Pt, incircle_small, orient2d};
+use crate::samples::GapSquares;
 
 /// No neighbour: the edge is on the chunk boundary.
 pub const NONE: u32 = u32::MAX;
@@ -27,14 +28,22 @@ pub struct Tri {
 pub struct Triangulation {
     /// Vertex positions, chunk-local sample coordinates.
     pub pts: Vec<Pt>,
-    /// Per vertex: its sample is dual (has a slab). Only read when
-    /// [`outline`](Self::outline) is on.
+    /// Per vertex: its sample is dual (has a slab): what
+    /// [`is_slab`](Self::is_slab) and the outline constraints read.
     pub vdual: Vec<bool>,
     /// Keep the slab outline: never flip an edge that separates a slab
-    /// triangle (three dual vertices) from a non-slab one. Those edges are
+    /// triangle ([`is_slab`](Self::is_slab)) from a non-slab one. Those edges are
     /// the constraints of a constrained Delaunay triangulation; every other
     /// edge stays locally Delaunay.
     pub outline: bool,
+    /// With [`outline`](Self::outline) on: the chunk's gaps, which no slab
+    /// edge crosses ([`slab_edge`](Self::slab_edge)).
+    pub gaps: GapSquares,
+    /// With [`outline`](Self::outline) on, per triangle: bit `k` is set
+    /// when its edge opposite `v[k]` is a [`slab_edge`](Self::slab_edge).
+    /// Kept as triangles are written, so the many questions of the fit
+    /// and the emission walk no squares.
+    slab_bits: Vec<u8>,
     /// Every triangle; all slots are live.
     pub tris: Vec<Tri>,
     /// Triangles created or rewritten by the last insertion (may repeat).
@@ -84,6 +93,27 @@ impl Triangulation {
             v: [0, 2, 3],
             n: [NONE, NONE, 0],
         });
+        self.slab_bits.clear();
+        self.slab_bits.extend([0, 0]);
+    }
+
+    /// Set whether the four corners (vertices 0 to 3) are dual, with
+    /// [`outline`](Self::outline) and [`gaps`](Self::gaps) already set.
+    pub fn classify_corners(&mut self, duals: [bool; 4]) {
+        self.vdual[..4].copy_from_slice(&duals);
+        if self.outline {
+            for t in 0..self.tris.len() as u32 {
+                self.slab_bits[t as usize] = self.edge_bits(t);
+            }
+        }
+    }
+
+    /// [`slab_bits`](Self::slab_bits) of triangle `t`, from its vertices.
+    fn edge_bits(&self, t: u32) -> u8 {
+        let v = self.tris[t as usize].v;
+        (0..3).fold(0, |bits, k| {
+            bits | u8::from(self.slab_edge(v[(k + 1) % 3], v[(k + 2) % 3])) << k
+        })
     }
 
     /// Position of vertex `v`.
@@ -170,6 +200,19 @@ impl Triangulation {
     /// with `outer[i]` across `ring[i] -> ring[i+1]`. A closed fan wraps.
     fn fan(&mut self, p: u32, ring: &[u32], outer: &[u32], slots: &[u32], closed: bool) {
         let m = slots.len();
+        if self.outline {
+            // Each spoke p-ring[i] once; the ring's edges are the old ones.
+            let mut spoke = [false; 4];
+            for (s, &r) in spoke.iter_mut().zip(ring) {
+                *s = self.slab_edge(p, r);
+            }
+            for i in 0..m {
+                let (k, l) = (i, (i + 1) % ring.len());
+                let rim = self.slab_edge(ring[k], ring[l]);
+                self.slab_bits[slots[i] as usize] =
+                    u8::from(rim) | u8::from(spoke[l]) << 1 | u8::from(spoke[k]) << 2;
+            }
+        }
         for i in 0..m {
             let a = ring[i];
             let b = ring[(i + 1) % ring.len()];
@@ -203,6 +246,7 @@ impl Triangulation {
             v: [0; 3],
             n: [NONE; 3],
         });
+        self.slab_bits.push(0);
         (self.tris.len() - 1) as u32
     }
 
@@ -264,9 +308,6 @@ impl Triangulation {
             };
             let [p, a, b] = tri.v;
             let d = ut.v[j];
-            if self.is_outline_edge(p, a, b, d) {
-                continue;
-            }
             // Flip only when d is strictly inside: cocircular quads keep their
             // current diagonal, which makes the result a deterministic
             // function of the insertion order.
@@ -319,7 +360,7 @@ impl Triangulation {
             };
             let (p, a, b) = (tri.v[i], tri.v[next(i)], tri.v[prev(i)]);
             let d = ut.v[j];
-            if self.is_outline_edge(p, a, b, d)
+            if self.is_outline_edge(t, i, u)
                 || incircle_small(self.pt(p), self.pt(a), self.pt(b), self.pt(d)) <= 0
             {
                 continue;
@@ -341,6 +382,16 @@ impl Triangulation {
         let d = ut.v[j];
         let (n_ad, n_db) = (ut.n[next(j)], ut.n[prev(j)]);
         let (n_bp, n_pa) = (tri.n[next(i)], tri.n[prev(i)]);
+        if self.outline {
+            // Four edges keep their bits; the new diagonal p-d is walked.
+            let bit = |bits: u8, k: usize| bits >> k & 1;
+            let (bt, bu) = (self.slab_bits[t as usize], self.slab_bits[u as usize]);
+            let (ad, db) = (bit(bu, next(j)), bit(bu, prev(j)));
+            let (bp, pa) = (bit(bt, next(i)), bit(bt, prev(i)));
+            let pd = u8::from(self.slab_edge(p, d));
+            self.slab_bits[t as usize] = ad | pd << 1 | pa << 2;
+            self.slab_bits[u as usize] = db | bp << 1 | pd << 2;
+        }
         self.tris[t as usize] = Tri {
             v: [p, a, d],
             n: [n_ad, u, n_pa],
@@ -353,21 +404,53 @@ impl Triangulation {
         self.relink(n_bp, p, b, u);
     }
 
-    /// With [`outline`](Self::outline) on: does edge `a`-`b`, with `p` and
-    /// `d` opposite it, separate a slab triangle from a non-slab one?
+    /// With [`outline`](Self::outline) on: does edge `i` of triangle `t`,
+    /// with `u` across it, separate a slab triangle from a non-slab one?
     #[inline]
-    fn is_outline_edge(&self, p: u32, a: u32, b: u32, d: u32) -> bool {
-        let dual = |v: u32| self.vdual[v as usize];
-        self.outline && dual(a) && dual(b) && dual(p) != dual(d)
+    fn is_outline_edge(&self, t: u32, i: usize, u: u32) -> bool {
+        self.outline
+            && self.slab_bits[t as usize] >> i & 1 == 1
+            && self.is_slab(t) != self.is_slab(u)
     }
 
-    /// Is triangle `t` a slab triangle (all three vertices dual)?
+    /// Can segment `a`-`b` bound a slab triangle? Both ends are dual and,
+    /// in the outline fit, it passes over no unit square without a dual
+    /// corner: every point of it lies within half a texel of a slab column.
+    /// Two rims of a canyon are dual at both ends, yet the segment between
+    /// them crosses the gap; a thin triangle on it covers no sample there
+    /// for the error to see, and its walls would stand across the gap.
+    #[inline]
+    pub fn slab_edge(&self, a: u32, b: u32) -> bool {
+        self.vdual[a as usize]
+            && self.vdual[b as usize]
+            && (!self.outline || self.gaps.clear(self.pt(a), self.pt(b)))
+    }
+
+    /// Is triangle `t` a slab triangle: all three vertices dual and, in the
+    /// outline fit, every edge a [`slab_edge`](Self::slab_edge)?
     #[inline]
     pub fn is_slab(&self, t: u32) -> bool {
-        self.tris[t as usize]
-            .v
-            .iter()
-            .all(|&v| self.vdual[v as usize])
+        if self.outline {
+            self.slab_bits[t as usize] == 0b111
+        } else {
+            self.tris[t as usize]
+                .v
+                .iter()
+                .all(|&v| self.vdual[v as usize])
+        }
+    }
+
+    /// Per edge of triangle `t` (the edge opposite vertex `k`): is it a
+    /// [`slab_edge`](Self::slab_edge)?
+    #[inline]
+    pub fn slab_edges(&self, t: u32) -> [bool; 3] {
+        if self.outline {
+            let bits = self.slab_bits[t as usize];
+            [0, 1, 2].map(|k| bits >> k & 1 == 1)
+        } else {
+            let v = self.tris[t as usize].v;
+            [0, 1, 2].map(|k| self.slab_edge(v[(k + 1) % 3], v[(k + 2) % 3]))
+        }
     }
 
     /// Edges whose opposite vertex lies strictly inside the circumcircle of
@@ -387,8 +470,7 @@ impl Triangulation {
                     continue;
                 };
                 let [a, b, c] = tri.v.map(|v| self.pt(v));
-                let (p, ea, eb) = (tri.v[i], tri.v[next(i)], tri.v[prev(i)]);
-                if self.is_outline_edge(p, ea, eb, ut.v[j]) {
+                if self.is_outline_edge(t as u32, i, u) {
                     continue;
                 }
                 if crate::predicates::incircle(a, b, c, self.pt(ut.v[j])) > 0 {
