@@ -206,10 +206,10 @@ impl Triangulation {
             for (s, &r) in spoke.iter_mut().zip(ring) {
                 *s = self.slab_edge(p, r);
             }
-            for i in 0..m {
-                let (k, l) = (i, (i + 1) % ring.len());
+            for (k, &slot) in slots.iter().enumerate() {
+                let l = (k + 1) % ring.len();
                 let rim = self.slab_edge(ring[k], ring[l]);
-                self.slab_bits[slots[i] as usize] =
+                self.slab_bits[slot as usize] =
                     u8::from(rim) | u8::from(spoke[l]) << 1 | u8::from(spoke[k]) << 2;
             }
         }
