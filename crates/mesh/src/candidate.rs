@@ -424,14 +424,13 @@ fn scan_slab_generic(
     }
     let bbox = [x0, y0, x1, y1];
     let area = (x1 - x0 + 1) * (y1 - y0 + 1);
-    let (best, at) = if slab && duals_in as i32 == area && area <= SMALL {
-        scan_small::<2>(pts, zs, den, bbox, chunk)
-    } else if area <= SMALL {
-        scan_slab_small(pts, zs, den, slab, covered, bbox, chunk)
-    } else if slab && duals_in as i32 == area {
-        scan_rows::<2>(pts, zs, den, bbox, chunk)
-    } else {
-        scan_slab_spans(pts, zs, den, slab, covered, bbox, chunk)
+    // Under a slab triangle a single sample has mid = high = low, so one
+    // kernel measures both classes; under any other only dual samples count.
+    let (best, at) = match (slab, area <= SMALL) {
+        (true, true) => scan_small::<2>(pts, zs, den, bbox, chunk),
+        (true, false) => scan_rows::<2>(pts, zs, den, bbox, chunk),
+        (false, true) => scan_slab_small(pts, zs, den, slab, covered, bbox, chunk),
+        (false, false) => scan_missing_slab(pts, den, covered, bbox, chunk),
     };
     (i64::from(best), i64::from(den), at)
 }
@@ -533,16 +532,14 @@ fn scan_slab_small(
     best
 }
 
-/// [`scan_slab`] where both classes are in the bounding box: row by row over
-/// the triangle's exact span; a span of one class takes the vectorised
-/// kernel (all dual under a slab triangle) or is skipped (no dual outside
-/// one), the others go sample by sample.
+/// [`scan_slab`] under a triangle that draws no slab, over a large
+/// bounding box: row by row over the triangle's exact span, visiting only
+/// the span's dual samples (bits of [`ChunkSamples::dual_bits`]), each by
+/// the whole slab it misses unless the slab across draws it.
 #[inline(always)]
-fn scan_slab_spans(
+fn scan_missing_slab(
     pts: [Pt; 3],
-    zs: [[u8; 3]; 3],
     den: i32,
-    slab: bool,
     covered: [bool; 3],
     bbox: [i32; 4],
     chunk: &ChunkSamples,
@@ -550,53 +547,39 @@ fn scan_slab_spans(
     let [a, b, c] = pts;
     let [x0, y0, x1, y1] = bbox;
     let stride = chunk.stride();
+    let words = chunk.words_per_row();
     let (dx, dy) = edge_steps(pts);
     let mut w_row = barycentric(a, b, c, [x0, y0]);
     let inv = reciprocals(dx);
-    let dn = numerator_steps(dx, zs);
     let mut best = (0i32, 0u32);
     for y in y0..=y1 {
         let (lo, hi) = row_span(w_row, dx, inv, x0, x1);
-        if lo <= hi {
-            let duals = chunk.duals_in(lo, y, hi, y) as i32;
-            let off = lo - x0;
-            let w = [
-                w_row[0] + dx[0] * off,
-                w_row[1] + dx[1] * off,
-                w_row[2] + dx[2] * off,
-            ];
-            let start = y as usize * stride + lo as usize;
-            let len = (hi - lo + 1) as usize;
-            if slab && duals == hi - lo + 1 {
-                let mut n = [0i32; 3];
-                for (f, nf) in n.iter_mut().enumerate() {
-                    *nf = (0..3).map(|i| w[i] * i32::from(zs[i][f])).sum();
+        let row = &chunk.dual_bits[y as usize * words..(y as usize + 1) * words];
+        for word in (lo.max(0) as usize / 64)..=(hi.max(0) as usize / 64) {
+            if lo > hi {
+                break;
+            }
+            let base = word as i32 * 64;
+            // Bits lo..=hi of this word.
+            let from = (lo - base).clamp(0, 64) as u32;
+            let to = (hi - base + 1).clamp(0, 64) as u32;
+            let keep = u64::MAX.checked_shl(from).unwrap_or(0)
+                & u64::MAX.checked_shr(64 - to).unwrap_or(0);
+            let mut bits = row[word] & keep;
+            while bits != 0 {
+                let x = base + bits.trailing_zeros() as i32;
+                bits &= bits - 1;
+                let i = y as usize * stride + x as usize;
+                let s = &chunk.samples[i];
+                let e = (i32::from(s.z[2]) - i32::from(s.z[0])) * den;
+                if e <= best.0 {
+                    continue;
                 }
-                let rows = [
-                    &chunk.planes[0][start..start + len],
-                    &chunk.planes[1][start..start + len],
-                    &chunk.planes[2][start..start + len],
-                ];
-                let m = row_max::<2>(rows, n, dn, den);
-                if m > best.0 {
-                    let k = (0..len)
-                        .find(|&k| err_at::<2>(rows, n, dn, den, k) == m)
-                        .unwrap_or(0);
-                    best = (m, (start + k) as u32);
-                }
-            } else if slab || duals > 0 {
-                let mut w = w;
-                for k in 0..len {
-                    let s = &chunk.samples[start + k];
-                    if slab || s.dual() {
-                        let e = slab_error(w, den, zs, s, slab, covered);
-                        if e > best.0 {
-                            best = (e, (start + k) as u32);
-                        }
-                    }
-                    for i in 0..3 {
-                        w[i] += dx[i];
-                    }
+                let off = x - x0;
+                let w = [0, 1, 2].map(|k| w_row[k] + dx[k] * off);
+                let zeros = w.iter().filter(|&&v| v == 0).count();
+                if zeros < 2 && !(0..3).any(|k| w[k] == 0 && covered[k]) {
+                    best = (e, i as u32);
                 }
             }
         }

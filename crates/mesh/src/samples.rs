@@ -95,6 +95,10 @@ pub struct ChunkSamples {
     /// Summed-area table of dual samples, stride `size_x + 2`:
     /// `dual_sum[(y + 1) * (sx + 2) + x + 1]` counts duals in `[0, x] x [0, y]`.
     pub dual_sum: Vec<u32>,
+    /// Dual samples as bits, [`words_per_row`](Self::words_per_row) `u64`s
+    /// per row (bit `x % 64` of word `x / 64`), for scans that visit only
+    /// the dual samples of a row.
+    pub dual_bits: Vec<u64>,
 }
 
 impl ChunkSamples {
@@ -102,6 +106,12 @@ impl ChunkSamples {
     #[inline]
     pub fn stride(&self) -> usize {
         self.size_x as usize + 1
+    }
+
+    /// `u64` words per row of [`dual_bits`](Self::dual_bits).
+    #[inline]
+    pub fn words_per_row(&self) -> usize {
+        self.stride().div_ceil(64)
     }
 
     /// Number of dual samples in `[x0, x1] x [y0, y1]` (inclusive, in range).
@@ -136,6 +146,8 @@ impl ChunkSamples {
         }
         self.dual_sum.clear();
         self.dual_sum.resize(src.dual_sum.len(), 0);
+        self.dual_bits.clear();
+        self.dual_bits.resize(src.dual_bits.len(), 0);
     }
 
     /// Decode chunk `(cx, cy)` of `level` into `self`, reusing the buffer.
@@ -167,10 +179,15 @@ impl ChunkSamples {
         let sw = nx + 1;
         self.dual_sum.clear();
         self.dual_sum.resize(sw * (ny + 1), 0);
+        let words = nx.div_ceil(64);
+        self.dual_bits.clear();
+        self.dual_bits.resize(words * ny, 0);
         for j in 0..ny {
             let mut run = 0;
             for i in 0..nx {
-                run += u32::from(self.samples[j * nx + i].flags & DUAL);
+                let dual = self.samples[j * nx + i].flags & DUAL;
+                run += u32::from(dual);
+                self.dual_bits[j * words + i / 64] |= u64::from(dual) << (i % 64);
                 self.dual_sum[(j + 1) * sw + i + 1] = self.dual_sum[j * sw + i + 1] + run;
             }
         }
