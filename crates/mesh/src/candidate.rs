@@ -555,7 +555,8 @@ fn scan_missing_slab(
     for y in y0..=y1 {
         let (lo, hi) = row_span(w_row, dx, inv, x0, x1);
         let row = &chunk.dual_bits[y as usize * words..(y as usize + 1) * words];
-        for word in (lo.max(0) as usize / 64)..=(hi.max(0) as usize / 64) {
+        let (first, last) = (lo.max(0) as usize / 64, hi.max(0) as usize / 64);
+        for (word, &dual) in row.iter().enumerate().take(last + 1).skip(first) {
             if lo > hi {
                 break;
             }
@@ -565,7 +566,7 @@ fn scan_missing_slab(
             let to = (hi - base + 1).clamp(0, 64) as u32;
             let keep = u64::MAX.checked_shl(from).unwrap_or(0)
                 & u64::MAX.checked_shr(64 - to).unwrap_or(0);
-            let mut bits = row[word] & keep;
+            let mut bits = dual & keep;
             while bits != 0 {
                 let x = base + bits.trailing_zeros() as i32;
                 bits &= bits - 1;
