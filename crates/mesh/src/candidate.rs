@@ -552,21 +552,30 @@ fn scan_missing_slab(
     let mut w_row = barycentric(a, b, c, [x0, y0]);
     let inv = reciprocals(dx);
     let mut best = (0i32, 0u32);
+    // Bits lo..=hi of word `word` of a row.
+    let span_bits = |dual: u64, word: usize, lo: i32, hi: i32| {
+        let base = word as i32 * 64;
+        let from = (lo - base).clamp(0, 64) as u32;
+        let to = (hi - base + 1).clamp(0, 64) as u32;
+        dual & u64::MAX.checked_shl(from).unwrap_or(0) & u64::MAX.checked_shr(64 - to).unwrap_or(0)
+    };
+    let (first, last) = (x0 as usize / 64, x1 as usize / 64);
     for y in y0..=y1 {
-        let (lo, hi) = row_span(w_row, dx, inv, x0, x1);
         let row = &chunk.dual_bits[y as usize * words..(y as usize + 1) * words];
-        let (first, last) = (lo.max(0) as usize / 64, hi.max(0) as usize / 64);
+        // Most rows of a large triangle that draws no slab have no dual
+        // sample in the whole box: skip them before the span's arithmetic.
+        let any = (first..=last).any(|word| span_bits(row[word], word, x0, x1) != 0);
+        let (lo, hi) = if any {
+            row_span(w_row, dx, inv, x0, x1)
+        } else {
+            (1, 0)
+        };
         for (word, &dual) in row.iter().enumerate().take(last + 1).skip(first) {
             if lo > hi {
                 break;
             }
             let base = word as i32 * 64;
-            // Bits lo..=hi of this word.
-            let from = (lo - base).clamp(0, 64) as u32;
-            let to = (hi - base + 1).clamp(0, 64) as u32;
-            let keep = u64::MAX.checked_shl(from).unwrap_or(0)
-                & u64::MAX.checked_shr(64 - to).unwrap_or(0);
-            let mut bits = dual & keep;
+            let mut bits = span_bits(dual, word, lo, hi);
             while bits != 0 {
                 let x = base + bits.trailing_zeros() as i32;
                 bits &= bits - 1;
