@@ -429,8 +429,7 @@ fn scan_slab_generic(
     let (best, at) = match (slab, area <= SMALL) {
         (true, true) => scan_small::<2>(pts, zs, den, bbox, chunk),
         (true, false) => scan_rows::<2>(pts, zs, den, bbox, chunk),
-        (false, true) => scan_slab_small(pts, zs, den, slab, covered, bbox, chunk),
-        (false, false) => scan_missing_slab(pts, den, covered, bbox, chunk),
+        (false, small) => scan_missing_slab(pts, den, covered, bbox, chunk, !small),
     };
     (i64::from(best), i64::from(den), at)
 }
@@ -461,81 +460,11 @@ pub fn slab_error(
     }
 }
 
-/// [`scan_slab`] over a small bounding box, sample by sample: the slab's
-/// interpolants stepped per sample under a slab triangle, the missing slab
-/// of uncovered dual samples under any other.
-#[inline(always)]
-fn scan_slab_small(
-    pts: [Pt; 3],
-    zs: [[u8; 3]; 3],
-    den: i32,
-    slab: bool,
-    covered: [bool; 3],
-    bbox: [i32; 4],
-    chunk: &ChunkSamples,
-) -> (i32, u32) {
-    let [a, b, c] = pts;
-    let [x0, y0, x1, y1] = bbox;
-    let stride = chunk.stride();
-    let (dx, dy) = edge_steps(pts);
-    let z = |f: usize| {
-        [
-            i32::from(zs[0][f]),
-            i32::from(zs[1][f]),
-            i32::from(zs[2][f]),
-        ]
-    };
-    let (z1, z2) = (z(1), z(2));
-    let dot = |w: [i32; 3], z: [i32; 3]| w[0] * z[0] + w[1] * z[1] + w[2] * z[2];
-    let (dn1, dn2) = (dot(dx, z1), dot(dx, z2));
-    let (en1, en2) = (dot(dy, z1), dot(dy, z2));
-    let mut w_row = barycentric(a, b, c, [x0, y0]);
-    let mut n_row = [dot(w_row, z1), dot(w_row, z2)];
-    let mut best = (0i32, 0u32);
-    for y in y0..=y1 {
-        let (mut w, mut n) = (w_row, n_row);
-        let row = y as usize * stride;
-        for x in x0..=x1 {
-            if (w[0] | w[1] | w[2]) >= 0 {
-                let i = row + x as usize;
-                let s = &chunk.samples[i];
-                let e = if slab {
-                    (n[0] - i32::from(s.z[1]) * den)
-                        .abs()
-                        .max((n[1] - i32::from(s.z[2]) * den).abs())
-                } else if s.dual() {
-                    let zeros = w.iter().filter(|&&v| v == 0).count();
-                    if zeros >= 2 || (0..3).any(|k| w[k] == 0 && covered[k]) {
-                        0
-                    } else {
-                        (i32::from(s.z[2]) - i32::from(s.z[0])) * den
-                    }
-                } else {
-                    0
-                };
-                if e > best.0 {
-                    best = (e, i as u32);
-                }
-            }
-            for k in 0..3 {
-                w[k] += dx[k];
-            }
-            n[0] += dn1;
-            n[1] += dn2;
-        }
-        for k in 0..3 {
-            w_row[k] += dy[k];
-        }
-        n_row[0] += en1;
-        n_row[1] += en2;
-    }
-    best
-}
-
-/// [`scan_slab`] under a triangle that draws no slab, over a large
-/// bounding box: row by row over the triangle's exact span, visiting only
-/// the span's dual samples (bits of [`ChunkSamples::dual_bits`]), each by
-/// the whole slab it misses unless the slab across draws it.
+/// [`scan_slab`] under a triangle that draws no slab: row by row, visiting
+/// only the dual samples (bits of [`ChunkSamples::dual_bits`]), each by the
+/// whole slab it misses unless the slab across draws it. `spans`: cut each
+/// row to the triangle's exact span first (large boxes); otherwise each
+/// dual sample of the box is tested against the triangle.
 #[inline(always)]
 fn scan_missing_slab(
     pts: [Pt; 3],
@@ -543,6 +472,7 @@ fn scan_missing_slab(
     covered: [bool; 3],
     bbox: [i32; 4],
     chunk: &ChunkSamples,
+    spans: bool,
 ) -> (i32, u32) {
     let [a, b, c] = pts;
     let [x0, y0, x1, y1] = bbox;
@@ -562,34 +492,44 @@ fn scan_missing_slab(
     let (first, last) = (x0 as usize / 64, x1 as usize / 64);
     for y in y0..=y1 {
         let row = &chunk.dual_bits[y as usize * words..(y as usize + 1) * words];
-        // Most rows of a large triangle that draws no slab have no dual
-        // sample in the whole box: skip them before the span's arithmetic.
-        let any = (first..=last).any(|word| span_bits(row[word], word, x0, x1) != 0);
-        let (lo, hi) = if any {
-            row_span(w_row, dx, inv, x0, x1)
-        } else {
-            (1, 0)
-        };
-        for (word, &dual) in row.iter().enumerate().take(last + 1).skip(first) {
-            if lo > hi {
-                break;
-            }
-            let base = word as i32 * 64;
-            let mut bits = span_bits(dual, word, lo, hi);
-            while bits != 0 {
-                let x = base + bits.trailing_zeros() as i32;
-                bits &= bits - 1;
-                let i = y as usize * stride + x as usize;
-                let s = &chunk.samples[i];
-                let e = (i32::from(s.z[2]) - i32::from(s.z[0])) * den;
-                if e <= best.0 {
-                    continue;
-                }
-                let off = x - x0;
-                let w = [0, 1, 2].map(|k| w_row[k] + dx[k] * off);
-                let zeros = w.iter().filter(|&&v| v == 0).count();
-                if zeros < 2 && !(0..3).any(|k| w[k] == 0 && covered[k]) {
-                    best = (e, i as u32);
+        let mut box_bits = [0u64; 3];
+        let mut any = 0;
+        let mut word = first;
+        while word <= last {
+            box_bits[word - first] = span_bits(row[word], word, x0, x1);
+            any |= box_bits[word - first];
+            word += 1;
+        }
+        // Rows with no dual sample in the box cost nothing more.
+        if any != 0 {
+            let (lo, hi) = if spans {
+                row_span(w_row, dx, inv, x0, x1)
+            } else {
+                (x0, x1)
+            };
+            let mut word = first;
+            while word <= last && lo <= hi {
+                let base = word as i32 * 64;
+                let mut bits = span_bits(box_bits[word - first], word, lo, hi);
+                word += 1;
+                while bits != 0 {
+                    let x = base + bits.trailing_zeros() as i32;
+                    bits &= bits - 1;
+                    let i = y as usize * stride + x as usize;
+                    let s = &chunk.samples[i];
+                    let e = (i32::from(s.z[2]) - i32::from(s.z[0])) * den;
+                    if e <= best.0 {
+                        continue;
+                    }
+                    let off = x - x0;
+                    let w = [0, 1, 2].map(|k| w_row[k] + dx[k] * off);
+                    if (w[0] | w[1] | w[2]) < 0 {
+                        continue;
+                    }
+                    let zeros = w.iter().filter(|&&v| v == 0).count();
+                    if zeros < 2 && !(0..3).any(|k| w[k] == 0 && covered[k]) {
+                        best = (e, i as u32);
+                    }
                 }
             }
         }
