@@ -257,6 +257,20 @@ impl Emitter {
         acc.border_walls += st.border_walls;
     }
 
+    /// Add `other`'s emitted triangles and counts (the other part of an
+    /// outline fit of the same chunk) to this one's.
+    pub fn absorb(&mut self, other: &Emitter) {
+        for (l, o) in self.lists.iter_mut().zip(&other.lists) {
+            l.extend_from_slice(o);
+        }
+        for (s, o) in self.stats.iter_mut().zip(&other.stats) {
+            s.planar += o.planar;
+            s.slab += o.slab;
+            s.wall += o.wall;
+            s.border_walls += o.border_walls;
+        }
+    }
+
     /// Lay the three LODs out by membership blocks and move them into
     /// `mesh`; `vertices`: the finest LOD's vertex count (of every
     /// triangulation emitted).

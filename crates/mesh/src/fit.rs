@@ -59,6 +59,33 @@ pub struct FitOptions {
     pub outline: bool,
 }
 
+/// One of the outline fit's two triangulations ([`ChunkFitter::fit_outline_part`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum OutlinePart {
+    /// The floor, fitted on `low` alone.
+    Floor,
+    /// The slab, constrained to the outline.
+    Slab,
+}
+
+/// What one outline part emitted, waiting for [`join_outline_parts`].
+pub struct OutlinePartFit {
+    emitter: Emitter,
+    causes: [u32; CAUSES],
+    vertices: usize,
+}
+
+/// The chunk mesh of the outline fit from its two parts (in either order):
+/// the same mesh as [`ChunkFitter::fit_with`] with the outline option.
+pub fn join_outline_parts(a: OutlinePartFit, b: OutlinePartFit) -> ChunkMesh {
+    let mut emitter = a.emitter;
+    emitter.absorb(&b.emitter);
+    let mut mesh = ChunkMesh::default();
+    emitter.finish(&mut mesh, (a.vertices + b.vertices) as u32);
+    mesh.stats.causes = std::array::from_fn(|k| a.causes[k] + b.causes[k]);
+    mesh
+}
+
 /// Which triangulation a greedy run builds.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 enum Pass {
@@ -118,23 +145,7 @@ impl ChunkFitter {
         self.emitter.begin(self.samples.size_x, self.samples.size_y);
         let mut causes = [0u32; CAUSES];
         let vertices = if options.outline {
-            // The floor first, on the floor view of the samples.
-            self.floor_samples.floor_of(&self.samples);
-            std::mem::swap(&mut self.samples, &mut self.floor_samples);
-            self.greedy(tol, Pass::Floor, &mut causes);
-            std::mem::swap(&mut self.samples, &mut self.floor_samples);
-            std::mem::swap(&mut self.tr, &mut self.floor_tr);
-            let floor = self.floor_tr.pts.len();
-            // The slab, where the chunk has one.
-            let (sx, sy) = (self.samples.size_x as i32, self.samples.size_y as i32);
-            if self.samples.duals_in(0, 0, sx, sy) > 0 {
-                self.greedy(tol, Pass::Slab, &mut causes);
-                floor + self.tr.pts.len()
-            } else {
-                self.tr.reset(sx, sy);
-                self.tr.outline = true;
-                floor
-            }
+            self.floor_pass(tol, &mut causes) + self.slab_pass(tol, &mut causes)
         } else {
             self.greedy(tol, Pass::Coupled, &mut causes);
             self.tr.pts.len()
@@ -143,6 +154,57 @@ impl ChunkFitter {
         self.emitter.finish(&mut mesh, vertices as u32);
         mesh.stats.causes = causes;
         mesh
+    }
+
+    /// One of the outline fit's two triangulations of chunk `(cx, cy)`, to
+    /// be joined with the other by [`join_outline_parts`]: the two are
+    /// independent, so an edit's refit can run them on two threads. The
+    /// join equals [`fit_with`](Self::fit_with) with the outline option.
+    pub fn fit_outline_part(
+        &mut self,
+        level: &Level,
+        layout: &ChunkLayout,
+        (cx, cy): (u32, u32),
+        tol: f64,
+        part: OutlinePart,
+    ) -> OutlinePartFit {
+        self.samples.load(level, layout, cx, cy);
+        self.emitter.begin(self.samples.size_x, self.samples.size_y);
+        let mut causes = [0u32; CAUSES];
+        let vertices = match part {
+            OutlinePart::Floor => self.floor_pass(tol, &mut causes),
+            OutlinePart::Slab => self.slab_pass(tol, &mut causes),
+        };
+        OutlinePartFit {
+            emitter: std::mem::take(&mut self.emitter),
+            causes,
+            vertices,
+        }
+    }
+
+    /// The outline fit's floor: fitted on `low` alone (the floor view of
+    /// the samples), left in `floor_tr`. Returns its vertex count.
+    fn floor_pass(&mut self, tol: f64, causes: &mut [u32; CAUSES]) -> usize {
+        self.floor_samples.floor_of(&self.samples);
+        std::mem::swap(&mut self.samples, &mut self.floor_samples);
+        self.greedy(tol, Pass::Floor, causes);
+        std::mem::swap(&mut self.samples, &mut self.floor_samples);
+        std::mem::swap(&mut self.tr, &mut self.floor_tr);
+        self.floor_tr.pts.len()
+    }
+
+    /// The outline fit's slab triangulation, where the chunk has a slab.
+    /// Returns its vertex count (0 without a slab).
+    fn slab_pass(&mut self, tol: f64, causes: &mut [u32; CAUSES]) -> usize {
+        let (sx, sy) = (self.samples.size_x as i32, self.samples.size_y as i32);
+        if self.samples.duals_in(0, 0, sx, sy) > 0 {
+            self.greedy(tol, Pass::Slab, causes);
+            self.tr.pts.len()
+        } else {
+            self.tr.reset(sx, sy);
+            self.tr.outline = true;
+            0
+        }
     }
 
     /// One greedy fit of `self.samples` into `self.tr` (border vertices,

@@ -8,7 +8,9 @@ use serde::Serialize;
 use strata_level::{DirtyRect, Level};
 
 use crate::emit::ChunkMesh;
-use crate::fit::{CAUSES, ChunkFitter, FitOptions, LODS};
+use crate::fit::{
+    CAUSES, ChunkFitter, FitOptions, LODS, OutlinePart, OutlinePartFit, join_outline_parts,
+};
 use crate::samples::ChunkLayout;
 
 /// Max vertical error for quality `q` in [0, 1]: `2^(4(1 - q))` height
@@ -114,16 +116,10 @@ impl LevelMesh {
             return (0..self.chunks.len()).collect();
         }
         let ids = dirty_chunks(&layout, level.width(), level.height(), dirty);
-        let (tol, options) = (self.tolerance(), self.options);
-        let fresh: Vec<(usize, ChunkMesh)> = ids
-            .par_iter()
-            .map_init(ChunkFitter::default, |f, &i| {
-                let (cx, cy) = layout.coords(i);
-                (i, f.fit_with(level, &layout, cx, cy, tol, options))
-            })
-            .collect();
+        let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+        let fresh = fit_chunks(level, self.tolerance(), self.options, &ids, threads);
         let mut changed = Vec::new();
-        for (i, mesh) in fresh {
+        for (&i, mesh) in ids.iter().zip(fresh) {
             // Compared by content hash, so this works after
             // [`release_indices`](Self::release_indices) too.
             let old = &self.chunks[i].stats;
@@ -243,6 +239,80 @@ fn sanitize(tol: f64) -> f64 {
     } else {
         1.0
     }
+}
+
+/// Fit chunks `ids` of `level` from scratch on up to `threads` threads
+/// (scoped threads, none when `threads` is 1), in `ids` order: what an
+/// edit's refit runs. The outline fit's two triangulations of a chunk are
+/// independent and run as two jobs, so a crater over a few chunks waits for
+/// the slower half of the slowest chunk, not the whole of it.
+pub fn fit_chunks(
+    level: &Level,
+    tolerance: f64,
+    options: FitOptions,
+    ids: &[usize],
+    threads: usize,
+) -> Vec<ChunkMesh> {
+    let layout = ChunkLayout::of(level);
+    let tol = sanitize(tolerance);
+    enum Done {
+        Whole(ChunkMesh),
+        Part(Box<OutlinePartFit>),
+    }
+    let parts: &[Option<OutlinePart>] = if options.outline {
+        &[Some(OutlinePart::Floor), Some(OutlinePart::Slab)]
+    } else {
+        &[None]
+    };
+    let jobs: Vec<(usize, Option<OutlinePart>)> = ids
+        .iter()
+        .flat_map(|&i| parts.iter().map(move |&p| (i, p)))
+        .collect();
+    let run = |jobs: &[(usize, Option<OutlinePart>)]| -> Vec<Done> {
+        let mut fitter = ChunkFitter::default();
+        jobs.iter()
+            .map(|&(i, part)| {
+                let (cx, cy) = layout.coords(i);
+                match part {
+                    None => Done::Whole(fitter.fit_with(level, &layout, cx, cy, tol, options)),
+                    Some(p) => Done::Part(Box::new(fitter.fit_outline_part(
+                        level,
+                        &layout,
+                        (cx, cy),
+                        tol,
+                        p,
+                    ))),
+                }
+            })
+            .collect()
+    };
+    let done: Vec<Done> = if threads < 2 || jobs.len() < 2 {
+        run(&jobs)
+    } else {
+        let per = jobs.len().div_ceil(threads);
+        std::thread::scope(|s| {
+            let handles: Vec<_> = jobs
+                .chunks(per)
+                .map(|part| s.spawn(move || run(part)))
+                .collect();
+            handles
+                .into_iter()
+                .flat_map(|h| h.join().expect("chunk fit thread panicked"))
+                .collect()
+        })
+    };
+    let mut meshes = Vec::with_capacity(ids.len());
+    let mut done = done.into_iter();
+    while let Some(first) = done.next() {
+        meshes.push(match first {
+            Done::Whole(mesh) => mesh,
+            Done::Part(floor) => match done.next() {
+                Some(Done::Part(slab)) => join_outline_parts(*floor, *slab),
+                _ => unreachable!("an outline chunk's parts come in pairs"),
+            },
+        });
+    }
+    meshes
 }
 
 /// Chunks whose sample square (including the shared last row and column)

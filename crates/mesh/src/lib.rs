@@ -98,9 +98,11 @@ pub mod synthetic;
 pub mod triangulation;
 
 pub use emit::{ChunkMesh, ChunkStats, LodStats, decode, encode};
-pub use fit::{CAUSES, Cause, ChunkFitter, FitOptions, LODS};
+pub use fit::{
+    CAUSES, Cause, ChunkFitter, FitOptions, LODS, OutlinePart, OutlinePartFit, join_outline_parts,
+};
 pub use level_mesh::{
-    ChunkRange, FitInSteps, FitTiming, LevelMesh, MeshStats, dirty_chunks, fit_on_threads,
-    fit_on_threads_with, timed_fit, timed_fit_with, tolerance_for_quality,
+    ChunkRange, FitInSteps, FitTiming, LevelMesh, MeshStats, dirty_chunks, fit_chunks,
+    fit_on_threads, fit_on_threads_with, timed_fit, timed_fit_with, tolerance_for_quality,
 };
 pub use samples::{CHUNK, ChunkLayout};

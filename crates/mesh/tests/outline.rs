@@ -479,3 +479,24 @@ fn gap_test_of_an_edge_equals_the_squares_it_meets() {
     }
     assert!(seen[0] > 100 && seen[1] > 100, "{seen:?}");
 }
+
+#[test]
+fn the_two_outline_parts_joined_are_the_outline_fit() {
+    use strata_mesh::{OutlinePart, fit_chunks, join_outline_parts};
+    let l = level();
+    let layout = ChunkLayout::of(&l);
+    let mut f = ChunkFitter::default();
+    let ids: Vec<usize> = (0..layout.count()).collect();
+    for threads in [1, 3] {
+        let fitted = fit_chunks(&l, 4.0, OUTLINE, &ids, threads);
+        for (&i, mesh) in ids.iter().zip(&fitted) {
+            let (cx, cy) = layout.coords(i);
+            let whole = f.fit_with(&l, &layout, cx, cy, 4.0, OUTLINE);
+            assert_eq!(*mesh, whole, "chunk {i}, {threads} threads");
+            // Either order.
+            let slab = f.fit_outline_part(&l, &layout, (cx, cy), 4.0, OutlinePart::Slab);
+            let floor = f.fit_outline_part(&l, &layout, (cx, cy), 4.0, OutlinePart::Floor);
+            assert_eq!(join_outline_parts(slab, floor), whole, "chunk {i}");
+        }
+    }
+}

@@ -31,7 +31,7 @@ use strata_camera::Camera;
 use strata_level::model::decode_column;
 use strata_level::{DirtyRect, Level};
 use strata_mesh::{
-    ChunkFitter, ChunkLayout, ChunkMesh, FitInSteps, FitOptions, LODS, LevelMesh, dirty_chunks,
+    ChunkLayout, ChunkMesh, FitInSteps, FitOptions, LODS, LevelMesh, dirty_chunks, fit_chunks,
     tolerance_for_quality,
 };
 
@@ -331,7 +331,8 @@ fn pool_headroom(chunks: &[Fitted]) -> u32 {
     (total / 16).max(1 << 15) as u32
 }
 
-/// Fit `ids` of `level` at `tol`, split over the available cores.
+/// Fit `ids` of `level` at `tol`, split over the available cores (the
+/// outline fit's two triangulations of a chunk as two jobs).
 fn refit_chunks(
     level: &Level,
     layout: &ChunkLayout,
@@ -339,32 +340,15 @@ fn refit_chunks(
     options: FitOptions,
     ids: &[usize],
 ) -> Vec<Fitted> {
-    let fit = |ids: &[usize]| -> Vec<Fitted> {
-        let mut fitter = ChunkFitter::default();
-        ids.iter()
-            .map(|&i| {
-                let (cx, cy) = layout.coords(i);
-                let m = fitter.fit_with(level, layout, cx, cy, tol, options);
-                let z = z_range(level, layout, i, &m);
-                (m, z)
-            })
-            .collect()
-    };
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
-    if threads < 2 || ids.len() < 2 {
-        return fit(ids);
-    }
-    let per = ids.len().div_ceil(threads);
-    std::thread::scope(|s| {
-        let handles: Vec<_> = ids
-            .chunks(per)
-            .map(|part| s.spawn(move || fit(part)))
-            .collect();
-        handles
-            .into_iter()
-            .flat_map(|h| h.join().expect("chunk fit thread panicked"))
-            .collect()
-    })
+    fit_chunks(level, tol, options, ids, threads)
+        .into_iter()
+        .zip(ids)
+        .map(|(m, &i)| {
+            let z = z_range(level, layout, i, &m);
+            (m, z)
+        })
+        .collect()
 }
 
 /// Whether the box `[lo, hi]` lies entirely outside one clip plane of `m`.
