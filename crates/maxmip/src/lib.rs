@@ -81,14 +81,18 @@ impl LevelInfo {
     }
 }
 
-/// The levels of a `width x height` map; `levels[0]` is level 1.
+/// The levels of a `width x height` map: every `step`-th one, so
+/// `levels[i]` is level `step (i + 1)` (level 1 first in the dense layout).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Layout {
     /// Map width in texels (a power of two).
     pub map_width: u32,
     /// Map height in texels (a power of two).
     pub map_height: u32,
-    /// Level 1 first, up to level [`Layout::top`].
+    /// The levels kept are the multiples of `step` (1: every level; 2: tiles
+    /// of 4, 16, 64, 256, all a traversal visiting every other level reads).
+    pub step: u32,
+    /// The kept levels, finest first, up to level [`Layout::top`].
     pub levels: Vec<LevelInfo>,
     /// Total bytes, a multiple of 4.
     pub bytes: u32,
@@ -115,6 +119,18 @@ impl Layout {
     ///
     /// When a side is not a power of two.
     pub fn new(width: u32, height: u32) -> Self {
+        Self::with_step(width, height, 1)
+    }
+
+    /// Levels `step, 2 step, ..` up to min(MAX_LEVEL, log2 width, log2
+    /// height): each built from the level `step` below it (the first from
+    /// the texels), for a traversal that never reads the others.
+    ///
+    /// # Panics
+    ///
+    /// When a side is not a power of two, or `step` is 0.
+    pub fn with_step(width: u32, height: u32, step: u32) -> Self {
+        assert!(step > 0, "the level step must be positive");
         assert!(
             width.is_power_of_two() && height.is_power_of_two(),
             "map sides must be powers of two"
@@ -124,7 +140,7 @@ impl Layout {
             .min(height.trailing_zeros());
         let mut levels = Vec::new();
         let mut offset = 0u32;
-        for k in 1..=top {
+        for k in (step..=top).step_by(step as usize) {
             let info = LevelInfo {
                 log2_tile: k,
                 width: width >> k,
@@ -137,6 +153,7 @@ impl Layout {
         Layout {
             map_width: width,
             map_height: height,
+            step,
             levels,
             bytes: offset,
         }
@@ -144,16 +161,21 @@ impl Layout {
 
     /// The coarsest level's number (0 when the map has no tiles).
     pub fn top(&self) -> u32 {
-        self.levels.len() as u32
+        self.levels.len() as u32 * self.step
     }
 
-    /// Level `k` (1-based).
+    /// Level `k` (a multiple of the step, from 1).
     ///
     /// # Panics
     ///
-    /// When `k` is 0 or above [`Layout::top`].
+    /// When `k` is not a kept level.
     pub fn level(&self, k: u32) -> &LevelInfo {
-        &self.levels[k as usize - 1]
+        assert!(
+            k.is_multiple_of(self.step),
+            "level {k} is not kept (step {})",
+            self.step
+        );
+        &self.levels[(k / self.step) as usize - 1]
     }
 
     /// Tiles of level `k` that hold a texel of `rect` (inside the map).
@@ -193,7 +215,12 @@ fn pair_top(level: &Level, px: u32, y: u32) -> u8 {
 impl Pyramid {
     /// Build every level from `level`.
     pub fn new(level: &Level) -> Self {
-        let layout = Layout::new(level.width(), level.height());
+        Self::with_step(level, 1)
+    }
+
+    /// Build levels `step, 2 step, ..` from `level` ([`Layout::with_step`]).
+    pub fn with_step(level: &Level, step: u32) -> Self {
+        let layout = Layout::with_step(level.width(), level.height(), step);
         let mut p = Pyramid {
             data: vec![0u8; layout.bytes as usize],
             layout,
@@ -229,20 +256,26 @@ impl Pyramid {
             let end = info.offset as usize + (r.y1 as usize + 1) * w;
             let (done, rest) = self.data.split_at_mut(start);
             let rows = &mut rest[..end - start];
-            let child = (k > 1).then(|| *layout.level(k - 1));
+            let s = layout.step;
+            let child = (k > s).then(|| *layout.level(k - s));
+            // A tile is `n x n` tiles of the level `s` below (texels for the first).
+            let n = 1u32 << s;
             rows.par_chunks_mut(w).enumerate().for_each(|(i, row)| {
                 let ty = r.y0 + i as u32;
                 for tx in r.x0..=r.x1 {
+                    let (x0, y0) = (n * tx, n * ty);
                     row[tx as usize] = match child {
-                        // Level 1: the two pairs of a 2x2 tile.
-                        None => pair_top(level, tx, 2 * ty).max(pair_top(level, tx, 2 * ty + 1)),
-                        Some(c) => {
-                            let at = |x: u32, y: u32| done[c.index(i64::from(x), i64::from(y))];
-                            at(2 * tx, 2 * ty)
-                                .max(at(2 * tx + 1, 2 * ty))
-                                .max(at(2 * tx, 2 * ty + 1))
-                                .max(at(2 * tx + 1, 2 * ty + 1))
-                        }
+                        // The first level: the pairs of its texel rows.
+                        None => (y0..y0 + n)
+                            .flat_map(|y| (x0 / 2..(x0 + n) / 2).map(move |px| (px, y)))
+                            .map(|(px, y)| pair_top(level, px, y))
+                            .max()
+                            .unwrap_or(0),
+                        Some(c) => (y0..y0 + n)
+                            .flat_map(|y| (x0..x0 + n).map(move |x| (x, y)))
+                            .map(|(x, y)| done[c.index(i64::from(x), i64::from(y))])
+                            .max()
+                            .unwrap_or(0),
                     };
                 }
             });
@@ -263,7 +296,7 @@ impl Pyramid {
         self.global_max
     }
 
-    /// Max top of tile (tx, ty) of level `k` (1-based), wrapping around the map.
+    /// Max top of tile (tx, ty) of level `k` (a kept level), wrapping around the map.
     #[inline]
     pub fn get(&self, k: u32, tx: i64, ty: i64) -> u8 {
         self.data[self.layout.level(k).index(tx, ty)]
@@ -335,6 +368,37 @@ mod tests {
             .max()
             .unwrap();
         assert_eq!(p.global_max(), max);
+    }
+
+    #[test]
+    fn every_other_level_holds_the_same_maxima_in_less_memory() {
+        let l = level(256, 128, 5);
+        let (dense, sparse) = (Pyramid::new(&l), Pyramid::with_step(&l, 2));
+        assert_eq!(sparse.top(), 6, "levels 2, 4, 6 (7 is not a multiple of 2)");
+        assert_eq!(sparse.layout.levels.len(), 3);
+        for k in [2, 4, 6] {
+            let info = sparse.layout.level(k);
+            for ty in 0..i64::from(info.height) {
+                for tx in 0..i64::from(info.width) {
+                    assert_eq!(sparse.get(k, tx, ty), dense.get(k, tx, ty), "level {k}");
+                }
+            }
+        }
+        assert!(sparse.layout.bytes * 4 < dense.layout.bytes);
+        let mut edited = l.clone();
+        edited.planes_mut().0[(70 * 256 + 33) as usize] = 250;
+        let mut p = sparse.clone();
+        p.update(
+            &edited,
+            &DirtyRect {
+                x: 33,
+                y: 70,
+                width: 1,
+                height: 1,
+            },
+        );
+        assert_eq!(p, Pyramid::with_step(&edited, 2));
+        assert_eq!(Layout::with_step(2048, 16384, 2).top(), MAX_LEVEL);
     }
 
     #[test]

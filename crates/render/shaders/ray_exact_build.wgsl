@@ -1,7 +1,8 @@
 // The max-height pyramid build on the GPU: the twin of `strata_maxmip`, bit
 // for bit. One invocation per u32 word (4 tiles of a row) of the dispatched
-// rectangle of one level: level 1 from the terrain texture, level k from
-// level k - 1. Every word it is dispatched over is overwritten whole.
+// rectangle of one level. The layout keeps every s-th level (s = 1 or 2):
+// level s from the terrain texture, level k from level k - s. Every word it
+// is dispatched over is overwritten whole.
 #include "frame.wgsl"
 #include "surface.wgsl"
 
@@ -9,7 +10,7 @@
 struct BuildParams {
     // x first byte of this level, y log2 tiles across, z tiles down, w level k
     level: vec4<u32>,
-    // x first byte of level k - 1, y its log2 tiles across
+    // x first byte of level k - s, y its log2 tiles across, z the step s
     child: vec4<u32>,
     // x first word column, y first row, z word columns, w rows
     // (levels under 4 tiles across: all their words as one row from 0)
@@ -47,13 +48,23 @@ fn cs_maxmip(@builtin(global_invocation_id) id: vec3<u32>) {
         if (y >= bp.level.z) {
             continue;
         }
+        // The tile is n x n tiles of the level s below (texels at level s).
+        let s = bp.child.z;
+        let n = 1u << s;
         var m = 0u;
-        if (bp.level.w == 1u) {
-            m = max(pair_top(x, 2u * y), pair_top(x, 2u * y + 1u));
+        if (bp.level.w == s) {
+            for (var r = 0u; r < n; r = r + 1u) {
+                for (var p = 0u; p < n / 2u; p = p + 1u) {
+                    m = max(m, pair_top(x * (n / 2u) + p, n * y + r));
+                }
+            }
         } else {
-            let c = bp.child.x + ((2u * y) << bp.child.y) + 2u * x;
-            let below = c + (1u << bp.child.y);
-            m = max(max(child_byte(c), child_byte(c + 1u)), max(child_byte(below), child_byte(below + 1u)));
+            for (var r = 0u; r < n; r = r + 1u) {
+                let row = bp.child.x + ((n * y + r) << bp.child.y) + n * x;
+                for (var c = 0u; c < n; c = c + 1u) {
+                    m = max(m, child_byte(row + c));
+                }
+            }
         }
         word = word | (m << (b * 8u));
     }

@@ -20,6 +20,12 @@
 //! Both fill the shared shadow map with the same march along the light
 //! ([`Method::record_shadow_map`]) instead of the renderer's 128-step march.
 //!
+//! The compute traversals visit every other level (tiles of 4, 16, 64 and
+//! 256 texels), so `ray-exact` builds only those
+//! ([`ExactOptions::pyramid_step`]): 2,236,928 bytes on the default
+//! 2048x16384 world instead of 11,184,640 for every level, which
+//! `ray-exact-fragment` (whose pipeline visits every level) keeps.
+//!
 //! On frames that cast the shadow map, `ray-exact` defers its shading
 //! (`ray_exact_deferred.wgsl`): the march writes each pixel's hit (`t` and
 //! column) and lists the 8x8-texel blocks of the map its shading will read;
@@ -176,6 +182,13 @@ impl ExactOptions {
 }
 
 impl ExactOptions {
+    /// Which pyramid levels to keep: only those the traversals visit. The
+    /// compute pipelines take `log_ratio` as a constant; the fragment
+    /// variant's pipeline keeps the shader's default (every level).
+    pub fn pyramid_step(&self) -> u32 {
+        if self.compute { self.log_ratio } else { 1 }
+    }
+
     /// The defaults, with the environment's measuring switches applied.
     pub fn from_env(compute: bool) -> Self {
         let d = ExactOptions::DEFAULT;
@@ -358,7 +371,7 @@ fn exact_params(layout: &strata_maxmip::Layout) -> ExactParams {
 pub fn build(shared: &Shared, level: &Level, options: ExactOptions) -> anyhow::Result<RayExact> {
     let compute = options.compute;
     let device = &shared.device;
-    let pyramid = GpuMaxMip::new(shared, level)?;
+    let pyramid = GpuMaxMip::new(shared, level, options.pyramid_step())?;
     let table = exact_params(&pyramid.layout);
     // The deferred frame (compute, exact shadow map) lists shadow blocks.
     let deferred_frame = compute && options.exact_shadow && shared.caps.compute;

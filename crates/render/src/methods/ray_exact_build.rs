@@ -43,9 +43,11 @@ pub struct GpuMaxMip {
 }
 
 impl GpuMaxMip {
-    /// Create the buffer and build every level.
-    pub fn new(shared: &Shared, level: &Level) -> anyhow::Result<Self> {
-        let layout = Layout::new(level.width(), level.height());
+    /// Create the buffer and build levels `step, 2 step, ..`: the levels a
+    /// traversal visiting every `step`-th one reads (`EXACT_LOG_RATIO`), and
+    /// no others.
+    pub fn new(shared: &Shared, level: &Level, step: u32) -> anyhow::Result<Self> {
+        let layout = Layout::with_step(level.width(), level.height(), step);
         let device = &shared.device;
         let limits = device.limits();
         // At least one word, so that a map without tiles still binds a buffer.
@@ -202,12 +204,12 @@ fn whole(level: &Level) -> DirtyRect {
 
 /// The dispatch over the words of level `info` holding tiles over `rect`.
 fn params(layout: &Layout, info: &LevelInfo, rect: &DirtyRect) -> BuildParams {
-    let k = info.log2_tile;
-    let child = if k > 1 {
-        let c = layout.level(k - 1);
-        [c.offset, c.width.trailing_zeros(), 0, 0]
+    let (k, s) = (info.log2_tile, layout.step);
+    let child = if k > s {
+        let c = layout.level(k - s);
+        [c.offset, c.width.trailing_zeros(), s, 0]
     } else {
-        [0; 4]
+        [0, 0, s, 0]
     };
     let r = layout.dirty_tiles(k, rect);
     let rect = if info.width >= 4 {

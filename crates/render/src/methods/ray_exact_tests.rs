@@ -80,12 +80,20 @@ fn gpu_pyramid_equals_its_twin_before_and_after_an_edit() {
     for gpu in common::gpus() {
         // A square map, a tall one (the default world's shape) and one
         // narrower than a word at its coarsest level.
-        for (w, h) in [(512, 512), (256, 1024), (8, 16)] {
+        // Every level, and every other one (what the default traversal reads).
+        for (w, h, step) in [
+            (512, 512, 1),
+            (256, 1024, 1),
+            (8, 16, 1),
+            (512, 512, 2),
+            (256, 1024, 2),
+            (8, 16, 2),
+        ] {
             let world = if w >= 256 { world(w, h, 6) } else { tiny(w, h) };
             let mut level = world.level.clone();
             let shared = shared_for(&gpu, &level);
-            let mut gp = GpuMaxMip::new(&shared, &level).unwrap();
-            let cpu = strata_maxmip::Pyramid::new(&level);
+            let mut gp = GpuMaxMip::new(&shared, &level, step).unwrap();
+            let cpu = strata_maxmip::Pyramid::with_step(&level, step);
             let got = gp.read_back(&shared).unwrap();
             assert!(
                 got == cpu.words(),
@@ -118,7 +126,7 @@ fn gpu_pyramid_equals_its_twin_before_and_after_an_edit() {
             for r in &rects {
                 twin.update(&level, r);
             }
-            let fresh = strata_maxmip::Pyramid::new(&level);
+            let fresh = strata_maxmip::Pyramid::with_step(&level, step);
             assert!(
                 twin == fresh,
                 "{w}x{h}: the CPU update differs from a fresh build"
@@ -149,7 +157,8 @@ struct TestRay {
 fn gpu_trace(gpu: &crate::Gpu, level: &Level, rays: &[TestRay]) -> Vec<[f32; 4]> {
     let shared = shared_for(gpu, level);
     let device = &shared.device;
-    let pyramid = GpuMaxMip::new(&shared, level).unwrap();
+    // `ray_exact_test.wgsl` keeps the default constants: every level.
+    let pyramid = GpuMaxMip::new(&shared, level, 1).unwrap();
     let params = shared.uniform_buffer(
         "test params",
         bytemuck::bytes_of(&exact_params(&pyramid.layout)),
