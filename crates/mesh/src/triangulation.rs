@@ -201,7 +201,8 @@ impl Triangulation {
     fn fan(&mut self, p: u32, ring: &[u32], outer: &[u32], slots: &[u32], closed: bool) {
         let m = slots.len();
         if self.outline {
-            // Each spoke p-ring[i] once; the ring's edges are the old ones.
+            // Each spoke p-ring[i] walked once for the two triangles that
+            // share it; the ring's edges (old ones) walked again.
             let mut spoke = [false; 4];
             for (s, &r) in spoke.iter_mut().zip(ring) {
                 *s = self.slab_edge(p, r);
