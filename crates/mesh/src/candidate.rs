@@ -452,12 +452,18 @@ pub fn slab_error(
     if !s.dual() {
         return 0;
     }
-    let vertex = w.iter().filter(|&&v| v == 0).count() >= 2;
-    if vertex || (0..3).any(|k| w[k] == 0 && covered[k]) {
+    if drawn_across(w, covered) {
         0
     } else {
         (i32::from(s.z[2]) - i32::from(s.z[0])) * den
     }
+}
+
+/// Is a point of a triangle that draws no slab (barycentric numerators
+/// `w`) drawn by a neighbour: a vertex, or on a slab edge (`covered`)?
+#[inline(always)]
+fn drawn_across(w: [i32; 3], covered: [bool; 3]) -> bool {
+    w.iter().filter(|&&v| v == 0).count() >= 2 || (0..3).any(|k| w[k] == 0 && covered[k])
 }
 
 /// [`scan_slab`] under a triangle that draws no slab: row by row, visiting
@@ -526,8 +532,7 @@ fn scan_missing_slab(
                     if (w[0] | w[1] | w[2]) < 0 {
                         continue;
                     }
-                    let zeros = w.iter().filter(|&&v| v == 0).count();
-                    if zeros < 2 && !(0..3).any(|k| w[k] == 0 && covered[k]) {
+                    if !drawn_across(w, covered) {
                         best = (e, i as u32);
                     }
                 }
