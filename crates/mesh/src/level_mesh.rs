@@ -268,9 +268,13 @@ pub fn fit_chunks(
         .iter()
         .flat_map(|&i| parts.iter().map(move |&p| (i, p)))
         .collect();
-    let run = |jobs: &[(usize, Option<OutlinePart>)]| -> Vec<Done> {
+    // Thread `t` of `n` takes jobs t, t + n, ..: a chunk's two parts go to
+    // two threads whenever there are two.
+    let run = |t: usize, n: usize| -> Vec<Done> {
         let mut fitter = ChunkFitter::default();
         jobs.iter()
+            .skip(t)
+            .step_by(n)
             .map(|&(i, part)| {
                 let (cx, cy) = layout.coords(i);
                 match part {
@@ -286,23 +290,22 @@ pub fn fit_chunks(
             })
             .collect()
     };
-    let done: Vec<Done> = if threads < 2 || jobs.len() < 2 {
-        run(&jobs)
+    let n = threads.clamp(1, jobs.len().max(1));
+    let mut by_thread: Vec<std::vec::IntoIter<Done>> = if n < 2 {
+        vec![run(0, 1).into_iter()]
     } else {
-        let per = jobs.len().div_ceil(threads);
         std::thread::scope(|s| {
-            let handles: Vec<_> = jobs
-                .chunks(per)
-                .map(|part| s.spawn(move || run(part)))
-                .collect();
+            let run = &run;
+            let handles: Vec<_> = (0..n).map(|t| s.spawn(move || run(t, n))).collect();
             handles
                 .into_iter()
-                .flat_map(|h| h.join().expect("chunk fit thread panicked"))
+                .map(|h| h.join().expect("chunk fit thread panicked").into_iter())
                 .collect()
         })
     };
+    // Back in job order: job k is thread k % n's next result.
+    let mut done = (0..jobs.len()).filter_map(|k| by_thread[k % n].next());
     let mut meshes = Vec::with_capacity(ids.len());
-    let mut done = done.into_iter();
     while let Some(first) = done.next() {
         meshes.push(match first {
             Done::Whole(mesh) => mesh,
