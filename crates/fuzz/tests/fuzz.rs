@@ -9,8 +9,20 @@ use strata_fuzz::readers;
 #[global_allocator]
 static ALLOC: CountingAlloc = CountingAlloc;
 
+/// The allocation counters are global: a test that frees memory while
+/// another measures its peak makes that peak read short (`installed()` then
+/// failed now and again). The tests of this binary measure one at a time.
+static MEASURING: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+fn measuring() -> std::sync::MutexGuard<'static, ()> {
+    // A test that failed while holding it leaves it poisoned; the counters
+    // are still fine.
+    MEASURING.lock().unwrap_or_else(|e| e.into_inner())
+}
+
 #[test]
 fn every_reader_survives_mutated_files() {
+    let _one_at_a_time = measuring();
     assert!(installed(), "the counting allocator is not installed");
     quiet_panics();
     let mut report = Vec::new();
@@ -59,6 +71,7 @@ fn every_reader_survives_mutated_files() {
 
 #[test]
 fn kept_regression_inputs_pass() {
+    let _one_at_a_time = measuring();
     quiet_panics();
     let results = replay(&regression_dir()).unwrap();
     assert!(
@@ -82,6 +95,7 @@ fn vmc_input(power_x: u8, power_y: u8, file: &[u8]) -> Vec<u8> {
 
 #[test]
 fn huge_declared_map_fails_before_allocating_it() {
+    let _one_at_a_time = measuring();
     assert!(installed());
     let vmc = readers::by_name("vmc").unwrap();
     // A 2^15 x 2^15 map (2 GiB of planes) over files far too short for it:
