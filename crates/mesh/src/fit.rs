@@ -141,8 +141,7 @@ impl ChunkFitter {
         tol: f64,
         options: FitOptions,
     ) -> ChunkMesh {
-        self.samples.load(level, layout, cx, cy);
-        self.emitter.begin(self.samples.size_x, self.samples.size_y);
+        self.start(level, layout, cx, cy);
         let mut causes = [0u32; CAUSES];
         let vertices = if options.outline {
             self.floor_pass(tol, &mut causes) + self.slab_pass(tol, &mut causes)
@@ -168,8 +167,7 @@ impl ChunkFitter {
         tol: f64,
         part: OutlinePart,
     ) -> OutlinePartFit {
-        self.samples.load(level, layout, cx, cy);
-        self.emitter.begin(self.samples.size_x, self.samples.size_y);
+        self.start(level, layout, cx, cy);
         let mut causes = [0u32; CAUSES];
         let vertices = match part {
             OutlinePart::Floor => self.floor_pass(tol, &mut causes),
@@ -180,6 +178,12 @@ impl ChunkFitter {
             causes,
             vertices,
         }
+    }
+
+    /// Load chunk `(cx, cy)` and start its emission.
+    fn start(&mut self, level: &Level, layout: &ChunkLayout, cx: u32, cy: u32) {
+        self.samples.load(level, layout, cx, cy);
+        self.emitter.begin(self.samples.size_x, self.samples.size_y);
     }
 
     /// The outline fit's floor: fitted on `low` alone (the floor view of
