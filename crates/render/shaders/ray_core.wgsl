@@ -169,7 +169,9 @@ fn texel_run(r: TexelRun, p: vec2<f32>) -> vec2<f32> {
 // Measured (default world, twelve views, 1280x800, lavapipe = the H100's
 // images): ray mean ꟻLIP 0.0561 with the point test, 0.0499 with this one
 // (0.0460 with the shadow map on it too, `bench/ray-flip/`). Its price on the
-// H100: `ray` 4.0 -> 7.1 ms, `ray-compute`'s march 0.135 -> 0.229 ms.
+// H100: `ray` 4.0 -> 7.1 ms, `ray-compute`'s march 0.135 -> 0.229 ms; with
+// the refinement out of the hot loop and the previous column's test carried
+// as one flag, 6.04 and 0.196 ms (`bench/ray-loop/`).
 const SEGMENT_STEP_TEST: bool = true;
 
 // Twin of `methods::ray::MAX_RAY_STEPS`.
@@ -212,8 +214,8 @@ fn march(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, steps: u32, segment: bool
         return result;
     }
     let p0 = o + d * t0;
-    var prev = decode_column(i32(floor(p0.x)), i32(floor(p0.y)));
-    if (column_is_solid(prev, p0.z)) {
+    let first = decode_column(i32(floor(p0.x)), i32(floor(p0.y)));
+    if (column_is_solid(first, p0.z)) {
         result.hit = true;
         result.t = t0;
         return result;
@@ -223,30 +225,46 @@ fn march(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, steps: u32, segment: bool
     let n = min(steps, MAX_MARCH_STEPS);
     let dt = (t1 - t0) / f32(n);
     var a = t0;
-    // The previous sample's z and how far the ray runs on inside its texel.
     let runs = texel_run_of(d.xy);
-    var prev_z = p0.z;
-    var prev_exit = texel_run(runs, p0.xy).y;
-    for (var i = 1u; i <= n; i = i + 1u) {
-        let t = t0 + dt * f32(i);
-        let p = o + d * t;
-        let c = decode_column(i32(floor(p.x)), i32(floor(p.y)));
-        let run = texel_run(runs, p.xy);
-        // The step's piece in this column: from its entry (or sample i - 1)
-        // to p, which holds the point test; and in the previous column: from
-        // sample i - 1 to its exit (or p).
-        let z_in = p.z - d.z * min(run.x, dt);
-        let z_out = prev_z + d.z * min(prev_exit, dt);
-        if (z_span_meets_solid(c, z_in, p.z) || z_span_meets_solid(prev, prev_z, z_out)) {
-            let r = refine_exact(o, d, a, t, column_is_solid(c, p.z));
-            if (r.hit) {
-                return r;
+    // The step's piece in the previous sample's column (from that sample to
+    // the column's exit, or the next sample) is known when that sample is
+    // taken: carry its test as one flag, not the column, its z and its exit
+    // (fewer live registers in the loop; the same test).
+    var leaves_solid = z_span_meets_solid(first, p0.z, p0.z + d.z * min(texel_run(runs, p0.xy).y, dt));
+    // The hot loop only finds the next flagged step; its refinement runs
+    // outside it (fewer live registers while marching), and a refinement
+    // that finds nothing resumes the march at the next step.
+    var i = 1u;
+    loop {
+        var flagged = false;
+        var t = t1;
+        var solid_end = false;
+        for (; i <= n; i = i + 1u) {
+            t = t0 + dt * f32(i);
+            let p = o + d * t;
+            let c = decode_column(i32(floor(p.x)), i32(floor(p.y)));
+            let run = texel_run(runs, p.xy);
+            // The step's piece in this column: from its entry (or sample
+            // i - 1) to p, which holds the point test.
+            let z_in = p.z - d.z * min(run.x, dt);
+            let flag = leaves_solid || z_span_meets_solid(c, z_in, p.z);
+            leaves_solid = z_span_meets_solid(c, p.z, p.z + d.z * min(run.y, dt));
+            if (flag) {
+                flagged = true;
+                solid_end = column_is_solid(c, p.z);
+                break;
             }
+            a = t;
+        }
+        if (!flagged) {
+            break;
+        }
+        let r = refine_exact(o, d, a, t, solid_end);
+        if (r.hit) {
+            return r;
         }
         a = t;
-        prev = c;
-        prev_z = p.z;
-        prev_exit = run.y;
+        i = i + 1u;
     }
     return result;
 }
