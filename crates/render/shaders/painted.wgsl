@@ -1,7 +1,9 @@
 // `painted`: one instance per footprint sample; each draws a bar [0, low] and,
 // for a dual column, a bar [mid, high], emitting only the (at most three)
 // faces that face the eye. Positions come from the instance and vertex
-// indices and the column decoded from the terrain texture.
+// indices and the column decoded from the terrain texture. The draw is
+// indexed (`methods::painted::BAR_INDICES`): a face's four corners are
+// shaded once and its two triangles share them.
 #include "frame.wgsl"
 #include "surface.wgsl"
 #include "shading.wgsl"
@@ -9,22 +11,13 @@
 
 @group(1) @binding(0) var<uniform> footprint: Footprint;
 
-// Vertices per bar: three faces of two triangles.
-const BAR_VERTICES: u32 = 18u;
+// Vertices per bar: three faces of four corners.
+const BAR_VERTICES: u32 = 12u;
 
 struct VertexOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) world: vec3<f32>,
     @location(1) @interpolate(flat) cell: vec2<i32>,
-}
-
-// The (s, t) corner of a quad for each of its six triangle vertices.
-fn quad_corner(k: u32) -> vec2<f32> {
-    var corners = array<vec2<f32>, 6>(
-        vec2<f32>(0.0, 0.0), vec2<f32>(1.0, 0.0), vec2<f32>(0.0, 1.0),
-        vec2<f32>(0.0, 1.0), vec2<f32>(1.0, 0.0), vec2<f32>(1.0, 1.0),
-    );
-    return corners[k];
 }
 
 // The plane of the face of [lo, hi] on one axis that faces the eye at `e`,
@@ -60,12 +53,14 @@ fn vs_painted(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) ->
         z0 = c.mid;
         z1 = c.high;
     }
-    let st = quad_corner(k % 6u);
+    // Corner k % 4 of face k / 4 at (s, t) = (bit 0, bit 1).
+    let corner = k % 4u;
+    let st = vec2<f32>(f32(corner & 1u), f32(corner >> 1u));
     let lo = vec3<f32>(f32(cell.x), f32(cell.y), z0);
     let hi = vec3<f32>(lo.x + 1.0, lo.y + 1.0, z1);
     let e = globals.eye.xyz;
     var p: vec3<f32>;
-    switch (k / 6u) {
+    switch (k / 4u) {
         case 0u: {
             // Top when the eye is above, bottom (a cave ceiling) when below.
             let side = facing_side(e.z, z0, z1);

@@ -2,7 +2,9 @@
 //! bar [0, low] and, for a dual column, a bar [mid, high]. One instanced draw,
 //! no vertex buffer: the vertex shader derives each corner from the instance
 //! index (the sample, front to back: `forward.wgsl`) and the vertex index
-//! (bar, face, corner), and emits only the faces that face the eye.
+//! (bar, face, corner), and emits only the faces that face the eye. The draw
+//! is indexed so that a face's two triangles share its four corners: 24
+//! vertex shader runs per sample, not 36.
 
 use super::common::{begin_pass, forward_pipeline, uniform_binding};
 use super::forward::{self, FootprintParams};
@@ -11,13 +13,27 @@ use crate::frame::Shared;
 use strata_camera::Camera;
 use strata_level::Level;
 
-/// Vertices per sample: two bars of three faces of two triangles.
-const VERTICES_PER_SAMPLE: u32 = 36;
+/// The indices of one sample: two bars of three faces of two triangles, over
+/// the four corners of each face (vertex `12 bar + 4 face + corner`, corner
+/// bits (s, t) as `painted.wgsl` reads them). Both triangles of a face wind as
+/// the six-vertex quads of the unindexed draw did.
+const BAR_INDICES: [u16; 36] = {
+    let mut out = [0u16; 36];
+    let quad = [0u16, 1, 2, 2, 1, 3];
+    let mut i = 0;
+    while i < 36 {
+        out[i] = (i / 6) as u16 * 4 + quad[i % 6];
+        i += 1;
+    }
+    out
+};
 
 pub struct Painted {
     pipeline: wgpu::RenderPipeline,
     group: wgpu::BindGroup,
     params: wgpu::Buffer,
+    /// [`BAR_INDICES`].
+    indices: wgpu::Buffer,
     /// Samples the next `record` draws (written by `prepare`).
     samples: u32,
 }
@@ -45,10 +61,20 @@ pub fn create(
         &layout,
         ("vs_painted", "fs_painted"),
     )?;
+    let indices = shared.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("painted indices"),
+        size: std::mem::size_of_val(&BAR_INDICES) as u64,
+        usage: wgpu::BufferUsages::INDEX | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    shared
+        .queue
+        .write_buffer(&indices, 0, bytemuck::cast_slice(&BAR_INDICES));
     Ok(Box::new(Painted {
         pipeline,
         group,
         params,
+        indices,
         samples: 0,
     }))
 }
@@ -80,13 +106,15 @@ impl Method for Painted {
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &shared.frame_group, &[]);
         pass.set_bind_group(1, &self.group, &[]);
-        pass.draw(0..VERTICES_PER_SAMPLE, 0..self.samples);
+        pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint16);
+        pass.draw_indexed(0..BAR_INDICES.len() as u32, 0, 0..self.samples);
     }
 
     fn retained_bytes(&self) -> RetainedBytes {
-        // The 48-byte footprint uniform; no per-column geometry.
+        // The 48-byte footprint uniform and 72 bytes of indices; no
+        // per-column geometry.
         RetainedBytes {
-            gpu: forward::PARAMS_BYTES,
+            gpu: forward::PARAMS_BYTES + std::mem::size_of_val(&BAR_INDICES) as u64,
             cpu: 0,
         }
     }
