@@ -2,8 +2,9 @@
 // for a dual column, a bar [mid, high], emitting only the (at most three)
 // faces that face the eye. Positions come from the instance and vertex
 // indices and the column decoded from the terrain texture. The draw is
-// indexed (`methods::painted::BAR_INDICES`): a face's four corners are
-// shaded once and its two triangles share them.
+// indexed (`methods::painted::BAR_INDICES`): a bar's visible faces meet at
+// one corner, and the three quads around it have seven corners, each shaded
+// once.
 #include "frame.wgsl"
 #include "surface.wgsl"
 #include "shading.wgsl"
@@ -11,8 +12,9 @@
 
 @group(1) @binding(0) var<uniform> footprint: Footprint;
 
-// Vertices per bar: three faces of four corners.
-const BAR_VERTICES: u32 = 12u;
+// Vertices per bar: the corner the visible faces share, then the six around
+// it in order (a face is that corner and three consecutive ones).
+const BAR_VERTICES: u32 = 7u;
 
 struct VertexOut {
     @builtin(position) clip: vec4<f32>,
@@ -53,37 +55,31 @@ fn vs_painted(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) ->
         z0 = c.mid;
         z1 = c.high;
     }
-    // Corner k % 4 of face k / 4 at (s, t) = (bit 0, bit 1).
-    let corner = k % 4u;
-    let st = vec2<f32>(f32(corner & 1u), f32(corner >> 1u));
     let lo = vec3<f32>(f32(cell.x), f32(cell.y), z0);
     let hi = vec3<f32>(lo.x + 1.0, lo.y + 1.0, z1);
     let e = globals.eye.xyz;
-    var p: vec3<f32>;
-    switch (k / 4u) {
-        case 0u: {
-            // Top when the eye is above, bottom (a cave ceiling) when below.
-            let side = facing_side(e.z, z0, z1);
-            if (side < 0.0) {
-                return out;
-            }
-            p = vec3<f32>(lo.xy + st, mix(z0, z1, side));
-        }
-        case 1u: {
-            let side = facing_side(e.x, lo.x, hi.x);
-            if (side < 0.0) {
-                return out;
-            }
-            p = vec3<f32>(lo.x + side, lo.y + st.x, mix(z0, z1, st.y));
-        }
-        default: {
-            let side = facing_side(e.y, lo.y, hi.y);
-            if (side < 0.0) {
-                return out;
-            }
-            p = vec3<f32>(lo.x + st.x, lo.y + side, mix(z0, z1, st.y));
-        }
+    // Per axis, the face that faces the eye: 1 the high one, 0 the low one,
+    // -1 neither (the eye is between them). Top when the eye is above,
+    // bottom (a cave ceiling) when below.
+    let side = vec3<f32>(
+        facing_side(e.x, lo.x, hi.x),
+        facing_side(e.y, lo.y, hi.y),
+        facing_side(e.z, z0, z1),
+    );
+    // The shared corner sits on each visible face (a hidden face's axis takes
+    // the low side). Vertex k flips it on the axes of bits x 1, y 2, z 4: the
+    // faces are z (0, 1, 2, 3), x (0, 3, 4, 5) and y (0, 5, 6, 1).
+    var flips = array<u32, 7>(0u, 1u, 3u, 2u, 6u, 4u, 5u);
+    var flip = flips[k];
+    // A hidden face's own corner (2 for z, 4 for x, 6 for y) falls onto the
+    // shared one, so both its triangles are degenerate and the faces beside
+    // it keep their corners.
+    if ((k == 2u && side.z < 0.0) || (k == 4u && side.x < 0.0) || (k == 6u && side.y < 0.0)) {
+        flip = 0u;
     }
+    let flipped = (vec3<u32>(flip, flip >> 1u, flip >> 2u) & vec3<u32>(1u)) == vec3<u32>(1u);
+    let at_hi = (side > vec3<f32>(0.0)) != flipped;
+    let p = select(lo, hi, at_hi);
     out.clip = globals.view_proj * vec4<f32>(p, 1.0);
     out.world = p;
     return out;

@@ -3,8 +3,8 @@
 //! no vertex buffer: the vertex shader derives each corner from the instance
 //! index (the sample, front to back: `forward.wgsl`) and the vertex index
 //! (bar, face, corner), and emits only the faces that face the eye. The draw
-//! is indexed so that a face's two triangles share its four corners: 24
-//! vertex shader runs per sample, not 36.
+//! is indexed over the seven corners of a bar's visible faces: 14 vertex
+//! shader runs per sample, not 36.
 
 use super::common::{begin_pass, forward_pipeline, uniform_binding};
 use super::forward::{self, FootprintParams};
@@ -13,16 +13,23 @@ use crate::frame::Shared;
 use strata_camera::Camera;
 use strata_level::Level;
 
-/// The indices of one sample: two bars of three faces of two triangles, over
-/// the four corners of each face (vertex `12 bar + 4 face + corner`, corner
-/// bits (s, t) as `painted.wgsl` reads them). Both triangles of a face wind as
-/// the six-vertex quads of the unindexed draw did.
+/// The indices of one sample: two bars of three faces of two triangles. A
+/// bar's seven vertices are the corner its visible faces share (0) and the
+/// six around it (1..=6, see `painted.wgsl`); each face is two triangles
+/// fanned from the shared corner over three consecutive ring corners.
 const BAR_INDICES: [u16; 36] = {
     let mut out = [0u16; 36];
-    let quad = [0u16, 1, 2, 2, 1, 3];
     let mut i = 0;
     while i < 36 {
-        out[i] = (i / 6) as u16 * 4 + quad[i % 6];
+        let (bar, k) = (i / 18, i % 18);
+        // Triangle k / 3 of the bar: (0, j, j + 1) with j = 1..=6, wrapping.
+        let j = k / 3 + 1;
+        let corner = match k % 3 {
+            0 => 0,
+            1 => j,
+            _ => j % 6 + 1,
+        };
+        out[i] = (bar * 7 + corner) as u16;
         i += 1;
     }
     out
