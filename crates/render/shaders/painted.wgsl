@@ -34,6 +34,18 @@ fn facing_side(e: f32, lo: f32, hi: f32) -> f32 {
     return -1.0;
 }
 
+// How high column `n`'s solid reaches from `z0` up, within [z0, z1]: the top
+// of its interval that holds z0 (z0 when it holds none).
+fn cover_top(n: Column, z0: f32, z1: f32) -> f32 {
+    if (z0 <= n.low) {
+        return min(n.low, z1);
+    }
+    if (n.dual && n.mid <= z0 && z0 <= n.high) {
+        return min(n.high, z1);
+    }
+    return z0;
+}
+
 @vertex
 fn vs_painted(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) -> VertexOut {
     var out: VertexOut;
@@ -79,7 +91,30 @@ fn vs_painted(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) ->
     }
     let flipped = (vec3<u32>(flip, flip >> 1u, flip >> 2u) & vec3<u32>(1u)) == vec3<u32>(1u);
     let at_hi = (side > vec3<f32>(0.0)) != flipped;
-    let p = select(lo, hi, at_hi);
+    var p = select(lo, hi, at_hi);
+    // A side face's part that touches the neighbour column's solid is inside
+    // the terrain: never the first surface along a ray, and most of a tall
+    // wall's area. Raise the face's bottom corners over it, so the rasteriser
+    // does not cover it only for the depth test to reject it. A corner on
+    // two side faces takes the lower of their cuts, so each face still
+    // covers all its visible part. Not where the bottom face is drawn.
+    if (!at_hi.z && side.z != 0.0) {
+        var z = z1;
+        var cut = false;
+        if ((flip & 1u) == 0u && side.x >= 0.0) {
+            let n = decode_column(cell.x + select(-1, 1, side.x > 0.0), cell.y);
+            z = min(z, cover_top(n, z0, z1));
+            cut = true;
+        }
+        if ((flip & 2u) == 0u && side.y >= 0.0) {
+            let n = decode_column(cell.x, cell.y + select(-1, 1, side.y > 0.0));
+            z = min(z, cover_top(n, z0, z1));
+            cut = true;
+        }
+        if (cut) {
+            p.z = z;
+        }
+    }
     out.clip = globals.view_proj * vec4<f32>(p, 1.0);
     out.world = p;
     return out;
