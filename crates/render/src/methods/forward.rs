@@ -14,7 +14,8 @@ pub const Z_MAX: f32 = 256.0;
 
 /// The most ground samples one frame may enumerate. Far beyond any real view
 /// (600 units of far plane give under 1.5 M at 1280 px), and small enough that
-/// 36 vertices per sample stay far from `u32` overflow.
+/// `painted`'s 14 vertices and 36 indices per sample stay far from `u32`
+/// overflow.
 pub const MAX_SAMPLES: u64 = 1 << 22;
 
 /// Twin of `Footprint` in `forward.wgsl`.

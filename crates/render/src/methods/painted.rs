@@ -4,7 +4,9 @@
 //! index (the sample, front to back: `forward.wgsl`) and the vertex index
 //! (bar, face, corner), and emits only the faces that face the eye. The draw
 //! is indexed over the seven corners of a bar's visible faces: 14 vertex
-//! shader runs per sample, not 36.
+//! shader runs per sample, not 36. A side face starts above the neighbour
+//! column's solid it touches, so the hidden part of every wall is not
+//! rasterised (`bench/painted-indexed/`: 2.9x faster on the H200).
 
 use super::common::{begin_pass, forward_pipeline, uniform_binding};
 use super::forward::{self, FootprintParams};
