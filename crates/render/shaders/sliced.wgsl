@@ -9,6 +9,19 @@
 // count.y: slices N; count.z: the slice nearest the eye's altitude.
 @group(1) @binding(0) var<uniform> footprint: Footprint;
 
+// Twin of `methods::slice_tiles::SliceTileParams`.
+struct SliceTiles {
+    // x, y: the footprint's first tile (unwrapped); z, w: tiles across and
+    // down (z 0: no culling, each slice one quad over the whole footprint)
+    grid: vec4<i32>,
+    // x: log2 of the tile side; y, z: the map's tiles across and down - 1
+    tiles: vec4<u32>,
+}
+
+@group(1) @binding(1) var<uniform> slice_tiles: SliceTiles;
+// The highest solid top over each tile of the map and a one-texel margin.
+@group(1) @binding(2) var tile_max: texture_2d<u32>;
+
 // Top of the sliced range (Rust: `forward::Z_MAX`).
 const SLICE_TOP: f32 = 256.0;
 
@@ -20,24 +33,44 @@ struct VertexOut {
     @location(2) @interpolate(flat) rank: u32,
 }
 
+// Instance i: slice rank i / tiles, tile i % tiles of the footprint's grid;
+// the quad is the tile cut to the footprint bound, or nothing where the
+// tile's highest top is below the slice (all of it air there).
 @vertex
 fn vs_sliced(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) -> VertexOut {
     let n = footprint.count.y;
+    let g = slice_tiles.grid;
+    let per_slice = u32(max(g.z, 1) * max(g.w, 1));
     // Slices nearest the eye's altitude first: near to far for the floors
     // below and the ceilings above, so the depth test rejects early.
-    let j = outward(i, footprint.count.z, n);
+    let j = outward(i / per_slice, footprint.count.z, n);
     let z = SLICE_TOP - f32(j + 1u) * (SLICE_TOP / f32(n));
-    var corners = array<vec2<f32>, 6>(
-        vec2<f32>(0.0, 0.0), vec2<f32>(1.0, 0.0), vec2<f32>(0.0, 1.0),
-        vec2<f32>(0.0, 1.0), vec2<f32>(1.0, 0.0), vec2<f32>(1.0, 1.0),
-    );
     // The bound's extent in x and y (rows run along x when origin.z is 0).
-    var extent = vec2<f32>(f32(footprint.size.y), f32(footprint.size.x));
+    var extent = vec2<i32>(i32(footprint.size.y), i32(footprint.size.x));
     if (footprint.origin.z != 0) {
         extent = extent.yx;
     }
-    let xy = vec2<f32>(footprint.origin.xy) + corners[v] * extent;
+    var lo = footprint.origin.xy;
+    var hi = lo + extent;
     var out: VertexOut;
+    if (g.z > 0) {
+        let t = i % per_slice;
+        let tile = g.xy + vec2<i32>(i32(t % u32(g.z)), i32(t / u32(g.z)));
+        let k = slice_tiles.tiles.x;
+        let wrapped = vec2<u32>(tile) & slice_tiles.tiles.yz;
+        if (z > f32(textureLoad(tile_max, wrapped, 0).r)) {
+            // A degenerate triangle (all three vertices equal) rasterises nothing.
+            out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
+            out.world = vec3<f32>(0.0);
+            out.altitude = z;
+            out.rank = j;
+            return out;
+        }
+        lo = max(lo, tile << vec2<u32>(k));
+        hi = min(hi, (tile + vec2<i32>(1)) << vec2<u32>(k));
+    }
+    // Corner v of the quad (indexed: `methods::sliced::QUAD_INDICES`): x bit 0, y bit 1.
+    let xy = vec2<f32>(select(lo, hi, vec2<bool>((v & 1u) != 0u, (v & 2u) != 0u)));
     out.world = vec3<f32>(xy, z);
     out.altitude = z;
     out.rank = j;

@@ -169,6 +169,21 @@ pub(crate) fn uniform_binding(
     (layout, group)
 }
 
+/// A `u16` index buffer holding `indices` (the fixed corner patterns of the
+/// instanced object-order draws).
+pub(crate) fn index_buffer(shared: &Shared, label: &str, indices: &[u16]) -> wgpu::Buffer {
+    let buffer = shared.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: std::mem::size_of_val(indices) as u64,
+        usage: wgpu::BufferUsages::INDEX | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    shared
+        .queue
+        .write_buffer(&buffer, 0, bytemuck::cast_slice(indices));
+    buffer
+}
+
 /// The shared depth target, cleared to far (the contract: the first pass
 /// that touches it clears it).
 fn depth_attachment(shared: &Shared) -> wgpu::RenderPassDepthStencilAttachment<'_> {

@@ -57,6 +57,7 @@ pub mod ray_exact_build;
 #[doc(hidden)]
 pub mod scattered;
 mod scattered_grid;
+mod slice_tiles;
 #[doc(hidden)]
 pub mod sliced;
 mod sliced_refine;

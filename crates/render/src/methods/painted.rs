@@ -8,7 +8,7 @@
 //! column's solid it touches, so the hidden part of every wall is not
 //! rasterised (`bench/painted-indexed/`: 2.9x faster on the H200).
 
-use super::common::{begin_pass, forward_pipeline, uniform_binding};
+use super::common::{begin_pass, forward_pipeline, index_buffer, uniform_binding};
 use super::forward::{self, FootprintParams};
 use super::{Frame, Method, MethodSettings, RetainedBytes};
 use crate::frame::Shared;
@@ -48,7 +48,7 @@ pub struct Painted {
 }
 
 /// The footprint uniform, its bind group layout and group.
-pub(crate) fn footprint_binding(
+fn footprint_binding(
     shared: &Shared,
     label: &str,
 ) -> (wgpu::Buffer, wgpu::BindGroupLayout, wgpu::BindGroup) {
@@ -70,15 +70,7 @@ pub fn create(
         &layout,
         ("vs_painted", "fs_painted"),
     )?;
-    let indices = shared.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("painted indices"),
-        size: std::mem::size_of_val(&BAR_INDICES) as u64,
-        usage: wgpu::BufferUsages::INDEX | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    shared
-        .queue
-        .write_buffer(&indices, 0, bytemuck::cast_slice(&BAR_INDICES));
+    let indices = index_buffer(shared, "painted indices", &BAR_INDICES);
     Ok(Box::new(Painted {
         pipeline,
         group,

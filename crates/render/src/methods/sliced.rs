@@ -1,18 +1,22 @@
 //! `sliced` (§3.3): `slices` horizontal quads over the camera's footprint at
 //! z = 256 - k·256/N (k = 1..N), one instanced draw; each fragment keeps its
 //! point where the decoded column is solid (floor column or slab) and
-//! discards it elsewhere. Depth-tested like any geometry.
+//! discards it elsewhere. Depth-tested like any geometry. Each slice is drawn
+//! as one quad per 32 x 32 tile of the footprint, and tiles that are all air
+//! at the slice's altitude are dropped (`slice_tiles.rs`).
 //!
 //! `sliced:N/refine` draws the same slices into a marks image instead and
 //! adds one full-screen pass that puts the exact surface crossing behind
 //! each pixel's nearest kept slice (`sliced_refine.rs`).
 
-use super::common::{begin_pass, begin_pass_into, forward_pipeline, forward_pipeline_into};
+use super::common::{
+    begin_pass, begin_pass_into, forward_pipeline, forward_pipeline_into, index_buffer,
+};
 use super::forward::{self, Z_MAX};
-use super::painted::footprint_binding;
+use super::slice_tiles::SliceTiles;
 use super::sliced_refine::{MARK_FORMAT, Refine};
 use super::{Frame, Method, MethodSettings, RetainedBytes};
-use crate::frame::Shared;
+use crate::frame::{Shared, texture_entry, uniform_layout_entry};
 use strata_camera::Camera;
 use strata_level::Level;
 
@@ -24,6 +28,12 @@ pub struct Sliced {
     pipeline: wgpu::RenderPipeline,
     group: wgpu::BindGroup,
     params: wgpu::Buffer,
+    /// The tile maxima that drop air tiles, and the grid over the footprint.
+    tiles: SliceTiles,
+    /// Tiles per slice in the next draw.
+    tiles_per_slice: u32,
+    /// [`QUAD_INDICES`].
+    quad: wgpu::Buffer,
     slices: u32,
     /// `sliced_refine`: `pipeline` marks the kept slices and this pass refines.
     refine: Option<Refine>,
@@ -39,13 +49,63 @@ fn checked_slices(settings: &MethodSettings) -> anyhow::Result<u32> {
     Ok(slices)
 }
 
+/// The slices' group: the footprint uniform, the tile grid uniform and the
+/// tile maxima.
+fn slices_binding(
+    shared: &Shared,
+    params: &wgpu::Buffer,
+    tiles: &SliceTiles,
+) -> (wgpu::BindGroupLayout, wgpu::BindGroup) {
+    let device = &shared.device;
+    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("sliced"),
+        entries: &[
+            uniform_layout_entry(0),
+            uniform_layout_entry(1),
+            texture_entry(
+                2,
+                wgpu::TextureSampleType::Uint,
+                wgpu::TextureViewDimension::D2,
+            ),
+        ],
+    });
+    let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("sliced"),
+        layout: &layout,
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: params.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: tiles.params.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 2,
+                resource: wgpu::BindingResource::TextureView(&tiles.view),
+            },
+        ],
+    });
+    (layout, group)
+}
+
+/// A quad's two triangles over its corners (bits: x 1, y 2), as
+/// `sliced.wgsl` places them.
+const QUAD_INDICES: [u16; 6] = [0, 1, 2, 2, 1, 3];
+
 pub fn create(
     shared: &Shared,
-    _level: &Level,
+    level: &Level,
     settings: &MethodSettings,
 ) -> anyhow::Result<Box<dyn Method>> {
     let slices = checked_slices(settings)?;
-    let (params, layout, group) = footprint_binding(shared, "sliced");
+    let params = shared.uniform_buffer(
+        "sliced",
+        bytemuck::bytes_of(&forward::FootprintParams::default()),
+    );
+    let tiles = SliceTiles::new(shared, level);
+    let (layout, group) = slices_binding(shared, &params, &tiles);
     let (pipeline, refine) = if settings.sliced_refine {
         let marks = forward_pipeline_into(
             shared,
@@ -70,6 +130,9 @@ pub fn create(
         pipeline,
         group,
         params,
+        tiles,
+        tiles_per_slice: 1,
+        quad: index_buffer(shared, "sliced quad", &QUAD_INDICES),
         slices,
         refine,
         empty: true,
@@ -85,6 +148,16 @@ fn slice_near(z: f32, slices: u32) -> u32 {
 impl Method for Sliced {
     fn name(&self) -> &'static str {
         "sliced"
+    }
+
+    fn apply_edit(
+        &mut self,
+        shared: &Shared,
+        level: &Level,
+        rects: &[strata_level::DirtyRect],
+    ) -> anyhow::Result<()> {
+        self.tiles.apply_edit(shared, level, rects);
+        Ok(())
     }
 
     fn update_settings(
@@ -114,6 +187,15 @@ impl Method for Sliced {
         self.empty = f.size[0] == 0 || f.size[1] == 0;
         f.count[1] = self.slices;
         f.count[2] = slice_near(camera.position.z, self.slices);
+        // The bound's extent in x and y (rows run along x when origin.z is 0).
+        let extent = if f.origin[2] == 0 {
+            [f.size[1], f.size[0]]
+        } else {
+            [f.size[0], f.size[1]]
+        };
+        self.tiles_per_slice = self
+            .tiles
+            .prepare(shared, [f.origin[0], f.origin[1]], extent);
         shared
             .queue
             .write_buffer(&self.params, 0, bytemuck::bytes_of(&f));
@@ -139,23 +221,27 @@ impl Method for Sliced {
     }
 
     fn retained_bytes(&self) -> RetainedBytes {
-        // The 48-byte footprint uniform (the quads come from indices), and
-        // the refined slicer's marks image.
+        // The 48-byte footprint uniform (the quads come from indices), the
+        // tile maxima (kept on the CPU too, for edits), and the refined
+        // slicer's marks image.
         let refine = self.refine.as_ref().map(Refine::retained_bytes);
         RetainedBytes {
-            gpu: forward::PARAMS_BYTES + refine.map_or(0, |r| r.gpu),
-            cpu: 0,
+            gpu: forward::PARAMS_BYTES + self.tiles.gpu_bytes() + refine.map_or(0, |r| r.gpu),
+            cpu: self.tiles.cpu_bytes(),
         }
     }
 }
 
 impl Sliced {
-    /// The slices, one instanced draw (nearest the eye's altitude first).
+    /// The slices, one instanced draw of a quad per slice and tile (slices
+    /// nearest the eye's altitude first).
     fn draw_slices(&self, shared: &Shared, pass: &mut wgpu::RenderPass<'_>) {
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &shared.frame_group, &[]);
         pass.set_bind_group(1, &self.group, &[]);
-        pass.draw(0..6, 0..self.slices);
+        // At most MAX_SLICES x MAX_TILES_PER_SLICE = 2^30 instances.
+        pass.set_index_buffer(self.quad.slice(..), wgpu::IndexFormat::Uint16);
+        pass.draw_indexed(0..6, 0, 0..self.slices * self.tiles_per_slice);
     }
 }
 
