@@ -69,8 +69,10 @@ fn vs_sliced(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) -> 
         lo = max(lo, tile << vec2<u32>(k));
         hi = min(hi, (tile + vec2<i32>(1)) << vec2<u32>(k));
     }
-    // Corner v of the quad (indexed: `methods::sliced::QUAD_INDICES`): x bit 0, y bit 1.
-    let xy = vec2<f32>(select(lo, hi, vec2<bool>((v & 1u) != 0u, (v & 2u) != 0u)));
+    // Corner v of the quad (indexed: `methods::sliced::QUAD_INDICES`): x bit
+    // 0, y bit 1. A float select: naga writes a vector select as mix(),
+    // which GLSL ES 3.00 (WebGL2) has for floats only.
+    let xy = select(vec2<f32>(lo), vec2<f32>(hi), vec2<bool>((v & 1u) != 0u, (v & 2u) != 0u));
     out.world = vec3<f32>(xy, z);
     out.altitude = z;
     out.rank = j;

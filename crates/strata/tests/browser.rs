@@ -4,7 +4,8 @@
 //! (computed in the page too) within the native lavapipe tests' limits; a
 //! crater dug through the page shows in the next frames and the edited
 //! level's reference agrees; undo brings the picture back; the screenshot is
-//! not blank; and `?backend=webgl2` draws `ray` within the same limits.
+//! not blank; and `?backend=webgl2` draws `ray`, `painted` and `sliced`
+//! within the same limits.
 //!
 //! Needs Debian's `chromium` and `chromium-driver` and the bundle
 //! (`crates/web/build.sh`). Without them it prints a SKIPPED line;
@@ -475,6 +476,20 @@ async fn drive(client: Client, url: String, fixture: CompareFixture) {
         depth <= 0.5,
         "WebGL2 ray: depth p50 {depth} world units off"
     );
+    // The object-order methods WebGL2 has: their vertex shaders read the
+    // terrain (and sliced its tile maxima) through GLSL ES 3.00.
+    for method in ["painted", "sliced"] {
+        assert!(
+            !unavailable.iter().any(|u| u["method"] == method),
+            "{method} must run on WebGL2"
+        );
+        run(&client, &format!("method {method}"), 300).await;
+        let s = run(&client, "frames 2", 300).await;
+        assert_not_blank(&canvas_pixels(&client).await, &format!("WebGL2 {method}"));
+        let scores = score(&client, &s, method).await;
+        eprintln!("WebGL2 {method}: {scores:?}");
+        check(method, scores, &mut failures);
+    }
     assert!(failures.is_empty(), "WebGL2: {failures:?}");
 
     // `?compare`: the quick protocol in the page; `strata merge` takes its
