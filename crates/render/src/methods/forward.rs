@@ -33,6 +33,18 @@ pub struct FootprintParams {
     pub count: [u32; 4],
 }
 
+impl FootprintParams {
+    /// The bound's extent in x and y, texels (rows run along x when
+    /// `origin[2]` is 0).
+    pub fn extent(&self) -> [u32; 2] {
+        if self.origin[2] == 0 {
+            [self.size[1], self.size[0]]
+        } else {
+            [self.size[0], self.size[1]]
+        }
+    }
+}
+
 /// Bytes of the footprint uniform (what `painted` and `sliced` retain).
 pub const PARAMS_BYTES: u64 = std::mem::size_of::<FootprintParams>() as u64;
 
@@ -169,11 +181,7 @@ mod tests {
             let cam = Camera::new(Vec3::new(300.0, 500.0, 120.0), yaw, pitch, 160, 100).unwrap();
             let f = footprint(&cam, None);
             let (x0, y0) = (f.origin[0] as f32, f.origin[1] as f32);
-            let (lx, ly) = if f.origin[2] == 0 {
-                (f.size[1], f.size[0])
-            } else {
-                (f.size[0], f.size[1])
-            };
+            let [lx, ly] = f.extent();
             // Every pixel ray's points inside the altitude range lie inside.
             for (i, j) in [(0, 0), (159, 0), (80, 50), (0, 99), (159, 99)] {
                 let d = cam.pixel_ray(i, j);

@@ -10,8 +10,8 @@
 //! f32 can put it a hair across the tile's edge into a column of the next
 //! tile; the margin covers that column, so culling removes only air.
 //!
-//! Edits rebuild the tile rows their rectangles touch (margin included) from
-//! the edited level and upload them before the next frame.
+//! Edits rebuild the tiles their rectangles touch (margins included) from
+//! the edited level and upload those tile rows before the next frame.
 
 use crate::frame::Shared;
 use strata_level::model::pair_is_dual;
@@ -100,25 +100,55 @@ impl TileMaxima {
         }
     }
 
-    /// Rebuild the tile rows whose tiles or margins meet `rects` (already
-    /// changed in `level`); returns those rows, ascending.
-    pub fn update(&mut self, level: &Level, rects: &[DirtyRect]) -> Vec<u32> {
+    /// Tile `(tx, ty)` alone from `level`: the same value as a row rebuild,
+    /// column by column (an edit touches a few tiles of a row).
+    fn tile_max(&self, level: &Level, tx: u32, ty: u32) -> u8 {
         let side = 1i64 << self.log2;
-        let h = i64::from(self.height);
-        let mut rows = vec![false; self.height as usize];
-        for r in rects {
-            // A texel row y is in the margin of the tile rows around it.
-            let first = (i64::from(r.y) - 1).div_euclid(side);
-            let last = (i64::from(r.y) + i64::from(r.height)).div_euclid(side);
-            for ty in first..=last.min(first + h - 1) {
-                rows[ty.rem_euclid(h) as usize] = true;
+        let (x0, y0) = (i64::from(tx) * side, i64::from(ty) * side);
+        let mut m = 0;
+        for y in y0 - 1..=y0 + side {
+            for x in x0 - 1..=x0 + side {
+                m = m.max(level.column(x, y).top());
             }
         }
-        let dirty: Vec<u32> = (0..self.height).filter(|&ty| rows[ty as usize]).collect();
-        for &ty in &dirty {
-            self.rebuild_row(level, ty);
+        m
+    }
+
+    /// Rebuild the tiles whose inside or margin meets `rects` (already
+    /// changed in `level`); returns their rows, ascending.
+    pub fn update(&mut self, level: &Level, rects: &[DirtyRect]) -> Vec<u32> {
+        let side = 1i64 << self.log2;
+        let (w, h) = (i64::from(self.width), i64::from(self.height));
+        // The tiles (wrapped) whose inside or one-texel margin holds texels
+        // a..a + n along one axis of `count` tiles.
+        let span = |a: u32, n: u32, count: i64| {
+            let first = (i64::from(a) - 1).div_euclid(side);
+            let last = (i64::from(a) + i64::from(n)).div_euclid(side);
+            (first..=last.min(first + count - 1)).map(move |t| t.rem_euclid(count) as usize)
+        };
+        let mut dirty = vec![false; self.data.len()];
+        for r in rects {
+            for ty in span(r.y, r.height, h) {
+                for tx in span(r.x, r.width, w) {
+                    dirty[ty * w as usize + tx] = true;
+                }
+            }
         }
-        dirty
+        let mut rows = Vec::new();
+        for ty in 0..self.height {
+            let mut any = false;
+            for tx in 0..self.width {
+                let i = (ty * self.width + tx) as usize;
+                if dirty[i] {
+                    self.data[i] = self.tile_max(level, tx, ty);
+                    any = true;
+                }
+            }
+            if any {
+                rows.push(ty);
+            }
+        }
+        rows
     }
 }
 
@@ -234,7 +264,7 @@ impl SliceTiles {
         );
     }
 
-    /// Rebuild and upload the rows `rects` touch.
+    /// Rebuild the tiles `rects` touch and upload their rows.
     pub fn apply_edit(&mut self, shared: &Shared, level: &Level, rects: &[DirtyRect]) {
         for ty in self.cpu.update(level, rects) {
             self.upload_rows(shared, ty, 1);
@@ -292,25 +322,13 @@ mod tests {
         Level::from_planes(w, h, heights, metas, MidRule::default()).unwrap()
     }
 
-    /// Brute force: the highest column top over the tile and its margin.
-    fn brute(level: &Level, log2: u32, tx: u32, ty: u32) -> u8 {
-        let side = 1i64 << log2;
-        let (x0, y0) = (i64::from(tx) * side, i64::from(ty) * side);
-        let mut m = 0;
-        for y in y0 - 1..=y0 + side {
-            for x in x0 - 1..=x0 + side {
-                m = m.max(level.column(x, y).top());
-            }
-        }
-        m
-    }
-
     fn check(level: &Level, t: &TileMaxima) {
         for ty in 0..t.height {
             for tx in 0..t.width {
+                // The whole-map rows against the tile alone (the edits' path).
                 assert_eq!(
                     t.data[(ty * t.width + tx) as usize],
-                    brute(level, t.log2, tx, ty),
+                    t.tile_max(level, tx, ty),
                     "tile ({tx}, {ty})"
                 );
             }

@@ -187,15 +187,9 @@ impl Method for Sliced {
         self.empty = f.size[0] == 0 || f.size[1] == 0;
         f.count[1] = self.slices;
         f.count[2] = slice_near(camera.position.z, self.slices);
-        // The bound's extent in x and y (rows run along x when origin.z is 0).
-        let extent = if f.origin[2] == 0 {
-            [f.size[1], f.size[0]]
-        } else {
-            [f.size[0], f.size[1]]
-        };
         self.tiles_per_slice = self
             .tiles
-            .prepare(shared, [f.origin[0], f.origin[1]], extent);
+            .prepare(shared, [f.origin[0], f.origin[1]], f.extent());
         shared
             .queue
             .write_buffer(&self.params, 0, bytemuck::bytes_of(&f));
@@ -221,12 +215,16 @@ impl Method for Sliced {
     }
 
     fn retained_bytes(&self) -> RetainedBytes {
-        // The 48-byte footprint uniform (the quads come from indices), the
+        // The 48-byte footprint uniform, the quad's 12 bytes of indices, the
         // tile maxima (kept on the CPU too, for edits), and the refined
         // slicer's marks image.
         let refine = self.refine.as_ref().map(Refine::retained_bytes);
+        let quad = std::mem::size_of_val(&QUAD_INDICES) as u64;
         RetainedBytes {
-            gpu: forward::PARAMS_BYTES + self.tiles.gpu_bytes() + refine.map_or(0, |r| r.gpu),
+            gpu: forward::PARAMS_BYTES
+                + quad
+                + self.tiles.gpu_bytes()
+                + refine.map_or(0, |r| r.gpu),
             cpu: self.tiles.cpu_bytes(),
         }
     }
