@@ -140,28 +140,15 @@ pub fn file_part(label: &str) -> String {
     s.trim_matches('-').to_string()
 }
 
-/// `$STRATA_SOURCE_REVISION` when set (a binary copied to a machine without
-/// the checkout), else `git describe --always --dirty` of the working
-/// directory, or "unknown".
+/// The revision this binary was built from (`git describe --always --tags`,
+/// `-dirty` when the sources differed from the commit, `unknown` outside
+/// git), baked in at build time by `build.rs`: where the binary runs, and
+/// what that directory holds, change nothing.
+pub const SOURCE_REVISION: &str = env!("STRATA_BUILD_REVISION");
+
+/// [`SOURCE_REVISION`] as a `String`, for results and reports.
 pub fn source_revision() -> String {
-    if let Ok(rev) = std::env::var("STRATA_SOURCE_REVISION")
-        && !rev.trim().is_empty()
-    {
-        return rev.trim().to_string();
-    }
-    let run = |args: &[&str]| {
-        std::process::Command::new("git")
-            .args(args)
-            .output()
-            .ok()
-            .filter(|o| o.status.success())
-            .and_then(|o| String::from_utf8(o.stdout).ok())
-            .map(|s| s.trim().to_string())
-            .filter(|s| !s.is_empty())
-    };
-    run(&["describe", "--always", "--dirty", "--tags"])
-        .or_else(|| run(&["rev-parse", "HEAD"]))
-        .unwrap_or_else(|| "unknown".into())
+    SOURCE_REVISION.to_string()
 }
 
 #[cfg(test)]

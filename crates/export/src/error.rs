@@ -22,7 +22,7 @@ pub enum ExportError {
     #[error("quality {0} is outside [0, 1]")]
     Quality(f64),
     /// An unknown format name.
-    #[error("format {0:?}: expected gltf or obj")]
+    #[error("format {0:?}: expected glb, gltf or obj")]
     Format(String),
     /// The region holds no triangles.
     #[error("the region holds no triangles")]

@@ -1,5 +1,7 @@
-//! glTF 2.0 binary (GLB): one mesh, one primitive with `POSITION` (f32),
-//! `COLOR_0` (normalised RGBA8) and u32 indices, in one buffer.
+//! glTF 2.0: one mesh, one primitive with `POSITION` (f32), `COLOR_0`
+//! (normalised RGBA8) and u32 indices, in one buffer; written as binary GLB
+//! (`.glb`: the JSON and the buffer in one container) or as `.gltf` JSON
+//! with the buffer embedded as a base64 data URI (one self-contained file).
 
 use crate::soup::TerrainSoup;
 use serde_json::json;
@@ -16,7 +18,8 @@ fn pad4(v: &mut Vec<u8>, byte: u8) {
     }
 }
 
-pub fn write(soup: &TerrainSoup, out: &mut impl Write) -> std::io::Result<()> {
+/// The glTF document (its buffer's `uri` left out) and the binary buffer.
+fn document(soup: &TerrainSoup) -> (serde_json::Value, Vec<u8>) {
     let n = soup.positions.len();
     let mut bin: Vec<u8> = Vec::with_capacity(n * 16 + soup.triangles.len() * 12);
     let (mut lo, mut hi) = ([f32::MAX; 3], [f32::MIN; 3]);
@@ -66,6 +69,25 @@ pub fn write(soup: &TerrainSoup, out: &mut impl Write) -> std::io::Result<()> {
         ],
         "extras": { "max_error": soup.max_error, "frame": "x east, y up (altitude), z = -north; 1 unit = 1 texel" }
     });
+    (doc, bin)
+}
+
+/// `.gltf`: the JSON document with the buffer as a base64 data URI.
+pub fn write_json(soup: &TerrainSoup, out: &mut impl Write) -> std::io::Result<()> {
+    use base64::Engine as _;
+    let (mut doc, bin) = document(soup);
+    let uri = format!(
+        "data:application/octet-stream;base64,{}",
+        base64::engine::general_purpose::STANDARD.encode(&bin)
+    );
+    doc["buffers"][0]["uri"] = json!(uri);
+    serde_json::to_writer(&mut *out, &doc).map_err(std::io::Error::other)?;
+    out.flush()
+}
+
+/// `.glb`: the binary container (JSON chunk, BIN chunk).
+pub fn write_binary(soup: &TerrainSoup, out: &mut impl Write) -> std::io::Result<()> {
+    let (doc, bin) = document(soup);
     let mut json_bytes = serde_json::to_vec(&doc).map_err(std::io::Error::other)?;
     pad4(&mut json_bytes, b' ');
     let total = 12 + 8 + json_bytes.len() + 8 + bin.len();

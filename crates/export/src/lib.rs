@@ -1,6 +1,6 @@
 //! Export the fitted terrain mesh (issue 18) for Blender and engines: glTF
-//! 2.0 binary (`.glb`) or Wavefront OBJ, with terrain colours as vertex
-//! colours.
+//! 2.0 as binary `.glb` or as `.gltf` JSON (buffer embedded), or Wavefront
+//! OBJ, with terrain colours as vertex colours.
 //!
 //! ```
 //! use strata_export::{Format, Region, TerrainSoup};
@@ -13,7 +13,7 @@
 //! let region = Region::parse("0,0,128,128", &world.level).unwrap();
 //! let soup = TerrainSoup::build(&world, region, 0.5).unwrap();
 //! let mut bytes = Vec::new();
-//! soup.write(Format::Gltf, &mut bytes).unwrap();
+//! soup.write(Format::Glb, &mut bytes).unwrap();
 //! assert_eq!(&bytes[..4], b"glTF");
 //! ```
 //!
@@ -42,16 +42,37 @@ pub use soup::TerrainSoup;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Format {
     /// glTF 2.0 binary (`.glb`): positions, `COLOR_0` (RGBA8), u32 indices.
+    Glb,
+    /// glTF 2.0 JSON (`.gltf`): the same document, its buffer embedded as a
+    /// base64 data URI, so the one file is complete.
     Gltf,
     /// Wavefront OBJ with `v x y z r g b` vertex colours.
     Obj,
+}
+
+impl Format {
+    /// The name `--format` takes, which is also the file extension.
+    pub fn name(self) -> &'static str {
+        match self {
+            Format::Glb => "glb",
+            Format::Gltf => "gltf",
+            Format::Obj => "obj",
+        }
+    }
+
+    /// The format a file name's extension says (`.glb`, `.gltf`, `.obj`, any case).
+    pub fn from_extension(path: &std::path::Path) -> Option<Format> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        ext.parse().ok()
+    }
 }
 
 impl std::str::FromStr for Format {
     type Err = ExportError;
     fn from_str(s: &str) -> Result<Self, ExportError> {
         match s {
-            "gltf" | "glb" => Ok(Format::Gltf),
+            "glb" => Ok(Format::Glb),
+            "gltf" => Ok(Format::Gltf),
             "obj" => Ok(Format::Obj),
             other => Err(ExportError::Format(other.to_string())),
         }
@@ -62,7 +83,8 @@ impl TerrainSoup {
     /// Write the mesh in `format`.
     pub fn write(&self, format: Format, out: &mut impl std::io::Write) -> std::io::Result<()> {
         match format {
-            Format::Gltf => gltf::write(self, out),
+            Format::Glb => gltf::write_binary(self, out),
+            Format::Gltf => gltf::write_json(self, out),
             Format::Obj => obj::write(self, out),
         }
     }

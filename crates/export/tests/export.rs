@@ -14,13 +14,49 @@ fn world() -> World {
     .expect("a small generated world")
 }
 
+/// `.gltf` is JSON (not GLB bytes), a valid glTF document whose one buffer
+/// is embedded as a base64 data URI holding the same bytes as the GLB's
+/// binary chunk.
+#[test]
+fn gltf_json_embeds_the_glb_buffer() {
+    use base64::Engine as _;
+    let world = world();
+    let region = Region::parse("0,0,96,96", &world.level).unwrap();
+    let soup = TerrainSoup::build(&world, region, 0.5).unwrap();
+    let (mut json, mut glb) = (Vec::new(), Vec::new());
+    soup.write(Format::Gltf, &mut json).unwrap();
+    soup.write(Format::Glb, &mut glb).unwrap();
+    assert_eq!(json[0], b'{', "a .gltf file starts as JSON");
+    let doc = gltf::Gltf::from_slice(&json).expect("a valid glTF JSON document");
+    assert!(doc.blob.is_none());
+    let buffer = doc.buffers().next().unwrap();
+    let gltf::buffer::Source::Uri(uri) = buffer.source() else {
+        panic!("the buffer must be embedded");
+    };
+    let b64 = uri
+        .strip_prefix("data:application/octet-stream;base64,")
+        .expect("a base64 data URI");
+    let bin = base64::engine::general_purpose::STANDARD
+        .decode(b64)
+        .unwrap();
+    assert_eq!(bin.len(), buffer.length());
+    let glb = gltf::Gltf::from_slice(&glb).unwrap();
+    assert_eq!(&glb.blob.as_deref().unwrap()[..bin.len()], &bin[..]);
+    assert_eq!(
+        Format::from_extension("t.GLTF".as_ref()),
+        Some(Format::Gltf)
+    );
+    assert_eq!(Format::from_extension("t.glb".as_ref()), Some(Format::Glb));
+    assert_eq!(Format::from_extension("t.png".as_ref()), None);
+}
+
 #[test]
 fn glb_reads_back_with_counts_bounds_and_colours() {
     let world = world();
     let region = Region::parse("10,20,200,150", &world.level).unwrap();
     let soup = TerrainSoup::build(&world, region, 0.5).unwrap();
     let mut bytes = Vec::new();
-    soup.write(Format::Gltf, &mut bytes).unwrap();
+    soup.write(Format::Glb, &mut bytes).unwrap();
     let glb = gltf::Gltf::from_slice(&bytes).expect("a valid GLB");
     let blob = glb.blob.as_deref().expect("the binary chunk");
     let prim = glb.meshes().next().unwrap().primitives().next().unwrap();

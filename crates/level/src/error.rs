@@ -5,13 +5,15 @@ use std::path::{Path, PathBuf};
 /// Why a world file could not be read or written; [`LevelError::path`] names it.
 #[derive(Debug, thiserror::Error)]
 pub enum LevelError {
-    /// The file could not be opened, read or written.
-    #[error("{path}: {source}")]
+    /// The file could not be opened, read or written. The OS error is part
+    /// of the message and not also a `source()`, so an error chain printed
+    /// whole (`{:#}`) says it once.
+    #[error("{path}: {error}")]
     Io {
         /// The file.
         path: std::path::PathBuf,
         /// The operating system's error.
-        source: std::io::Error,
+        error: std::io::Error,
     },
     /// The file's contents are not a valid file of its format (wrong size,
     /// corrupt Huffman tree, a value out of range, ...).
@@ -38,10 +40,10 @@ pub enum LevelError {
 
 impl LevelError {
     /// An [`Io`](LevelError::Io) error about `path`.
-    pub fn io(path: &Path, source: std::io::Error) -> Self {
+    pub fn io(path: &Path, error: std::io::Error) -> Self {
         LevelError::Io {
             path: path.to_path_buf(),
-            source,
+            error,
         }
     }
 

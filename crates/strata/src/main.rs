@@ -4,12 +4,24 @@ mod adapter_arg;
 mod cmd;
 mod world_arg;
 
+use std::sync::LazyLock;
+
 use clap::{Parser, Subcommand};
+
+/// `--version`: the crate version and the revision baked in at build time
+/// (the one results files carry).
+static VERSION: LazyLock<String> = LazyLock::new(|| {
+    format!(
+        "{} (revision {})",
+        env!("CARGO_PKG_VERSION"),
+        strata_bench::plan::SOURCE_REVISION
+    )
+});
 
 #[derive(Parser)]
 #[command(
     name = "strata",
-    version,
+    version = VERSION.as_str(),
     about = "Render and measure editable multi-layer height fields (Vangers terrain)"
 )]
 struct Cli {
@@ -35,7 +47,7 @@ enum Command {
     Survey(cmd::survey::Args),
     /// Build the terrain collider: build time, memory, crater refit, ray-cast throughput.
     Collide(cmd::collide::Args),
-    /// Export the fitted mesh with terrain colours as glTF (.glb) or OBJ.
+    /// Export the fitted mesh with terrain colours as glTF (.glb binary or .gltf JSON) or OBJ.
     Export(cmd::export::Args),
     /// The one-command comparison of every method over the level's views.
     Compare(cmd::compare::Args),

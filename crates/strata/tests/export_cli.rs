@@ -53,7 +53,7 @@ fn export_writes_files_and_names_bad_input() {
         "--level",
         p(&world),
         "--format",
-        "gltf",
+        "glb",
         "--out",
         p(&glb),
     ]);
@@ -61,6 +61,22 @@ fn export_writes_files_and_names_bad_input() {
     let bytes = std::fs::read(&glb).unwrap();
     assert_eq!(&bytes[..4], b"glTF");
     assert!(bytes.len() > 10_000, "{} bytes", bytes.len());
+
+    // `.gltf` holds JSON by convention: the format follows the extension.
+    let gltf = world.with_file_name("t.gltf");
+    let out = strata(&[
+        "export",
+        "--level",
+        p(&world),
+        "--region",
+        "0,0,64,64",
+        "--out",
+        p(&gltf),
+    ]);
+    assert!(out.status.success(), "{}", text(&out));
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(&gltf).unwrap()).expect("a .gltf file is JSON");
+    assert_eq!(json["asset"]["version"], "2.0");
 
     let obj = world.with_file_name("t.obj");
     let args = [
@@ -95,7 +111,15 @@ fn export_writes_files_and_names_bad_input() {
         ),
         (
             vec!["--format", "fbx", "--out", p(&obj)],
-            "expected gltf or obj",
+            "expected glb, gltf or obj",
+        ),
+        (
+            vec!["--format", "glb", "--out", p(&gltf)],
+            "--format glb but",
+        ),
+        (
+            vec!["--out", "/tmp/terrain.mesh"],
+            "cannot tell the format from /tmp/terrain.mesh",
         ),
         (
             vec!["--quality", "2", "--out", p(&obj)],

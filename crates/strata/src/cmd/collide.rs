@@ -15,10 +15,10 @@ pub struct Args {
     #[command(flatten)]
     world: crate::world_arg::WorldArgs,
     /// Mesh quality q in [0, 1] (max vertical error 2^(4(1-q))).
-    #[arg(long, default_value_t = 0.5)]
+    #[arg(long, value_name = "Q", default_value_t = 0.5)]
     quality: f64,
     /// Rays cast by each tracer for the throughput numbers.
-    #[arg(long, default_value_t = 20_000)]
+    #[arg(long, value_name = "N", default_value_t = 20_000)]
     rays: usize,
     /// Print one JSON object instead of text.
     #[arg(long)]

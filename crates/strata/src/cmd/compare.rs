@@ -38,6 +38,10 @@ pub struct Args {
     /// Views file (`NAME X,Y:YAW:EYE[:under] PITCH` per line). Default: the level's own views.
     #[arg(long, value_name = "FILE")]
     pub views: Option<PathBuf>,
+    /// Keep only these of the views (comma-separated names, e.g. `hangar,stash`): a shorter
+    /// run of the same protocol (CI runs the README's command so).
+    #[arg(long, value_name = "NAMES")]
+    pub view_names: Option<String>,
     /// Turn the shared shadow map off (a method-only diagnostic run).
     #[arg(long)]
     pub no_shadows: bool,
@@ -166,7 +170,10 @@ fn prepare(args: &Args) -> anyhow::Result<Prepared> {
         let _ = std::fs::remove_dir(args.out.join("cells"));
     }
     let world = args.world.load()?;
-    let views = file_views.unwrap_or_else(|| world.views.clone());
+    let mut views = file_views.unwrap_or_else(|| world.views.clone());
+    if let Some(names) = &args.view_names {
+        views = keep_views(views, names)?;
+    }
     let edits = if args.no_edits {
         EditMode::Off
     } else if args.edits {
@@ -181,6 +188,29 @@ fn prepare(args: &Args) -> anyhow::Result<Prepared> {
         world,
         edits,
     })
+}
+
+/// The views named in `names` (comma-separated), in the order given; an
+/// unknown name is an error listing the views there are.
+fn keep_views(views: Vec<ViewSpec>, names: &str) -> anyhow::Result<Vec<ViewSpec>> {
+    names
+        .split(',')
+        .map(str::trim)
+        .filter(|n| !n.is_empty())
+        .map(|name| {
+            views
+                .iter()
+                .find(|v| v.name == name)
+                .cloned()
+                .with_context(|| {
+                    let known: Vec<&str> = views.iter().map(|v| v.name.as_str()).collect();
+                    format!(
+                        "--view-names: no view `{name}` (the views are {})",
+                        known.join(", ")
+                    )
+                })
+        })
+        .collect()
 }
 
 fn announce(report: &AdapterReport) {

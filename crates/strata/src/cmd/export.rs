@@ -8,22 +8,53 @@ use strata_export::{Format, Region, TerrainSoup};
 pub struct Args {
     #[command(flatten)]
     world: crate::world_arg::WorldArgs,
-    /// Output format: gltf (binary .glb) or obj.
-    #[arg(long, default_value = "gltf")]
-    format: String,
+    /// Output format: glb (binary glTF), gltf (glTF JSON, buffer embedded) or obj.
+    /// Default: what --out's extension says.
+    #[arg(long, value_name = "NAME")]
+    format: Option<String>,
     /// Texels X0,Y0,X1,Y1 (half-open); X1/Y1 may pass the map edge (it wraps; the piece stays whole). Default: the whole map.
     #[arg(long, value_name = "X0,Y0,X1,Y1")]
     region: Option<String>,
     /// Mesh quality q in [0, 1] (max vertical error 2^(4(1-q))).
-    #[arg(long, default_value_t = 0.5)]
+    #[arg(long, value_name = "Q", default_value_t = 0.5)]
     quality: f64,
-    /// Output file.
-    #[arg(long)]
+    /// Output file: `.glb`, `.gltf` or `.obj`.
+    #[arg(long, value_name = "FILE")]
     out: PathBuf,
 }
 
+/// The format `--format` names, checked against `--out`'s extension (a file
+/// named `.gltf` holds JSON by convention, so GLB bytes there are refused),
+/// or the one the extension says.
+fn format_for(format: Option<&str>, out: &std::path::Path) -> anyhow::Result<Format> {
+    let by_extension = Format::from_extension(out);
+    match (format, by_extension) {
+        (Some(name), ext) => {
+            let format: Format = name.parse()?;
+            if let Some(ext) = ext
+                && ext != format
+            {
+                anyhow::bail!(
+                    "--format {} but {} is named `.{}`: name the file `.{}` or pass --format {}",
+                    format.name(),
+                    out.display(),
+                    ext.name(),
+                    format.name(),
+                    ext.name()
+                );
+            }
+            Ok(format)
+        }
+        (None, Some(ext)) => Ok(ext),
+        (None, None) => anyhow::bail!(
+            "cannot tell the format from {}: name it `.glb`, `.gltf` or `.obj`, or pass --format",
+            out.display()
+        ),
+    }
+}
+
 pub fn run(args: Args) -> anyhow::Result<()> {
-    let format: Format = args.format.parse()?;
+    let format = format_for(args.format.as_deref(), &args.out)?;
     let world = args.world.load()?;
     let region = match &args.region {
         Some(text) => Region::parse(text, &world.level)?,

@@ -12,7 +12,7 @@ pub struct Args {
     #[command(flatten)]
     world: crate::world_arg::WorldArgs,
     /// Mesh quality q in [0, 1]: max vertical error 2^(4(1-q)) height units.
-    #[arg(long, default_value_t = 0.5)]
+    #[arg(long, value_name = "Q", default_value_t = 0.5)]
     quality: f64,
     /// Print one JSON object instead of text.
     #[arg(long)]
@@ -21,7 +21,7 @@ pub struct Args {
     #[arg(long, value_name = "WxH")]
     synthetic: Option<String>,
     /// Worker threads (default: all cores).
-    #[arg(long)]
+    #[arg(long, value_name = "N")]
     threads: Option<usize>,
     /// Constrain the triangulation to the single/double region outline (issue 17).
     #[arg(long)]

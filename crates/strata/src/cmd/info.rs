@@ -24,7 +24,7 @@ pub struct Args {
     reencode: bool,
     /// Decode the map file this many more times and report the fastest and
     /// the median (a small benchmark; the first decode may pay for page faults).
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=100))]
+    #[arg(long, value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=100))]
     repeat: u32,
 }
 

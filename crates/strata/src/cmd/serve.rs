@@ -13,8 +13,9 @@ pub struct Args {
     /// Port on 127.0.0.1 (0: any free one; the URL printed says which).
     #[arg(long, default_value_t = 8080)]
     pub port: u16,
-    /// The bundle directory (`index.html` + `pkg/`).
-    #[arg(long, value_name = "DIR", default_value = default_bundle())]
+    /// The bundle directory (`index.html` + `pkg/`). Default: `target/web` of the checkout
+    /// this binary was built from, where `crates/web/build.sh` writes.
+    #[arg(long, value_name = "DIR", default_value = default_bundle(), hide_default_value = true)]
     pub bundle: PathBuf,
 }
 

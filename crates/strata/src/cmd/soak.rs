@@ -15,29 +15,29 @@ use strata_level::generate::{GenerateParams, generate, parse_size};
 #[derive(clap::Args)]
 pub struct Args {
     /// Actions in the script.
-    #[arg(long, default_value_t = 10_000)]
+    #[arg(long, value_name = "N", default_value_t = 10_000)]
     pub actions: u32,
     /// Sample memory every N actions.
-    #[arg(long, default_value_t = 100)]
+    #[arg(long, value_name = "N", default_value_t = 100)]
     pub sample_every: u32,
     /// The generated world's size.
-    #[arg(long, default_value = "256x512")]
+    #[arg(long, value_name = "WxH", default_value = "256x512")]
     pub world: String,
     /// Seed of the world and of the action sequence.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Window size (the picture is the window's, render scale 1).
-    #[arg(long, default_value = "160x100", value_parser = crate::cmd::render::parse_size)]
+    #[arg(long, value_name = "WxH", default_value = "160x100", value_parser = crate::cmd::render::parse_size)]
     pub size: (u32, u32),
     /// Methods switched between (default: every method).
-    #[arg(long, value_delimiter = ',')]
+    #[arg(long, value_name = "LIST", value_delimiter = ',')]
     pub methods: Vec<String>,
     /// Draw the 1024² shadow map every frame (off by default: on a CPU
     /// rasteriser it is most of a frame, 0.4 s an action instead of 0.09).
     #[arg(long)]
     pub shadows: bool,
     /// Where the world, the script, the viewer's log and soak.json go.
-    #[arg(long, default_value = "out/soak")]
+    #[arg(long, value_name = "DIR", default_value = "out/soak")]
     pub out: PathBuf,
 }
 

@@ -20,13 +20,13 @@ pub struct Args {
     #[arg(long, conflicts_with = "size")]
     quick: bool,
     /// Size of each generated world, WIDTHxHEIGHT.
-    #[arg(long, default_value = "2048x4096")]
+    #[arg(long, value_name = "WxH", default_value = "2048x4096")]
     size: String,
     /// Seed of the generated worlds.
     #[arg(long, default_value_t = GenerateParams::default().seed)]
     seed: u64,
     /// Fit worker threads (default: all cores).
-    #[arg(long)]
+    #[arg(long, value_name = "N")]
     threads: Option<usize>,
     /// Use the outline-constrained fit.
     #[arg(long)]
