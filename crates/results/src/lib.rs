@@ -268,6 +268,18 @@ pub struct EditRow {
     pub checks: Vec<EditCheck>,
 }
 
+/// One accuracy field of one cell on which an adapter differs from the baseline.
+/// Found by [`merge::disagreements`], listed in `report.md`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Disagreement {
+    pub adapter: String,
+    pub view: String,
+    pub method: String,
+    pub field: &'static str,
+    pub baseline: Option<f64>,
+    pub other: Option<f64>,
+}
+
 /// The frame counts at which consistency is checked.
 pub const EDIT_CHECK_FRAMES: [u32; 5] = [1, 2, 4, 8, 16];
 /// Consistency thresholds (paper §Dynamic-edit protocol).

@@ -4,6 +4,7 @@
 //! methods, frames, shadows); accuracy is expected to be device-independent,
 //! so every accuracy field that differs from the baseline is flagged.
 
+pub use crate::Disagreement;
 use crate::{Row, RunResults};
 use anyhow::{Context, bail};
 use std::path::Path;
@@ -12,17 +13,6 @@ use std::path::Path;
 pub const PERCENT_TOLERANCE: f64 = 0.5;
 /// Depth fields (world units) disagree beyond this.
 pub const DEPTH_TOLERANCE: f64 = 0.5;
-
-/// One accuracy field of one cell on which an adapter differs from the baseline.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Disagreement {
-    pub adapter: String,
-    pub view: String,
-    pub method: String,
-    pub field: &'static str,
-    pub baseline: Option<f64>,
-    pub other: Option<f64>,
-}
 
 /// Refuse runs that were not measured under the same protocol. The error
 /// names the first differing field.

@@ -2,9 +2,8 @@
 //! different adapters (`strata merge`). Accuracy comes from the first run
 //! (the baseline); the other runs are cross-checked in `merge`.
 
-use crate::merge::Disagreement;
 use crate::stats;
-use crate::{EditRow, FlipScore, Row, RunResults, TimingSource};
+use crate::{Disagreement, EditRow, FlipScore, Row, RunResults, TimingSource};
 use std::fmt::Write as _;
 use strata_markdown::{Align, Table, cell_text};
 
