@@ -6,8 +6,8 @@
 use crate::results::{
     EDIT_CHECK_FRAMES, EDIT_MAX_CLASS_MISMATCH, EDIT_MAX_DEPTH_P95, EditCheck, EditRow,
 };
-use crate::run::ms;
 use crate::stats::{median, percentile};
+use crate::warm::{ms, warm_up};
 use std::time::Instant;
 use strata_camera::Camera;
 use strata_level::{DirtyRect, Level};
@@ -74,7 +74,7 @@ fn build(
         input.camera.width,
         input.camera.height,
     )?;
-    crate::run::warm_up(&mut r, input.camera, 1, input.warmup_cap, input.timestamps)?;
+    warm_up(&mut r, input.camera, 1, input.warmup_cap, input.timestamps)?;
     if input.hold_busy_ms > 0 {
         r.hold_busy(
             input.camera,

@@ -8,24 +8,35 @@
 //! bitmap font: plotters' own PNG text needs a system font (fontconfig and
 //! FreeType), which a fresh CI machine does not have.
 
+use crate::report::{self, Pictures};
 use crate::results::{Row, RunResults};
-use crate::{font, grid, report, stats};
+use crate::{font, grid, stats};
 use anyhow::Context;
 use image::{Rgba, RgbaImage};
 use plotters::coord::Shift;
 use plotters::prelude::*;
-use plotters_backend::text_anchor::{HPos, VPos};
+use plotters_backend::text_anchor::{HPos, Pos, VPos};
 use plotters_backend::{BackendColor, BackendCoord, BackendTextStyle, DrawingErrorKind};
 use std::path::{Path, PathBuf};
 
 const SIZE: (u32, u32) = (720, 420);
 
-/// A figure written as `<name>.png` and `<name>.svg`: relative paths.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct Figure {
-    pub title: String,
-    pub png: String,
-    pub svg: String,
+pub use crate::report::Figure;
+
+/// `pictures` with the figures of `runs` drawn into `dir` (a failure costs
+/// the figures, with a warning, never the report).
+pub fn with_figures(mut pictures: Pictures, runs: &[RunResults], dir: &Path) -> Pictures {
+    match write_all(runs, dir) {
+        Ok(f) => pictures.figures = f,
+        Err(e) => eprintln!("warning: figures not drawn: {e:#}"),
+    }
+    if let Some(base) = runs.first() {
+        match edit_figure(base, dir) {
+            Ok(f) => pictures.edit_figure = f,
+            Err(e) => eprintln!("warning: edit figure not drawn: {e:#}"),
+        }
+    }
+    pictures
 }
 
 /// Draw every figure the runs support into `dir/figures/`.
@@ -133,18 +144,23 @@ fn frame_time_by_pitch<DB: DrawingBackend>(
             series.push((label, pitch_series(run, m)));
         }
     }
+    let labels: Vec<String> = series.iter().map(|(l, _)| l.clone()).collect();
+    let area = with_legend(area, &labels, Swatch::Line)?;
     let ys = series.iter().flat_map(|(_, s)| s.iter().map(|p| p.1));
     let (lo, hi) = ys.fold((f64::MAX, f64::MIN), |(a, b), y| (a.min(y), b.max(y)));
-    // Headroom above the lines for the legend (a log axis: a factor).
+    // Out to the powers of ten around the lines, so both ends are labelled.
     let (lo, hi) = if lo <= hi {
-        (lo / 1.5, hi * 8.0)
+        (
+            10f64.powf((lo / 1.2).log10().floor()),
+            10f64.powf((hi * 1.2).log10().ceil()),
+        )
     } else {
         (0.1, 10.0)
     };
-    let mut chart = ChartBuilder::on(area)
+    let mut chart = ChartBuilder::on(&area)
         .caption("frame time by pitch (ms)", ("sans-serif", 18))
         .margin(10)
-        .x_label_area_size(30)
+        .x_label_area_size(X_LABEL_AREA)
         .y_label_area_size(50)
         .build_cartesian_2d(-95.0f64..5.0f64, (lo..hi).log_scale())
         .map_err(plot_error)?;
@@ -152,30 +168,107 @@ fn frame_time_by_pitch<DB: DrawingBackend>(
         .configure_mesh()
         .x_desc("pitch (degrees)")
         .x_labels(5)
+        .x_label_formatter(&|x| format!("{x:.0}"))
+        .y_label_formatter(&|y| tick(*y))
         .draw()
         .map_err(plot_error)?;
-    for (i, (label, points)) in series.into_iter().enumerate() {
+    for (i, (_, points)) in series.into_iter().enumerate() {
         let c = colour(i);
         chart
             .draw_series(LineSeries::new(points.clone(), c.stroke_width(2)))
-            .map_err(plot_error)?
-            .label(label)
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], c.stroke_width(2)));
+            .map_err(plot_error)?;
         chart
             .draw_series(points.into_iter().map(|p| Circle::new(p, 3, c.filled())))
             .map_err(plot_error)?;
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .position(SeriesLabelPosition::UpperRight)
-        .draw()
-        .map_err(plot_error)?;
     Ok(())
 }
 
-/// Grouped bars: one group per method, one bar per value.
+/// Width of the area left of a bar chart for the axis's labels.
+const Y_LABEL_AREA: u32 = 60;
+
+/// Height of the area under a chart for the axis's labels and title (two
+/// lines of the bitmap font and their gaps).
+const X_LABEL_AREA: u32 = 44;
+
+/// An axis value without a needless `.0`: `100`, `2.5`, `0.25`.
+fn tick(v: f64) -> String {
+    if v >= 10.0 || v == v.round() {
+        format!("{v:.0}")
+    } else if v >= 1.0 {
+        format!("{v:.1}")
+    } else {
+        format!("{v:.2}")
+    }
+}
+
+/// What a legend entry shows beside its label.
+#[derive(Clone, Copy)]
+enum Swatch {
+    Line,
+    Block,
+}
+
+/// Legend text, in the SVG; the PNG writes the bitmap font whatever the size.
+const LEGEND_FONT: f64 = 15.0;
+/// Legend rows start below the caption.
+const LEGEND_TOP: i32 = 44;
+/// Room left of a legend label for its swatch.
+const SWATCH_WIDTH: u32 = 26;
+
+/// Draw a legend (colour `i` for label `i`) in a panel at the right of
+/// `area`, as wide as its longest label (at most 45 % of the figure), and
+/// return the rest of the area for the chart: the legend never covers it.
+fn with_legend<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    labels: &[String],
+    swatch: Swatch,
+) -> anyhow::Result<DrawingArea<DB, Shift>> {
+    let (w, h) = area.dim_in_pixel();
+    let longest = labels
+        .iter()
+        .map(|l| font::text_width(l))
+        .max()
+        .unwrap_or(0);
+    let panel = (longest + SWATCH_WIDTH + 12).min(w * 45 / 100);
+    let (chart, side) = area.split_horizontally(w - panel);
+    let n = labels.len().max(1) as i32;
+    let step = ((h as i32 - LEGEND_TOP - 10) / n).clamp(font::LINE as i32, 20);
+    let style = ("sans-serif", LEGEND_FONT)
+        .into_font()
+        .color(&BLACK)
+        .pos(Pos::new(HPos::Left, VPos::Center));
+    let room = panel.saturating_sub(SWATCH_WIDTH + 4);
+    for (i, label) in labels.iter().enumerate() {
+        let c = colour(i);
+        let y = LEGEND_TOP + step * i as i32;
+        match swatch {
+            Swatch::Line => side.draw(&PathElement::new(vec![(2, y), (20, y)], c.stroke_width(2))),
+            Swatch::Block => side.draw(&Rectangle::new([(6, y - 5), (16, y + 5)], c.filled())),
+        }
+        .map_err(plot_error)?;
+        side.draw(&Text::new(
+            shortened(label, room),
+            (SWATCH_WIDTH as i32, y),
+            style.clone(),
+        ))
+        .map_err(plot_error)?;
+    }
+    Ok(chart)
+}
+
+/// `text` cut to `width` pixels of the bitmap font, `..` marking a cut.
+fn shortened(text: &str, width: u32) -> String {
+    if font::text_width(text) <= width {
+        return text.to_string();
+    }
+    let keep = (width / font::ADVANCE).saturating_sub(2) as usize;
+    format!("{}..", text.chars().take(keep).collect::<String>())
+}
+
+/// Grouped bars: one group per method, one bar per value; the methods
+/// are named under their groups (on staggered lines where one line would
+/// run them together).
 fn bars<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     caption: &str,
@@ -184,15 +277,27 @@ fn bars<DB: DrawingBackend>(
     names: &[&str],
     log: bool,
 ) -> anyhow::Result<()> {
+    let labels: Vec<String> = names.iter().map(|n| n.to_string()).collect();
+    let area = with_legend(area, &labels, Swatch::Block)?;
+    // Lines the group names need: one, unless the widest name is wider
+    // than the groups are apart (the chart's width less the y labels and
+    // margins, over the groups).
+    let pitch =
+        area.dim_in_pixel().0.saturating_sub(Y_LABEL_AREA + 20) / methods.len().max(1) as u32;
+    let widest = methods
+        .iter()
+        .map(|m| font::text_width(m))
+        .max()
+        .unwrap_or(0);
+    let lines = (widest + font::ADVANCE).div_ceil(pitch.max(1)).clamp(1, 4);
     let k = names.len().max(1) as f64;
-    // Headroom above the bars for the legend.
     let top = values
         .iter()
         .flatten()
         .copied()
         .fold(0.0f64, f64::max)
         .max(1e-3);
-    let hi = if log { top * 20.0 } else { top * 1.5 };
+    let hi = if log { top * 2.0 } else { top * 1.1 };
     let lo = values
         .iter()
         .flatten()
@@ -201,68 +306,72 @@ fn bars<DB: DrawingBackend>(
         .fold(f64::MAX, f64::min)
         .min(hi)
         / 2.0;
-    // Group i is centred on x = i, so the axis's whole-number ticks name them.
+    // Group i is centred on x = i.
     let n = methods.len() as f64 - 0.5;
-    let label = |x: &f64| {
-        if (x - x.round()).abs() < 1e-6 && *x >= 0.0 {
-            methods.get(x.round() as usize).cloned().unwrap_or_default()
-        } else {
-            String::new()
-        }
-    };
-    let x_labels = methods.len().max(1);
     macro_rules! draw_bars {
         ($chart:expr, $floor:expr) => {{
             let mut chart = $chart;
             chart
                 .configure_mesh()
                 .disable_x_mesh()
-                .x_labels(x_labels)
-                .x_label_formatter(&label)
+                .x_labels(0)
+                .y_label_formatter(&|y| tick(*y))
                 .draw()
                 .map_err(plot_error)?;
-            for (j, name) in names.iter().enumerate() {
+            for (j, _) in names.iter().enumerate() {
                 let c = colour(j);
                 let rects = values.iter().enumerate().map(|(i, v)| {
                     let x0 = i as f64 - 0.4 + 0.8 * j as f64 / k;
                     let y = v.get(j).copied().unwrap_or(0.0).max($floor);
                     Rectangle::new([(x0, $floor), (x0 + 0.8 / k, y)], c.filled())
                 });
-                chart
-                    .draw_series(rects)
-                    .map_err(plot_error)?
-                    .label(*name)
-                    .legend(move |(x, y)| {
-                        Rectangle::new([(x, y - 4), (x + 10, y + 4)], c.filled())
-                    });
+                chart.draw_series(rects).map_err(plot_error)?;
             }
-            chart
-                .configure_series_labels()
-                .background_style(WHITE.mix(0.8))
-                .border_style(BLACK)
-                .position(SeriesLabelPosition::UpperRight)
-                .draw()
-                .map_err(plot_error)?;
+            let at: Vec<BackendCoord> = (0..methods.len())
+                .map(|i| chart.backend_coord(&(i as f64, $floor)))
+                .collect();
+            group_labels(&area, methods, &at, lines)?;
         }};
     }
     let builder = |area| {
         let mut b = ChartBuilder::on(area);
         b.caption(caption, ("sans-serif", 18))
             .margin(10)
-            .x_label_area_size(30)
-            .y_label_area_size(60);
+            .x_label_area_size(8 + lines * (font::LINE + 4))
+            .y_label_area_size(Y_LABEL_AREA);
         b
     };
     if log {
-        let chart = builder(area)
+        let chart = builder(&area)
             .build_cartesian_2d(-0.5..n, (lo.max(1e-3)..hi).log_scale())
             .map_err(plot_error)?;
         draw_bars!(chart, lo.max(1e-3));
     } else {
-        let chart = builder(area)
+        let chart = builder(&area)
             .build_cartesian_2d(-0.5..n, 0.0..hi)
             .map_err(plot_error)?;
         draw_bars!(chart, 0.0);
+    }
+    Ok(())
+}
+
+/// Name each group under the axis at `at` (the groups' centres on the
+/// axis, backend pixels), group `i` on line `i % lines`.
+fn group_labels<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    methods: &[String],
+    at: &[BackendCoord],
+    lines: u32,
+) -> anyhow::Result<()> {
+    let style = ("sans-serif", 12.0)
+        .into_font()
+        .color(&BLACK)
+        .pos(Pos::new(HPos::Center, VPos::Top));
+    for (i, (m, &(x, y))) in methods.iter().zip(at).enumerate() {
+        let line = (i as u32 % lines) as i32;
+        let y = y + 6 + line * (font::LINE as i32 + 4);
+        area.draw(&Text::new(m.clone(), (x, y), style.clone()))
+            .map_err(plot_error)?;
     }
     Ok(())
 }
@@ -342,7 +451,8 @@ pub const UPDATE_CLASSES: [(&str, &[&str]); 3] = [
 
 /// The edit figure: rows = one method per update class (the first the run
 /// has pictures of), columns = before the crater, first post-edit frame.
-/// Written as `figures/edit.png`; `None` without edit pictures.
+/// Written as `figures/edit.png`; `None` without edit pictures (or when
+/// none of them is found).
 pub fn edit_figure(run: &RunResults, dir: &Path) -> anyhow::Result<Option<(String, Vec<String>)>> {
     let mut rows = Vec::new();
     let mut cells = Vec::new();
@@ -359,8 +469,13 @@ pub fn edit_figure(run: &RunResults, dir: &Path) -> anyhow::Result<Option<(Strin
                 .ok()
                 .map(|i| grid::thumbnail(&i.to_rgba8()))
         };
+        // Pictures not beside the results file (a copied results file):
+        // no row, rather than a row of empty cells.
+        let (Some(before), Some(after)) = (load(&pics.before), load(&pics.after)) else {
+            continue;
+        };
         rows.push(format!("{} ({class})", pics.method));
-        cells.push(vec![load(&pics.before), load(&pics.after)]);
+        cells.push(vec![Some(before), Some(after)]);
     }
     if rows.is_empty() {
         return Ok(None);
@@ -491,5 +606,63 @@ mod tests {
         let svg = std::fs::read_to_string(dir.join("figures/frame-time-by-pitch.svg")).unwrap();
         assert!(svg.contains("ray (GPU B)"), "legend per adapter");
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// The panel width `with_legend` gives these labels in a figure of
+    /// [`SIZE`].
+    fn panel_width(labels: &[String]) -> u32 {
+        let longest = labels.iter().map(|l| font::text_width(l)).max().unwrap();
+        (longest + SWATCH_WIDTH + 12).min(SIZE.0 * 45 / 100)
+    }
+
+    #[test]
+    fn the_legend_stands_beside_the_committed_runs_lines() {
+        let results = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../bench/results-nvidia-h100-80gb-hbm3.json"
+        );
+        let run = crate::merge::read_run(std::path::Path::new(results)).unwrap();
+        let dir = std::env::temp_dir().join(format!("strata-legend-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        write_all(std::slice::from_ref(&run), &dir).unwrap();
+        let png = image::open(dir.join("figures/frame-time-by-pitch.png"))
+            .unwrap()
+            .to_rgba8();
+        let methods = &run.settings.methods;
+        let panel = panel_width(methods);
+        // Under the legend's rows the panel is empty: no line, grid or
+        // label of the chart reaches into it.
+        let below = LEGEND_TOP as u32 + 20 * methods.len() as u32;
+        for y in below..SIZE.1 {
+            for x in SIZE.0 - panel..SIZE.0 {
+                assert_eq!(png.get_pixel(x, y).0, [255; 4], "chart pixel at ({x}, {y})");
+            }
+        }
+        // Every method's name is whole in the legend.
+        let svg = std::fs::read_to_string(dir.join("figures/frame-time-by-pitch.svg")).unwrap();
+        for m in methods {
+            assert!(svg.contains(&format!(">\n{m}\n</text>")), "{m}");
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn long_labels_are_cut_to_the_panel() {
+        assert_eq!(shortened("ray", 100), "ray");
+        let cut = shortened("ray-exact-fragment (NVIDIA H100 80GB HBM3)", 80);
+        assert!(font::text_width(&cut) <= 80 && cut.ends_with(".."), "{cut}");
+    }
+
+    #[test]
+    fn an_edit_figure_without_its_pictures_is_not_drawn() {
+        let mut run = fixtures::run("GPU A");
+        run.edit_images.push(crate::results::EditImages {
+            method: "ray".into(),
+            before: "cells/missing-before.png".into(),
+            after: "cells/missing-after.png".into(),
+        });
+        let dir = std::env::temp_dir().join(format!("strata-edit-fig-{}", std::process::id()));
+        assert_eq!(edit_figure(&run, &dir).unwrap(), None);
+        assert!(!dir.join("figures/edit.png").exists());
     }
 }

@@ -18,14 +18,18 @@ pub mod merge;
 pub mod methods;
 pub mod plan;
 pub mod portability;
-pub mod report;
-pub mod results;
 pub mod resume;
 pub mod run;
 pub mod session;
-pub mod stats;
 pub mod tune;
 pub mod video;
+pub mod warm;
+
+// The results file, merge's checks, the statistics and `report.md` need no
+// GPU: their home is `strata-results` (which `strata-fuzz` fuzzes without
+// building wgpu); these keep the `strata_bench::…` paths.
+pub use strata_results as results;
+pub use strata_results::{report, stats};
 
 #[cfg(test)]
-mod fixtures;
+use strata_results::fixtures;

@@ -10,6 +10,7 @@ use crate::results::*;
 use crate::session::{GridMode, Session, color_image, reference_image};
 use crate::stats::summarize;
 use crate::video;
+pub use crate::warm::{INCREMENTAL_BUDGET_TEXELS, WarmUp, build_frames, ms, warm_up};
 use anyhow::Context;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
@@ -18,11 +19,6 @@ use strata_camera::Camera;
 use strata_level::{EditSite, ViewSpec, World};
 use strata_reference::{ColorImage, Reference, ReferenceCache, Tracer};
 use strata_render::{Gpu, MethodSettings, Renderer, TerrainColors};
-
-/// Texels the incremental voxel build processes per frame
-/// (`voxel_build::DEFAULT_BUDGET_TEXELS`): the first view's warm-up covers a
-/// whole-level build at this budget, so no method is timed mid-build.
-pub const INCREMENTAL_BUDGET_TEXELS: u64 = 1 << 20;
 
 /// `--temporal`: the default path played in this many seconds ...
 pub const TEMPORAL_SECONDS: f32 = 2.0;
@@ -124,10 +120,7 @@ impl Plan {
                 (Some((site.clone(), cam)), None)
             }
         };
-        let texels = u64::from(world.level.width()) * u64::from(world.level.height());
-        let build_frames =
-            u32::try_from(texels.div_ceil(INCREMENTAL_BUDGET_TEXELS)).unwrap_or(u32::MAX);
-        let warmup_first = opts.min_warmup.saturating_add(build_frames);
+        let warmup_first = opts.min_warmup.saturating_add(build_frames(&world.level));
         let colors = TerrainColors::from_world(&world);
         Ok(Plan {
             world,
@@ -467,8 +460,8 @@ impl Plan {
                 }
             };
             let image = session.save_picture(
-                v,
-                0,
+                GridMode::Pictures,
+                (v, 0),
                 &format!("{}-reference", view.name),
                 reference_image(&r, camera.far),
             )?;
@@ -514,9 +507,9 @@ impl Plan {
                             .0
                     }
                 };
-                session.save_flip_picture(
-                    v,
-                    0,
+                session.save_picture(
+                    GridMode::Flip,
+                    (v, 0),
                     &format!("{}-color-reference", view.name),
                     crate::flip::reference_picture(&c),
                 )?;
@@ -653,8 +646,9 @@ impl Plan {
         let flip = match color_reference {
             Some(c) => {
                 let map = crate::flip::FlipMap::compare(c, &color)?;
+                let flip_file = format!("{file}-flip");
                 let image =
-                    session.save_flip_picture(v, m + 1, &format!("{file}-flip"), map.picture())?;
+                    session.save_picture(GridMode::Flip, (v, m + 1), &flip_file, map.picture())?;
                 Some(FlipScore {
                     mean: map.mean(),
                     over_half: map.percent_over_half(),
@@ -665,7 +659,7 @@ impl Plan {
         };
         #[cfg(target_arch = "wasm32")]
         let flip = color_reference.and(None);
-        let image = session.save_picture(v, m + 1, &file, color)?;
+        let image = session.save_picture(GridMode::Pictures, (v, m + 1), &file, color)?;
         let measured = Measured {
             metrics,
             frames,
@@ -729,11 +723,7 @@ impl Plan {
             coherence: metrics.coherence,
             gpu_ms_mean: gpu_t.as_ref().map(|t| t.mean),
             cpu_ms_mean: cpu_t.mean,
-            timing_source: if gpu_t.is_some() {
-                TimingSource::GpuTimestamps
-            } else {
-                TimingSource::CpuSubmitWait
-            },
+            timing_source: TimingSource::of(gpu_t.as_ref()),
             gpu_ms: gpu_t,
             cpu_ms: cpu_t,
             prep_setup_ms: setup_ms,
@@ -777,52 +767,6 @@ pub struct Measured {
     pub retained: strata_render::RetainedBytes,
 }
 
-/// What warming a renderer up at one view cost.
-pub struct WarmUp {
-    /// The first frame (lazy builds land here).
-    pub first_ms: f64,
-    /// Every pre-timing frame, the first included.
-    pub total_ms: f64,
-    pub frames: u32,
-}
-
-/// Does a frame carry derived-data work (an incremental build or update)?
-/// Methods label such passes `… update` / `… build` / `… bake`.
-fn building(t: &strata_render::FrameTimings) -> bool {
-    t.passes.iter().any(|(label, _)| {
-        ["update", "build", "bake"]
-            .iter()
-            .any(|w| label.contains(w))
-    })
-}
-
-/// Render `min` frames (at least one), then go on while the last frame still
-/// did incremental build work, up to `cap`. Without timestamps the passes are
-/// not reported, so the cap (enough for a whole-level build) is always used.
-pub fn warm_up(
-    renderer: &mut Renderer,
-    camera: &Camera,
-    min: u32,
-    cap: u32,
-    timestamps: bool,
-) -> anyhow::Result<WarmUp> {
-    let start = Instant::now();
-    let mut last = renderer.render_frame(camera)?;
-    let first_ms = ms(start);
-    let mut frames = 1;
-    let min = min.max(1);
-    let cap = cap.max(min);
-    while frames < cap && (frames < min || !timestamps || building(&last)) {
-        last = renderer.render_frame(camera)?;
-        frames += 1;
-    }
-    Ok(WarmUp {
-        first_ms,
-        total_ms: ms(start),
-        frames,
-    })
-}
-
 /// Save the edit camera's before and first-post-edit pictures and record them.
 fn save_edit_pictures(
     session: &mut Session,
@@ -846,8 +790,4 @@ fn save_edit_pictures(
         after,
     });
     Ok(())
-}
-
-pub fn ms(since: Instant) -> f64 {
-    since.elapsed().as_secs_f64() * 1e3
 }

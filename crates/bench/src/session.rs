@@ -77,46 +77,25 @@ impl Session {
         self.results.write(&self.out)
     }
 
-    /// Write a full-size cell picture under `cells/` and keep its thumbnail
-    /// for the grid (in [`GridMode::Pictures`]). Returns the path relative
-    /// to the output directory.
+    /// Write a full-size cell picture under `cells/`, and keep its
+    /// thumbnail for the grid when the grid shows pictures of this `kind`
+    /// ([`GridMode::Pictures`]: a method's or the reference's picture;
+    /// [`GridMode::Flip`]: a ꟻLIP error map or the colour reference).
+    /// Returns the path relative to the output directory.
     pub fn save_picture(
         &mut self,
-        view: usize,
-        column: usize,
+        kind: GridMode,
+        (view, column): (usize, usize),
         file: &str,
         img: RgbaImage,
-    ) -> anyhow::Result<String> {
-        let shown = self.grid == GridMode::Pictures;
-        self.save_cell_file(view, column, file, img, shown)
-    }
-
-    /// [`Session::save_picture`] for what `--grid flip` shows: a ꟻLIP error
-    /// map, or the colour reference in the reference column.
-    pub fn save_flip_picture(
-        &mut self,
-        view: usize,
-        column: usize,
-        file: &str,
-        img: RgbaImage,
-    ) -> anyhow::Result<String> {
-        let shown = self.grid == GridMode::Flip;
-        self.save_cell_file(view, column, file, img, shown)
-    }
-
-    fn save_cell_file(
-        &mut self,
-        view: usize,
-        column: usize,
-        file: &str,
-        img: RgbaImage,
-        thumbnail: bool,
     ) -> anyhow::Result<String> {
         let rel = format!("cells/{file}.png");
         let path = self.out.join(&rel);
         img.save(&path)
             .with_context(|| format!("writing {}", path.display()))?;
-        if thumbnail && let Some(slot) = self.thumbs.get_mut(view).and_then(|r| r.get_mut(column)) {
+        if kind == self.grid
+            && let Some(slot) = self.thumbs.get_mut(view).and_then(|r| r.get_mut(column))
+        {
             *slot = Some(grid::thumbnail(&img));
         }
         Ok(rel)
@@ -140,9 +119,10 @@ impl Session {
             grid: Some("grid.png".into()),
             grid_columns: self.columns.clone(),
             ..Pictures::default()
-        }
-        .with_figures(std::slice::from_ref(&self.results), &self.out);
-        let md = report::render(std::slice::from_ref(&self.results), &pictures, &[]);
+        };
+        let runs = std::slice::from_ref(&self.results);
+        let pictures = crate::figures::with_figures(pictures, runs, &self.out);
+        let md = report::render(runs, &pictures, &[]);
         let path = self.out.join("report.md");
         std::fs::write(&path, md).with_context(|| format!("writing {}", path.display()))?;
         Ok(path)

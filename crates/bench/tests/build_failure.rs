@@ -4,20 +4,14 @@
 //! JSON and the report, and the run goes on with the next method, whose
 //! cells and edit row are all there. Runs on any adapter.
 
-use strata_bench::plan::MethodChoice;
-use strata_bench::run::{EditMode, Options, Plan};
+mod common;
+
+use common::skip_loudly;
+use strata_bench::run::Plan;
 use strata_level::ViewSpec;
 use strata_level::generate::{GenerateParams, generate};
 use strata_render::Gpu;
 use strata_render::build_guard::FORCE_OVERSIZE_ENV;
-
-fn skip_loudly(why: &str) {
-    use std::io::Write;
-    if std::env::var_os("STRATA_REQUIRE_GPU").is_some_and(|v| v == "1") {
-        panic!("STRATA_REQUIRE_GPU=1 but {why}");
-    }
-    let _ = writeln!(std::io::stderr(), "\n*** SKIPPED GPU test: {why} ***\n");
-}
 
 #[test]
 fn a_build_the_gpu_refuses_is_recorded_and_the_next_method_runs() {
@@ -36,32 +30,11 @@ fn a_build_the_gpu_refuses_is_recorded_and_the_next_method_runs() {
     .unwrap();
     let out = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("build_failure");
     let _ = std::fs::remove_dir_all(&out);
-    let methods = ["ray", "painted"]
-        .iter()
-        .map(|n| MethodChoice {
-            name: (*n).into(),
-            setting: None,
-        })
-        .collect();
-    let opts = Options {
-        out: out.clone(),
-        methods,
-        views: vec![
-            ViewSpec::parse("low", "100,100:0:30", 0.0).unwrap(),
-            ViewSpec::parse("down", "120,300:90:80", -60.0).unwrap(),
-        ],
-        width: 32,
-        height: 20,
-        frames: 1,
-        min_warmup: 1,
-        hold_busy_ms: 0,
-        shadows: true,
-        edits: EditMode::Required,
-        temporal: false,
-        cache_dir: out.join("cache"),
-        resume: false,
-        grid: Default::default(),
-    };
+    let views = vec![
+        ViewSpec::parse("low", "100,100:0:30", 0.0).unwrap(),
+        ViewSpec::parse("down", "120,300:90:80", -60.0).unwrap(),
+    ];
+    let opts = common::options(out.clone(), &["ray", "painted"], views);
     let (json, report) = Plan::new(world, opts).unwrap().run(&gpu).unwrap();
     let run = strata_bench::merge::read_run(&json).unwrap();
     // The other method: every view and its edit row.

@@ -2,21 +2,13 @@
 //! a tiny run (2 views x 1 method, plus the edit protocol) writes results
 //! with sane metrics. The GPU part skips loudly without an adapter.
 
+mod common;
+
+use common::{gpu_or_skip, world};
 use std::path::PathBuf;
-use strata_bench::plan::MethodChoice;
 use strata_bench::results::RunResults;
 use strata_bench::run::{EditMode, Options, Plan};
 use strata_level::World;
-use strata_level::generate::{GenerateParams, generate};
-
-fn world() -> World {
-    generate(&GenerateParams {
-        seed: 7,
-        width: 256,
-        height: 1024,
-    })
-    .expect("generate a small world")
-}
 
 fn temp(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("strata-bench-{name}-{}", std::process::id()));
@@ -25,24 +17,13 @@ fn temp(name: &str) -> PathBuf {
 }
 
 fn options(world: &World, out: PathBuf) -> Options {
+    let views = world.views.iter().take(2).cloned().collect();
     Options {
-        out: out.clone(),
-        methods: vec![MethodChoice {
-            name: "ray".into(),
-            setting: None,
-        }],
-        views: world.views.iter().take(2).cloned().collect(),
         width: 64,
         height: 40,
         frames: 2,
-        min_warmup: 1,
-        hold_busy_ms: 0,
-        shadows: true,
         edits: EditMode::Auto,
-        temporal: false,
-        cache_dir: out.join("cache"),
-        resume: false,
-        grid: Default::default(),
+        ..common::options(out, &["ray"], views)
     }
 }
 
@@ -85,26 +66,6 @@ fn bad_input_is_refused_before_gpu_work() {
         .unwrap_or_default();
     assert!(e.contains("no edit site"), "{e}");
     std::fs::remove_dir_all(&base).unwrap();
-}
-
-/// The headless adapter, or `None` after a loud SKIPPED line (a failure
-/// under `STRATA_REQUIRE_GPU=1`).
-fn gpu_or_skip(test: &str) -> Option<strata_render::Gpu> {
-    match strata_render::Gpu::headless() {
-        Ok(g) => Some(g),
-        Err(e) => {
-            // Straight to stderr: libtest swallows eprintln! of passing tests.
-            use std::io::Write;
-            if std::env::var_os("STRATA_REQUIRE_GPU").is_some_and(|v| v == "1") {
-                panic!("STRATA_REQUIRE_GPU=1 but no GPU adapter ({e:#})");
-            }
-            let _ = writeln!(
-                std::io::stderr(),
-                "\n*** SKIPPED {test}: no GPU adapter ({e:#}) ***\n"
-            );
-            None
-        }
-    }
 }
 
 #[test]
@@ -207,12 +168,7 @@ fn interrupted_run_resumes_to_the_full_cell_set() {
     let base = temp("resume");
     let two_methods = |out: PathBuf| {
         let mut o = options(&w, out);
-        o.methods = ["ray", "ray-compute"]
-            .map(|n| MethodChoice {
-                name: n.into(),
-                setting: None,
-            })
-            .to_vec();
+        o.methods = common::choices(&["ray", "ray-compute"]);
         o.edits = EditMode::Off;
         // One reference cache for the three runs.
         o.cache_dir = base.join("cache");

@@ -3,19 +3,13 @@
 //! row for it, while the other methods run. The adapter's capabilities are
 //! narrowed by hand (no compute), so this runs on any adapter.
 
-use strata_bench::plan::MethodChoice;
-use strata_bench::run::{EditMode, Options, Plan};
+mod common;
+
+use common::skip_loudly;
+use strata_bench::run::Plan;
 use strata_level::ViewSpec;
 use strata_level::generate::{GenerateParams, generate};
 use strata_render::Gpu;
-
-fn skip_loudly(why: &str) {
-    use std::io::Write;
-    if std::env::var_os("STRATA_REQUIRE_GPU").is_some_and(|v| v == "1") {
-        panic!("STRATA_REQUIRE_GPU=1 but {why}");
-    }
-    let _ = writeln!(std::io::stderr(), "\n*** SKIPPED GPU test: {why} ***\n");
-}
 
 #[test]
 fn a_method_the_adapter_cannot_run_is_one_failure_and_no_edit_row() {
@@ -35,29 +29,8 @@ fn a_method_the_adapter_cannot_run_is_one_failure_and_no_edit_row() {
     assert!(world.edit.is_some(), "generated worlds carry an edit site");
     let out = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("refusal");
     let _ = std::fs::remove_dir_all(&out);
-    let methods = ["ray", "ray-compute"]
-        .iter()
-        .map(|n| MethodChoice {
-            name: (*n).into(),
-            setting: None,
-        })
-        .collect();
-    let opts = Options {
-        out: out.clone(),
-        methods,
-        views: vec![ViewSpec::parse("low", "100,100:0:30", 0.0).unwrap()],
-        width: 32,
-        height: 20,
-        frames: 1,
-        min_warmup: 1,
-        hold_busy_ms: 0,
-        shadows: true,
-        edits: EditMode::Required,
-        temporal: false,
-        cache_dir: out.join("cache"),
-        resume: false,
-        grid: Default::default(),
-    };
+    let views = vec![ViewSpec::parse("low", "100,100:0:30", 0.0).unwrap()];
+    let opts = common::options(out.clone(), &["ray", "ray-compute"], views);
     let (json, _) = Plan::new(world, opts).unwrap().run(&gpu).unwrap();
     let run = strata_bench::merge::read_run(&json).unwrap();
     assert_eq!(run.rows.len(), 1, "{:?}", run.rows);

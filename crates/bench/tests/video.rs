@@ -2,21 +2,13 @@
 //! (each method draws the same frame, the reference traces the same
 //! picture); a slow pan flickers little. Skips loudly without an adapter.
 
+mod common;
+
+use common::world;
 use indicatif::ProgressBar;
-use strata_bench::plan::MethodChoice;
 use strata_bench::video::path::CameraPath;
 use strata_bench::video::{VideoOptions, record};
 use strata_level::World;
-use strata_level::generate::{GenerateParams, generate};
-
-fn world() -> World {
-    generate(&GenerateParams {
-        seed: 7,
-        width: 256,
-        height: 1024,
-    })
-    .expect("generate a small world")
-}
 
 fn flicker(
     gpu: &strata_render::Gpu,
@@ -27,10 +19,7 @@ fn flicker(
 ) -> (f64, f64) {
     let path = CameraPath::parse(path).unwrap();
     let opts = VideoOptions {
-        methods: vec![MethodChoice {
-            name: method.into(),
-            setting: None,
-        }],
+        methods: common::choices(&[method]),
         tile: (64, 40),
         frame: None,
         fps: 4,
@@ -47,19 +36,8 @@ fn flicker(
 
 #[test]
 fn still_camera_does_not_flicker_and_a_slow_pan_little() {
-    let gpu = match strata_render::Gpu::headless() {
-        Ok(g) => g,
-        Err(e) => {
-            use std::io::Write;
-            if std::env::var_os("STRATA_REQUIRE_GPU").is_some_and(|v| v == "1") {
-                panic!("STRATA_REQUIRE_GPU=1 but no GPU adapter ({e:#})");
-            }
-            let _ = writeln!(
-                std::io::stderr(),
-                "\n*** SKIPPED still_camera_does_not_flicker: no GPU adapter ({e:#}) ***\n"
-            );
-            return;
-        }
+    let Some(gpu) = common::gpu_or_skip("still_camera_does_not_flicker") else {
+        return;
     };
     let w = world();
     let v = &w.views[3];

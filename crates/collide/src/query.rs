@@ -91,6 +91,17 @@ impl TerrainCollider {
         ]
     }
 
+    /// A point of cell `(gx, gy)`'s chunk mesh (chunk-local x, y) in world
+    /// coordinates.
+    fn world_point(&self, p: Vector, gx: i64, gy: i64) -> [f64; 3] {
+        let cell = self.cell_origin(gx, gy);
+        [
+            f64::from(p.x) + cell[0],
+            f64::from(p.y) + cell[1],
+            f64::from(p.z),
+        ]
+    }
+
     /// Cells whose chunk square `[g·size + 0.5, (g+1)·size + 0.5]` meets
     /// `[lo, hi]` along one axis.
     fn cells(lo: f64, hi: f64, size: u32) -> std::ops::RangeInclusive<i64> {
@@ -228,15 +239,10 @@ impl TerrainCollider {
                     continue;
                 };
                 if best.is_none_or(|b| c.dist < b.distance) {
-                    let cell = self.cell_origin(gx, gy);
                     best = Some(BoxContact {
                         distance: c.dist,
-                        point: [
-                            f64::from(c.point1.x) + cell[0],
-                            f64::from(c.point1.y) + cell[1],
-                            f64::from(c.point1.z),
-                        ],
-                        normal: [c.normal1.x, c.normal1.y, c.normal1.z],
+                        point: self.world_point(c.point1, gx, gy),
+                        normal: c.normal1.to_array(),
                     });
                 }
             }
@@ -298,15 +304,10 @@ impl TerrainCollider {
                 let Ok(Some(h)) = hit else { continue };
                 let t = f64::from(h.time_of_impact);
                 if best.is_none_or(|b| t < b.distance) {
-                    let cell = self.cell_origin(gx, gy);
                     best = Some(BoxCastHit {
                         distance: t,
-                        point: [
-                            f64::from(h.witness1.x) + cell[0],
-                            f64::from(h.witness1.y) + cell[1],
-                            f64::from(h.witness1.z),
-                        ],
-                        normal: [h.normal1.x, h.normal1.y, h.normal1.z],
+                        point: self.world_point(h.witness1, gx, gy),
+                        normal: h.normal1.to_array(),
                     });
                 }
             }

@@ -2,23 +2,12 @@
 
 use glam::DVec3;
 use strata_collide::{BoxShape, TerrainCollider};
+use strata_level::lcg::Lcg;
 use strata_level::{EditSite, Level};
 use strata_mesh::{ChunkLayout, dirty_chunks, synthetic::synthetic_level};
 use strata_reference::{ReferenceSettings, Tracer};
 
 const TOL: f64 = 1.0;
-
-/// A small deterministic generator (no dependency for a few numbers).
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
 
 fn level() -> Level {
     synthetic_level(256, 256, 3)
@@ -40,12 +29,12 @@ fn collider_hit(c: &TerrainCollider, o: DVec3, d: DVec3) -> Option<f64> {
 fn vertical_rays_agree_with_reference_within_tolerance() {
     let level = level();
     let collider = TerrainCollider::fit(&level, TOL);
-    let mut rng = Rng(7);
+    let mut rng = Lcg(7);
     let (mut worst, n) = (0.0f64, 2000);
     let mut over = 0;
     for _ in 0..n {
-        let x = (rng.next() * 256.0).floor() + 0.5;
-        let y = (rng.next() * 256.0).floor() + 0.5;
+        let x = (rng.next_f64() * 256.0).floor() + 0.5;
+        let y = (rng.next_f64() * 256.0).floor() + 0.5;
         let o = DVec3::new(x, y, 300.0);
         let d = DVec3::NEG_Z;
         let r = reference_hit(&level, o, d).expect("reference sees the ground");
@@ -124,17 +113,17 @@ fn random_rays_agree_with_reference() {
     let level = level();
     let collider = TerrainCollider::fit(&level, TOL);
     let tracer = Tracer::new(&level);
-    let mut rng = Rng(11);
+    let mut rng = Lcg(11);
     let (mut n, mut close, mut up, mut misses) = (0, 0, 0, 0);
     let mut errors = Vec::new();
     while n < 3000 {
-        let x = rng.next() * 256.0;
-        let y = rng.next() * 256.0;
+        let x = rng.next_f64() * 256.0;
+        let y = rng.next_f64() * 256.0;
         let c = level.column(x.floor() as i64, y.floor() as i64);
-        let az = rng.next() * std::f64::consts::TAU;
-        let into_ceiling = c.dual && c.mid > c.low + 4 && rng.next() < 0.5;
+        let az = rng.next_f64() * std::f64::consts::TAU;
+        let into_ceiling = c.dual && c.mid > c.low + 4 && rng.next_f64() < 0.5;
         let (o, d) = if into_ceiling {
-            let el = 0.8 + rng.next() * 0.19;
+            let el = 0.8 + rng.next_f64() * 0.19;
             let h = (1.0 - el * el).sqrt();
             // From the middle of the cave, well clear of the floor's ramps.
             let z = (f64::from(c.low) + f64::from(c.mid)) * 0.5;
@@ -143,7 +132,7 @@ fn random_rays_agree_with_reference() {
                 DVec3::new(h * az.cos(), h * az.sin(), el),
             )
         } else {
-            let el = 0.3 + rng.next() * 0.69;
+            let el = 0.3 + rng.next_f64() * 0.69;
             let h = (1.0 - el * el).sqrt();
             (
                 DVec3::new(x, y, 260.0),

@@ -45,6 +45,19 @@ impl DirtyRect {
     pub fn contains(&self, x: u32, y: u32) -> bool {
         x >= self.x && x - self.x < self.width && y >= self.y && y - self.y < self.height
     }
+
+    /// Every texel `(x, y)` inside, row by row.
+    ///
+    /// ```
+    /// let r = strata_level::DirtyRect { x: 2, y: 5, width: 2, height: 2 };
+    /// let texels: Vec<(u32, u32)> = r.texels().collect();
+    /// assert_eq!(texels, [(2, 5), (3, 5), (2, 6), (3, 6)]);
+    /// assert!(texels.iter().all(|&(x, y)| r.contains(x, y)));
+    /// ```
+    pub fn texels(&self) -> impl Iterator<Item = (u32, u32)> + use<> {
+        let (x0, x1) = (self.x, self.x + self.width);
+        (self.y..self.y + self.height).flat_map(move |y| (x0..x1).map(move |x| (x, y)))
+    }
 }
 
 /// A rectangle in unwrapped texel coordinates: `x .. x + width`, `y .. y + height`.

@@ -93,6 +93,7 @@ pub mod error;
 pub mod generate;
 pub mod huffman;
 pub mod io;
+pub mod lcg;
 pub mod model;
 pub mod palette;
 pub mod save;

@@ -412,10 +412,8 @@ mod tests {
             width: 30,
             height: 90,
         };
-        for y in rect.y..rect.y + rect.height {
-            for x in rect.x..rect.x + rect.width {
-                edited.planes_mut().0[(y * 512 + x) as usize] = 255 - (x as u8 ^ y as u8);
-            }
+        for (x, y) in rect.texels() {
+            edited.planes_mut().0[(y * 512 + x) as usize] = 255 - (x as u8 ^ y as u8);
         }
         p.update(&edited, &rect);
         assert_eq!(p, Pyramid::new(&edited));

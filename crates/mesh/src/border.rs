@@ -24,29 +24,14 @@ pub fn fit_border(edge: &[Sample], tol: f64, out: &mut Vec<u32>) {
     if edge.len() < 3 {
         return;
     }
-    let mut stack = vec![(0usize, edge.len() - 1)];
-    while let Some((i, j)) = stack.pop() {
-        let len = (j - i) as i64;
-        let (zi, zj) = (edge[i].z, edge[j].z);
-        let mut best = (0i64, 0usize);
-        for (k, s) in edge.iter().enumerate().take(j).skip(i + 1) {
-            let (a, b) = ((j - k) as i64, (k - i) as i64);
-            let mut e = 0;
-            for f in 0..3 {
-                let interp = i64::from(zi[f]) * a + i64::from(zj[f]) * b;
-                e = e.max((interp - i64::from(s.z[f]) * len).abs());
-            }
-            if e > best.0 {
-                best = (e, k);
-            }
+    split_greedily(edge, tol, out, |ends, s, (a, b), len| {
+        let mut e = 0;
+        for f in 0..3 {
+            let interp = i64::from(ends[0].z[f]) * a + i64::from(ends[1].z[f]) * b;
+            e = e.max((interp - i64::from(s.z[f]) * len).abs());
         }
-        if best.1 != 0 && exceeds(best.0, len, tol) {
-            out.push(best.1 as u32);
-            stack.push((i, best.1));
-            stack.push((best.1, j));
-        }
-    }
-    out.sort_unstable();
+        e
+    });
 }
 
 /// [`fit_border`] for the outline fit's slab triangulation: a segment
@@ -61,27 +46,41 @@ pub fn fit_border_slab(edge: &[Sample], tol: f64, out: &mut Vec<u32>) {
     if edge.len() < 3 || !edge.iter().any(Sample::dual) {
         return;
     }
+    split_greedily(edge, tol, out, |ends, s, (a, b), len| {
+        if ends[0].dual() && ends[1].dual() {
+            (1..3)
+                .map(|f| {
+                    let interp = i64::from(ends[0].z[f]) * a + i64::from(ends[1].z[f]) * b;
+                    (interp - i64::from(s.z[f]) * len).abs()
+                })
+                .max()
+                .unwrap_or(0)
+        } else if s.dual() {
+            (i64::from(s.z[2]) - i64::from(s.z[0])) * len
+        } else {
+            0
+        }
+    });
+}
+
+/// The greedy split both border fits share: keep the worst sample of a
+/// segment while its error exceeds `tol`, then split there. `error(ends, s,
+/// (a, b), len)` is `len` times the error at sample `s` between the
+/// segment's `ends`, where `s` interpolates as `(a · end0 + b · end1) / len`.
+#[inline(always)]
+fn split_greedily(
+    edge: &[Sample],
+    tol: f64,
+    out: &mut Vec<u32>,
+    error: impl Fn([&Sample; 2], &Sample, (i64, i64), i64) -> i64,
+) {
     let mut stack = vec![(0usize, edge.len() - 1)];
     while let Some((i, j)) = stack.pop() {
         let len = (j - i) as i64;
-        let (zi, zj) = (edge[i].z, edge[j].z);
-        let slab = edge[i].dual() && edge[j].dual();
+        let ends = [&edge[i], &edge[j]];
         let mut best = (0i64, 0usize);
         for (k, s) in edge.iter().enumerate().take(j).skip(i + 1) {
-            let (a, b) = ((j - k) as i64, (k - i) as i64);
-            let e = if slab {
-                (1..3)
-                    .map(|f| {
-                        let interp = i64::from(zi[f]) * a + i64::from(zj[f]) * b;
-                        (interp - i64::from(s.z[f]) * len).abs()
-                    })
-                    .max()
-                    .unwrap_or(0)
-            } else if s.dual() {
-                (i64::from(s.z[2]) - i64::from(s.z[0])) * len
-            } else {
-                0
-            };
+            let e = error(ends, s, ((j - k) as i64, (k - i) as i64), len);
             if e > best.0 {
                 best = (e, k);
             }

@@ -35,7 +35,7 @@
 //! `[2 only][1,2][0,1,2][0,1][0 only][1 only]`. LOD 2 and LOD 0 are one range
 //! each, LOD 1 is two ranges.
 
-use crate::fit::LODS;
+use crate::lod::{CAUSES, LODS};
 use crate::samples::ChunkSamples;
 use crate::triangulation::{NONE, Triangulation};
 
@@ -92,8 +92,8 @@ pub struct ChunkStats {
     pub hash: u64,
     /// Triangle counts per LOD (0 the finest).
     pub lods: [LodStats; LODS],
-    /// Insertions by [`crate::fit::Cause`].
-    pub causes: [u32; crate::fit::CAUSES],
+    /// Insertions by [`crate::lod::Cause`].
+    pub causes: [u32; CAUSES],
 }
 
 /// One chunk's drawable data.

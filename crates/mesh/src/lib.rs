@@ -32,7 +32,8 @@
 //!
 //! Module map: [`predicates`] (exact integer geometry), [`triangulation`]
 //! (arena + flips), [`candidate`] (worst-sample scan), [`border`] (1D edge
-//! fit), [`fit`] (one chunk, all LODs), [`emit`] (index data),
+//! fit), [`lod`] (the LOD count, insertion causes), [`fit`] (one chunk, all
+//! LODs), [`emit`] (index data),
 //! [`level_mesh`] (whole level, refit, statistics), [`synthetic`] (fixture).
 //!
 //! # Example: fit a level, read the triangle counts, refit after an edit
@@ -92,6 +93,7 @@ pub mod cpu_time;
 pub mod emit;
 pub mod fit;
 pub mod level_mesh;
+pub mod lod;
 pub mod predicates;
 pub mod samples;
 pub mod synthetic;

@@ -24,30 +24,28 @@ pub fn orient2d(a: Pt, b: Pt, c: Pt) -> i64 {
 /// differences of `i32`s, which `i128` holds without overflow.
 #[inline]
 pub fn incircle(a: Pt, b: Pt, c: Pt, d: Pt) -> i128 {
-    let adx = i128::from(a[0]) - i128::from(d[0]);
-    let ady = i128::from(a[1]) - i128::from(d[1]);
-    let bdx = i128::from(b[0]) - i128::from(d[0]);
-    let bdy = i128::from(b[1]) - i128::from(d[1]);
-    let cdx = i128::from(c[0]) - i128::from(d[0]);
-    let cdy = i128::from(c[1]) - i128::from(d[1]);
-    let alift = adx * adx + ady * ady;
-    let blift = bdx * bdx + bdy * bdy;
-    let clift = cdx * cdx + cdy * cdy;
-    alift * (bdx * cdy - cdx * bdy)
-        + blift * (cdx * ady - adx * cdy)
-        + clift * (adx * bdy - bdx * ady)
+    incircle_in::<i128>(a, b, c, d)
 }
 
 /// `incircle` for chunk-local coordinates (|x|, |y| <= 2^12), where every
 /// intermediate fits in `i64`; the fitter's hot path.
 #[inline]
 pub fn incircle_small(a: Pt, b: Pt, c: Pt, d: Pt) -> i64 {
-    let adx = i64::from(a[0] - d[0]);
-    let ady = i64::from(a[1] - d[1]);
-    let bdx = i64::from(b[0] - d[0]);
-    let bdy = i64::from(b[1] - d[1]);
-    let cdx = i64::from(c[0] - d[0]);
-    let cdy = i64::from(c[1] - d[1]);
+    incircle_in::<i64>(a, b, c, d)
+}
+
+/// The incircle determinant computed in `T` (exact where `T` holds its
+/// products of three coordinate differences).
+#[inline(always)]
+fn incircle_in<T>(a: Pt, b: Pt, c: Pt, d: Pt) -> T
+where
+    T: Copy + From<i32> + std::ops::Add<Output = T> + std::ops::Sub<Output = T>,
+    T: std::ops::Mul<Output = T>,
+{
+    let diff = |p: Pt, k: usize| T::from(p[k]) - T::from(d[k]);
+    let (adx, ady) = (diff(a, 0), diff(a, 1));
+    let (bdx, bdy) = (diff(b, 0), diff(b, 1));
+    let (cdx, cdy) = (diff(c, 0), diff(c, 1));
     let alift = adx * adx + ady * ady;
     let blift = bdx * bdx + bdy * bdy;
     let clift = cdx * cdx + cdy * cdy;

@@ -111,3 +111,29 @@ pub fn side_edges_of(triangles: &[[[i32; 2]; 3]], axis: usize, at: i32) -> Vec<(
     out.sort_unstable();
     out
 }
+
+/// For every chunk of `mesh` and every pair of LODs: the chunk's x and y
+/// seams (at 128) equal its right and lower neighbours' (at 0, wrapping),
+/// then `more(chunk, [right, below], lod_a, lod_b, y_seam)` checks more.
+pub fn check_seams(
+    mesh: &strata_mesh::LevelMesh,
+    layout: &strata_mesh::ChunkLayout,
+    mut more: impl FnMut(usize, [usize; 2], usize, usize, &[(i32, i32)]),
+) {
+    for i in 0..layout.count() {
+        let (cx, cy) = layout.coords(i);
+        let right = layout.index((cx + 1) % layout.chunks_x, cy);
+        let below = layout.index(cx, (cy + 1) % layout.chunks_y);
+        for la in 0..strata_mesh::LODS {
+            for lb in 0..strata_mesh::LODS {
+                let a = side_edges(&mesh.chunks[i], la, 0, 128);
+                let b = side_edges(&mesh.chunks[right], lb, 0, 0);
+                assert_eq!(a, b, "x seam chunk {i} lods {la}/{lb}");
+                let a = side_edges(&mesh.chunks[i], la, 1, 128);
+                let b = side_edges(&mesh.chunks[below], lb, 1, 0);
+                assert_eq!(a, b, "y seam chunk {i} lods {la}/{lb}");
+                more(i, [right, below], la, lb, &a);
+            }
+        }
+    }
+}

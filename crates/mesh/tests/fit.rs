@@ -2,7 +2,7 @@
 
 mod common;
 
-use common::{dig, floor_triangles, side_edges};
+use common::{dig, floor_triangles};
 use strata_level::Level;
 use strata_mesh::candidate::barycentric;
 use strata_mesh::predicates::orient2d;
@@ -113,29 +113,16 @@ fn seams_match_between_neighbours_at_every_lod_pair() {
     let layout = ChunkLayout::of(&l);
     let mesh = LevelMesh::fit(&l, 4.0);
     let mut checked = 0;
-    for i in 0..layout.count() {
-        let (cx, cy) = layout.coords(i);
-        let right = layout.index((cx + 1) % layout.chunks_x, cy);
-        let below = layout.index(cx, (cy + 1) % layout.chunks_y);
-        for la in 0..LODS {
-            for lb in 0..LODS {
-                let a = side_edges(&mesh.chunks[i], la, 0, 128);
-                let b = side_edges(&mesh.chunks[right], lb, 0, 0);
-                assert_eq!(a, b, "x seam chunk {i} lods {la}/{lb}");
-                let a = side_edges(&mesh.chunks[i], la, 1, 128);
-                let b = side_edges(&mesh.chunks[below], lb, 1, 0);
-                assert_eq!(a, b, "y seam chunk {i} lods {la}/{lb}");
-                // The seam is a contiguous polyline from 0 to 128.
-                let mut at = 0;
-                for (u, v) in &a {
-                    assert_eq!(*u, at);
-                    at = *v;
-                }
-                assert_eq!(at, 128);
-                checked += 1;
-            }
+    common::check_seams(&mesh, &layout, |_, _, _, _, seam| {
+        // The seam is a contiguous polyline from 0 to 128.
+        let mut at = 0;
+        for (u, v) in seam {
+            assert_eq!(*u, at);
+            at = *v;
         }
-    }
+        assert_eq!(at, 128);
+        checked += 1;
+    });
     assert_eq!(checked, layout.count() * LODS * LODS);
 }
 

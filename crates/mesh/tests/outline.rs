@@ -213,46 +213,27 @@ fn outline_seams_match_between_neighbours_at_every_lod_pair() {
     let l = synthetic_level(512, 256, 11);
     let layout = ChunkLayout::of(&l);
     let mesh = fit(&l, 4.0);
-    for i in 0..layout.count() {
-        let (cx, cy) = layout.coords(i);
-        let right = layout.index((cx + 1) % layout.chunks_x, cy);
-        let below = layout.index(cx, (cy + 1) % layout.chunks_y);
-        for la in 0..LODS {
-            for lb in 0..LODS {
-                let a = common::side_edges(&mesh.chunks[i], la, 0, 128);
-                let b = common::side_edges(&mesh.chunks[right], lb, 0, 0);
-                assert_eq!(a, b, "x seam chunk {i} lods {la}/{lb}");
-                let a = common::side_edges(&mesh.chunks[i], la, 1, 128);
-                let b = common::side_edges(&mesh.chunks[below], lb, 1, 0);
-                assert_eq!(a, b, "y seam chunk {i} lods {la}/{lb}");
-                // The slab's seam edges on both sides join the same border
-                // vertices: where they overlap, they are the same edge.
-                for (axis, other) in [(0, right), (1, below)] {
-                    let a = common::side_edges_of(
-                        &common::slab_triangles(&mesh.chunks[i], la).0,
-                        axis,
-                        128,
+    common::check_seams(&mesh, &layout, |i, [right, below], la, lb, _| {
+        // The slab's seam edges on both sides join the same border
+        // vertices: where they overlap, they are the same edge.
+        for (axis, other) in [(0, right), (1, below)] {
+            let a =
+                common::side_edges_of(&common::slab_triangles(&mesh.chunks[i], la).0, axis, 128);
+            let b =
+                common::side_edges_of(&common::slab_triangles(&mesh.chunks[other], lb).0, axis, 0);
+            for &(u0, u1) in &a {
+                for &(v0, v1) in &b {
+                    let overlap = u1.min(v1) - u0.max(v0);
+                    assert!(
+                        overlap <= 0 || (u0, u1) == (v0, v1),
+                        "slab seam chunk {i} axis {axis} lods {la}/{lb}: {:?} {:?}",
+                        (u0, u1),
+                        (v0, v1)
                     );
-                    let b = common::side_edges_of(
-                        &common::slab_triangles(&mesh.chunks[other], lb).0,
-                        axis,
-                        0,
-                    );
-                    for &(u0, u1) in &a {
-                        for &(v0, v1) in &b {
-                            let overlap = u1.min(v1) - u0.max(v0);
-                            assert!(
-                                overlap <= 0 || (u0, u1) == (v0, v1),
-                                "slab seam chunk {i} axis {axis} lods {la}/{lb}: {:?} {:?}",
-                                (u0, u1),
-                                (v0, v1)
-                            );
-                        }
-                    }
                 }
             }
         }
-    }
+    });
 }
 
 #[test]

@@ -59,20 +59,7 @@ mod tests {
     use strata_level::model::{META_DOUBLE_LEVEL, META_TERRAIN_SHIFT};
     use strata_level::{DirtyRect, Level, MidRule};
 
-    /// A small deterministic pseudo-random generator (tests need no crate).
-    struct Lcg(u64);
-    impl Lcg {
-        fn next(&mut self) -> u32 {
-            self.0 = self
-                .0
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (self.0 >> 33) as u32
-        }
-        fn below(&mut self, n: u32) -> u32 {
-            self.next() % n
-        }
-    }
+    use strata_level::lcg::Lcg;
 
     /// Rolling hills with caves: a third of the pairs dual, some heights at
     /// the extremes 0 and 255.

@@ -219,15 +219,7 @@ impl TerrainPhysics {
     pub fn apply_edit(&mut self, level: &Level, dirty: &[DirtyRect]) -> EditReport {
         let t = Instant::now();
         let chunks = self.terrain.apply_edit(level, dirty);
-        let refit_ms = t.elapsed().as_secs_f64() * 1e3;
-        let t = Instant::now();
-        let colliders_replaced = self.chunks.replace(&mut self.world, &self.terrain, &chunks);
-        EditReport {
-            chunks,
-            colliders_replaced,
-            refit_ms,
-            replace_ms: t.elapsed().as_secs_f64() * 1e3,
-        }
+        self.replace_colliders(chunks, t)
     }
 
     /// Like [`TerrainPhysics::apply_edit`] for chunks someone else already
@@ -235,8 +227,14 @@ impl TerrainPhysics {
     pub fn replace_chunks(&mut self, level: &Level, refit: &[(usize, &ChunkMesh)]) -> EditReport {
         let t = Instant::now();
         self.terrain.replace_chunks(level, refit);
-        let refit_ms = t.elapsed().as_secs_f64() * 1e3;
         let chunks: Vec<usize> = refit.iter().map(|&(i, _)| i).collect();
+        self.replace_colliders(chunks, t)
+    }
+
+    /// The second half of an edit: the refit `chunks` (refit since
+    /// `refit_start`) get new colliders in the world.
+    fn replace_colliders(&mut self, chunks: Vec<usize>, refit_start: Instant) -> EditReport {
+        let refit_ms = refit_start.elapsed().as_secs_f64() * 1e3;
         let t = Instant::now();
         let colliders_replaced = self.chunks.replace(&mut self.world, &self.terrain, &chunks);
         EditReport {

@@ -9,6 +9,7 @@ use serde::Serialize;
 
 use crate::correlate::pearson;
 use crate::run::{FitRow, Survey, WorldRow};
+use strata_markdown::{Align, Table};
 
 /// Correlations of log reduction against each predictor at one quality,
 /// over the worlds that have a fit there.
@@ -121,105 +122,104 @@ pub fn markdown(
         survey.threads
     );
     let _ = writeln!(md, "## The table at q = {q}\n");
-    let _ = writeln!(
-        md,
-        "| world | texels | tris | red. | slab | dual | r_f | r_s | fit s |"
-    );
-    let _ = writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|---:|");
     let mut rows: Vec<&WorldRow> = survey.worlds.iter().collect();
     rows.sort_by(|a, b| {
         let red = |w: &WorldRow| w.fit_at(q).map_or(f64::INFINITY, |f| -f.reduction);
         red(a).total_cmp(&red(b))
     });
+    let mut t = Table::new().left("world").columns(
+        [
+            "texels", "tris", "red.", "slab", "dual", "r_f", "r_s", "fit s",
+        ],
+        Align::Right,
+    );
     for w in rows {
         match w.fit_at(q) {
-            Some(f) => {
-                let _ = writeln!(
-                    md,
-                    "| {} | {} | {} | {:.1}× | {:.1} % | {:.1} % | {:.2} | {:.2} | {:.2} |",
-                    w.label,
-                    millions(w.texels),
-                    millions(f.triangles),
-                    f.reduction,
-                    f.slab_share,
-                    w.dual_percent,
-                    w.r_f,
-                    w.r_s,
-                    f.fit_seconds
-                );
-            }
+            Some(f) => t.row([
+                w.label.clone(),
+                millions(w.texels),
+                millions(f.triangles),
+                format!("{:.1}×", f.reduction),
+                format!("{:.1} %", f.slab_share),
+                format!("{:.1} %", w.dual_percent),
+                format!("{:.2}", w.r_f),
+                format!("{:.2}", w.r_s),
+                format!("{:.2}", f.fit_seconds),
+            ]),
             None => {
-                let _ = writeln!(
-                    md,
-                    "| {} | — | — | — | — | — | — | — | failed: {} |",
-                    w.label,
-                    w.error.as_deref().unwrap_or("no fit at this quality")
+                let why = w.error.as_deref().unwrap_or("no fit at this quality");
+                t.row(
+                    std::iter::once(w.label.clone())
+                        .chain(std::iter::repeat_n("—".to_string(), 7))
+                        .chain([format!("failed: {why}")]),
                 );
             }
         }
     }
+    t.write_to(&mut md);
     let _ = writeln!(
         md,
         "\nslab: share of finest planar triangles that carry a slab; dual: texels in dual pairs; r_f, r_s: rough(floor), rough(surface) as `strata info` prints them.\n"
     );
     let _ = writeln!(md, "## Correlation of log reduction\n");
-    let _ = writeln!(md, "| q | worlds | r_f | dual % | r_s | slab share |");
-    let _ = writeln!(md, "|---:|---:|---:|---:|---:|---:|");
+    let mut t = Table::new().columns(
+        ["q", "worlds", "r_f", "dual %", "r_s", "slab share"],
+        Align::Right,
+    );
     for c in corr {
-        let _ = writeln!(
-            md,
-            "| {} | {} | {} | {} | {} | {} |",
-            c.quality,
-            c.worlds,
+        t.row([
+            c.quality.to_string(),
+            c.worlds.to_string(),
             opt(c.r_f),
             opt(c.dual),
             opt(c.r_s),
-            opt(c.slab_share)
-        );
+            opt(c.slab_share),
+        ]);
     }
+    t.write_to(&mut md);
     let _ = writeln!(
         md,
         "\nThe paper, ten shipped worlds: r_f −0.17, dual −0.77, r_s −0.82, slab share −0.89.\n"
     );
     let _ = writeln!(md, "## Insertion causes against quality (all worlds)\n");
-    let _ = writeln!(
-        md,
-        "| q | max error | floor | slab interior | boundary | chunk border | boundary share |"
+    let mut t = Table::new().columns(
+        [
+            "q",
+            "max error",
+            "floor",
+            "slab interior",
+            "boundary",
+            "chunk border",
+            "boundary share",
+        ],
+        Align::Right,
     );
-    let _ = writeln!(md, "|---:|---:|---:|---:|---:|---:|---:|");
     for &(qq, causes) in &cause_totals(survey) {
         let total: u64 = causes.iter().sum();
-        let _ = writeln!(
-            md,
-            "| {qq} | {} | {} | {} | {} | {} | {:.1} % |",
-            strata_mesh::tolerance_for_quality(qq).unwrap_or(f64::NAN),
-            causes[0],
-            causes[1],
-            causes[2],
-            causes[3],
-            100.0 * causes[2] as f64 / total.max(1) as f64
-        );
+        t.row([
+            qq.to_string(),
+            strata_mesh::tolerance_for_quality(qq)
+                .unwrap_or(f64::NAN)
+                .to_string(),
+            causes[0].to_string(),
+            causes[1].to_string(),
+            causes[2].to_string(),
+            causes[3].to_string(),
+            format!("{:.1} %", 100.0 * causes[2] as f64 / total.max(1) as f64),
+        ]);
     }
+    t.write_to(&mut md);
     let _ = writeln!(md, "\n### Boundary insertions per world\n");
-    let mut head = String::from("| world |");
-    let mut rule = String::from("|---|");
-    for qq in &survey.qualities {
-        let _ = write!(head, " q={qq} |");
-        rule.push_str("---:|");
-    }
-    let _ = writeln!(md, "{head}\n{rule}");
+    let qualities = survey.qualities.iter().map(|qq| format!("q={qq}"));
+    let mut t = Table::new().left("world").columns(qualities, Align::Right);
     for w in &survey.worlds {
-        let mut line = format!("| {} |", w.label);
-        for &qq in &survey.qualities {
-            match w.fit_at(qq) {
-                Some(f) => {
-                    let _ = write!(line, " {} |", f.causes[2]);
-                }
-                None => line.push_str(" — |"),
-            }
-        }
-        let _ = writeln!(md, "{line}");
+        let cells = survey.qualities.iter().map(|&qq| {
+            w.fit_at(qq)
+                .map_or("—".to_string(), |f| f.causes[2].to_string())
+        });
+        t.row(std::iter::once(w.label.clone()).chain(cells));
     }
+    t.write_to(&mut md);
     if !figures.is_empty() {
         let _ = writeln!(md, "\n## Plots\n");
         for (title, file) in figures {

@@ -1,288 +1,30 @@
-//! `--script FILE`: the viewer driven without a person, for tests, demos and
-//! reproducible screenshots. One command per line; `#` starts a comment.
-//! Commands run in order through the real window and event loop, one frame
-//! (or the stated number of frames) each:
-//!
-//! ```text
-//! view NAME                 jump to one of the level's named views
-//! method NAME               switch the method (waits while it is built)
-//! split NAME | split off    A/B: the current method left, NAME right
-//! fly F R U [FRAMES]        move F units along the view, R to the screen's right, U up
-//! goto X Y                  fly to (X, Y) at the same height above the ground (a map click)
-//! turn RIGHT UP [FRAMES]    turn, degrees
-//! frames N                  render N frames
-//! dig X Y                   click at (X, Y) of the picture, fractions 0..1 (0.5 0.5 = centre)
-//! undo                      undo the last dig
-//! physics on|off            the physics toy (on: waits until its collider is fitted)
-//! drop ball|box X Y         drop a body where picture point (X, Y) shows terrain (fractions)
-//! clear-bodies              remove the physics toy's bodies
-//! save DIR                  save the edited world as a world directory (see `save`)
-//! set KNOB VALUE            ray-steps, voxel-steps, slices, density, mesh-quality, shadows (0/1)
-//! overlay on|off            show or hide the overlay
-//! window W H                resize the window (the picture follows)
-//! screenshot PATH           save what the window shows as PNG
-//! copy-view [NAME]          print the current view as a views.txt line
-//! score                     print the drawn method(s)' metrics against the CPU reference
-//! memory                    print a `memory …` line: process RSS, the renderer's GPU and
-//!                           CPU bytes (shared + kept methods), undo bytes (the soak)
-//! lose-device               destroy the GPU device, as a driver reset would (tests
-//!                           that the edits are saved to OUT/<world>-recovered)
-//! quit                      stop here (the end of the file does too)
-//! ```
+//! `--script FILE`: the viewer driven without a person. The language (its
+//! commands and parser) lives in `strata-script`, GPU-free so that it is
+//! fuzzed without a window; here `set` names the viewer's [`Knob`]s and
+//! `drop` the physics toy's bodies.
 
 use crate::knobs::Knob;
-use anyhow::{Context, bail};
-use std::path::{Path, PathBuf};
+use crate::physics::Drop;
+pub use strata_script::{Body, Setting};
 
-#[derive(Clone, Debug, PartialEq)]
-pub enum Command {
-    View(String),
-    Method(String),
-    Split(Option<String>),
-    /// Offset in camera terms (forward, right, up), spread over `frames`.
-    Fly {
-        offset: [f32; 3],
-        frames: u32,
-    },
-    /// Degrees (right, up), spread over `frames`.
-    Turn {
-        degrees: [f32; 2],
-        frames: u32,
-    },
-    Frames(u32),
-    /// World x, y.
-    Goto(f32, f32),
-    /// Fractions of the picture's width and height.
-    Dig(f32, f32),
-    Undo,
-    /// The physics toy on or off.
-    Physics(bool),
-    /// A body dropped at fractions of the picture's width and height.
-    Drop(crate::physics::Drop, f32, f32),
-    ClearBodies,
-    /// A world directory to save the edited world into.
-    Save(PathBuf),
-    Set(Knob, f32),
-    Overlay(bool),
-    /// Window inner size, pixels.
-    Window(u32, u32),
-    Screenshot(PathBuf),
-    CopyView(String),
-    Score,
-    Memory,
-    LoseDevice,
-    Quit,
-}
+/// A parsed script of the viewer's commands.
+pub type Script = strata_script::Script<Knob, Drop>;
+/// One command of a [`Script`].
+pub type Command = strata_script::Command<Knob, Drop>;
 
-/// A parsed script with each command's line number, for messages.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct Script {
-    pub commands: Vec<(usize, Command)>,
-}
-
-impl Script {
-    pub fn load(path: &Path) -> anyhow::Result<Script> {
-        let text = std::fs::read_to_string(path)
-            .with_context(|| format!("reading the script {}", path.display()))?;
-        Script::parse(&text).with_context(|| format!("in the script {}", path.display()))
-    }
-
-    /// `--frames N --screenshot PATH` as a script.
-    pub fn frames_then_screenshot(frames: u32, screenshot: Option<PathBuf>) -> Script {
-        let mut commands = vec![(0, Command::Frames(frames))];
-        if let Some(path) = screenshot {
-            commands.push((0, Command::Screenshot(path)));
-        }
-        Script { commands }
-    }
-
-    pub fn parse(text: &str) -> anyhow::Result<Script> {
-        let mut commands = Vec::new();
-        for (i, raw) in text.lines().enumerate() {
-            let line = raw.split('#').next().unwrap_or("").trim();
-            if line.is_empty() {
-                continue;
-            }
-            let command = parse_line(line).with_context(|| format!("line {}: `{line}`", i + 1))?;
-            commands.push((i + 1, command));
-        }
-        Ok(Script { commands })
+impl Setting for Knob {
+    fn parse(name: &str) -> anyhow::Result<Knob> {
+        Knob::parse(name)
     }
 }
 
-fn number<T: std::str::FromStr>(text: &str, what: &str) -> anyhow::Result<T> {
-    text.parse()
-        .map_err(|_| anyhow::anyhow!("{what} `{text}` is not a number"))
-}
-
-fn finite(text: &str, what: &str) -> anyhow::Result<f32> {
-    let v: f32 = number(text, what)?;
-    if !v.is_finite() {
-        bail!("{what} must be finite");
+impl From<Body> for Drop {
+    fn from(body: Body) -> Drop {
+        match body {
+            Body::Ball => Drop::Sphere,
+            Body::Box => Drop::Box,
+        }
     }
-    Ok(v)
-}
-
-/// Frames of an optional trailing count: at least one.
-fn frames_arg(arg: Option<&&str>) -> anyhow::Result<u32> {
-    match arg {
-        None => Ok(1),
-        Some(t) => match number::<u32>(t, "frame count")? {
-            0 => bail!("frame count must be at least 1"),
-            n => Ok(n),
-        },
-    }
-}
-
-fn parse_line(line: &str) -> anyhow::Result<Command> {
-    let words: Vec<&str> = line.split_whitespace().collect();
-    let args = &words[1..];
-    let arity = |min: usize, max: usize| -> anyhow::Result<()> {
-        if args.len() < min || args.len() > max {
-            bail!(
-                "`{}` takes {} argument(s), got {}",
-                words[0],
-                if min == max {
-                    min.to_string()
-                } else {
-                    format!("{min} to {max}")
-                },
-                args.len()
-            );
-        }
-        Ok(())
-    };
-    Ok(match words[0] {
-        "view" => {
-            arity(1, 1)?;
-            Command::View(args[0].to_string())
-        }
-        "method" => {
-            arity(1, 1)?;
-            Command::Method(args[0].to_string())
-        }
-        "split" => {
-            arity(1, 1)?;
-            Command::Split((args[0] != "off").then(|| args[0].to_string()))
-        }
-        "fly" => {
-            arity(3, 4)?;
-            Command::Fly {
-                offset: [
-                    finite(args[0], "forward")?,
-                    finite(args[1], "right")?,
-                    finite(args[2], "up")?,
-                ],
-                frames: frames_arg(args.get(3))?,
-            }
-        }
-        "turn" => {
-            arity(2, 3)?;
-            Command::Turn {
-                degrees: [finite(args[0], "right")?, finite(args[1], "up")?],
-                frames: frames_arg(args.get(2))?,
-            }
-        }
-        "goto" => {
-            arity(2, 2)?;
-            Command::Goto(finite(args[0], "x")?, finite(args[1], "y")?)
-        }
-        "frames" => {
-            arity(1, 1)?;
-            Command::Frames(frames_arg(args.first())?)
-        }
-        "dig" => {
-            arity(2, 2)?;
-            let (x, y) = (finite(args[0], "x")?, finite(args[1], "y")?);
-            if !(0.0..=1.0).contains(&x) || !(0.0..=1.0).contains(&y) {
-                bail!("dig takes fractions of the picture, 0..1");
-            }
-            Command::Dig(x, y)
-        }
-        "undo" => {
-            arity(0, 0)?;
-            Command::Undo
-        }
-        "save" => {
-            arity(1, 1)?;
-            Command::Save(PathBuf::from(args[0]))
-        }
-        "set" => {
-            arity(2, 2)?;
-            Command::Set(Knob::parse(args[0])?, finite(args[1], "value")?)
-        }
-        "physics" => {
-            arity(1, 1)?;
-            match args[0] {
-                "on" => Command::Physics(true),
-                "off" => Command::Physics(false),
-                other => bail!("physics takes on or off, not `{other}`"),
-            }
-        }
-        "drop" => {
-            arity(3, 3)?;
-            let what = match args[0] {
-                "ball" => crate::physics::Drop::Sphere,
-                "box" => crate::physics::Drop::Box,
-                other => bail!("drop takes ball or box, not `{other}`"),
-            };
-            let (x, y) = (finite(args[1], "x")?, finite(args[2], "y")?);
-            if !(0.0..=1.0).contains(&x) || !(0.0..=1.0).contains(&y) {
-                bail!("drop takes fractions of the picture, 0..1");
-            }
-            Command::Drop(what, x, y)
-        }
-        "clear-bodies" => {
-            arity(0, 0)?;
-            Command::ClearBodies
-        }
-        "overlay" => {
-            arity(1, 1)?;
-            match args[0] {
-                "on" => Command::Overlay(true),
-                "off" => Command::Overlay(false),
-                other => bail!("overlay takes on or off, not `{other}`"),
-            }
-        }
-        "window" => {
-            arity(2, 2)?;
-            let side = |t: &str| -> anyhow::Result<u32> {
-                match number::<u32>(t, "window size")? {
-                    v @ 1..=16384 => Ok(v),
-                    _ => bail!("window sides are 1..=16384 pixels"),
-                }
-            };
-            Command::Window(side(args[0])?, side(args[1])?)
-        }
-        "screenshot" => {
-            arity(1, 1)?;
-            Command::Screenshot(PathBuf::from(args[0]))
-        }
-        "copy-view" => {
-            arity(0, 1)?;
-            Command::CopyView(args.first().unwrap_or(&"viewer").to_string())
-        }
-        "score" => {
-            arity(0, 0)?;
-            Command::Score
-        }
-        "memory" => {
-            arity(0, 0)?;
-            Command::Memory
-        }
-        "lose-device" => {
-            arity(0, 0)?;
-            Command::LoseDevice
-        }
-        "quit" => {
-            arity(0, 0)?;
-            Command::Quit
-        }
-        other => bail!(
-            "unknown command `{other}` (view, method, split, fly, goto, turn, frames, dig, undo, \
-             save, set, overlay, window, screenshot, copy-view, score, memory, lose-device, quit)"
-        ),
-    })
 }
 
 #[cfg(test)]
@@ -290,87 +32,16 @@ mod tests {
     use super::*;
 
     #[test]
-    fn parses_the_physics_commands_and_names_bad_ones() {
-        use crate::physics::Drop;
-        let script =
-            Script::parse("physics on\ndrop box 0.25 0.5\nclear-bodies\nphysics off").unwrap();
-        let commands: Vec<_> = script.commands.into_iter().map(|(_, c)| c).collect();
+    fn set_names_a_knob_and_drop_a_physics_body() {
+        let script = Script::parse("set ray-steps 64\ndrop ball 0.5 0.5").unwrap();
         assert_eq!(
-            commands,
+            script.commands,
             [
-                Command::Physics(true),
-                Command::Drop(Drop::Box, 0.25, 0.5),
-                Command::ClearBodies,
-                Command::Physics(false)
+                (1, Command::Set(Knob::RaySteps, 64.0)),
+                (2, Command::Drop(Drop::Sphere, 0.5, 0.5))
             ]
         );
-        for (bad, says) in [
-            ("drop ball 2 0.5", "fractions"),
-            ("drop car 0.5 0.5", "`car`"),
-            ("physics maybe", "`maybe`"),
-        ] {
-            let e = format!("{:#}", Script::parse(bad).unwrap_err());
-            assert!(e.contains(says), "{bad}: {e}");
-        }
-    }
-
-    #[test]
-    fn parses_every_command() {
-        let script = Script::parse(
-            "# a flight\nview hangar\nmethod mesh  # switch\nsplit ray\nsplit off\n\
-             fly 10 -2 3 5\ngoto 100 2000\nturn 15 -5\nframes 4\ndig 0.5 0.25\nundo\nsave out/w\nset ray-steps 64\n\
-             overlay off\nwindow 640 480\nscreenshot out/a.png\ncopy-view\nscore\nmemory\nlose-device\nquit\n",
-        )
-        .unwrap();
-        let commands: Vec<_> = script.commands.iter().map(|(_, c)| c.clone()).collect();
-        assert_eq!(
-            commands,
-            vec![
-                Command::View("hangar".into()),
-                Command::Method("mesh".into()),
-                Command::Split(Some("ray".into())),
-                Command::Split(None),
-                Command::Fly {
-                    offset: [10.0, -2.0, 3.0],
-                    frames: 5
-                },
-                Command::Goto(100.0, 2000.0),
-                Command::Turn {
-                    degrees: [15.0, -5.0],
-                    frames: 1
-                },
-                Command::Frames(4),
-                Command::Dig(0.5, 0.25),
-                Command::Undo,
-                Command::Save("out/w".into()),
-                Command::Set(Knob::RaySteps, 64.0),
-                Command::Overlay(false),
-                Command::Window(640, 480),
-                Command::Screenshot("out/a.png".into()),
-                Command::CopyView("viewer".into()),
-                Command::Score,
-                Command::Memory,
-                Command::LoseDevice,
-                Command::Quit,
-            ]
-        );
-        assert_eq!(script.commands[0].0, 2, "line numbers count comments");
-    }
-
-    #[test]
-    fn bad_lines_name_their_line_and_reason() {
-        for (text, needle) in [
-            ("frames 2\nwalk 3", "line 2"),
-            ("dig 1.5 0.5", "fractions"),
-            ("fly 1 2", "3 to 4"),
-            ("frames 0", "at least 1"),
-            ("set warp 3", "unknown setting"),
-            ("turn nan 2", "finite"),
-            ("overlay maybe", "on or off"),
-            ("window 0 100", "1..=16384"),
-        ] {
-            let err = format!("{:#}", Script::parse(text).unwrap_err());
-            assert!(err.contains(needle), "`{text}` gave `{err}`");
-        }
+        let err = format!("{:#}", Script::parse("set warp 3").unwrap_err());
+        assert!(err.contains("unknown setting"), "{err}");
     }
 }

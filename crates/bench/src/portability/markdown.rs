@@ -1,10 +1,9 @@
 //! `portability.md`: the report as Markdown tables, disagreeing cells first.
 
 use super::*;
-
-fn cell_text(s: &str) -> String {
-    s.replace('|', "/").replace('\n', " ")
-}
+use crate::report::{distinct_pitches, pitch_label};
+use std::fmt::Write as _;
+use strata_markdown::{Align, Table, cell_text};
 
 fn field_title(f: &str) -> &str {
     match f {
@@ -35,9 +34,24 @@ fn num(v: f64, digits: usize) -> String {
     }
 }
 
-fn pitch_label(p: f32) -> String {
-    format!("{p}°")
+/// A value or the dash of a missing one.
+fn or_dash(v: Option<String>) -> String {
+    v.unwrap_or_else(|| "—".into())
 }
+
+/// The five accuracy fields, three decimals each.
+fn accuracy_cells(a: &Accuracy) -> [String; 5] {
+    [
+        num(a.see_through, 3),
+        num(a.covers_sky, 3),
+        num(a.depth_p50, 3),
+        num(a.depth_p95, 3),
+        num(a.coherence, 3),
+    ]
+}
+
+/// The accuracy fields' columns, units in the titles.
+const ACCURACY_TITLES: [&str; 5] = ["see-through %", "covers-sky %", "p50", "p95", "coherence %"];
 
 /// `portability.md`.
 pub fn render_markdown(r: &Portability) -> String {
@@ -58,77 +72,93 @@ pub fn render_markdown(r: &Portability) -> String {
         r.tolerances.percent,
         r.tolerances.depth
     );
-    md.push_str(
-        "| adapter | backend | driver | timing | group | revision | cells | results | grid |\n\
-         |---|---|---|---|---|---|---|---|---|\n",
-    );
-    for e in &r.runs {
-        let timing = if e.adapter.timestamps {
-            "GPU timestamps"
-        } else {
-            "CPU submit-and-wait"
-        };
-        let _ = writeln!(
-            md,
-            "| {} | {} | {} | {} | {} | `{}` | {} / {}{} | [json]({}) | {} |",
-            cell_text(&e.label),
-            cell_text(&e.adapter.backend),
-            cell_text(&e.adapter.driver),
-            timing,
-            e.group,
-            cell_text(&e.source_revision),
-            e.cells,
-            e.expected_cells,
-            if e.complete { "" } else { " (incomplete)" },
-            e.results,
-            e.grid
-                .as_ref()
-                .map_or("—".to_string(), |g| format!("[grid]({g})")),
-        );
-    }
-    md.push('\n');
-    if !r.skipped.is_empty() {
-        md.push_str("**Adapters that could not run at all:**\n\n");
-        for s in &r.skipped {
-            let _ = writeln!(
-                md,
-                "- {} ({}): {}",
-                cell_text(&s.adapter),
-                cell_text(&s.backend),
-                cell_text(&s.error)
-            );
-        }
-        md.push('\n');
-    }
+    runs_table(&mut md, &r.runs);
+    skipped(&mut md, &r.skipped);
     if r.groups.len() > 1 {
-        md.push_str("## Protocol groups\n\n");
-        md.push_str(
-            "These runs were not all measured under one protocol, so merge refuses to compare accuracy \
-             across groups; each group is reported on its own below.\n\n",
-        );
-        for g in &r.groups {
-            let _ = write!(
-                md,
-                "- **{}** ({}): {}",
-                g.id,
-                protocol_line(&g.protocol),
-                g.adapters
-                    .iter()
-                    .map(|a| cell_text(a))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            );
-            if let Some(why) = &g.separate_because {
-                let _ = write!(md, ". Not compared with group A: {}", cell_text(why));
-            }
-            md.push('\n');
-        }
-        md.push('\n');
+        protocol_groups(&mut md, &r.groups);
     }
     for g in &r.groups {
         group_markdown(&mut md, g);
     }
     md
+}
+
+fn runs_table(md: &mut String, runs: &[RunEntry]) {
+    let mut t = Table::new().columns(
+        [
+            "adapter", "backend", "driver", "timing", "group", "revision", "cells", "results",
+            "grid",
+        ],
+        Align::Left,
+    );
+    for e in runs {
+        let timing = if e.adapter.timestamps {
+            "GPU timestamps"
+        } else {
+            "CPU submit-and-wait"
+        };
+        t.row([
+            e.label.clone(),
+            e.adapter.backend.clone(),
+            e.adapter.driver.clone(),
+            timing.to_string(),
+            e.group.clone(),
+            format!("`{}`", e.source_revision),
+            format!(
+                "{} / {}{}",
+                e.cells,
+                e.expected_cells,
+                if e.complete { "" } else { " (incomplete)" }
+            ),
+            format!("[json]({})", e.results),
+            or_dash(e.grid.as_ref().map(|g| format!("[grid]({g})"))),
+        ]);
+    }
+    t.write_to(md);
+    md.push('\n');
+}
+
+fn skipped(md: &mut String, skipped: &[SkippedAdapter]) {
+    if skipped.is_empty() {
+        return;
+    }
+    md.push_str("**Adapters that could not run at all:**\n\n");
+    for s in skipped {
+        let _ = writeln!(
+            md,
+            "- {} ({}): {}",
+            cell_text(&s.adapter),
+            cell_text(&s.backend),
+            cell_text(&s.error)
+        );
+    }
+    md.push('\n');
+}
+
+fn protocol_groups(md: &mut String, groups: &[ProtocolGroup]) {
+    md.push_str("## Protocol groups\n\n");
+    md.push_str(
+        "These runs were not all measured under one protocol, so merge refuses to compare accuracy \
+         across groups; each group is reported on its own below.\n\n",
+    );
+    for g in groups {
+        let _ = write!(
+            md,
+            "- **{}** ({}): {}",
+            g.id,
+            protocol_line(&g.protocol),
+            g.adapters
+                .iter()
+                .map(|a| cell_text(a))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+        if let Some(why) = &g.separate_because {
+            let _ = write!(md, ". Not compared with group A: {}", cell_text(why));
+        }
+        md.push('\n');
+    }
+    md.push('\n');
 }
 
 fn protocol_line(p: &ProtocolSummary) -> String {
@@ -145,6 +175,8 @@ fn protocol_line(p: &ProtocolSummary) -> String {
     )
 }
 
+/// One protocol group: disagreements first, then refusals, accuracy by
+/// pitch, spreads, edits and timing.
 fn group_markdown(md: &mut String, g: &ProtocolGroup) {
     let _ = writeln!(
         md,
@@ -155,181 +187,134 @@ fn group_markdown(md: &mut String, g: &ProtocolGroup) {
     );
     if g.adapters.len() < 2 {
         md.push_str("One adapter under this protocol: no spread to measure.\n\n");
+    } else {
+        disagreements(md, g);
     }
-
-    // Disagreements first.
+    refusals(md, g);
+    let pitches = distinct_pitches(g.cells.iter().map(|c| c.pitch));
+    accuracy_by_pitch(md, g, &pitches);
+    largest_spreads(md, g);
     if g.adapters.len() > 1 {
-        let _ = writeln!(
-            md,
-            "### Cells that disagree across adapters ({} of {})\n",
-            g.disagreeing_cells,
-            g.cells.len()
-        );
-        if g.disagreeing_cells == 0 {
-            md.push_str("Every cell agrees within tolerance.\n\n");
-        } else {
-            for c in g.cells.iter().filter(|c| !c.disagrees.is_empty()) {
-                let fields: Vec<&str> = c.disagrees.iter().map(|f| field_title(f)).collect();
-                let _ = writeln!(
-                    md,
-                    "**{} / {}** ({}): {}\n",
-                    cell_text(&c.view),
-                    cell_text(&c.method),
-                    pitch_label(c.pitch),
-                    fields.join(", ")
-                );
-                md.push_str(
-                    "| adapter | see-through % | covers-sky % | p50 | p95 | coherence % | picture |\n\
-                     |---|---:|---:|---:|---:|---:|---|\n",
-                );
-                for v in &c.values {
-                    let a = &v.accuracy;
-                    let _ = writeln!(
-                        md,
-                        "| {} | {} | {} | {} | {} | {} | {} |",
-                        cell_text(&v.adapter),
-                        num(a.see_through, 3),
-                        num(a.covers_sky, 3),
-                        num(a.depth_p50, 3),
-                        num(a.depth_p95, 3),
-                        num(a.coherence, 3),
-                        v.picture
-                            .as_ref()
-                            .map_or("—".to_string(), |p| format!("[png]({p})"))
-                    );
-                }
-                for a in &c.absent {
-                    let _ = writeln!(
-                        md,
-                        "| {} | — | — | — | — | — | {} |",
-                        cell_text(&a.adapter),
-                        a.failure.as_ref().map_or(
-                            "missing (run incomplete)".to_string(),
-                            |f| format!("refused: {}", cell_text(f))
-                        )
-                    );
-                }
-                if let Some(s) = &c.spread {
-                    let _ = writeln!(
-                        md,
-                        "| **spread** | {} | {} | {} | {} | {} | |",
-                        num(s.see_through, 3),
-                        num(s.covers_sky, 3),
-                        num(s.depth_p50, 3),
-                        num(s.depth_p95, 3),
-                        num(s.coherence, 3)
-                    );
-                }
-                md.push('\n');
-                match &c.side_by_side {
-                    Some(p) => {
-                        let _ = writeln!(
-                            md,
-                            "![{} {}: reference, then each adapter]({p})\n",
-                            cell_text(&c.view),
-                            cell_text(&c.method)
-                        );
-                    }
-                    None => md.push_str("(no cell pictures found beside the results files)\n\n"),
-                }
-            }
-        }
+        cell_spreads(md, g);
     }
+    edit_consistency(md, g);
+    frame_times(md, g, &pitches);
+}
 
-    // Refusals and failures.
+fn disagreements(md: &mut String, g: &ProtocolGroup) {
+    let _ = writeln!(
+        md,
+        "### Cells that disagree across adapters ({} of {})\n",
+        g.disagreeing_cells,
+        g.cells.len()
+    );
+    if g.disagreeing_cells == 0 {
+        md.push_str("Every cell agrees within tolerance.\n\n");
+        return;
+    }
+    for c in g.cells.iter().filter(|c| !c.disagrees.is_empty()) {
+        disagreeing_cell(md, c);
+    }
+}
+
+/// One disagreeing cell: its fields, every adapter's value, the spread and
+/// the pictures side by side.
+fn disagreeing_cell(md: &mut String, c: &CellSpread) {
+    let fields: Vec<&str> = c.disagrees.iter().map(|f| field_title(f)).collect();
+    let _ = writeln!(
+        md,
+        "**{} / {}** ({}): {}\n",
+        cell_text(&c.view),
+        cell_text(&c.method),
+        pitch_label(c.pitch),
+        fields.join(", ")
+    );
+    let mut t = Table::new()
+        .left("adapter")
+        .columns(ACCURACY_TITLES, Align::Right)
+        .left("picture");
+    for v in &c.values {
+        let picture = or_dash(v.picture.as_ref().map(|p| format!("[png]({p})")));
+        t.row(
+            std::iter::once(v.adapter.clone())
+                .chain(accuracy_cells(&v.accuracy))
+                .chain([picture]),
+        );
+    }
+    for a in &c.absent {
+        let why = a
+            .failure
+            .as_ref()
+            .map_or("missing (run incomplete)".to_string(), |f| {
+                format!("refused: {f}")
+            });
+        t.row(
+            std::iter::once(a.adapter.clone())
+                .chain(std::iter::repeat_n("—".to_string(), 5))
+                .chain([why]),
+        );
+    }
+    if let Some(s) = &c.spread {
+        t.row(
+            std::iter::once("**spread**".to_string())
+                .chain(accuracy_cells(s))
+                .chain([String::new()]),
+        );
+    }
+    t.write_to(md);
+    md.push('\n');
+    match &c.side_by_side {
+        Some(p) => {
+            let _ = writeln!(
+                md,
+                "![{} {}: reference, then each adapter]({p})\n",
+                cell_text(&c.view),
+                cell_text(&c.method)
+            );
+        }
+        None => md.push_str("(no cell pictures found beside the results files)\n\n"),
+    }
+}
+
+fn refusals(md: &mut String, g: &ProtocolGroup) {
     let _ = writeln!(md, "### Refused or failed ({})\n", g.failures.len());
     if g.failures.is_empty() {
         md.push_str("Every method ran on every adapter of this group.\n\n");
-    } else {
-        md.push_str("| adapter | method | view | error |\n|---|---|---|---|\n");
-        for f in &g.failures {
-            let view = if f.view == "*" {
-                "every view"
-            } else {
-                f.view.as_str()
-            };
-            let _ = writeln!(
-                md,
-                "| {} | {} | {} | {} |",
-                cell_text(&f.adapter),
-                cell_text(&f.method),
-                cell_text(view),
-                cell_text(&f.error)
-            );
-        }
-        md.push('\n');
+        return;
     }
+    let mut t = Table::new().columns(["adapter", "method", "view", "error"], Align::Left);
+    for f in &g.failures {
+        let view = if f.view == "*" {
+            "every view"
+        } else {
+            f.view.as_str()
+        };
+        t.row([
+            f.adapter.as_str(),
+            f.method.as_str(),
+            view,
+            f.error.as_str(),
+        ]);
+    }
+    t.write_to(md);
+    md.push('\n');
+}
 
-    // Pitch means: methods and pitches down, adapters across, spread last.
-    let pitches = {
-        let mut ps: Vec<f32> = Vec::new();
-        for c in &g.cells {
-            if !ps.contains(&c.pitch) {
-                ps.push(c.pitch);
-            }
-        }
-        ps.sort_by(|a, b| b.total_cmp(a));
-        ps
-    };
-    let spread_col = g.adapters.len() > 1;
-    let accuracy_table = |md: &mut String, title: &str, fmt: &dyn Fn(&Accuracy) -> String| {
-        md.push_str(title);
-        md.push_str("\n\n| method / pitch |");
-        for a in &g.adapters {
-            let _ = write!(md, " {} |", cell_text(a));
-        }
-        if spread_col {
-            md.push_str(" spread |");
-        }
-        md.push_str("\n|---|");
-        for _ in &g.adapters {
-            md.push_str("---:|");
-        }
-        if spread_col {
-            md.push_str("---:|");
-        }
-        md.push('\n');
-        for m in &g.protocol.methods {
-            for &p in &pitches {
-                let _ = write!(md, "| {} / {} |", cell_text(m), pitch_label(p));
-                for a in &g.adapters {
-                    match g
-                        .pitch_means
-                        .iter()
-                        .find(|x| x.adapter == *a && x.method == *m && x.pitch == p)
-                    {
-                        Some(x) => {
-                            let _ = write!(md, " {} |", fmt(&x.mean));
-                        }
-                        None => md.push_str(" — |"),
-                    }
-                }
-                if spread_col {
-                    match g
-                        .pitch_spreads
-                        .iter()
-                        .find(|x| x.method == *m && x.pitch == p)
-                    {
-                        Some(x) => {
-                            let _ = write!(md, " {} |", fmt(&x.spread));
-                        }
-                        None => md.push_str(" — |"),
-                    }
-                }
-                md.push('\n');
-            }
-        }
-        md.push('\n');
-    };
+/// Pitch means: methods and pitches down, adapters across, spread last.
+fn accuracy_by_pitch(md: &mut String, g: &ProtocolGroup, pitches: &[f32]) {
     md.push_str("### Accuracy by pitch\n\n");
-    accuracy_table(
+    pitch_mean_table(
         md,
+        g,
+        pitches,
         "see-through / coherence error (% of pixels), mean over the views at each pitch; spread = max − min \
          of the adapters' means.",
         &|a| format!("{} / {}", num(a.see_through, 2), num(a.coherence, 2)),
     );
-    accuracy_table(
+    pitch_mean_table(
         md,
+        g,
+        pitches,
         "covers-sky (%) / depth error p50 / p95 (world units), same means.",
         &|a| {
             format!(
@@ -340,101 +325,142 @@ fn group_markdown(md: &mut String, g: &ProtocolGroup) {
             )
         },
     );
+}
 
-    if !g.method_max_spreads.is_empty() {
-        md.push_str("### Largest spread per method\n\n");
-        md.push_str(
-            "The largest max − min across adapters over the method's cells, each field on its own.\n\n\
-             | method | see-through % | covers-sky % | p50 | p95 | coherence % |\n\
-             |---|---:|---:|---:|---:|---:|\n",
-        );
-        for m in &g.method_max_spreads {
-            let a = &m.max;
-            let _ = writeln!(
-                md,
-                "| {} | {} | {} | {} | {} | {} |",
-                cell_text(&m.method),
-                num(a.see_through, 3),
-                num(a.covers_sky, 3),
-                num(a.depth_p50, 3),
-                num(a.depth_p95, 3),
-                num(a.coherence, 3)
-            );
-        }
-        md.push('\n');
+fn pitch_mean_table(
+    md: &mut String,
+    g: &ProtocolGroup,
+    pitches: &[f32],
+    title: &str,
+    fmt: &dyn Fn(&Accuracy) -> String,
+) {
+    let spread_col = g.adapters.len() > 1;
+    md.push_str(title);
+    md.push_str("\n\n");
+    let mut t = Table::new()
+        .left("method / pitch")
+        .columns(&g.adapters, Align::Right);
+    if spread_col {
+        t = t.right("spread");
     }
-
-    // Every cell's spread.
-    if g.adapters.len() > 1 {
-        md.push_str("### Spread per cell\n\n");
-        md.push_str(
-            "max − min across the adapters that have the cell; disagreeing cells first (**bold** fields \
-             beyond tolerance).\n\n\
-             | view | pitch | method | see-through | covers-sky | p50 | p95 | coherence | adapters |\n\
-             |---|---:|---|---:|---:|---:|---:|---:|---:|\n",
-        );
-        for c in &g.cells {
-            let _ = write!(
-                md,
-                "| {} | {} | {} |",
-                cell_text(&c.view),
-                c.pitch,
-                cell_text(&c.method)
-            );
-            for f in [
-                "see_through",
-                "covers_sky",
-                "depth_p50",
-                "depth_p95",
-                "coherence",
-            ] {
-                match c.spread.as_ref().and_then(|s| s.get(f)) {
-                    Some(v) if c.disagrees.iter().any(|d| d == f) => {
-                        let _ = write!(md, " **{}** |", num(v, 3));
-                    }
-                    Some(v) => {
-                        let _ = write!(md, " {} |", num(v, 3));
-                    }
-                    None => md.push_str(" — |"),
-                }
-            }
-            let _ = writeln!(md, " {} / {} |", c.values.len(), g.adapters.len());
-        }
-        md.push('\n');
-    }
-
-    // Edits.
-    if !g.edits.is_empty() {
-        md.push_str("### Edit consistency\n\n");
-        md.push_str(
-            "Post-edit frames until the edited renderer matches a fresh build, per adapter.\n\n",
-        );
-        md.push_str("| method |");
-        for a in &g.adapters {
-            let _ = write!(md, " {} |", cell_text(a));
-        }
-        md.push_str(" agrees |\n|---|");
-        for _ in &g.adapters {
-            md.push_str("---:|");
-        }
-        md.push_str("---|\n");
-        for e in &g.edits {
-            let _ = write!(md, "| {} |", cell_text(&e.method));
+    for m in &g.protocol.methods {
+        for &p in pitches {
+            let mut row = vec![format!("{m} / {}", pitch_label(p))];
             for a in &g.adapters {
-                match e.consistent_after_frames.iter().find(|(x, _)| x == a) {
-                    Some((_, Some(n))) => {
-                        let _ = write!(md, " {n} |");
-                    }
-                    Some((_, None)) => md.push_str(" not by 16 |"),
-                    None => md.push_str(" — |"),
-                }
+                let mean = g
+                    .pitch_means
+                    .iter()
+                    .find(|x| x.adapter == *a && x.method == *m && x.pitch == p);
+                row.push(or_dash(mean.map(|x| fmt(&x.mean))));
             }
-            let _ = writeln!(md, " {} |", if e.agrees { "yes" } else { "**no**" });
+            if spread_col {
+                let spread = g
+                    .pitch_spreads
+                    .iter()
+                    .find(|x| x.method == *m && x.pitch == p);
+                row.push(or_dash(spread.map(|x| fmt(&x.spread))));
+            }
+            t.row(row);
         }
-        md.push('\n');
     }
+    t.write_to(md);
+    md.push('\n');
+}
 
-    // Timing, apart per adapter and source.
+fn largest_spreads(md: &mut String, g: &ProtocolGroup) {
+    if g.method_max_spreads.is_empty() {
+        return;
+    }
+    md.push_str("### Largest spread per method\n\n");
+    md.push_str(
+        "The largest max − min across adapters over the method's cells, each field on its own.\n\n",
+    );
+    let mut t = Table::new()
+        .left("method")
+        .columns(ACCURACY_TITLES, Align::Right);
+    for m in &g.method_max_spreads {
+        t.row(std::iter::once(m.method.clone()).chain(accuracy_cells(&m.max)));
+    }
+    t.write_to(md);
+    md.push('\n');
+}
+
+/// Every cell's spread.
+fn cell_spreads(md: &mut String, g: &ProtocolGroup) {
+    md.push_str("### Spread per cell\n\n");
+    md.push_str(
+        "max − min across the adapters that have the cell; disagreeing cells first (**bold** fields \
+         beyond tolerance).\n\n",
+    );
+    let mut t = Table::new()
+        .left("view")
+        .right("pitch")
+        .left("method")
+        .columns(
+            [
+                "see-through",
+                "covers-sky",
+                "p50",
+                "p95",
+                "coherence",
+                "adapters",
+            ],
+            Align::Right,
+        );
+    for c in &g.cells {
+        let mut row = vec![c.view.clone(), c.pitch.to_string(), c.method.clone()];
+        for f in [
+            "see_through",
+            "covers_sky",
+            "depth_p50",
+            "depth_p95",
+            "coherence",
+        ] {
+            row.push(match c.spread.as_ref().and_then(|s| s.get(f)) {
+                Some(v) if c.disagrees.iter().any(|d| d == f) => format!("**{}**", num(v, 3)),
+                Some(v) => num(v, 3),
+                None => "—".into(),
+            });
+        }
+        row.push(format!("{} / {}", c.values.len(), g.adapters.len()));
+        t.row(row);
+    }
+    t.write_to(md);
+    md.push('\n');
+}
+
+fn edit_consistency(md: &mut String, g: &ProtocolGroup) {
+    if g.edits.is_empty() {
+        return;
+    }
+    md.push_str("### Edit consistency\n\n");
+    md.push_str(
+        "Post-edit frames until the edited renderer matches a fresh build, per adapter.\n\n",
+    );
+    let mut t = Table::new()
+        .left("method")
+        .columns(&g.adapters, Align::Right)
+        .left("agrees");
+    for e in &g.edits {
+        let mut row = vec![e.method.clone()];
+        for a in &g.adapters {
+            row.push(
+                match e.consistent_after_frames.iter().find(|(x, _)| x == a) {
+                    Some((_, Some(n))) => n.to_string(),
+                    Some((_, None)) => "not by 16".into(),
+                    None => "—".into(),
+                },
+            );
+        }
+        row.push(if e.agrees { "yes" } else { "**no**" }.to_string());
+        t.row(row);
+    }
+    t.write_to(md);
+    md.push('\n');
+}
+
+/// Timing, apart per adapter and source.
+fn frame_times(md: &mut String, g: &ProtocolGroup, pitches: &[f32]) {
     md.push_str("### Frame time (ms)\n\n");
     md.push_str(
         "Mean over the views of each view's frame mean, one row per adapter, timing source and pitch. GPU \
@@ -442,15 +468,9 @@ fn group_markdown(md: &mut String, g: &ProtocolGroup) {
          GPU's work (what the paper reports where an adapter has no timestamps). Rows of different sources \
          are not comparable with each other.\n\n",
     );
-    md.push_str("| adapter | source | pitch |");
-    for m in &g.protocol.methods {
-        let _ = write!(md, " {} |", cell_text(m));
-    }
-    md.push_str("\n|---|---|---|");
-    for _ in &g.protocol.methods {
-        md.push_str("---:|");
-    }
-    md.push('\n');
+    let mut t = Table::new()
+        .columns(["adapter", "source", "pitch"], Align::Left)
+        .columns(&g.protocol.methods, Align::Right);
     for a in &g.adapters {
         for source in [TimingSource::GpuTimestamps, TimingSource::CpuSubmitWait] {
             if !g
@@ -462,26 +482,21 @@ fn group_markdown(md: &mut String, g: &ProtocolGroup) {
             }
             let pitch_rows = pitches.iter().map(|&p| Some(p)).chain([None]);
             for p in pitch_rows {
-                let _ = write!(
-                    md,
-                    "| {} | {} | {} |",
-                    cell_text(a),
-                    source_title(source),
-                    p.map_or("all views".to_string(), pitch_label)
-                );
+                let mut row = vec![
+                    a.clone(),
+                    source_title(source).to_string(),
+                    p.map_or("all views".to_string(), pitch_label),
+                ];
                 for m in &g.protocol.methods {
-                    match g.timing.iter().find(|t| {
+                    let time = g.timing.iter().find(|t| {
                         t.adapter == *a && t.source == source && t.method == *m && t.pitch == p
-                    }) {
-                        Some(t) => {
-                            let _ = write!(md, " {} |", num(t.mean_ms, 3));
-                        }
-                        None => md.push_str(" — |"),
-                    }
+                    });
+                    row.push(or_dash(time.map(|t| num(t.mean_ms, 3))));
                 }
-                md.push('\n');
+                t.row(row);
             }
         }
     }
+    t.write_to(md);
     md.push('\n');
 }

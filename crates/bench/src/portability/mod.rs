@@ -13,14 +13,13 @@
 //! and per timing source (GPU timestamps vs CPU submit-and-wait).
 
 use crate::grid;
-use crate::merge::{DEPTH_FIELDS, DEPTH_TOLERANCE, PERCENT_FIELDS, PERCENT_TOLERANCE};
+use crate::merge::{DEPTH_TOLERANCE, PERCENT_TOLERANCE, fields_with_tolerance};
 use crate::plan::file_part;
 use crate::results::{AdapterInfo, Row, RunResults, TimingSource, slug};
 use crate::stats;
 use anyhow::{Context, bail};
 use image::RgbaImage;
 use serde::{Deserialize, Serialize};
-use std::fmt::Write as _;
 use std::path::{Component, Path, PathBuf};
 
 /// Bumped when a field of `portability.json` changes meaning.
@@ -158,30 +157,46 @@ impl Accuracy {
         })
     }
 
+    /// Each field of the result is `f` of that field's values over `xs`;
+    /// `None` when `f` gives none for some field.
+    fn fieldwise(xs: &[Accuracy], f: impl Fn(&[f64]) -> Option<f64>) -> Option<Accuracy> {
+        let field = |get: fn(&Accuracy) -> f64| f(&xs.iter().map(get).collect::<Vec<f64>>());
+        Some(Accuracy {
+            see_through: field(|a| a.see_through)?,
+            covers_sky: field(|a| a.covers_sky)?,
+            depth_p50: field(|a| a.depth_p50)?,
+            depth_p95: field(|a| a.depth_p95)?,
+            coherence: field(|a| a.coherence)?,
+        })
+    }
+
+    /// Field-wise mean over `xs` (NaN where there are none).
+    fn mean(xs: &[Accuracy]) -> Accuracy {
+        let mean = |v: &[f64]| Some(stats::mean(v).unwrap_or(f64::NAN));
+        Accuracy::fieldwise(xs, mean).expect("a mean for every field")
+    }
+
     /// Field-wise max − min over `xs`; `None` for fewer than two.
     fn spread(xs: &[Accuracy]) -> Option<Accuracy> {
         if xs.len() < 2 {
             return None;
         }
-        let range = |f: fn(&Accuracy) -> f64| {
-            let v: Vec<f64> = xs.iter().map(f).collect();
+        Accuracy::fieldwise(xs, |v| {
             // A NaN on some adapters only is an infinite spread; on all, none.
-            if v.iter().all(|x| x.is_nan()) {
+            Some(if v.iter().all(|x| x.is_nan()) {
                 0.0
             } else if v.iter().any(|x| x.is_nan()) {
                 f64::INFINITY
             } else {
                 v.iter().copied().fold(f64::NEG_INFINITY, f64::max)
                     - v.iter().copied().fold(f64::INFINITY, f64::min)
-            }
-        };
-        Some(Accuracy {
-            see_through: range(|a| a.see_through),
-            covers_sky: range(|a| a.covers_sky),
-            depth_p50: range(|a| a.depth_p50),
-            depth_p95: range(|a| a.depth_p95),
-            coherence: range(|a| a.coherence),
+            })
         })
+    }
+
+    /// Field-wise maximum over `xs`; `None` for none.
+    fn max(xs: &[Accuracy]) -> Option<Accuracy> {
+        Accuracy::fieldwise(xs, |v| v.iter().copied().reduce(f64::max))
     }
 }
 
@@ -255,14 +270,8 @@ impl CellSpread {
         let Some(s) = &self.spread else {
             return 0.0;
         };
-        PERCENT_FIELDS
-            .iter()
-            .map(|(n, _)| s.get(n).unwrap_or(0.0) / PERCENT_TOLERANCE)
-            .chain(
-                DEPTH_FIELDS
-                    .iter()
-                    .map(|(n, _)| s.get(n).unwrap_or(0.0) / DEPTH_TOLERANCE),
-            )
+        fields_with_tolerance()
+            .map(|((n, _), tol)| s.get(n).unwrap_or(0.0) / tol)
             .fold(0.0, f64::max)
     }
 }
@@ -505,261 +514,6 @@ impl Member<'_> {
     }
 }
 
-fn build_group(
-    id: String,
-    members: &[Member<'_>],
-    separate_because: Option<String>,
-    out: &Path,
-) -> ProtocolGroup {
-    let base = members[0].run;
-    let s = &base.settings;
-    let protocol = ProtocolSummary {
-        protocol_version: base.protocol_version,
-        level: base.level.name.clone(),
-        level_hash: base.level.hash.clone(),
-        width: s.width,
-        height: s.height,
-        far: s.far,
-        frames: s.frames,
-        shadows: s.shadows,
-        edits: s.edits,
-        mid_rule: s.mid_rule.clone(),
-        methods: s.methods.clone(),
-        views: s.views.iter().map(|v| v.name.clone()).collect(),
-    };
-    let pitches = crate::report::pitches(base);
-
-    let mut pitch_means = Vec::new();
-    let mut pitch_spreads = Vec::new();
-    for m in &s.methods {
-        for &p in &pitches {
-            let mut means = Vec::new();
-            for mem in members {
-                let rows: Vec<&Row> = mem
-                    .run
-                    .rows
-                    .iter()
-                    .filter(|r| r.method == *m && r.pitch == p)
-                    .collect();
-                if rows.is_empty() {
-                    continue;
-                }
-                let mean_of = |f: fn(&Row) -> f64| {
-                    let xs: Vec<f64> = rows.iter().map(|r| f(r)).collect();
-                    stats::mean(&xs).unwrap_or(f64::NAN)
-                };
-                let mean = Accuracy {
-                    see_through: mean_of(|r| r.see_through),
-                    covers_sky: mean_of(|r| r.covers_sky),
-                    depth_p50: mean_of(|r| r.depth_p50),
-                    depth_p95: mean_of(|r| r.depth_p95),
-                    coherence: mean_of(|r| r.coherence),
-                };
-                means.push(mean);
-                pitch_means.push(PitchMean {
-                    adapter: mem.label.to_string(),
-                    method: m.clone(),
-                    pitch: p,
-                    views: rows.len(),
-                    mean,
-                });
-            }
-            if let Some(spread) = Accuracy::spread(&means) {
-                pitch_spreads.push(PitchSpread {
-                    method: m.clone(),
-                    pitch: p,
-                    spread,
-                });
-            }
-        }
-    }
-
-    let mut cells = Vec::new();
-    for view in &s.views {
-        for m in &s.methods {
-            let mut values = Vec::new();
-            let mut absent = Vec::new();
-            for mem in members {
-                match mem
-                    .run
-                    .rows
-                    .iter()
-                    .find(|r| r.view == view.name && r.method == *m)
-                {
-                    Some(r) => values.push(CellValue {
-                        adapter: mem.label.to_string(),
-                        accuracy: Accuracy::of(r),
-                        picture: mem.picture(&r.image, out),
-                    }),
-                    None => absent.push(CellAbsence {
-                        adapter: mem.label.to_string(),
-                        failure: mem.failure_for(&view.name, m).map(|f| f.error.clone()),
-                    }),
-                }
-            }
-            let accs: Vec<Accuracy> = values.iter().map(|v| v.accuracy).collect();
-            let spread = Accuracy::spread(&accs);
-            let mut disagrees = Vec::new();
-            if let Some(sp) = &spread {
-                let fields = PERCENT_FIELDS
-                    .iter()
-                    .map(|f| (f, PERCENT_TOLERANCE))
-                    .chain(DEPTH_FIELDS.iter().map(|f| (f, DEPTH_TOLERANCE)));
-                for ((name, _), tol) in fields {
-                    let name: &str = name;
-                    if sp.get(name).is_some_and(|v| v > tol) {
-                        disagrees.push(name.to_string());
-                    }
-                }
-            }
-            // A lacking cell only disagrees when it is not explained by a
-            // recorded failure, and only in a group of several adapters.
-            if members.len() > 1 && absent.iter().any(|a| a.failure.is_none()) {
-                disagrees.push("cell".to_string());
-            }
-            let reference_picture = members.iter().find_map(|mem| {
-                mem.run
-                    .reference_images
-                    .iter()
-                    .find(|r| r.view == view.name)
-                    .and_then(|r| mem.picture(&r.image, out))
-            });
-            cells.push(CellSpread {
-                view: view.name.clone(),
-                pitch: view.pitch,
-                method: m.clone(),
-                values,
-                absent,
-                spread,
-                disagrees,
-                reference_picture,
-                side_by_side: None,
-            });
-        }
-    }
-    // Disagreeing cells first, the worst first; the rest in view x method order.
-    cells.sort_by(|a, b| {
-        let (da, db) = (!a.disagrees.is_empty(), !b.disagrees.is_empty());
-        db.cmp(&da).then_with(|| {
-            if da {
-                b.excess().total_cmp(&a.excess())
-            } else {
-                std::cmp::Ordering::Equal
-            }
-        })
-    });
-    let disagreeing_cells = cells.iter().filter(|c| !c.disagrees.is_empty()).count();
-    let method_max_spreads = s
-        .methods
-        .iter()
-        .filter_map(|m| {
-            let spreads: Vec<Accuracy> = cells
-                .iter()
-                .filter(|c| c.method == *m)
-                .filter_map(|c| c.spread)
-                .collect();
-            let max = |f: fn(&Accuracy) -> f64| spreads.iter().map(f).reduce(f64::max);
-            Some(MethodSpread {
-                method: m.clone(),
-                max: Accuracy {
-                    see_through: max(|a| a.see_through)?,
-                    covers_sky: max(|a| a.covers_sky)?,
-                    depth_p50: max(|a| a.depth_p50)?,
-                    depth_p95: max(|a| a.depth_p95)?,
-                    coherence: max(|a| a.coherence)?,
-                },
-            })
-        })
-        .collect();
-
-    let failures = members
-        .iter()
-        .flat_map(|mem| {
-            mem.run.failures.iter().map(|f| AdapterFailure {
-                adapter: mem.label.to_string(),
-                view: f.view.clone(),
-                method: f.method.clone(),
-                error: f.error.clone(),
-            })
-        })
-        .collect();
-
-    let mut edits = Vec::new();
-    for m in &s.methods {
-        let per: Vec<(String, Option<u32>)> = members
-            .iter()
-            .filter_map(|mem| {
-                mem.run
-                    .edit_rows
-                    .iter()
-                    .find(|e| e.method == *m)
-                    .map(|e| (mem.label.to_string(), e.consistent_after_frames))
-            })
-            .collect();
-        if per.is_empty() {
-            continue;
-        }
-        let agrees = per.iter().all(|(_, n)| *n == per[0].1);
-        edits.push(EditAgreement {
-            method: m.clone(),
-            consistent_after_frames: per,
-            agrees,
-        });
-    }
-
-    let mut timing = Vec::new();
-    for mem in members {
-        for source in [TimingSource::GpuTimestamps, TimingSource::CpuSubmitWait] {
-            // CPU submit-and-wait is measured on every row; GPU time only
-            // where the row's frames all carried timestamps.
-            let time = |r: &Row| match source {
-                TimingSource::GpuTimestamps => r.gpu_ms_mean,
-                TimingSource::CpuSubmitWait => Some(r.cpu_ms_mean),
-            };
-            if !mem.run.rows.iter().any(|r| time(r).is_some()) {
-                continue;
-            }
-            for m in &s.methods {
-                let pitch_sets = pitches.iter().map(|&p| Some(p)).chain([None]);
-                for p in pitch_sets {
-                    let xs: Vec<f64> = mem
-                        .run
-                        .rows
-                        .iter()
-                        .filter(|r| r.method == *m && p.is_none_or(|p| r.pitch == p))
-                        .filter_map(time)
-                        .collect();
-                    if let Some(mean) = stats::mean(&xs) {
-                        timing.push(TimingRow {
-                            adapter: mem.label.to_string(),
-                            source,
-                            method: m.clone(),
-                            pitch: p,
-                            views: xs.len(),
-                            mean_ms: mean,
-                        });
-                    }
-                }
-            }
-        }
-    }
-
-    ProtocolGroup {
-        id,
-        protocol,
-        adapters: members.iter().map(|m| m.label.to_string()).collect(),
-        separate_because,
-        pitch_means,
-        pitch_spreads,
-        method_max_spreads,
-        cells,
-        disagreeing_cells,
-        failures,
-        edits,
-        timing,
-    }
-}
-
 /// Compose the side-by-side picture of every disagreeing cell into
 /// `<out>/disagreements/` and record its path. Cells whose pictures are
 /// all missing get none.
@@ -893,7 +647,9 @@ pub fn adapter_dir_name(name: &str, backend: &str) -> String {
     slug(&format!("{name} {backend}"))
 }
 
+mod build;
 mod markdown;
+use build::build_group;
 pub use markdown::render_markdown;
 
 #[cfg(test)]

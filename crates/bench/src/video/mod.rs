@@ -10,9 +10,9 @@ pub mod tiles;
 
 use crate::methods::{describe, settings_for};
 use crate::plan::MethodChoice;
-use crate::run::{INCREMENTAL_BUDGET_TEXELS, ms, warm_up};
 use crate::session::color_image;
 use crate::stats::mean;
+use crate::warm::{build_frames, ms, warm_up};
 use anyhow::Context;
 use encode::FrameSink;
 use indicatif::ProgressBar;
@@ -322,8 +322,7 @@ fn build_lane(
     let setup_ms = ms(start);
     // Settle incremental builds before the first frame (as compare's first
     // view does), so the video shows the edit's catch-up, not the initial build.
-    let texels = u64::from(level.width()) * u64::from(level.height());
-    let cap = u32::try_from(texels.div_ceil(INCREMENTAL_BUDGET_TEXELS)).unwrap_or(u32::MAX);
+    let cap = build_frames(level);
     warm_up(&mut renderer, first, 1, cap + 1, gpu.report.timestamps)?;
     Ok(Lane {
         choice: choice.clone(),

@@ -408,21 +408,49 @@ impl Terrain {
         if lx < x0 || ly < y0 || lx >= x1 || ly >= y1 {
             return t;
         }
-        let (u, v, pw, ph) = (lx - x0, ly - y0, x1 - x0, y1 - y0);
-        let h = plan.hash;
-        let (xf, yf) = (x as f32, y as f32);
+        let lot = Lot {
+            floor: plan.floor,
+            lx: lx - x0,
+            ly: ly - y0,
+            pw: x1 - x0,
+            ph: y1 - y0,
+            h: plan.hash,
+            xf: x as f32,
+            yf: y as f32,
+        };
         match plan.kind {
             District::Natural => t,
-            District::Pits => pits(self, t, u, v, h, xf, yf),
-            District::Furrows => furrows(t, u, v, pw, ph, h),
-            District::Hall => hall(self, plan.floor, u, v, pw, ph, h, xf, yf),
-            District::Hangars => hangars(self, plan.floor, u, v, pw, ph, h, xf, yf),
+            District::Pits => pits(self, t, &lot),
+            District::Furrows => furrows(t, &lot),
+            District::Hall => hall(self, &lot),
+            District::Hangars => hangars(self, &lot),
         }
     }
 }
 
+/// Where in its district's rectangle a texel lies, and what the patterns
+/// read of the district.
+struct Lot {
+    /// The district's floor height.
+    floor: i32,
+    /// The texel in the rectangle.
+    lx: i32,
+    ly: i32,
+    /// The rectangle's size.
+    pw: i32,
+    ph: i32,
+    /// The district's hash.
+    h: u32,
+    /// The texel in the map, for the noise.
+    xf: f32,
+    yf: f32,
+}
+
 /// A grid of round pits, each stepped with a raised rim.
-fn pits(tr: &Terrain, t: Texel, lx: i32, ly: i32, h: u32, xf: f32, yf: f32) -> Texel {
+fn pits(tr: &Terrain, t: Texel, lot: &Lot) -> Texel {
+    let &Lot {
+        lx, ly, h, xf, yf, ..
+    } = lot;
     let sp = 20 + 4 * (h % 3) as i32;
     let r = sp as f32 * 0.33;
     let u = (lx % sp) as f32 - sp as f32 * 0.5 + 0.5;
@@ -445,7 +473,10 @@ fn pits(tr: &Terrain, t: Texel, lx: i32, ly: i32, h: u32, xf: f32, yf: f32) -> T
 }
 
 /// Fields of parallel ridges, four patches with their own direction.
-fn furrows(t: Texel, lx: i32, ly: i32, pw: i32, ph: i32, h: u32) -> Texel {
+fn furrows(t: Texel, lot: &Lot) -> Texel {
+    let &Lot {
+        lx, ly, pw, ph, h, ..
+    } = lot;
     if t.slab.is_some() {
         return t;
     }
@@ -469,18 +500,17 @@ fn furrows(t: Texel, lx: i32, ly: i32, pw: i32, ph: i32, h: u32) -> Texel {
 
 /// A pillared cave hall: a flat roof slab over a flat floor, walls with
 /// doorways, square pillars and a few skylights.
-#[allow(clippy::too_many_arguments)]
-fn hall(
-    tr: &Terrain,
-    floor: i32,
-    lx: i32,
-    ly: i32,
-    pw: i32,
-    ph: i32,
-    h: u32,
-    xf: f32,
-    yf: f32,
-) -> Texel {
+fn hall(tr: &Terrain, lot: &Lot) -> Texel {
+    let &Lot {
+        floor,
+        lx,
+        ly,
+        pw,
+        ph,
+        h,
+        xf,
+        yf,
+    } = lot;
     let ty = tr.region_type(xf, yf);
     let roof_ty = (ty + 2) % 7 + 1;
     let top = floor + 34 + (h % 3) as i32 * 8;
@@ -515,36 +545,28 @@ fn hall(
 }
 
 /// A row of arch-roofed hangars on a flat apron, open at the south end.
-#[allow(clippy::too_many_arguments)]
-fn hangars(
-    tr: &Terrain,
-    floor: i32,
-    lx: i32,
-    ly: i32,
-    pw: i32,
-    ph: i32,
-    h: u32,
-    xf: f32,
-    yf: f32,
-) -> Texel {
-    let ground = floor + (tr.fine(xf, yf) >> 1);
+fn hangars(tr: &Terrain, lot: &Lot) -> Texel {
+    let ground = lot.floor + (tr.fine(lot.xf, lot.yf) >> 1);
     // Apron markings: a raised line every 16 texels.
-    let apron = Texel::single(ground + ((lx % 16 == 0 || ly % 16 == 0) as i32), ROAD);
+    let apron = Texel::single(
+        ground + ((lot.lx % 16 == 0 || lot.ly % 16 == 0) as i32),
+        ROAD,
+    );
     let (hw, gap) = (40, 16);
-    let hl = (72 + (h % 3) as i32 * 16).min(ph - 8);
+    let hl = (72 + (lot.h % 3) as i32 * 16).min(lot.ph - 8);
     let stride = hw + gap;
-    let count = (pw - gap) / stride;
-    let k = (lx - gap / 2) / stride;
-    let u = (lx - gap / 2) % stride;
-    let v = ly - (ph - hl) / 2;
-    if k >= count || lx < gap / 2 || u >= hw || v < 0 || v >= hl {
+    let count = (lot.pw - gap) / stride;
+    let k = (lot.lx - gap / 2) / stride;
+    let u = (lot.lx - gap / 2) % stride;
+    let v = lot.ly - (lot.ph - hl) / 2;
+    if k >= count || lot.lx < gap / 2 || u >= hw || v < 0 || v >= hl {
         return apron;
     }
     let tt = (u as f32 + 0.5 - hw as f32 * 0.5) / (hw as f32 * 0.5);
-    let roof = floor + 22 + (14.0 * (1.0 - tt * tt).max(0.0).sqrt()).round() as i32;
+    let roof = lot.floor + 22 + (14.0 * (1.0 - tt * tt).max(0.0).sqrt()).round() as i32;
     if u < 2 || u >= hw - 2 || v >= hl - 2 {
         return Texel::single(roof, METAL); // side and back walls
     }
     // A low lintel over the open front, the full hall height inside.
-    apron.with_slab(floor + if v < 4 { 16 } else { 20 }, roof, METAL)
+    apron.with_slab(lot.floor + if v < 4 { 16 } else { 20 }, roof, METAL)
 }

@@ -2,10 +2,19 @@
 //! different adapters (`strata merge`). Accuracy comes from the first run
 //! (the baseline); the other runs are cross-checked in `merge`.
 
-use crate::merge::Disagreement;
-use crate::results::{EditRow, FlipScore, Row, RunResults, TimingSource};
 use crate::stats;
+use crate::{Disagreement, EditRow, FlipScore, Row, RunResults, TimingSource};
 use std::fmt::Write as _;
+use strata_markdown::{Align, Table, cell_text};
+
+/// A figure written as `<name>.png` and `<name>.svg`: relative paths
+/// (`strata_bench::figures` draws them).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Figure {
+    pub title: String,
+    pub png: String,
+    pub svg: String,
+}
 
 /// What the report embeds besides the tables.
 #[derive(Clone, Debug, Default)]
@@ -15,27 +24,9 @@ pub struct Pictures {
     /// Column titles of the grid, left to right.
     pub grid_columns: Vec<String>,
     /// The plotted figures (PNG and SVG), relative paths.
-    pub figures: Vec<crate::figures::Figure>,
+    pub figures: Vec<Figure>,
     /// The edit figure and its row titles.
     pub edit_figure: Option<(String, Vec<String>)>,
-}
-
-impl Pictures {
-    /// Draw the figures of `runs` into `dir` (a failure costs the figures,
-    /// with a warning, never the report).
-    pub fn with_figures(mut self, runs: &[RunResults], dir: &std::path::Path) -> Self {
-        match crate::figures::write_all(runs, dir) {
-            Ok(f) => self.figures = f,
-            Err(e) => eprintln!("warning: figures not drawn: {e:#}"),
-        }
-        if let Some(base) = runs.first() {
-            match crate::figures::edit_figure(base, dir) {
-                Ok(f) => self.edit_figure = f,
-                Err(e) => eprintln!("warning: edit figure not drawn: {e:#}"),
-            }
-        }
-        self
-    }
 }
 
 /// Render the report. `runs` must be non-empty; the first is the baseline.
@@ -44,7 +35,27 @@ pub fn render(runs: &[RunResults], pictures: &Pictures, disagreements: &[Disagre
     let Some(base) = runs.first() else {
         return "# Strata comparison\n\nNo runs.\n".into();
     };
-    let methods = &base.settings.methods;
+    heading(&mut md, base);
+    adapters_table(&mut md, runs);
+    grid(&mut md, base, pictures);
+    failures(&mut md, runs);
+    accuracy_tables(&mut md, base);
+    flip_table(&mut md, base);
+    if runs.len() > 1 {
+        cross_check(&mut md, runs, disagreements);
+    }
+    timing_tables(&mut md, runs);
+    preparation_table(&mut md, runs);
+    memory_table(&mut md, base);
+    edit_tables(&mut md, runs);
+    temporal_table(&mut md, runs);
+    figures(&mut md, pictures);
+    per_view_table(&mut md, base);
+    md
+}
+
+/// The title and the protocol in one paragraph.
+fn heading(md: &mut String, base: &RunResults) {
     let s = &base.settings;
     let _ = writeln!(md, "# Strata comparison: {}\n", base.level.name);
     let _ = writeln!(
@@ -69,70 +80,69 @@ pub fn render(runs: &[RunResults], pictures: &Pictures, disagreements: &[Disagre
         },
         if s.shadows { "on" } else { "off" },
         s.views.len(),
-        methods.len(),
+        s.methods.len(),
         base.protocol_version,
     );
-    md.push_str(
-        "| adapter | backend | driver | timing | revision | cells |\n|---|---|---|---|---|---|\n",
+}
+
+/// One row per run: the adapter, its timing source, revision and cells.
+fn adapters_table(md: &mut String, runs: &[RunResults]) {
+    let mut t = Table::new().columns(
+        [
+            "adapter", "backend", "driver", "timing", "revision", "cells",
+        ],
+        Align::Left,
     );
     for run in runs {
         let expected = run.settings.views.len() * run.settings.methods.len();
-        let _ = writeln!(
-            md,
-            "| {} | {} | {} | {} | `{}` | {} / {}{} |",
-            cell_text(&run.adapter.name),
-            cell_text(&run.adapter.backend),
-            cell_text(&run.adapter.driver),
+        t.row([
+            run.adapter.name.clone(),
+            run.adapter.backend.clone(),
+            run.adapter.driver.clone(),
             if run.adapter.timestamps {
                 "GPU timestamps"
             } else {
                 "CPU submit-and-wait*"
-            },
-            cell_text(&run.source_revision),
-            run.rows.len(),
-            expected,
-            if run.complete { "" } else { " (incomplete)" },
-        );
-    }
-    md.push('\n');
-
-    if let Some(grid) = &pictures.grid {
-        let _ = writeln!(md, "![views down, methods across]({grid})\n");
-        let _ = writeln!(
-            md,
-            "Views down ({}); columns: {}.\n",
-            s.views
-                .iter()
-                .map(|v| v.name.as_str())
-                .collect::<Vec<_>>()
-                .join(", "),
-            pictures.grid_columns.join(", ")
-        );
-    }
-
-    for run in runs {
-        if !run.failures.is_empty() {
-            let _ = writeln!(md, "**Failures on {}:**\n", cell_text(&run.adapter.name));
-            for f in &run.failures {
-                let _ = writeln!(md, "- {} at {}: {}", f.method, f.view, cell_text(&f.error));
             }
-            md.push('\n');
-        }
+            .to_string(),
+            format!("`{}`", run.source_revision),
+            format!(
+                "{} / {expected}{}",
+                run.rows.len(),
+                if run.complete { "" } else { " (incomplete)" }
+            ),
+        ]);
     }
+    t.write_to(md);
+    md.push('\n');
+}
 
-    accuracy_tables(&mut md, base);
-    flip_table(&mut md, base);
-    if runs.len() > 1 {
-        cross_check(&mut md, runs, disagreements);
+fn grid(md: &mut String, base: &RunResults, pictures: &Pictures) {
+    let Some(grid) = &pictures.grid else {
+        return;
+    };
+    let _ = writeln!(md, "![views down, methods across]({grid})\n");
+    let _ = writeln!(
+        md,
+        "Views down ({}); columns: {}.\n",
+        base.settings
+            .views
+            .iter()
+            .map(|v| v.name.as_str())
+            .collect::<Vec<_>>()
+            .join(", "),
+        pictures.grid_columns.join(", ")
+    );
+}
+
+fn failures(md: &mut String, runs: &[RunResults]) {
+    for run in runs.iter().filter(|r| !r.failures.is_empty()) {
+        let _ = writeln!(md, "**Failures on {}:**\n", cell_text(&run.adapter.name));
+        for f in &run.failures {
+            let _ = writeln!(md, "- {} at {}: {}", f.method, f.view, cell_text(&f.error));
+        }
+        md.push('\n');
     }
-    timing_tables(&mut md, runs);
-    preparation_table(&mut md, runs);
-    memory_table(&mut md, base);
-    edit_tables(&mut md, runs);
-    temporal_table(&mut md, runs);
-    figures(&mut md, pictures);
-    per_view_table(&mut md, base);
-    md
 }
 
 fn figures(md: &mut String, pictures: &Pictures) {
@@ -170,23 +180,26 @@ fn temporal_table(md: &mut String, runs: &[RunResults]) {
          when the reference does not: mean over frame pairs / worst pair, along the video's \
          default path played short (the crater dug midway).\n\n",
     );
-    md.push_str("| adapter | method | flicker % mean / worst | frames | dug | frame ms |\n|---|---|---:|---:|---|---:|\n");
+    let mut t = Table::new()
+        .left("adapter")
+        .left("method")
+        .right("flicker % mean / worst")
+        .right("frames")
+        .left("dug")
+        .right("frame ms");
     for run in runs {
-        for t in &run.temporal {
-            let _ = writeln!(
-                md,
-                "| {} | {} | {:.2} / {:.2} | {} at {} fps | {} | {:.2} |",
-                cell_text(&run.adapter.name),
-                t.method,
-                t.flicker_mean,
-                t.flicker_max,
-                t.frames,
-                t.fps,
-                if t.dug { "yes" } else { "no" },
-                t.frame_ms_mean
-            );
+        for r in &run.temporal {
+            t.row([
+                run.adapter.name.clone(),
+                r.method.clone(),
+                format!("{:.2} / {:.2}", r.flicker_mean, r.flicker_max),
+                format!("{} at {} fps", r.frames, r.fps),
+                if r.dug { "yes" } else { "no" }.to_string(),
+                format!("{:.2}", r.frame_ms_mean),
+            ]);
         }
     }
+    t.write_to(md);
     md.push('\n');
 }
 
@@ -194,24 +207,25 @@ fn short_hash(h: &str) -> &str {
     h.get(..12).unwrap_or(h)
 }
 
-/// Keep user text from breaking a table row.
-fn cell_text(s: &str) -> String {
-    s.replace('|', "/").replace('\n', " ")
-}
-
 /// Distinct pitches in view order, highest (horizon) first.
 pub fn pitches(run: &RunResults) -> Vec<f32> {
+    distinct_pitches(run.settings.views.iter().map(|v| v.pitch))
+}
+
+/// The distinct values of `pitches`, highest (horizon) first.
+pub fn distinct_pitches(pitches: impl IntoIterator<Item = f32>) -> Vec<f32> {
     let mut ps: Vec<f32> = Vec::new();
-    for v in &run.settings.views {
-        if !ps.contains(&v.pitch) {
-            ps.push(v.pitch);
+    for p in pitches {
+        if !ps.contains(&p) {
+            ps.push(p);
         }
     }
     ps.sort_by(|a, b| b.total_cmp(a));
     ps
 }
 
-fn pitch_label(p: f32) -> String {
+/// A pitch as the tables write it (`-45°`).
+pub fn pitch_label(p: f32) -> String {
     format!("{p}°")
 }
 
@@ -228,58 +242,47 @@ fn pitch_mean(run: &RunResults, method: &str, pitch: f32, f: impl Fn(&Row) -> f6
     stats::mean(&xs)
 }
 
-fn header(md: &mut String, first: &str, methods: &[String]) {
-    let _ = write!(md, "| {first} |");
-    for m in methods {
-        let _ = write!(md, " {m} |");
+/// A table of one row title column, then one number column per method.
+fn per_method(first: &str, methods: &[String]) -> Table {
+    Table::new().left(first).columns(methods, Align::Right)
+}
+
+/// A value or the dash of a missing one.
+fn or_dash(v: Option<String>) -> String {
+    v.unwrap_or_else(|| "—".into())
+}
+
+/// One row per pitch, one column per method: `cell` formats the method's
+/// rows at that pitch.
+fn pitch_table(md: &mut String, run: &RunResults, cell: impl Fn(&str, f32) -> Option<String>) {
+    let methods = &run.settings.methods;
+    let mut t = per_method("pitch", methods);
+    for p in pitches(run) {
+        let cells = methods.iter().map(|m| or_dash(cell(m, p)));
+        t.row(std::iter::once(pitch_label(p)).chain(cells));
     }
-    md.push_str("\n|---|");
-    for _ in methods {
-        md.push_str("---:|");
-    }
-    md.push('\n');
+    t.write_to(md);
 }
 
 fn accuracy_tables(md: &mut String, run: &RunResults) {
-    let methods = &run.settings.methods;
     md.push_str("## Accuracy by pitch\n\n");
     let _ = writeln!(
         md,
         "see-through / coherence error (% of pixels), arithmetic mean over the views at each pitch ({}).\n",
         cell_text(&run.adapter.name)
     );
-    header(md, "pitch", methods);
-    for p in pitches(run) {
-        let _ = write!(md, "| {} |", pitch_label(p));
-        for m in methods {
-            let see = pitch_mean(run, m, p, |r| r.see_through);
-            let coh = pitch_mean(run, m, p, |r| r.coherence);
-            match (see, coh) {
-                (Some(a), Some(b)) => {
-                    let _ = write!(md, " {a:.1} / {b:.1} |");
-                }
-                _ => md.push_str(" — |"),
-            }
-        }
-        md.push('\n');
-    }
+    pitch_table(md, run, |m, p| {
+        let see = pitch_mean(run, m, p, |r| r.see_through)?;
+        let coh = pitch_mean(run, m, p, |r| r.coherence)?;
+        Some(format!("{see:.1} / {coh:.1}"))
+    });
     md.push_str("\ncovers-sky (%) / depth error p50 / p95 (world units), same means.\n\n");
-    header(md, "pitch", methods);
-    for p in pitches(run) {
-        let _ = write!(md, "| {} |", pitch_label(p));
-        for m in methods {
-            let sky = pitch_mean(run, m, p, |r| r.covers_sky);
-            let p50 = pitch_mean(run, m, p, |r| r.depth_p50);
-            let p95 = pitch_mean(run, m, p, |r| r.depth_p95);
-            match (sky, p50, p95) {
-                (Some(a), Some(b), Some(c)) => {
-                    let _ = write!(md, " {a:.1} / {b:.2} / {c:.2} |");
-                }
-                _ => md.push_str(" — |"),
-            }
-        }
-        md.push('\n');
-    }
+    pitch_table(md, run, |m, p| {
+        let sky = pitch_mean(run, m, p, |r| r.covers_sky)?;
+        let p50 = pitch_mean(run, m, p, |r| r.depth_p50)?;
+        let p95 = pitch_mean(run, m, p, |r| r.depth_p95)?;
+        Some(format!("{sky:.1} / {p50:.2} / {p95:.2}"))
+    });
     md.push('\n');
 }
 
@@ -289,7 +292,6 @@ fn flip_table(md: &mut String, run: &RunResults) {
     if !run.rows.iter().any(|r| r.flip.is_some()) {
         return;
     }
-    let methods = &run.settings.methods;
     md.push_str("## Colour error by pitch (ꟻLIP)\n\n");
     let _ = writeln!(
         md,
@@ -298,26 +300,20 @@ fn flip_table(md: &mut String, run: &RunResults) {
          mean over the views at each pitch ({}). Error maps: `cells/*-flip.png`.\n",
         cell_text(&run.adapter.name)
     );
-    header(md, "pitch", methods);
-    for p in pitches(run) {
-        let _ = write!(md, "| {} |", pitch_label(p));
-        for m in methods {
-            let flip = |f: fn(&FlipScore) -> f64| {
-                let xs: Vec<f64> = rows_of(run, m)
-                    .filter(|r| r.pitch == p)
-                    .filter_map(|r| r.flip.as_ref().map(f))
-                    .collect();
-                stats::mean(&xs)
-            };
-            match (flip(|f| f.mean), flip(|f| f.over_half)) {
-                (Some(a), Some(b)) => {
-                    let _ = write!(md, " {a:.3} / {b:.1} |");
-                }
-                _ => md.push_str(" — |"),
-            }
-        }
-        md.push('\n');
-    }
+    pitch_table(md, run, |m, p| {
+        let flip = |f: fn(&FlipScore) -> f64| {
+            let xs: Vec<f64> = rows_of(run, m)
+                .filter(|r| r.pitch == p)
+                .filter_map(|r| r.flip.as_ref().map(f))
+                .collect();
+            stats::mean(&xs)
+        };
+        Some(format!(
+            "{:.3} / {:.1}",
+            flip(|f| f.mean)?,
+            flip(|f| f.over_half)?
+        ))
+    });
     md.push('\n');
 }
 
@@ -334,20 +330,22 @@ fn cross_check(md: &mut String, runs: &[RunResults], disagreements: &[Disagreeme
         md.push_str("No field disagrees.\n\n");
         return;
     }
-    md.push_str("| adapter | view | method | field | baseline | this adapter |\n|---|---|---|---|---:|---:|\n");
+    let mut t = Table::new()
+        .columns(["adapter", "view", "method", "field"], Align::Left)
+        .right("baseline")
+        .right("this adapter");
+    let fmt = |v: Option<f64>| v.map_or("missing".to_string(), |v| format!("{v:.3}"));
     for d in disagreements {
-        let fmt = |v: Option<f64>| v.map_or("missing".to_string(), |v| format!("{v:.3}"));
-        let _ = writeln!(
-            md,
-            "| {} | {} | {} | {} | {} | {} |",
-            cell_text(&d.adapter),
-            cell_text(&d.view),
-            cell_text(&d.method),
-            d.field,
+        t.row([
+            d.adapter.clone(),
+            d.view.clone(),
+            d.method.clone(),
+            d.field.to_string(),
             fmt(d.baseline),
-            fmt(d.other)
-        );
+            fmt(d.other),
+        ]);
     }
+    t.write_to(md);
     md.push('\n');
 }
 
@@ -357,6 +355,12 @@ fn uses_cpu_time(run: &RunResults) -> bool {
         .any(|r| r.timing_source == TimingSource::CpuSubmitWait)
 }
 
+/// A run's adapter name, starred when some of its times are CPU submit-and-wait.
+fn starred_name(run: &RunResults) -> String {
+    let star = if uses_cpu_time(run) { "*" } else { "" };
+    format!("{}{star}", run.adapter.name)
+}
+
 fn timing_tables(md: &mut String, runs: &[RunResults]) {
     let methods = &runs[0].settings.methods;
     md.push_str("## Frame time by pitch (ms)\n\n");
@@ -364,16 +368,9 @@ fn timing_tables(md: &mut String, runs: &[RunResults]) {
         "Mean over the views at each pitch of each view's frame mean. GPU rows sum per-pass timestamps; \
          rows marked * are CPU submit-and-wait (no timestamps), comparable among methods on that adapter only.\n\n",
     );
-    header(md, "adapter / pitch", methods);
+    let mut t = per_method("adapter / pitch", methods);
     for run in runs {
-        let star = if uses_cpu_time(run) { "*" } else { "" };
         for p in pitches(run) {
-            let _ = write!(
-                md,
-                "| {}{star} / {} |",
-                cell_text(&run.adapter.name),
-                pitch_label(p)
-            );
             let means: Vec<Option<f64>> = methods
                 .iter()
                 .map(|m| pitch_mean(run, m, p, Row::frame_ms))
@@ -383,60 +380,44 @@ fn timing_tables(md: &mut String, runs: &[RunResults]) {
                 .flatten()
                 .copied()
                 .fold(f64::INFINITY, f64::min);
-            for v in means {
-                match v {
-                    Some(v) if v == best => {
-                        let _ = write!(md, " **{v:.3}** |");
-                    }
-                    Some(v) => {
-                        let _ = write!(md, " {v:.3} |");
-                    }
-                    None => md.push_str(" — |"),
-                }
-            }
-            md.push('\n');
+            let cells = means.into_iter().map(|v| match v {
+                Some(v) if v == best => format!("**{v:.3}**"),
+                Some(v) => format!("{v:.3}"),
+                None => "—".into(),
+            });
+            let title = format!("{} / {}", starred_name(run), pitch_label(p));
+            t.row(std::iter::once(title).chain(cells));
         }
     }
+    t.write_to(md);
     md.push_str("\nCPU submit-and-wait (ms), same means, every adapter.\n\n");
-    header(md, "adapter / pitch", methods);
+    let mut t = per_method("adapter / pitch", methods);
     for run in runs {
         for p in pitches(run) {
-            let _ = write!(
-                md,
-                "| {} / {} |",
-                cell_text(&run.adapter.name),
-                pitch_label(p)
-            );
-            for m in methods {
-                match pitch_mean(run, m, p, |r| r.cpu_ms_mean) {
-                    Some(v) => {
-                        let _ = write!(md, " {v:.3} |");
-                    }
-                    None => md.push_str(" — |"),
-                }
-            }
-            md.push('\n');
+            let cells = methods.iter().map(|m| {
+                or_dash(pitch_mean(run, m, p, |r| r.cpu_ms_mean).map(|v| format!("{v:.3}")))
+            });
+            let title = format!("{} / {}", run.adapter.name, pitch_label(p));
+            t.row(std::iter::once(title).chain(cells));
         }
     }
+    t.write_to(md);
     md.push_str(
         "\n95 % intervals of the mean over all views of each view's frame mean, from the frame samples \
          (mean ± 1.96·sqrt(Σ s²/n)/V).\n\n",
     );
-    header(md, "adapter", methods);
+    let mut t = per_method("adapter", methods);
     for run in runs {
-        let star = if uses_cpu_time(run) { "*" } else { "" };
-        let _ = write!(md, "| {}{star} |", cell_text(&run.adapter.name));
-        for m in methods {
+        let cells = methods.iter().map(|m| {
             let samples: Vec<&[f64]> = rows_of(run, m).map(Row::frame_samples).collect();
-            match stats::mean_of_means_interval(&samples) {
-                Some((mean, half)) => {
-                    let _ = write!(md, " {mean:.3} ± {half:.3} |");
-                }
-                None => md.push_str(" — |"),
-            }
-        }
-        md.push('\n');
+            or_dash(
+                stats::mean_of_means_interval(&samples)
+                    .map(|(mean, half)| format!("{mean:.3} ± {half:.3}")),
+            )
+        });
+        t.row(std::iter::once(starred_name(run)).chain(cells));
     }
+    t.write_to(md);
     md.push('\n');
 }
 
@@ -450,7 +431,10 @@ fn preparation_table(md: &mut String, runs: &[RunResults]) {
         "setup builds pipelines and uploads; first frame adds whatever the method builds lazily; \
          warm-up covers every pre-timing frame.\n\n",
     );
-    md.push_str("| adapter | method | setup | first frame | warm-up |\n|---|---|---:|---:|---:|\n");
+    let mut t = Table::new()
+        .left("adapter")
+        .left("method")
+        .columns(["setup", "first frame", "warm-up"], Align::Right);
     for run in runs {
         for m in &run.settings.methods {
             let (Some(a), Some(b), Some(c)) = (
@@ -460,13 +444,16 @@ fn preparation_table(md: &mut String, runs: &[RunResults]) {
             ) else {
                 continue;
             };
-            let _ = writeln!(
-                md,
-                "| {} | {m} | {a:.0} | {b:.0} | {c:.0} |",
-                cell_text(&run.adapter.name)
-            );
+            t.row([
+                run.adapter.name.clone(),
+                m.clone(),
+                format!("{a:.0}"),
+                format!("{b:.0}"),
+                format!("{c:.0}"),
+            ]);
         }
     }
+    t.write_to(md);
     md.push('\n');
 }
 
@@ -486,19 +473,22 @@ fn memory_table(md: &mut String, run: &RunResults) {
         "Persistent method-specific allocations only: shared terrain, palette, colour/depth and shadow \
          textures, pipelines and staging are excluded. Maximum over views.\n\n",
     );
-    md.push_str("| method | GPU data | CPU data |\n|---|---:|---:|\n");
+    let mut t = Table::new()
+        .left("method")
+        .columns(["GPU data", "CPU data"], Align::Right);
     for m in &run.settings.methods {
         let gpu = rows_of(run, m).map(|r| r.gpu_bytes).max();
         let cpu = rows_of(run, m).map(|r| r.cpu_bytes).max();
         if let (Some(g), Some(c)) = (gpu, cpu) {
-            let _ = writeln!(md, "| {m} | {} | {} |", mib(g), mib(c));
+            t.row([m.clone(), mib(g), mib(c)]);
         }
     }
+    t.write_to(md);
     md.push('\n');
 }
 
 fn fmt_opt(v: Option<f64>) -> String {
-    v.map_or("—".into(), |v| format!("{v:.2}"))
+    or_dash(v.map(|v| format!("{v:.2}")))
 }
 
 fn fmt_delta(a: Option<f64>, b: Option<f64>) -> String {
@@ -537,56 +527,72 @@ fn edit_tables(md: &mut String, runs: &[RunResults]) {
             let _ = writeln!(md, "Not run: {}\n", cell_text(why));
             continue;
         }
-        md.push_str(
-            "| method | CPU₀ | CPU₁ | ΔC | GPU₀ | GPU₁ | ΔG | match | last check: hit/miss % / p95 |\n\
-             |---|---:|---:|---:|---:|---:|---:|---|---|\n",
-        );
-        for e in &run.edit_rows {
-            let last = e.checks.last().map_or("—".into(), |c| {
-                format!("{:.4} / {:.2}", c.class_mismatch, c.depth_p95)
-            });
-            let _ = writeln!(
-                md,
-                "| {} | {:.2} | {:.2} | {} | {} | {} | {} | {} | {} |",
-                e.method,
-                e.steady_cpu_ms,
-                e.first_frame_cpu_ms,
-                fmt_delta(Some(e.steady_cpu_ms), Some(e.first_frame_cpu_ms)),
-                fmt_opt(e.steady_gpu_ms),
-                fmt_opt(e.first_frame_gpu_ms),
-                fmt_delta(e.steady_gpu_ms, e.first_frame_gpu_ms),
-                match_label(e),
-                last
-            );
-        }
+        edit_table(md, &run.edit_rows);
         md.push('\n');
     }
+}
+
+fn edit_table(md: &mut String, rows: &[EditRow]) {
+    let mut t = Table::new()
+        .left("method")
+        .columns(["CPU₀", "CPU₁", "ΔC", "GPU₀", "GPU₁", "ΔG"], Align::Right)
+        .left("match")
+        .left("last check: hit/miss % / p95");
+    for e in rows {
+        let last = e.checks.last().map_or("—".into(), |c| {
+            format!("{:.4} / {:.2}", c.class_mismatch, c.depth_p95)
+        });
+        t.row([
+            e.method.clone(),
+            format!("{:.2}", e.steady_cpu_ms),
+            format!("{:.2}", e.first_frame_cpu_ms),
+            fmt_delta(Some(e.steady_cpu_ms), Some(e.first_frame_cpu_ms)),
+            fmt_opt(e.steady_gpu_ms),
+            fmt_opt(e.first_frame_gpu_ms),
+            fmt_delta(e.steady_gpu_ms, e.first_frame_gpu_ms),
+            match_label(e),
+            last,
+        ]);
+    }
+    t.write_to(md);
 }
 
 fn per_view_table(md: &mut String, run: &RunResults) {
     md.push_str("## Every cell\n\n");
     let _ = writeln!(md, "{}.\n", cell_text(&run.adapter.name));
-    md.push_str(
-        "| view | pitch | method | see-through % | covers-sky % | p50 | p95 | coherence % | GPU ms | CPU ms | picture |\n\
-         |---|---:|---|---:|---:|---:|---:|---:|---:|---:|---|\n",
-    );
+    let mut t = Table::new()
+        .left("view")
+        .right("pitch")
+        .left("method")
+        .columns(
+            [
+                "see-through %",
+                "covers-sky %",
+                "p50",
+                "p95",
+                "coherence %",
+                "GPU ms",
+                "CPU ms",
+            ],
+            Align::Right,
+        )
+        .left("picture");
     for r in &run.rows {
-        let _ = writeln!(
-            md,
-            "| {} | {} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {} | {:.3} | [png]({}) |",
-            cell_text(&r.view),
-            r.pitch,
-            r.method,
-            r.see_through,
-            r.covers_sky,
-            r.depth_p50,
-            r.depth_p95,
-            r.coherence,
-            r.gpu_ms_mean.map_or("—".into(), |v| format!("{v:.3}")),
-            r.cpu_ms_mean,
-            r.image
-        );
+        t.row([
+            r.view.clone(),
+            r.pitch.to_string(),
+            r.method.clone(),
+            format!("{:.2}", r.see_through),
+            format!("{:.2}", r.covers_sky),
+            format!("{:.2}", r.depth_p50),
+            format!("{:.2}", r.depth_p95),
+            format!("{:.2}", r.coherence),
+            or_dash(r.gpu_ms_mean.map(|v| format!("{v:.3}"))),
+            format!("{:.3}", r.cpu_ms_mean),
+            format!("[png]({})", r.image),
+        ]);
     }
+    t.write_to(md);
     md.push('\n');
 }
 

@@ -1,6 +1,6 @@
 //! Summary statistics of frame samples and the 95 % interval of a mean over views.
 
-use crate::results::Timing;
+use crate::Timing;
 
 pub fn mean(xs: &[f64]) -> Option<f64> {
     if xs.is_empty() {

@@ -1,7 +1,7 @@
 //! Hand-made results for the report and merge tests.
 
-use crate::results::*;
 use crate::stats::summarize;
+use crate::*;
 use strata_level::ViewSpec;
 
 pub fn view(name: &str, pitch: f32) -> ViewSpec {
@@ -37,11 +37,7 @@ pub fn row(view: &str, pitch: f32, method: &str, see: f64, coh: f64, gpu: &[f64]
         coherence: coh,
         gpu_ms_mean: gpu_t.as_ref().map(|t| t.mean),
         cpu_ms_mean: cpu_t.mean,
-        timing_source: if gpu_t.is_some() {
-            TimingSource::GpuTimestamps
-        } else {
-            TimingSource::CpuSubmitWait
-        },
+        timing_source: TimingSource::of(gpu_t.as_ref()),
         gpu_ms: gpu_t,
         cpu_ms: cpu_t,
         prep_setup_ms: 10.0,

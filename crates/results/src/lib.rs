@@ -1,5 +1,18 @@
 //! The results file (`results-<adapter>.json`): typed, serialised with serde.
 //! Other tools read `rows` and `edit_rows`; the field names are a contract.
+//!
+//! With what reads it and needs no GPU: [`merge`] (the checks `strata
+//! merge` makes before it combines runs), [`stats`] and [`report`]
+//! (`report.md`). `strata-bench` measures and writes these files and
+//! re-exports this crate as `strata_bench::results`; `strata-fuzz` fuzzes
+//! the reader without building a GPU stack.
+
+pub mod merge;
+pub mod report;
+pub mod stats;
+
+#[cfg(any(test, feature = "fixtures"))]
+pub mod fixtures;
 
 use serde::{Deserialize, Serialize};
 use strata_level::ViewSpec;
@@ -16,6 +29,18 @@ pub enum TimingSource {
     GpuTimestamps,
     /// CPU submit-and-wait (the adapter has no timestamps).
     CpuSubmitWait,
+}
+
+impl TimingSource {
+    /// GPU timestamps where every frame carried them (`gpu`), else CPU
+    /// submit-and-wait.
+    pub fn of(gpu: Option<&Timing>) -> Self {
+        if gpu.is_some() {
+            TimingSource::GpuTimestamps
+        } else {
+            TimingSource::CpuSubmitWait
+        }
+    }
 }
 
 /// One run of `strata compare` on one adapter.
@@ -241,6 +266,18 @@ pub struct EditRow {
     /// renderer matches the fresh one; null if never within 16.
     pub consistent_after_frames: Option<u32>,
     pub checks: Vec<EditCheck>,
+}
+
+/// One accuracy field of one cell on which an adapter differs from the baseline.
+/// Found by [`merge::disagreements`], listed in `report.md`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Disagreement {
+    pub adapter: String,
+    pub view: String,
+    pub method: String,
+    pub field: &'static str,
+    pub baseline: Option<f64>,
+    pub other: Option<f64>,
 }
 
 /// The frame counts at which consistency is checked.
