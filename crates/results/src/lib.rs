@@ -50,7 +50,9 @@ pub struct RunResults {
     pub level: LevelInfo,
     pub adapter: AdapterInfo,
     pub settings: Settings,
-    /// `git describe` of the source at run time, or "unknown".
+    /// The revision the binary was built from (`git describe`, `-dirty` when
+    /// its sources differed from the commit), baked in at build time; "unknown"
+    /// when built outside git.
     pub source_revision: String,
     /// False while the run is in progress or when it was interrupted.
     pub complete: bool,
