@@ -28,7 +28,7 @@ fn options(world: &World, out: PathBuf) -> Options {
     Options {
         out: out.clone(),
         methods: vec![MethodChoice {
-            name: "ray".into(),
+            method: strata_render::methods::entry("ray").unwrap(),
             setting: None,
         }],
         views: world.views.iter().take(2).cloned().collect(),
@@ -209,7 +209,7 @@ fn interrupted_run_resumes_to_the_full_cell_set() {
         let mut o = options(&w, out);
         o.methods = ["ray", "ray-compute"]
             .map(|n| MethodChoice {
-                name: n.into(),
+                method: strata_render::methods::entry(n).unwrap(),
                 setting: None,
             })
             .to_vec();

@@ -38,7 +38,7 @@ fn a_method_the_adapter_cannot_run_is_one_failure_and_no_edit_row() {
     let methods = ["ray", "ray-compute"]
         .iter()
         .map(|n| MethodChoice {
-            name: (*n).into(),
+            method: strata_render::methods::entry(n).unwrap(),
             setting: None,
         })
         .collect();

@@ -28,7 +28,7 @@ fn flicker(
     let path = CameraPath::parse(path).unwrap();
     let opts = VideoOptions {
         methods: vec![MethodChoice {
-            name: method.into(),
+            method: strata_render::methods::entry(method).unwrap(),
             setting: None,
         }],
         tile: (64, 40),

@@ -87,20 +87,15 @@ impl DepthReader {
         depth: &wgpu::Texture,
     ) -> crate::gpu::TextureReadback {
         let view = depth.create_view(&Default::default());
-        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("depth read"),
-            layout: &self.layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::TextureView(&view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::Sampler(&self.sampler),
-                },
+        let group = crate::frame::bind_group(
+            &device,
+            "depth read",
+            &self.layout,
+            &[
+                wgpu::BindingResource::TextureView(&view),
+                wgpu::BindingResource::Sampler(&self.sampler),
             ],
-        });
+        );
         let (target, target_view) = texture_2d(
             device,
             "depth read",

@@ -306,28 +306,17 @@ fn bind_images(
     left: &wgpu::TextureView,
     right: &wgpu::TextureView,
 ) -> wgpu::BindGroup {
-    device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("present"),
+    strata_render::frame::bind_group(
+        &device,
+        "present",
         layout,
-        entries: &[
-            wgpu::BindGroupEntry {
-                binding: 0,
-                resource: params.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 1,
-                resource: wgpu::BindingResource::TextureView(left),
-            },
-            wgpu::BindGroupEntry {
-                binding: 2,
-                resource: wgpu::BindingResource::TextureView(right),
-            },
-            wgpu::BindGroupEntry {
-                binding: 3,
-                resource: wgpu::BindingResource::Sampler(sampler),
-            },
+        &[
+            params.as_entire_binding(),
+            wgpu::BindingResource::TextureView(left),
+            wgpu::BindingResource::TextureView(right),
+            wgpu::BindingResource::Sampler(sampler),
         ],
-    })
+    )
 }
 
 /// The kept A picture (the renderer's size) and the compose groups: the
