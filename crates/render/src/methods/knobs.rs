@@ -86,6 +86,24 @@ pub enum SliderKind {
 }
 
 impl Slider {
+    /// A whole-number slider taken in place while dragging.
+    pub const fn count(
+        name: &'static str,
+        label: &'static str,
+        (min, max): (u32, u32),
+        get: fn(&MethodSettings) -> f32,
+        put: fn(&mut MethodSettings, f32),
+    ) -> Slider {
+        Slider {
+            name,
+            label,
+            kind: SliderKind::Count { min, max },
+            get,
+            put,
+            live: true,
+        }
+    }
+
     /// Write `value` (counts must be whole and positive; each method checks
     /// its own range when built).
     pub fn set(&self, settings: &mut MethodSettings, value: f32) -> anyhow::Result<()> {

@@ -7,7 +7,7 @@
 
 use super::common::{draw_fullscreen, fullscreen_pipeline, uniform_binding};
 use super::contract::{Frame, Method, MethodSettings, RetainedBytes};
-use super::knobs::{Flag, Knobs, Slider, SliderKind, Sweep, count, plain};
+use super::knobs::{Flag, Knobs, Slider, Sweep, count, plain};
 use crate::frame::Shared;
 use strata_level::Level;
 
@@ -108,14 +108,13 @@ pub static KNOBS: Knobs = Knobs {
     },
     describe: |s| format!("steps={}", s.ray_steps),
     keep: |from, to| to.ray_steps = from.ray_steps,
-    sliders: &[Slider {
-        name: "ray-steps",
-        label: "ray steps",
-        kind: SliderKind::Count { min: 8, max: 512 },
-        get: |s| s.ray_steps as f32,
-        put: |s, v| s.ray_steps = v as u32,
-        live: true,
-    }],
+    sliders: &[Slider::count(
+        "ray-steps",
+        "ray steps",
+        (8, 512),
+        |s| s.ray_steps as f32,
+        |s, v| s.ray_steps = v as u32,
+    )],
     flags: &[Flag {
         long: "ray-steps",
         value: Some("N"),

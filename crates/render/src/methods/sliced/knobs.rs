@@ -1,7 +1,7 @@
 //! `sliced:N` and `sliced:N/refine`: the slice count, and the refining pass.
 
 use super::super::contract::MethodSettings;
-use super::super::knobs::{Flag, Knobs, Slider, SliderKind, Sweep, count, plain};
+use super::super::knobs::{Flag, Knobs, Slider, Sweep, count, plain};
 use anyhow::bail;
 
 pub static KNOBS: Knobs = Knobs {
@@ -19,14 +19,13 @@ pub static KNOBS: Knobs = Knobs {
         to.slices = from.slices;
         to.sliced_refine = from.sliced_refine;
     },
-    sliders: &[Slider {
-        name: "slices",
-        label: "slices",
-        kind: SliderKind::Count { min: 16, max: 2048 },
-        get: |s| s.slices as f32,
-        put: |s, v| s.slices = v as u32,
-        live: true,
-    }],
+    sliders: &[Slider::count(
+        "slices",
+        "slices",
+        (16, 2048),
+        |s| s.slices as f32,
+        |s, v| s.slices = v as u32,
+    )],
     flags: &[
         Flag {
             long: "slices",

@@ -2,9 +2,7 @@
 //! the traversal's step budget.
 
 use super::super::contract::MethodSettings;
-use super::super::knobs::{
-    Flag, Knobs, Slider, SliderKind, Sweep, count, count_triple, plain, show_triple,
-};
+use super::super::knobs::{Flag, Knobs, Slider, Sweep, count, count_triple, plain, show_triple};
 use anyhow::bail;
 
 pub static KNOBS: Knobs = Knobs {
@@ -19,14 +17,13 @@ pub static KNOBS: Knobs = Knobs {
         to.voxel_size = from.voxel_size;
         to.voxel_steps = from.voxel_steps;
     },
-    sliders: &[Slider {
-        name: "voxel-steps",
-        label: "voxel steps",
-        kind: SliderKind::Count { min: 8, max: 400 },
-        get: |s| s.voxel_steps as f32,
-        put: |s, v| s.voxel_steps = v as u32,
-        live: true,
-    }],
+    sliders: &[Slider::count(
+        "voxel-steps",
+        "voxel steps",
+        (8, 400),
+        |s| s.voxel_steps as f32,
+        |s, v| s.voxel_steps = v as u32,
+    )],
     flags: &[
         Flag {
             long: "voxel-size",
