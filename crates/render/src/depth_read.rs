@@ -88,7 +88,7 @@ impl DepthReader {
     ) -> crate::gpu::TextureReadback {
         let view = depth.create_view(&Default::default());
         let group = crate::frame::bind_group(
-            &device,
+            device,
             "depth read",
             &self.layout,
             &[

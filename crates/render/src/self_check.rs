@@ -112,7 +112,7 @@ pub fn uniforms_read_back(
         entries: &[uniform_layout_entry(0)],
     });
     let frame_group = crate::frame::bind_group(
-        &device,
+        device,
         "self check frame",
         &frame_layout,
         &[
@@ -122,7 +122,7 @@ pub fn uniforms_read_back(
         ],
     );
     let method_group = crate::frame::bind_group(
-        &device,
+        device,
         "self check method",
         &method_layout,
         &[method.as_entire_binding()],

@@ -50,7 +50,7 @@ impl ShadowPass {
                         entries: &[storage_texture_entry(0, wgpu::TextureFormat::R32Float)],
                     });
                 let out_group = crate::frame::bind_group(
-                    &device,
+                    device,
                     "shadow out",
                     &out_layout,
                     &[wgpu::BindingResource::TextureView(&shared.shadow_view)],

@@ -188,7 +188,7 @@ impl BodyPainter {
             mapped_at_creation: false,
         });
         let group = strata_render::frame::bind_group(
-            &device,
+            device,
             "bodies",
             &pipeline.get_bind_group_layout(0),
             &[uniform.as_entire_binding()],

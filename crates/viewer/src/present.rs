@@ -307,7 +307,7 @@ fn bind_images(
     right: &wgpu::TextureView,
 ) -> wgpu::BindGroup {
     strata_render::frame::bind_group(
-        &device,
+        device,
         "present",
         layout,
         &[

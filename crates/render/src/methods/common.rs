@@ -158,7 +158,7 @@ pub(crate) fn uniform_binding(
         label: Some(label),
         entries: &[uniform_layout_entry(0)],
     });
-    let group = crate::frame::bind_group(&device, label, &layout, &[buffer.as_entire_binding()]);
+    let group = crate::frame::bind_group(device, label, &layout, &[buffer.as_entire_binding()]);
     (layout, group)
 }
 

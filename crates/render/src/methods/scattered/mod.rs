@@ -130,13 +130,13 @@ impl ScreenBuffer {
             mapped_at_creation: false,
         });
         let scatter_group = crate::frame::bind_group(
-            &device,
+            device,
             "scattered",
             scatter_layout,
             &[params.as_entire_binding(), screen.as_entire_binding()],
         );
         let resolve_group = crate::frame::bind_group(
-            &device,
+            device,
             "scattered resolve",
             resolve_layout,
             &[screen.as_entire_binding()],

@@ -74,7 +74,7 @@ fn slices_binding(
         ],
     });
     let group = crate::frame::bind_group(
-        &device,
+        device,
         "sliced",
         &layout,
         &[
