@@ -206,16 +206,7 @@ pub(crate) struct CompositeCache {
 
 impl CompositeCache {
     fn layout(&mut self, device: &wgpu::Device) -> wgpu::BindGroupLayout {
-        let texture = |binding| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::FRAGMENT,
-            ty: wgpu::BindingType::Texture {
-                sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                view_dimension: wgpu::TextureViewDimension::D2,
-                multisampled: false,
-            },
-            count: None,
-        };
+        let texture = |binding| crate::frame::fragment_texture_entry(binding, false);
         self.layout
             .get_or_insert_with(|| {
                 device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {

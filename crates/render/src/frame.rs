@@ -416,6 +416,21 @@ pub fn texture_entry(
     }
 }
 
+/// A layout entry for a 2D float texture a fragment shader reads
+/// (`filterable` for a filtering sampler; depth is bound unfilterable).
+pub fn fragment_texture_entry(binding: u32, filterable: bool) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable },
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    }
+}
+
 /// A layout entry for a write-only 2D storage texture (compute stage).
 pub fn storage_texture_entry(
     binding: u32,

@@ -78,7 +78,8 @@ pub mod composite;
 pub mod depth_read;
 pub mod embed;
 pub mod frame;
-pub(crate) mod fullscreen;
+#[doc(hidden)]
+pub mod fullscreen;
 pub mod gpu;
 pub mod methods;
 pub mod options;

@@ -7,6 +7,7 @@
 //! renderer has been resized; until then (a method is being built in the
 //! background) it is scaled to fit, with bars.
 
+use strata_render::fullscreen;
 use bytemuck::{Pod, Zeroable};
 use strata_render::Shared;
 use strata_render::frame::texture_2d;
@@ -71,16 +72,7 @@ impl Compositor {
             label: Some("present.wgsl"),
             source: wgpu::ShaderSource::Wgsl(include_str!("../shaders/present.wgsl").into()),
         });
-        let texture_entry = |binding| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::FRAGMENT,
-            ty: wgpu::BindingType::Texture {
-                sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                view_dimension: wgpu::TextureViewDimension::D2,
-                multisampled: false,
-            },
-            count: None,
-        };
+        let texture_entry = |binding| strata_render::frame::fragment_texture_entry(binding, true);
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("present"),
             entries: &[
@@ -266,7 +258,8 @@ impl Compositor {
             &self.single_group
         };
         let target = &self.window.view;
-        fullscreen(encoder, "compose", target, &self.compose, group, timestamps);
+        // The shaders write every pixel (bars included): the clear is unseen.
+        fullscreen::draw(encoder, "compose", target, &self.compose, &[group], timestamps);
     }
 
     /// The window image, for the overlay to paint on (load, don't clear).
@@ -282,7 +275,7 @@ impl Compositor {
         timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
     ) {
         let group = &self.present_group;
-        fullscreen(encoder, "present", target, &self.present, group, timestamps);
+        fullscreen::draw(encoder, "present", target, &self.present, &[group], timestamps);
     }
 
     /// The window image as RGBA8 (what a screenshot saves).
@@ -361,36 +354,6 @@ pub fn window_to_picture(
     let (u, v) = ((at.0 - px) / pw, (at.1 - py) / ph);
     ((0.0..1.0).contains(&u) && (0.0..1.0).contains(&v))
         .then_some((u * render.0 as f32, v * render.1 as f32))
-}
-
-/// One full-screen triangle into `target`, overwriting it.
-fn fullscreen(
-    encoder: &mut wgpu::CommandEncoder,
-    label: &str,
-    target: &wgpu::TextureView,
-    pipeline: &wgpu::RenderPipeline,
-    group: &wgpu::BindGroup,
-    timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
-) {
-    let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-        label: Some(label),
-        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-            view: target,
-            depth_slice: None,
-            resolve_target: None,
-            ops: wgpu::Operations {
-                load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-                store: wgpu::StoreOp::Store,
-            },
-        })],
-        depth_stencil_attachment: None,
-        timestamp_writes: timestamps,
-        occlusion_query_set: None,
-        multiview_mask: None,
-    });
-    pass.set_pipeline(pipeline);
-    pass.set_bind_group(0, group, &[]);
-    pass.draw(0..3, 0..1);
 }
 
 #[cfg(test)]
