@@ -7,10 +7,10 @@
 //! renderer has been resized; until then (a method is being built in the
 //! background) it is scaled to fit, with bars.
 
-use strata_render::fullscreen;
 use bytemuck::{Pod, Zeroable};
 use strata_render::Shared;
 use strata_render::frame::texture_2d;
+use strata_render::fullscreen;
 use strata_render::gpu::TextureReadback;
 
 /// The window image's format: what egui paints into and screenshots hold.
@@ -259,7 +259,14 @@ impl Compositor {
         };
         let target = &self.window.view;
         // The shaders write every pixel (bars included): the clear is unseen.
-        fullscreen::draw(encoder, "compose", target, &self.compose, &[group], timestamps);
+        fullscreen::draw(
+            encoder,
+            "compose",
+            target,
+            &self.compose,
+            &[group],
+            timestamps,
+        );
     }
 
     /// The window image, for the overlay to paint on (load, don't clear).
@@ -275,7 +282,14 @@ impl Compositor {
         timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
     ) {
         let group = &self.present_group;
-        fullscreen::draw(encoder, "present", target, &self.present, &[group], timestamps);
+        fullscreen::draw(
+            encoder,
+            "present",
+            target,
+            &self.present,
+            &[group],
+            timestamps,
+        );
     }
 
     /// The window image as RGBA8 (what a screenshot saves).
