@@ -1,10 +1,10 @@
 //! Method settings from the command line: `name` takes the tuned default
-//! (the paper's publication setting); `name:setting` overrides the one knob
-//! that method has.
+//! (the paper's publication setting); `name:setting` overrides that method's
+//! knobs, in the form its entry in `strata_render::methods::METHODS` reads.
 
 use crate::plan::MethodChoice;
-use anyhow::{Context, bail};
-use strata_render::MethodSettings;
+use anyhow::Context;
+use strata_render::{MethodEntry, MethodSettings};
 
 /// The tuned settings of `choice`, with its override applied and `shadows` set.
 pub fn settings_for(choice: &MethodChoice, shadows: bool) -> anyhow::Result<MethodSettings> {
@@ -12,135 +12,18 @@ pub fn settings_for(choice: &MethodChoice, shadows: bool) -> anyhow::Result<Meth
         shadows,
         ..MethodSettings::default()
     };
-    let Some(text) = choice.setting.as_deref() else {
-        return Ok(s);
-    };
-    let name = choice.name.as_str();
-    let ctx = || format!("method `{}`: setting `{text}`", choice.label());
-    match name {
-        "ray" | "ray-compute" => s.ray_steps = positive(text).with_context(ctx)?,
-        "sliced" => {
-            // `N` (the paper's plain slicer) or `N/refine`.
-            let (n, refine) = match text.split_once('/') {
-                Some((n, "refine")) => (n, true),
-                Some((_, other)) => bail!("{}: `{other}` is not `refine`", ctx()),
-                None => (text, false),
-            };
-            s.slices = positive(n).with_context(ctx)?;
-            s.sliced_refine = refine;
-        }
-        "voxel" | "voxel-compute" => {
-            // `X,Y,Z/STEPS`, `(X,Y,Z)/STEPS`, `X,Y,Z` or `/STEPS`.
-            let (grid, steps) = match text.split_once('/') {
-                Some((g, st)) => (g, Some(st)),
-                None => (text, None),
-            };
-            let grid = grid.trim().trim_start_matches('(').trim_end_matches(')');
-            if !grid.is_empty() {
-                let v: Vec<u32> = grid
-                    .split(',')
-                    .map(positive)
-                    .collect::<anyhow::Result<_>>()
-                    .with_context(ctx)?;
-                let [x, y, z] = v[..] else {
-                    bail!("{}: the voxel grid needs three sizes X,Y,Z", ctx())
-                };
-                s.voxel_size = [x, y, z];
-            }
-            if let Some(st) = steps {
-                s.voxel_steps = positive(st).with_context(ctx)?;
-            }
-        }
-        "scattered" => {
-            let v: Vec<f32> = text
-                .split(',')
-                .map(positive_f32)
-                .collect::<anyhow::Result<_>>()
-                .with_context(ctx)?;
-            s.scatter_density = match v[..] {
-                [d] => [d; 3],
-                [x, y, z] => [x, y, z],
-                _ => bail!("{}: scattered density is D or X,Y,Z", ctx()),
-            };
-        }
-        "mesh" => {
-            // `Q`, `q=Q`, `Qo` (outline-constrained), then `/PX` (the LOD
-            // tolerance in pixels; `/`, as `,` separates methods) and
-            // `/gradient` (the gradient-normal diagnostic), in either order.
-            let mut parts = text.split('/');
-            let q = parts.next().unwrap_or_default().trim();
-            let mut px = None;
-            for part in parts.map(str::trim) {
-                if part == "gradient" {
-                    s.mesh_gradient_normal = true;
-                } else if px.replace(part).is_some() {
-                    bail!("{}: more than one LOD tolerance", ctx());
-                }
-            }
-            let q = q.trim_start_matches("q=");
-            let (q, outline) = match q.strip_suffix('o') {
-                Some(q) => (q, true),
-                None => (q, false),
-            };
-            let q: f32 = q
-                .trim()
-                .parse()
-                .ok()
-                .filter(|q: &f32| (0.0..=1.0).contains(q))
-                .with_context(|| format!("{}: mesh quality must be a number in [0, 1]", ctx()))?;
-            s.mesh_quality = q;
-            s.mesh_outline = outline;
-            if let Some(px) = px {
-                let px = px.trim_start_matches("px=");
-                s.mesh_lod_pixels = positive_f32(px).with_context(ctx)?;
-            }
-        }
-        _ => bail!("{}: `{name}` has no setting to change", ctx()),
+    if let Some(text) = choice.setting.as_deref() {
+        choice
+            .method
+            .apply_setting(text, &mut s)
+            .with_context(|| format!("method `{}`: setting `{text}`", choice.label()))?;
     }
     Ok(s)
 }
 
-fn positive(text: &str) -> anyhow::Result<u32> {
-    match text.trim().parse::<u32>() {
-        Ok(v) if v > 0 => Ok(v),
-        _ => bail!("`{}` is not a positive whole number", text.trim()),
-    }
-}
-
-fn positive_f32(text: &str) -> anyhow::Result<f32> {
-    match text.trim().parse::<f32>() {
-        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
-        _ => bail!("`{}` is not a positive number", text.trim()),
-    }
-}
-
-/// The knob that matters for `name`, for the results' settings record.
-pub fn describe(name: &str, s: &MethodSettings) -> String {
-    match name {
-        "ray" | "ray-compute" => format!("{name} steps={}", s.ray_steps),
-        "voxel" | "voxel-compute" => {
-            let [x, y, z] = s.voxel_size;
-            format!("{name} grid=({x},{y},{z}) steps={}", s.voxel_steps)
-        }
-        "sliced" if s.sliced_refine => format!("{name} slices={} refined", s.slices),
-        "sliced" => format!("{name} slices={}", s.slices),
-        "scattered" => {
-            let [x, y, z] = s.scatter_density;
-            format!("{name} density={x},{y},{z}")
-        }
-        "mesh" => format!(
-            "{name} q={}{} lod={}px{}",
-            s.mesh_quality,
-            if s.mesh_outline { " outline" } else { "" },
-            s.mesh_lod_pixels,
-            if s.mesh_gradient_normal {
-                " gradient-normal"
-            } else {
-                ""
-            }
-        ),
-        _ => name.to_string(),
-    }
+/// The knobs that matter for `method`, for the results' settings record.
+pub fn describe(method: &MethodEntry, s: &MethodSettings) -> String {
+    method.describe(s)
 }
 
 #[cfg(test)]
@@ -149,9 +32,13 @@ mod tests {
 
     fn choice(name: &str, setting: Option<&str>) -> MethodChoice {
         MethodChoice {
-            name: name.into(),
+            method: strata_render::methods::entry(name).unwrap(),
             setting: setting.map(String::from),
         }
+    }
+
+    fn describe(name: &str, s: &MethodSettings) -> String {
+        super::describe(strata_render::methods::entry(name).unwrap(), s)
     }
 
     #[test]

@@ -3,6 +3,8 @@
 
 use anyhow::{Context, bail};
 use std::path::Path;
+use strata_render::MethodEntry;
+use strata_render::methods::METHODS;
 
 /// `WxH`, both positive and at most 16384.
 pub fn parse_size(text: &str) -> anyhow::Result<(u32, u32)> {
@@ -22,28 +24,53 @@ pub fn parse_size(text: &str) -> anyhow::Result<(u32, u32)> {
     Ok((parse(w)?, parse(h)?))
 }
 
-/// A method as named on the command line: `name` or `name:setting`.
+/// A method as named on the command line: `name` or `name:setting`. The
+/// method is its entry in `strata_render::methods::METHODS`; the label
+/// (`ray:64`) only names the column in results and reports.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct MethodChoice {
-    pub name: String,
+    pub method: &'static MethodEntry,
     pub setting: Option<String>,
 }
 
 impl MethodChoice {
+    /// `method` at its default setting.
+    pub fn plain(method: &'static MethodEntry) -> Self {
+        MethodChoice {
+            method,
+            setting: None,
+        }
+    }
+
+    /// The method's name (`ray`).
+    pub fn name(&self) -> &'static str {
+        self.method.name
+    }
+
     /// The label used in results and reports.
     pub fn label(&self) -> String {
         match &self.setting {
-            Some(s) => format!("{}:{s}", self.name),
-            None => self.name.clone(),
+            Some(s) => format!("{}:{s}", self.method.name),
+            None => self.method.name.to_string(),
         }
     }
 }
 
-/// Parse `a,b:setting,c` against the known method names. A setting may hold
-/// commas (`voxel:4,8,2/100`, `scattered:4,4,4`): a comma-separated piece that
-/// starts with a digit, `(`, `.` or `-` continues the previous setting.
-/// Duplicate labels and unknown names are errors (listing the known ones).
-pub fn parse_methods(list: &str, known: &[&str]) -> anyhow::Result<Vec<MethodChoice>> {
+/// Every method of `METHODS` at its default setting.
+pub fn every_method() -> Vec<MethodChoice> {
+    METHODS.iter().map(MethodChoice::plain).collect()
+}
+
+/// Parse `a,b:setting,c` against the methods `known` (a part of `METHODS`,
+/// usually all of it). A setting may hold commas (`voxel:4,8,2/100`,
+/// `scattered:4,4,4`): a comma-separated piece that starts with a digit,
+/// `(`, `.` or `-` continues the previous setting. Duplicate labels and
+/// unknown names are errors (listing the known ones).
+pub fn parse_methods(
+    list: &str,
+    known: &'static [MethodEntry],
+) -> anyhow::Result<Vec<MethodChoice>> {
+    let names = || known.iter().map(|m| m.name).collect::<Vec<_>>().join(", ");
     let mut out: Vec<MethodChoice> = Vec::new();
     for piece in list.split(',').map(str::trim).filter(|s| !s.is_empty()) {
         let continues = piece.starts_with(|c: char| c.is_ascii_digit() || "(.-".contains(c));
@@ -58,7 +85,7 @@ pub fn parse_methods(list: &str, known: &[&str]) -> anyhow::Result<Vec<MethodCho
                 }
                 _ => bail!(
                     "`{piece}` in the method list is not a method name (known: {})",
-                    known.join(", ")
+                    names()
                 ),
             }
         }
@@ -66,13 +93,10 @@ pub fn parse_methods(list: &str, known: &[&str]) -> anyhow::Result<Vec<MethodCho
             Some((n, s)) => (n.trim(), Some(s.trim().to_string())),
             None => (piece, None),
         };
-        if !known.contains(&name) {
-            bail!("unknown method `{name}` (known: {})", known.join(", "));
-        }
-        out.push(MethodChoice {
-            name: name.to_string(),
-            setting,
-        });
+        let Some(method) = known.iter().find(|m| m.name == name) else {
+            bail!("unknown method `{name}` (known: {})", names());
+        };
+        out.push(MethodChoice { method, setting });
     }
     for (i, c) in out.iter().enumerate() {
         if out[..i].iter().any(|o| o.label() == c.label()) {
@@ -166,19 +190,26 @@ mod tests {
 
     #[test]
     fn methods() {
-        let known = ["ray", "voxel"];
-        let m = parse_methods("ray, voxel:4,8,2/100,ray:64", &known).unwrap();
+        // `ray` and `ray-compute`.
+        let known = &METHODS[..2];
+        let m = parse_methods("ray, ray-compute:4,8,2/100,ray:64", known).unwrap();
         assert_eq!(m.len(), 3);
-        assert_eq!(m[1].label(), "voxel:4,8,2/100");
+        assert_eq!(m[1].label(), "ray-compute:4,8,2/100");
+        assert_eq!(m[1].method.name, "ray-compute");
         assert_eq!(m[2].setting.as_deref(), Some("64"));
-        assert!(parse_methods("8,ray", &known).is_err());
-        let err = parse_methods("ray,mesh", &known).unwrap_err().to_string();
+        assert_eq!(m[2].method, &METHODS[0]);
+        assert!(parse_methods("8,ray", known).is_err());
+        let err = parse_methods("ray,mesh", known).unwrap_err().to_string();
         assert!(
-            err.contains("unknown method `mesh`") && err.contains("ray, voxel"),
+            err.contains("unknown method `mesh`") && err.contains("ray, ray-compute"),
             "{err}"
         );
-        assert!(parse_methods("ray,ray", &known).is_err());
-        assert!(parse_methods(" , ", &known).is_err());
+        assert!(parse_methods("ray,ray", known).is_err());
+        assert!(parse_methods(" , ", known).is_err());
+        assert_eq!(
+            parse_methods("mesh:0.75", METHODS).unwrap()[0].label(),
+            "mesh:0.75"
+        );
     }
 
     #[test]

@@ -200,7 +200,7 @@ impl Plan {
                     .methods
                     .iter()
                     .zip(&self.settings)
-                    .map(|(m, s)| describe(&m.name, s))
+                    .map(|(m, s)| describe(m.method, s))
                     .collect(),
                 views: self.opts.views.clone(),
                 warmup_first_view: self.warmup_first,
@@ -255,7 +255,7 @@ impl Plan {
             .methods
             .iter()
             .map(|m| {
-                strata_render::methods::check_support(&m.name, &gpu.caps)
+                strata_render::methods::check_support(m.method, &gpu.caps)
                     .err()
                     .map(|e| format!("refused: {e:#}"))
             })
@@ -331,7 +331,7 @@ impl Plan {
                     timestamps: gpu.report.timestamps,
                     steady_frames: self.opts.frames.min(10),
                 };
-                match edits::edit_row(&input, &choice.name, settings) {
+                match edits::edit_row(&input, choice.name(), settings) {
                     Ok((mut row, pictures)) => {
                         row.method = choice.label();
                         session.results.edit_rows.push(row);
@@ -555,7 +555,7 @@ impl Plan {
             gpu,
             &self.world.level,
             &self.colors,
-            &choice.name,
+            choice.method,
             &self.settings[m],
             self.opts.width,
             self.opts.height,

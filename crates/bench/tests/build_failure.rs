@@ -11,17 +11,15 @@ use strata_bench::run::Plan;
 use strata_level::ViewSpec;
 use strata_level::generate::{GenerateParams, generate};
 use strata_render::Gpu;
-use strata_render::build_guard::FORCE_OVERSIZE_ENV;
 
 #[test]
 fn a_build_the_gpu_refuses_is_recorded_and_the_next_method_runs() {
-    // SAFETY: this file holds one test, so no other thread reads the
-    // environment meanwhile.
-    unsafe { std::env::set_var(FORCE_OVERSIZE_ENV, "ray") };
-    let gpu = match Gpu::headless() {
+    let mut gpu = match Gpu::headless() {
         Ok(gpu) => gpu,
         Err(e) => return skip_loudly(&format!("no GPU adapter ({e:#})")),
     };
+    // The test hook (`STRATA_TEST_OVERSIZE_BUILD=ray` for the binary).
+    gpu.options.oversize_build = Some("ray".into());
     let world = generate(&GenerateParams {
         seed: 4,
         width: 256,

@@ -5,12 +5,9 @@
 //! names the method, the picture size and the level size, so `compare` can
 //! record the cell and go on and the viewer can say what failed.
 
+use crate::gpu::catching;
+use crate::options::RenderOptions;
 use strata_level::Level;
-
-/// Set to a method name, its build also asks for a buffer over the device's
-/// `max_buffer_size`, as a build too large for the GPU would: the tests'
-/// way to make one method's build fail on any adapter.
-pub const FORCE_OVERSIZE_ENV: &str = "STRATA_TEST_OVERSIZE_BUILD";
 
 /// What was being built, for the error.
 pub struct BuildTarget<'a> {
@@ -33,44 +30,39 @@ impl BuildTarget<'_> {
     }
 }
 
-/// Run `build` for `target`, turning a GPU error it raised into a clear one.
+/// Run `build` for `target`, turning a GPU error it raised into a clear
+/// one. `options.oversize_build` naming the method (a test hook) makes the
+/// build also ask for a buffer over the device's limit.
 pub fn guarded<T>(
     device: &wgpu::Device,
+    options: &RenderOptions,
     target: &BuildTarget<'_>,
     build: impl FnOnce() -> anyhow::Result<T>,
 ) -> anyhow::Result<T> {
-    #[cfg(not(target_arch = "wasm32"))]
-    {
-        let oom = device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
-        let invalid = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let built = build();
-        if std::env::var(FORCE_OVERSIZE_ENV).is_ok_and(|m| m == target.method) {
-            force_oversize(device);
-        }
-        // Popped in reverse order of pushing.
-        let invalid = pollster::block_on(invalid.pop());
-        let oom = pollster::block_on(oom.pop());
-        if let Some(e) = oom {
-            anyhow::bail!(
-                "{} ran out of GPU memory ({}); try a smaller --size or coarser settings",
-                target.describe(),
-                innermost(&e)
-            );
-        }
-        if let Some(e) = invalid {
-            anyhow::bail!(
-                "{} failed: the GPU refused it ({})",
-                target.describe(),
-                innermost(&e)
-            );
-        }
-        flatten(built, target)
+    let ((built, invalid), oom) = catching(device, wgpu::ErrorFilter::OutOfMemory, || {
+        catching(device, wgpu::ErrorFilter::Validation, || {
+            let built = build();
+            if options.oversize_build.as_deref() == Some(target.method) {
+                force_oversize(device);
+            }
+            built
+        })
+    });
+    if let Some(e) = oom {
+        anyhow::bail!(
+            "{} ran out of GPU memory ({}); try a smaller --size or coarser settings",
+            target.describe(),
+            innermost(&e)
+        );
     }
-    #[cfg(target_arch = "wasm32")]
-    {
-        let _ = device;
-        flatten(build(), target)
+    if let Some(e) = invalid {
+        anyhow::bail!(
+            "{} failed: the GPU refused it ({})",
+            target.describe(),
+            innermost(&e)
+        );
     }
+    flatten(built, target)
 }
 
 /// The build's own error, prefixed with what was built, as one message (its
@@ -81,7 +73,6 @@ fn flatten<T>(built: anyhow::Result<T>, target: &BuildTarget<'_>) -> anyhow::Res
 
 /// The root cause of a wgpu error, one line (its full text is a
 /// multi-line "Caused by" dump).
-#[cfg(not(target_arch = "wasm32"))]
 fn innermost(e: &wgpu::Error) -> String {
     let mut cause: &dyn std::error::Error = e;
     while let Some(next) = cause.source() {
@@ -93,7 +84,6 @@ fn innermost(e: &wgpu::Error) -> String {
 }
 
 /// A buffer one block over the device's limit, as an oversized build asks for.
-#[cfg(not(target_arch = "wasm32"))]
 fn force_oversize(device: &wgpu::Device) {
     let size = device.limits().max_buffer_size.saturating_add(256);
     let _ = device.create_buffer(&wgpu::BufferDescriptor {

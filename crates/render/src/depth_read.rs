@@ -25,18 +25,9 @@ impl DepthReader {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("depth read"),
             entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Texture {
-                        // Depth bound as unfilterable float (WebGPU allows it):
-                        // naga's GLSL output cannot textureLoad a depth texture.
-                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
+                // Depth bound as unfilterable float (WebGPU allows it):
+                // naga's GLSL output cannot textureLoad a depth texture.
+                crate::frame::fragment_texture_entry(0, false),
                 wgpu::BindGroupLayoutEntry {
                     binding: 1,
                     visibility: wgpu::ShaderStages::FRAGMENT,
@@ -87,20 +78,15 @@ impl DepthReader {
         depth: &wgpu::Texture,
     ) -> crate::gpu::TextureReadback {
         let view = depth.create_view(&Default::default());
-        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("depth read"),
-            layout: &self.layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::TextureView(&view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::Sampler(&self.sampler),
-                },
+        let group = crate::frame::bind_group(
+            device,
+            "depth read",
+            &self.layout,
+            &[
+                wgpu::BindingResource::TextureView(&view),
+                wgpu::BindingResource::Sampler(&self.sampler),
             ],
-        });
+        );
         let (target, target_view) = texture_2d(
             device,
             "depth read",

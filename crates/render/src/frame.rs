@@ -4,6 +4,7 @@
 //! [`Shared::frame_layout`]; `shaders/frame.wgsl` declares it.
 
 use crate::caps::{Capabilities, Capability, ShadowPassKind};
+use crate::options::RenderOptions;
 use crate::terrain::TerrainTexture;
 use bytemuck::{Pod, Zeroable};
 use strata_camera::Camera;
@@ -165,7 +166,11 @@ fn v4(v: glam::Vec3, w: f32) -> [f32; 4] {
 
 impl Globals {
     /// Camera, light and level parameters of one frame.
-    pub fn new(camera: &Camera, level: &LevelShape, shadow: &crate::shadow::ShadowFrame) -> Self {
+    pub fn new(
+        camera: &Camera,
+        level: &LevelShape,
+        shadow: &strata_camera::light::ShadowFrame,
+    ) -> Self {
         let b = camera.basis();
         let (w, h) = (camera.width as f32, camera.height as f32);
         let mid_add = match level.mid_rule {
@@ -221,6 +226,28 @@ pub fn texture_2d(
     });
     let view = texture.create_view(&Default::default());
     (texture, view)
+}
+
+/// A bind group of `resources` at bindings 0, 1, 2, … in order.
+pub fn bind_group(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::BindGroupLayout,
+    resources: &[wgpu::BindingResource<'_>],
+) -> wgpu::BindGroup {
+    let entries: Vec<wgpu::BindGroupEntry<'_>> = resources
+        .iter()
+        .enumerate()
+        .map(|(i, resource)| wgpu::BindGroupEntry {
+            binding: i as u32,
+            resource: resource.clone(),
+        })
+        .collect();
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout,
+        entries: &entries,
+    })
 }
 
 /// The colour and depth targets every method draws into.
@@ -316,6 +343,9 @@ pub struct Shared {
     pub caps: Capabilities,
     /// How far slow method builds have come (for a viewer's progress bar).
     pub progress: BuildProgress,
+    /// The caller's measuring switches and test hooks (the renderer copies
+    /// [`crate::Gpu::options`] here).
+    pub options: RenderOptions,
 }
 
 /// Fractions done of method builds in flight, by method name: a build that
@@ -386,6 +416,21 @@ pub fn texture_entry(
     }
 }
 
+/// A layout entry for a 2D float texture a fragment shader reads
+/// (`filterable` for a filtering sampler; depth is bound unfilterable).
+pub fn fragment_texture_entry(binding: u32, filterable: bool) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable },
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    }
+}
+
 /// A layout entry for a write-only 2D storage texture (compute stage).
 pub fn storage_texture_entry(
     binding: u32,
@@ -416,6 +461,24 @@ pub fn storage_texture_entry_with(
 /// A layout entry for a uniform buffer visible to all stages.
 pub fn uniform_layout_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     uniform_entry(binding)
+}
+
+impl Shared {
+    /// A 2D texture (and its view) of the shared targets' size.
+    pub fn target_texture(
+        &self,
+        label: &str,
+        format: wgpu::TextureFormat,
+        usage: wgpu::TextureUsages,
+    ) -> (wgpu::Texture, wgpu::TextureView) {
+        texture_2d(
+            &self.device,
+            label,
+            (self.width, self.height),
+            format,
+            usage,
+        )
+    }
 }
 
 impl Shared {
@@ -522,6 +585,7 @@ impl Shared {
             frame_group,
             caps: caps.clone(),
             progress: BuildProgress::default(),
+            options: RenderOptions::default(),
         })
     }
 

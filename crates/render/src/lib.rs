@@ -69,16 +69,20 @@
 #[cfg(test)]
 extern crate self as strata_render;
 
+pub mod adapter;
 #[doc(hidden)]
 pub mod build_guard;
 pub mod caps;
+pub mod composite;
 #[doc(hidden)]
 pub mod depth_read;
 pub mod embed;
 pub mod frame;
-pub(crate) mod fullscreen;
+#[doc(hidden)]
+pub mod fullscreen;
 pub mod gpu;
 pub mod methods;
+pub mod options;
 pub mod renderer;
 #[doc(hidden)]
 pub mod report;
@@ -92,10 +96,12 @@ pub mod shadow;
 pub mod terrain;
 pub mod timing;
 
+pub use adapter::{AdapterChoice, BackendChoice};
 pub use caps::{Capabilities, Capability, Refusal};
-pub use embed::{COLOR_TARGET_FORMATS, DEPTH_TARGET_FORMATS, TargetError, TargetViews};
+pub use composite::{COLOR_TARGET_FORMATS, DEPTH_TARGET_FORMATS, TargetError, TargetViews};
 pub use frame::{COLOR_FORMAT, DEPTH_FORMAT, SHADOW_SIZE, Shared, TerrainColors};
-pub use gpu::{AdapterChoice, AdapterReport, BackendChoice, Gpu};
-pub use methods::{Method, MethodSettings, RetainedBytes};
+pub use gpu::{AdapterReport, Gpu};
+pub use methods::{Method, MethodEntry, MethodSettings, RetainedBytes};
+pub use options::RenderOptions;
 pub use renderer::Renderer;
 pub use timing::{FrameTimings, Stats};

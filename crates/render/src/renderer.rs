@@ -9,7 +9,7 @@
 use crate::depth_read::DepthReader;
 use crate::frame::{Globals, LevelShape, Shared, TerrainColors};
 use crate::gpu::{ErrorSink, Gpu, wait_device};
-use crate::methods::{self, Frame, Method, MethodSettings, RetainedBytes};
+use crate::methods::{self, Frame, Method, MethodId, MethodSettings, RetainedBytes};
 use crate::shadow::{ShadowFrame, ShadowPass};
 use crate::timing::{FrameTimings, PassTimer};
 use std::sync::Arc;
@@ -66,7 +66,7 @@ pub struct Renderer {
     /// Called by [`Renderer::apply_edit`] after the GPU copies changed.
     edit_listener: Option<EditListener>,
     /// Pipelines that copy the frame into a caller's targets ([`Renderer::render_into`]).
-    pub(crate) composite: crate::embed::CompositeCache,
+    pub(crate) composite: crate::composite::CompositeCache,
 }
 
 /// Frames [`Renderer::hold_busy`] lets queue up before it waits for the oldest.
@@ -79,8 +79,8 @@ const FRAMES_IN_FLIGHT: usize = 3;
 pub type EditListener = Box<dyn FnMut(&Level, &[DirtyRect]) + Send>;
 
 impl Renderer {
-    /// Upload `level`, build method `method` (a name of
-    /// [`methods::names`]) for `width` x `height` targets. An unknown name, or
+    /// Upload `level`, build `method` (its [`methods::MethodEntry`], or a
+    /// name of [`methods::names`]) for `width` x `height` targets. An unknown name, or
     /// a method this adapter cannot run, is an error naming it.
     ///
     /// ```no_run
@@ -95,7 +95,7 @@ impl Renderer {
         gpu: &Gpu,
         level: &Level,
         colors: &TerrainColors,
-        method: &str,
+        method: &(impl MethodId + ?Sized),
         settings: &MethodSettings,
         width: u32,
         height: u32,
@@ -104,7 +104,7 @@ impl Renderer {
         // Unknown names, and methods this adapter cannot run, fail before
         // any GPU work.
         methods::check_support(method, &gpu.caps)?;
-        let shared = Arc::new(Shared::new(
+        let mut shared = Shared::new(
             &gpu.device,
             &gpu.queue,
             &gpu.caps,
@@ -112,7 +112,9 @@ impl Renderer {
             colors,
             width,
             height,
-        )?);
+        )?;
+        shared.options = gpu.options.clone();
+        let shared = Arc::new(shared);
         let method = methods::create(method, &shared, level, settings)?;
         let shadow = ShadowPass::new(&shared)?;
         let depth_reader = DepthReader::new(&gpu.device, &gpu.caps)?;
@@ -132,14 +134,10 @@ impl Renderer {
             last_submission: None,
             adapter: gpu.report.clone(),
             setup_ms: 0.0,
-            // Off by default (the protocol pays for every frame's map);
-            // `STRATA_SHADOW_REUSE=1` turns it on to measure a cached map.
-            shadow_reuse: env_is("STRATA_SHADOW_REUSE", "1"),
+            shadow_reuse: gpu.options.shadow_reuse,
             shadow_drawn: None,
-            // `STRATA_SHADOW_CULL=0` casts the whole map, to measure the cull.
-            shadow_cull: !env_is("STRATA_SHADOW_CULL", "0"),
-            // `STRATA_DEPTH_ATTACHMENT=1` copies every frame, to measure it.
-            depth_attachment: env_is("STRATA_DEPTH_ATTACHMENT", "1"),
+            shadow_cull: gpu.options.shadow_cull,
+            depth_attachment: gpu.options.depth_attachment,
             depth_target_current: false,
             depth_reader,
             edit_listener: None,
@@ -174,7 +172,7 @@ impl Renderer {
     pub fn build_method(
         &mut self,
         level: &Level,
-        name: &str,
+        name: &(impl MethodId + ?Sized),
         settings: &MethodSettings,
     ) -> anyhow::Result<()> {
         let method = methods::create(name, &self.shared, level, settings)?;
@@ -621,20 +619,6 @@ impl Renderer {
             texture,
             aspect,
         )
-    }
-}
-
-/// Whether environment variable `name` is `value`: the measuring switches
-/// (`STRATA_SHADOW_REUSE`, `STRATA_EXACT_*`, ...), never set in a browser.
-pub(crate) fn env_is(name: &str, value: &str) -> bool {
-    #[cfg(not(target_arch = "wasm32"))]
-    {
-        std::env::var(name).is_ok_and(|v| v == value)
-    }
-    #[cfg(target_arch = "wasm32")]
-    {
-        let _ = (name, value);
-        false
     }
 }
 

@@ -111,32 +111,22 @@ pub fn uniforms_read_back(
         label: Some("self check method"),
         entries: &[uniform_layout_entry(0)],
     });
-    let frame_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("self check frame"),
-        layout: &frame_layout,
-        entries: &[
-            wgpu::BindGroupEntry {
-                binding: 0,
-                resource: first.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 1,
-                resource: second.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 2,
-                resource: wgpu::BindingResource::TextureView(&texels_view),
-            },
+    let frame_group = crate::frame::bind_group(
+        device,
+        "self check frame",
+        &frame_layout,
+        &[
+            first.as_entire_binding(),
+            second.as_entire_binding(),
+            wgpu::BindingResource::TextureView(&texels_view),
         ],
-    });
-    let method_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("self check method"),
-        layout: &method_layout,
-        entries: &[wgpu::BindGroupEntry {
-            binding: 0,
-            resource: method.as_entire_binding(),
-        }],
-    });
+    );
+    let method_group = crate::frame::bind_group(
+        device,
+        "self check method",
+        &method_layout,
+        &[method.as_entire_binding()],
+    );
     let format = wgpu::TextureFormat::R32Uint;
     let pipeline = crate::fullscreen::pipeline(
         device,

@@ -188,19 +188,14 @@ pub fn create_module(device: &wgpu::Device, name: &str) -> anyhow::Result<wgpu::
         label: Some(name),
         source: wgpu::ShaderSource::Wgsl(text.into()),
     };
-    // A browser answers an error scope only after the page yields: there a
-    // bad shader reaches the device's error sink (checked after each frame).
-    #[cfg(target_arch = "wasm32")]
-    let module = device.create_shader_module(descriptor);
-    #[cfg(not(target_arch = "wasm32"))]
-    let module = {
-        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let module = device.create_shader_module(descriptor);
-        if let Some(err) = pollster::block_on(scope.pop()) {
-            anyhow::bail!("shader `{name}` failed to compile: {err}");
-        }
-        module
-    };
+    // In a browser a bad shader reaches the device's error sink instead
+    // (checked after each frame).
+    let (module, error) = crate::gpu::catching(device, wgpu::ErrorFilter::Validation, || {
+        device.create_shader_module(descriptor)
+    });
+    if let Some(err) = error {
+        anyhow::bail!("shader `{name}` failed to compile: {err}");
+    }
     Ok(module)
 }
 

@@ -49,14 +49,12 @@ impl ShadowPass {
                         label: Some("shadow out"),
                         entries: &[storage_texture_entry(0, wgpu::TextureFormat::R32Float)],
                     });
-                let out_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("shadow out"),
-                    layout: &out_layout,
-                    entries: &[wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: wgpu::BindingResource::TextureView(&shared.shadow_view),
-                    }],
-                });
+                let out_group = crate::frame::bind_group(
+                    device,
+                    "shadow out",
+                    &out_layout,
+                    &[wgpu::BindingResource::TextureView(&shared.shadow_view)],
+                );
                 let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                     label: Some("shadow"),
                     bind_group_layouts: &[Some(&frame_layout), Some(&out_layout)],

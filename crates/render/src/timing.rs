@@ -114,6 +114,16 @@ impl PassTimer {
         Ok((Some(passes.iter().map(|p| p.1).sum()), passes))
     }
 
+    /// This frame's summed GPU ms, waiting for the stamps (a method's own
+    /// timer, outside the frame's sum). `None` without timestamps, and in a
+    /// browser, where a read-back completes only after the page yields.
+    pub fn read_blocking(&self, device: &wgpu::Device) -> anyhow::Result<Option<f64>> {
+        if cfg!(target_arch = "wasm32") {
+            return Ok(None);
+        }
+        Ok(self.read(device, &crate::gpu::ErrorSink::default())?.0)
+    }
+
     /// Start a frame: no pass timed yet.
     pub fn reset(&self) {
         self.labels.borrow_mut().clear();

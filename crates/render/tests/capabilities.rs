@@ -89,6 +89,7 @@ fn fallbacks_match_the_direct_paths() {
         let mut fallback_gpu = Gpu::open(&strata_render::AdapterChoice {
             backend: gpu.report.backend.parse().unwrap(),
             index: None,
+            name: None,
         })
         .unwrap();
         fallback_gpu.caps.depth_copies = false;

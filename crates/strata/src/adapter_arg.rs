@@ -1,6 +1,9 @@
-//! `--backend` and `--adapter`: which GPU a command draws on.
+//! `--backend` and `--adapter`: which GPU a command draws on, and the
+//! renderer's measuring switches, which the binary (never the library) reads
+//! from the environment.
 
-use strata_render::{AdapterChoice, BackendChoice};
+use strata_render::options::{DepthMode, ExactOptions, RenderOptions};
+use strata_render::{AdapterChoice, BackendChoice, Gpu};
 
 #[derive(clap::Args, Clone, Debug, Default)]
 pub struct AdapterArgs {
@@ -18,10 +21,88 @@ impl AdapterArgs {
         AdapterChoice {
             backend: self.backend,
             index: self.adapter,
+            name: std::env::var("WGPU_ADAPTER_NAME").ok(),
         }
+    }
+
+    /// The chosen adapter's device, with [`render_options`].
+    pub fn open(&self) -> anyhow::Result<Gpu> {
+        let mut gpu = Gpu::open(&self.choice())?;
+        gpu.options = render_options();
+        Ok(gpu)
     }
 }
 
 pub fn parse_backend(s: &str) -> anyhow::Result<BackendChoice> {
     s.parse()
+}
+
+/// The renderer's measuring switches and test hook from the environment
+/// (`bench/ray-exact.md` has what each measured): `STRATA_SHADOW_REUSE=1`
+/// keeps the shadow map while its frame and the terrain are unchanged;
+/// `STRATA_SHADOW_CULL=0` casts the whole map; `STRATA_DEPTH_ATTACHMENT=1`
+/// copies depth into the shared target every frame;
+/// `STRATA_EXACT_SHADOW=shared|exact`, `STRATA_EXACT_DEPTH=blit|points|load`,
+/// `STRATA_EXACT_CLIMB=all`, `STRATA_EXACT_RATIO=2|4` configure
+/// `ray-exact`; `STRATA_EXACT_STATS=1` prints its statistics;
+/// `STRATA_TEST_OVERSIZE_BUILD=METHOD` makes that method's build ask for a
+/// buffer over the device's limit (the README's way to see a refused build).
+pub fn render_options() -> RenderOptions {
+    render_options_from(|name| std::env::var(name).ok())
+}
+
+fn render_options_from(var: impl Fn(&str) -> Option<String>) -> RenderOptions {
+    let is = |name: &str, value: &str| var(name).is_some_and(|v| v == value);
+    let e = ExactOptions::DEFAULT;
+    RenderOptions {
+        shadow_reuse: is("STRATA_SHADOW_REUSE", "1"),
+        shadow_cull: !is("STRATA_SHADOW_CULL", "0"),
+        depth_attachment: is("STRATA_DEPTH_ATTACHMENT", "1"),
+        exact: ExactOptions {
+            depth: match var("STRATA_EXACT_DEPTH").as_deref() {
+                Some("points") => DepthMode::Points,
+                Some("load") => DepthMode::BlitLoad,
+                Some("blit") => DepthMode::Blit,
+                _ => e.depth,
+            },
+            exact_shadow: match var("STRATA_EXACT_SHADOW").as_deref() {
+                Some("shared") => false,
+                Some("exact") => true,
+                _ => e.exact_shadow,
+            },
+            climb: if is("STRATA_EXACT_CLIMB", "all") {
+                8
+            } else {
+                e.climb
+            },
+            log_ratio: match var("STRATA_EXACT_RATIO").as_deref() {
+                Some("4") => 2,
+                Some("2") => 1,
+                _ => e.log_ratio,
+            },
+            ..e
+        },
+        exact_stats: is("STRATA_EXACT_STATS", "1"),
+        oversize_build: var("STRATA_TEST_OVERSIZE_BUILD").filter(|m| !m.is_empty()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn no_variables_give_the_product_and_each_switch_reads_its_own() {
+        assert_eq!(render_options_from(|_| None), RenderOptions::default());
+        let o = render_options_from(|n| match n {
+            "STRATA_SHADOW_CULL" => Some("0".into()),
+            "STRATA_EXACT_DEPTH" => Some("points".into()),
+            "STRATA_EXACT_RATIO" => Some("2".into()),
+            "STRATA_TEST_OVERSIZE_BUILD" => Some("voxel".into()),
+            _ => None,
+        });
+        assert!(!o.shadow_cull && !o.shadow_reuse);
+        assert_eq!((o.exact.depth, o.exact.log_ratio), (DepthMode::Points, 1));
+        assert_eq!(o.oversize_build.as_deref(), Some("voxel"));
+    }
 }

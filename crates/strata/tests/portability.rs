@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use strata_bench::portability::Portability;
 use strata_render::BackendChoice;
-use strata_render::gpu::list_adapters;
+use strata_render::adapter::list_adapters;
 
 const STRATA: &str = env!("CARGO_BIN_EXE_strata");
 

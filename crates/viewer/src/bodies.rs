@@ -187,14 +187,12 @@ impl BodyPainter {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("bodies"),
-            layout: &pipeline.get_bind_group_layout(0),
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: uniform.as_entire_binding(),
-            }],
-        });
+        let group = strata_render::frame::bind_group(
+            device,
+            "bodies",
+            &pipeline.get_bind_group_layout(0),
+            &[uniform.as_entire_binding()],
+        );
         let capacity = 64;
         BodyPainter {
             pipeline,

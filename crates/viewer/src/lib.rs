@@ -28,6 +28,8 @@ pub mod fly;
 pub mod knobs;
 pub mod minimap;
 pub mod overlay;
+#[cfg(target_arch = "wasm32")]
+mod page;
 pub mod physics;
 pub mod platform;
 pub mod present;
@@ -67,6 +69,9 @@ pub struct Options {
     pub vsync: bool,
     /// The backend and adapter to draw on (`--backend`, `--adapter`).
     pub adapter: strata_render::AdapterChoice,
+    /// The renderer's measuring switches and test hooks (the CLI's, from
+    /// the environment; the page's are the defaults).
+    pub render: strata_render::RenderOptions,
     /// Where screenshots taken with P or the overlay go.
     pub out: PathBuf,
     /// Where Ctrl+S and script `save` may write the edited world.
@@ -116,7 +121,7 @@ impl App {
             self.display.clone(),
         ));
         desc.backends = options.adapter.backend.backends();
-        desc.flags = strata_render::gpu::instance_flags(desc.flags);
+        desc.flags = strata_render::adapter::instance_flags(desc.flags);
         let instance = wgpu::Instance::new(desc);
         let opened = viewer::Viewer::open_window(event_loop, &options, &instance).and_then(
             |(window, surface)| {

@@ -8,6 +8,7 @@ use crate::fly::FlyCamera;
 use crate::knobs::Knob;
 use egui_wgpu::ScreenDescriptor;
 use strata_level::ViewSpec;
+use strata_render::methods::{Slider, SliderKind};
 use strata_render::{AdapterReport, FrameTimings, MethodSettings, RetainedBytes, methods};
 use winit::window::Window;
 
@@ -534,44 +535,51 @@ fn knobs(
     actions: &mut Vec<Action>,
 ) {
     let shown: Vec<&str> = std::iter::once(status.active).chain(status.split).collect();
-    let relevant = |knob: Knob| knob.methods().iter().any(|m| shown.contains(m));
     let s = &mut *editable.settings;
-    // Knobs methods take in place apply while dragging; the mesh quality (a
-    // new fit, in the background) when the drag ends or a click changes it.
-    let mut knob = |k: Knob, response: egui::Response| {
-        let live = !matches!(k, Knob::MeshQuality | Knob::MeshLodPixels) && response.changed();
+    for k in Knob::all() {
+        let response = match k {
+            Knob::Method(slider) if shown.iter().any(|m| k.read_by(m)) => slider_ui(ui, slider, s),
+            Knob::Method(_) => continue,
+            Knob::Shadows => ui.checkbox(&mut s.shadows, "shadows"),
+        };
+        // Knobs methods take in place apply while dragging; the others (a
+        // new mesh fit, in the background) when the drag ends or a click
+        // changes them.
+        let live = matches!(k, Knob::Method(slider) if slider.live) || k == Knob::Shadows;
+        let live = live && response.changed();
         if live || response.drag_stopped() || (response.changed() && !response.dragged()) {
             actions.push(Action::Knob(k));
         }
-    };
-    if relevant(Knob::RaySteps) {
-        let r = ui.add(egui::Slider::new(&mut s.ray_steps, 8..=512).text("ray steps"));
-        knob(Knob::RaySteps, r);
     }
-    if relevant(Knob::VoxelSteps) {
-        let r = ui.add(egui::Slider::new(&mut s.voxel_steps, 8..=400).text("voxel steps"));
-        knob(Knob::VoxelSteps, r);
+}
+
+/// One method slider as its kind draws it.
+fn slider_ui(
+    ui: &mut egui::Ui,
+    slider: &Slider,
+    s: &mut strata_render::MethodSettings,
+) -> egui::Response {
+    let value = (slider.get)(s);
+    match slider.kind {
+        SliderKind::Count { min, max } => {
+            let mut v = value as u32;
+            let r = ui.add(egui::Slider::new(&mut v, min..=max).text(slider.label));
+            (slider.put)(s, v as f32);
+            r
+        }
+        SliderKind::Number { min, max } => {
+            let mut v = value;
+            let r = ui.add(egui::Slider::new(&mut v, min..=max).text(slider.label));
+            (slider.put)(s, v);
+            r
+        }
+        SliderKind::Toggle => {
+            let mut on = value != 0.0;
+            let r = ui.checkbox(&mut on, slider.label);
+            (slider.put)(s, f32::from(u8::from(on)));
+            r
+        }
     }
-    if relevant(Knob::Slices) {
-        let r = ui.add(egui::Slider::new(&mut s.slices, 16..=2048).text("slices"));
-        knob(Knob::Slices, r);
-    }
-    if relevant(Knob::Density) {
-        let mut d = s.scatter_density[0];
-        let r = ui.add(egui::Slider::new(&mut d, 0.5..=8.0).text("density"));
-        s.scatter_density = [d; 3];
-        knob(Knob::Density, r);
-    }
-    if relevant(Knob::MeshQuality) {
-        let r = ui.add(egui::Slider::new(&mut s.mesh_quality, 0.0..=1.0).text("mesh quality"));
-        knob(Knob::MeshQuality, r);
-        let r = ui.checkbox(&mut s.mesh_outline, "mesh outline-constrained (refits)");
-        knob(Knob::MeshOutline, r);
-        let r = ui.add(egui::Slider::new(&mut s.mesh_lod_pixels, 0.25..=16.0).text("mesh LOD px"));
-        knob(Knob::MeshLodPixels, r);
-    }
-    let r = ui.checkbox(&mut s.shadows, "shadows");
-    knob(Knob::Shadows, r);
 }
 
 fn views(ui: &mut egui::Ui, status: &Status<'_>, actions: &mut Vec<Action>) {

@@ -10,6 +10,7 @@
 use bytemuck::{Pod, Zeroable};
 use strata_render::Shared;
 use strata_render::frame::texture_2d;
+use strata_render::fullscreen;
 use strata_render::gpu::TextureReadback;
 
 /// The window image's format: what egui paints into and screenshots hold.
@@ -71,16 +72,7 @@ impl Compositor {
             label: Some("present.wgsl"),
             source: wgpu::ShaderSource::Wgsl(include_str!("../shaders/present.wgsl").into()),
         });
-        let texture_entry = |binding| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::FRAGMENT,
-            ty: wgpu::BindingType::Texture {
-                sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                view_dimension: wgpu::TextureViewDimension::D2,
-                multisampled: false,
-            },
-            count: None,
-        };
+        let texture_entry = |binding| strata_render::frame::fragment_texture_entry(binding, true);
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("present"),
             entries: &[
@@ -266,7 +258,15 @@ impl Compositor {
             &self.single_group
         };
         let target = &self.window.view;
-        fullscreen(encoder, "compose", target, &self.compose, group, timestamps);
+        // The shaders write every pixel (bars included): the clear is unseen.
+        fullscreen::draw(
+            encoder,
+            "compose",
+            target,
+            &self.compose,
+            &[group],
+            timestamps,
+        );
     }
 
     /// The window image, for the overlay to paint on (load, don't clear).
@@ -282,7 +282,14 @@ impl Compositor {
         timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
     ) {
         let group = &self.present_group;
-        fullscreen(encoder, "present", target, &self.present, group, timestamps);
+        fullscreen::draw(
+            encoder,
+            "present",
+            target,
+            &self.present,
+            &[group],
+            timestamps,
+        );
     }
 
     /// The window image as RGBA8 (what a screenshot saves).
@@ -306,28 +313,17 @@ fn bind_images(
     left: &wgpu::TextureView,
     right: &wgpu::TextureView,
 ) -> wgpu::BindGroup {
-    device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("present"),
+    strata_render::frame::bind_group(
+        device,
+        "present",
         layout,
-        entries: &[
-            wgpu::BindGroupEntry {
-                binding: 0,
-                resource: params.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 1,
-                resource: wgpu::BindingResource::TextureView(left),
-            },
-            wgpu::BindGroupEntry {
-                binding: 2,
-                resource: wgpu::BindingResource::TextureView(right),
-            },
-            wgpu::BindGroupEntry {
-                binding: 3,
-                resource: wgpu::BindingResource::Sampler(sampler),
-            },
+        &[
+            params.as_entire_binding(),
+            wgpu::BindingResource::TextureView(left),
+            wgpu::BindingResource::TextureView(right),
+            wgpu::BindingResource::Sampler(sampler),
         ],
-    })
+    )
 }
 
 /// The kept A picture (the renderer's size) and the compose groups: the
@@ -372,36 +368,6 @@ pub fn window_to_picture(
     let (u, v) = ((at.0 - px) / pw, (at.1 - py) / ph);
     ((0.0..1.0).contains(&u) && (0.0..1.0).contains(&v))
         .then_some((u * render.0 as f32, v * render.1 as f32))
-}
-
-/// One full-screen triangle into `target`, overwriting it.
-fn fullscreen(
-    encoder: &mut wgpu::CommandEncoder,
-    label: &str,
-    target: &wgpu::TextureView,
-    pipeline: &wgpu::RenderPipeline,
-    group: &wgpu::BindGroup,
-    timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
-) {
-    let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-        label: Some(label),
-        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-            view: target,
-            depth_slice: None,
-            resolve_target: None,
-            ops: wgpu::Operations {
-                load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-                store: wgpu::StoreOp::Store,
-            },
-        })],
-        depth_stencil_attachment: None,
-        timestamp_writes: timestamps,
-        occlusion_query_set: None,
-        multiview_mask: None,
-    });
-    pass.set_pipeline(pipeline);
-    pass.set_bind_group(0, group, &[]);
-    pass.draw(0..3, 0..1);
 }
 
 #[cfg(test)]

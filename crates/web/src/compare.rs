@@ -11,13 +11,13 @@
 //! native runner uses without timestamps), read-backs are polled, the mesh
 //! fits a slice at a time, and it yields to the browser between steps.
 
-use crate::page::{progress, yield_to_browser};
+use crate::progress::{progress, yield_to_browser};
 use anyhow::Context;
 use std::cell::RefCell;
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
-use strata_bench::plan::{MethodChoice, file_part, parse_methods};
+use strata_bench::plan::{every_method, file_part, parse_methods};
 use strata_bench::results::{Failure, RunResults};
 use strata_bench::run::{EditMode, Measured, Options, Plan, WarmUp};
 use strata_camera::Camera;
@@ -77,14 +77,8 @@ pub async fn run(
             .collect::<anyhow::Result<_>>()?,
     };
     let methods = match methods {
-        Some(list) => parse_methods(list, &methods::names()).context("?methods")?,
-        None => methods::names()
-            .into_iter()
-            .map(|name| MethodChoice {
-                name: name.to_string(),
-                setting: None,
-            })
-            .collect(),
+        Some(list) => parse_methods(list, methods::METHODS).context("?methods")?,
+        None => every_method(),
     };
     let options = Options {
         out: PathBuf::new(),
@@ -127,12 +121,14 @@ pub async fn run(
 
     let n_methods = plan.options().methods.len();
     for m in 0..n_methods {
-        let label = plan.options().methods[m].label();
-        if let Err(e) = methods::check_support(&label, &gpu.caps) {
+        // The method is its entry; the label (`ray:64`) only names the column.
+        let choice = &plan.options().methods[m];
+        let label = choice.label();
+        if let Err(e) = choice.method.check(&gpu.caps) {
             results.failures.push(Failure {
                 view: "*".into(),
                 method: label,
-                error: format!("refused: {e:#}"),
+                error: format!("refused: {e}"),
             });
             continue;
         }
@@ -232,7 +228,7 @@ async fn method_column(
     let mut renderer = Renderer::new(gpu, level, plan.colors(), "ray", settings, w, h)?;
     let mut build_ms = now_ms() - start;
     let shared = renderer.shared_handle();
-    let mut steps = methods::create_in_steps(&choice.name, &shared.caps, settings)?;
+    let mut steps = methods::create_in_steps(choice.method, &shared.caps, settings)?;
     let method = loop {
         let step = now_ms();
         let built = steps.step(&shared, level, STEP_BUDGET_MS)?;
@@ -240,12 +236,12 @@ async fn method_column(
         if let Some(method) = built {
             break method;
         }
-        let fraction = shared.progress.get(&choice.name).unwrap_or(0.0);
+        let fraction = shared.progress.get(choice.name()).unwrap_or(0.0);
         status(&format!("setup {:.0} %", fraction * 100.0));
         yield_to_browser().await;
     };
     renderer.insert_method(method, settings.clone());
-    renderer.activate(&choice.name)?;
+    renderer.activate(choice.name())?;
     drop(shared);
 
     for (v, camera) in plan.cameras().iter().enumerate() {

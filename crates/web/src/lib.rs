@@ -4,7 +4,8 @@
 //! `?level=URL`), then hand `strata_viewer` to the browser's event loop.
 //! Errors and panics are shown in the page.
 //!
-//! URL parameters: `backend=webgl2`, `method=NAME`, `view=NAME`, `voxel=X,Y,Z`,
+//! URL parameters: `backend=webgl2`, `method=NAME`, `view=NAME`,
+//! `NAME=SETTING` (a method's knobs: `voxel=X,Y,Z`, `ray=64`, `mesh=0.75`),
 //! `size=WxH` (canvas), `scale=F` (picture / canvas), `world=WxH` and
 //! `seed=N` (the generated world), `level=URL` (a world directory),
 //! `compare` (the quick protocol instead of the viewer; `views=A,B` to
@@ -13,6 +14,7 @@
 
 mod compare;
 mod page;
+mod progress;
 
 use wasm_bindgen::prelude::*;
 

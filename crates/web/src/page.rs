@@ -1,10 +1,12 @@
 //! URL parameters, the world in the page (generated, fetched or picked),
 //! the progress bar.
 
+use crate::progress::{progress, yield_to_browser};
 use anyhow::{Context, bail};
 use strata_level::World;
 use strata_level::generate::{GenerateParams, Generation, parse_size};
 use strata_render::MethodSettings;
+use strata_render::methods::METHODS;
 use strata_viewer::web::{Backend, now_ms, set_state};
 use wasm_bindgen::JsCast;
 use wasm_bindgen_futures::JsFuture;
@@ -18,7 +20,8 @@ pub struct Params {
     pub scale: Option<f32>,
     pub world: GenerateParams,
     pub level: Option<String>,
-    /// `?voxel=X,Y,Z`: the voxel methods' grid (default the tuned one).
+    /// `?NAME=SETTING` (`?voxel=X,Y,Z`, `?ray=64`): a method's knobs in
+    /// `--methods NAME:SETTING`'s form (default the tuned ones).
     pub settings: MethodSettings,
     /// `?compare`: run the quick protocol instead of the viewer.
     pub compare: bool,
@@ -70,17 +73,14 @@ impl Params {
                 .ok()
                 .with_context(|| format!("?seed={text}: a whole number"))?;
         }
+        // `?NAME=SETTING`: a method's knobs, in `--methods NAME:SETTING`'s
+        // form (`?voxel=2,4,1`, `?ray=64`, `?mesh=0.75`).
         let mut settings = MethodSettings::default();
-        if let Some(text) = get("voxel") {
-            let sizes: Vec<u32> = text
-                .split(',')
-                .map(|v| v.trim().parse::<u32>().ok().filter(|v| *v > 0))
-                .collect::<Option<_>>()
-                .with_context(|| format!("?voxel={text}: three positive whole numbers X,Y,Z"))?;
-            let [x, y, z] = sizes[..] else {
-                bail!("?voxel={text}: three sizes X,Y,Z");
-            };
-            settings.voxel_size = [x, y, z];
+        for m in METHODS {
+            if let Some(text) = get(m.name) {
+                m.apply_setting(&text, &mut settings)
+                    .with_context(|| format!("?{}={text}: {}", m.name, m.knobs.grammar))?;
+            }
         }
         Ok(Params {
             backend,
@@ -127,46 +127,13 @@ pub async fn run() -> anyhow::Result<()> {
             script: None,
             vsync: true,
             adapter: Default::default(),
+            render: Default::default(),
             out: "screenshots".into(),
             save: Default::default(),
             physics: false,
         },
         params.backend,
     )
-}
-
-/// Let the browser paint and handle input.
-pub async fn yield_to_browser() {
-    let promise = js_sys::Promise::new(&mut |resolve, _| {
-        if let Some(window) = web_sys::window() {
-            let _ = window.set_timeout_with_callback_and_timeout_and_arguments_0(&resolve, 0);
-        }
-    });
-    let _ = JsFuture::from(promise).await;
-}
-
-/// Show (or with `None` hide) the page's progress bar and its line.
-pub fn progress(fraction: Option<f64>, text: &str) {
-    let Some(document) = web_sys::window().and_then(|w| w.document()) else {
-        return;
-    };
-    if let Some(bar) = document
-        .get_element_by_id("strata-progress")
-        .and_then(|e| e.dyn_into::<web_sys::HtmlProgressElement>().ok())
-    {
-        match fraction {
-            Some(f) => {
-                bar.set_value(f);
-                let _ = bar.set_attribute("style", "display: inline-block");
-            }
-            None => {
-                let _ = bar.set_attribute("style", "display: none");
-            }
-        }
-    }
-    if let Some(line) = document.get_element_by_id("strata-status") {
-        line.set_text_content(Some(text));
-    }
 }
 
 /// The built-in world, generated here a band of rows per turn of the

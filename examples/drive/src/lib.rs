@@ -158,25 +158,34 @@ pub struct Offscreen {
     pub depth_view: wgpu::TextureView,
 }
 
+/// A 2D render target of `size` (yours: Strata draws into its view).
+pub fn target(
+    device: &wgpu::Device,
+    label: &str,
+    size: (u32, u32),
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+) -> wgpu::Texture {
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d {
+            width: size.0,
+            height: size.1,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage,
+        view_formats: &[],
+    })
+}
+
 impl Offscreen {
     /// Targets of `size` on `device`.
     pub fn new(device: &wgpu::Device, size: (u32, u32)) -> Self {
-        let texture = |format, usage| {
-            device.create_texture(&wgpu::TextureDescriptor {
-                label: Some("offscreen"),
-                size: wgpu::Extent3d {
-                    width: size.0,
-                    height: size.1,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage,
-                view_formats: &[],
-            })
-        };
+        let texture = |format, usage| target(device, "offscreen", size, format, usage);
         use wgpu::TextureUsages as U;
         let color = texture(HEADLESS_COLOR, U::RENDER_ATTACHMENT | U::COPY_SRC);
         let depth = texture(DEPTH, U::RENDER_ATTACHMENT);

@@ -22,7 +22,8 @@ use std::time::Instant;
 use strata_camera::Camera;
 use strata_level::{ViewSpec, World};
 use strata_reference::{Reference, ReferenceCache, Tracer};
-use strata_render::{Gpu, Renderer, TerrainColors};
+use strata_render::methods::{METHODS, Sweep as MethodSweep};
+use strata_render::{Gpu, MethodEntry, Renderer, TerrainColors};
 
 /// What to sweep and how.
 #[derive(Clone, Debug)]
@@ -52,7 +53,7 @@ pub struct TuneOptions {
 /// One method's sweep: its knob's settings in `methods::settings_for` syntax.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Sweep {
-    pub method: &'static str,
+    pub method: &'static MethodEntry,
     /// What the knob is, for the table.
     pub knob: &'static str,
     pub settings: Vec<Option<String>>,
@@ -61,103 +62,42 @@ pub struct Sweep {
     pub size: (u32, u32),
 }
 
-/// The sweeps of the protocol (issue 16's ranges), fewer points with `quick`
-/// (always the ends and the paper's setting, so ours can be set beside it).
+/// The methods `strata tune` sweeps (their entries' [`MethodSweep`]), in
+/// the report's order.
+fn tuned() -> Vec<&'static MethodEntry> {
+    let mut tuned: Vec<&'static MethodEntry> =
+        METHODS.iter().filter(|m| m.tune.is_some()).collect();
+    tuned.sort_by_key(|m| m.tune.map(|t| t.order));
+    tuned
+}
+
+/// The sweeps of the protocol (issue 16's ranges, each method's entry's
+/// [`MethodSweep`]), fewer points with `quick` (always the ends and the
+/// paper's setting, so ours can be set beside it).
 pub fn sweeps(quick: bool, size: (u32, u32), mesh_size: Option<(u32, u32)>) -> Vec<Sweep> {
-    let pick = |full: &[&str], few: &[&str]| -> Vec<Option<String>> {
-        let list = if quick { few } else { full };
-        list.iter().map(|s| Some((*s).to_string())).collect()
-    };
-    let voxel: Vec<String> = {
-        let steps: &[&str] = if quick {
-            &["40", "100", "400"]
+    let sweep = |method: &'static MethodEntry, t: &MethodSweep, size| Sweep {
+        method,
+        knob: t.knob,
+        settings: if t.full.is_empty() {
+            vec![None]
         } else {
-            &["40", "70", "100", "200", "400"]
-        };
-        ["4,8,2", "2,4,1"]
-            .iter()
-            .flat_map(|g| steps.iter().map(move |s| format!("{g}/{s}")))
-            .collect()
+            let list = if quick { t.quick } else { t.full };
+            list.iter().map(|s| Some((*s).to_string())).collect()
+        },
+        paper: method.knobs.default,
+        size,
     };
-    let mesh = pick(&["0", "0.25", "0.5", "0.75", "1"], &["0", "0.5", "1"]);
-    let mut out = vec![
-        Sweep {
-            method: "ray",
-            knob: "steps",
-            settings: pick(&["16", "32", "64", "128", "256"], &["16", "128", "256"]),
-            paper: Some("128"),
-            size,
-        },
-        Sweep {
-            method: "voxel",
-            knob: "grid / steps",
-            settings: voxel.into_iter().map(Some).collect(),
-            paper: Some("4,8,2/100"),
-            size,
-        },
-        Sweep {
-            method: "sliced",
-            // The refined slicer is a setting of the same method (its slices
-            // still decide coverage), so the rule weighs it against the
-            // paper's plain slicer at equal tuning.
-            knob: "slices [/refine]",
-            settings: pick(
-                &[
-                    "32",
-                    "64",
-                    "128",
-                    "256",
-                    "512",
-                    "1024",
-                    "32/refine",
-                    "64/refine",
-                    "128/refine",
-                    "256/refine",
-                    "512/refine",
-                    "1024/refine",
-                ],
-                &["32", "512", "1024", "32/refine", "512/refine"],
-            ),
-            paper: Some("512"),
-            size,
-        },
-        Sweep {
-            method: "scattered",
-            knob: "density",
-            settings: pick(&["1", "2", "4", "8"], &["1", "4", "8"]),
-            paper: Some("4"),
-            size,
-        },
-        Sweep {
-            method: "mesh",
-            knob: "q",
-            settings: mesh.clone(),
-            paper: Some("0.5"),
-            size,
-        },
-        Sweep {
-            method: "painted",
-            knob: "none",
-            settings: vec![None],
-            paper: None,
-            size,
-        },
-        Sweep {
-            method: "ray-exact",
-            knob: "none",
-            settings: vec![None],
-            paper: None,
-            size,
-        },
-    ];
+    let tuned = tuned();
+    let mut out: Vec<Sweep> = tuned
+        .iter()
+        .filter_map(|m| m.tune.map(|t| sweep(m, t, size)))
+        .collect();
     if let Some(big) = mesh_size {
-        out.push(Sweep {
-            method: "mesh",
-            knob: "q",
-            settings: mesh,
-            paper: Some("0.5"),
-            size: big,
-        });
+        out.extend(
+            tuned
+                .iter()
+                .filter_map(|m| m.tune.filter(|t| t.at_paper_size).map(|t| sweep(m, t, big))),
+        );
     }
     out
 }
@@ -242,13 +182,15 @@ pub fn run(world: &World, gpu: &Gpu, opts: &TuneOptions) -> anyhow::Result<Tunin
     let mut sweeps = sweeps(opts.quick, opts.size, opts.mesh_size);
     if let Some(only) = &opts.methods {
         for m in only {
-            if !sweeps.iter().any(|s| s.method == m) {
+            if !sweeps.iter().any(|s| s.method.name == m) {
+                let swept: Vec<&str> = tuned().iter().map(|m| m.name).collect();
                 anyhow::bail!(
-                    "tune: method `{m}` has no sweep; swept: ray, voxel, sliced, scattered, mesh, painted, ray-exact"
+                    "tune: method `{m}` has no sweep; swept: {}",
+                    swept.join(", ")
                 );
             }
         }
-        sweeps.retain(|s| only.iter().any(|m| m == s.method));
+        sweeps.retain(|s| only.iter().any(|m| m == s.method.name));
     }
     // Check every setting before GPU work.
     for s in &sweeps {
@@ -371,7 +313,7 @@ pub fn run(world: &World, gpu: &Gpu, opts: &TuneOptions) -> anyhow::Result<Tunin
         }
         let pairs: Vec<(f64, f64)> = points.iter().map(|p| (p.cost_ms, p.combined)).collect();
         methods.push(MethodTuning {
-            method: s.method.to_string(),
+            method: s.method.name.to_string(),
             knob: s.knob.to_string(),
             size: [s.size.0, s.size.1],
             chosen: rule::choose(&pairs, rule::TOLERANCE_POINTS),
@@ -401,9 +343,9 @@ pub fn run(world: &World, gpu: &Gpu, opts: &TuneOptions) -> anyhow::Result<Tunin
     })
 }
 
-fn choice(method: &str, setting: &Option<String>) -> MethodChoice {
+fn choice(method: &'static MethodEntry, setting: &Option<String>) -> MethodChoice {
     MethodChoice {
-        name: method.to_string(),
+        method,
         setting: setting.clone(),
     }
 }
@@ -420,7 +362,7 @@ mod tests {
                     assert!(
                         s.settings.iter().any(|x| x.as_deref() == Some(p)),
                         "{} (quick {quick}) lacks the paper's {p}",
-                        s.method
+                        s.method.name
                     );
                 }
                 for setting in &s.settings {
@@ -432,7 +374,7 @@ mod tests {
         let full = sweeps(false, (400, 260), Some((1280, 800)));
         assert!(
             full.iter()
-                .any(|s| s.method == "mesh" && s.size == (1280, 800))
+                .any(|s| s.method.name == "mesh" && s.size == (1280, 800))
         );
     }
 }

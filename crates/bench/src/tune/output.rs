@@ -37,9 +37,12 @@ impl TunedSettings {
                 mesh_area = area;
             }
             methods.insert(m.method.clone(), setting.to_string());
-            for (base, twin) in [("ray", "ray-compute"), ("voxel", "voxel-compute")] {
-                if m.method == base {
-                    methods.insert(twin.to_string(), setting.to_string());
+            // The methods that share the tuned one's knobs and are not swept.
+            if let Ok(tuned) = strata_render::methods::entry(&m.method) {
+                for twin in strata_render::methods::METHODS.iter().filter(|e| {
+                    e.tune.is_none() && e.name != tuned.name && std::ptr::eq(e.knobs, tuned.knobs)
+                }) {
+                    methods.insert(twin.name.to_string(), setting.to_string());
                 }
             }
         }
@@ -68,7 +71,7 @@ impl TunedSettings {
     pub fn apply(&self, methods: &mut [MethodChoice]) {
         for m in methods {
             if m.setting.is_none() {
-                m.setting = self.methods.get(&m.name).cloned();
+                m.setting = self.methods.get(m.method.name).cloned();
             }
         }
     }
@@ -272,15 +275,15 @@ mod tests {
         // Applied only where the command line named no setting.
         let mut choices = vec![
             MethodChoice {
-                name: "ray".into(),
+                method: strata_render::methods::entry("ray").unwrap(),
                 setting: None,
             },
             MethodChoice {
-                name: "mesh".into(),
+                method: strata_render::methods::entry("mesh").unwrap(),
                 setting: Some("0.5".into()),
             },
             MethodChoice {
-                name: "painted".into(),
+                method: strata_render::methods::entry("painted").unwrap(),
                 setting: None,
             },
         ];

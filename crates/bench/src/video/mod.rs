@@ -314,7 +314,7 @@ fn build_lane(
         gpu,
         level,
         colors,
-        &choice.name,
+        choice.method,
         &settings,
         opts.tile.0,
         opts.tile.1,
@@ -333,7 +333,7 @@ fn build_lane(
         flicker: FlickerTracker::default(),
         previous: None,
         setup_ms,
-        settings: describe(&choice.name, &settings),
+        settings: describe(choice.method, &settings),
     })
 }
 

@@ -37,7 +37,7 @@ pub fn choices(names: &[&str]) -> Vec<MethodChoice> {
     names
         .iter()
         .map(|n| MethodChoice {
-            name: (*n).into(),
+            method: strata_render::methods::entry(n).unwrap(),
             setting: None,
         })
         .collect()

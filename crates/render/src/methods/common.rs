@@ -1,7 +1,7 @@
 //! Pipeline and pass plumbing that several methods share, so that the
 //! method files hold only what makes each method different.
 
-use super::Frame;
+use super::contract::Frame;
 use crate::frame::{
     COLOR_FORMAT, DEPTH_FORMAT, Shared, sky_clear, storage_texture_entry, texture_entry,
     uniform_layout_entry,
@@ -158,14 +158,7 @@ pub(crate) fn uniform_binding(
         label: Some(label),
         entries: &[uniform_layout_entry(0)],
     });
-    let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some(label),
-        layout: &layout,
-        entries: &[wgpu::BindGroupEntry {
-            binding: 0,
-            resource: buffer.as_entire_binding(),
-        }],
-    });
+    let group = crate::frame::bind_group(device, label, &layout, &[buffer.as_entire_binding()]);
     (layout, group)
 }
 
@@ -187,10 +180,18 @@ pub(crate) fn index_buffer(shared: &Shared, label: &str, indices: &[u16]) -> wgp
 /// The shared depth target, cleared to far (the contract: the first pass
 /// that touches it clears it).
 fn depth_attachment(shared: &Shared) -> wgpu::RenderPassDepthStencilAttachment<'_> {
+    depth_attachment_with(shared, wgpu::LoadOp::Clear(1.0))
+}
+
+/// The shared depth target, loaded by `load`.
+fn depth_attachment_with(
+    shared: &Shared,
+    load: wgpu::LoadOp<f32>,
+) -> wgpu::RenderPassDepthStencilAttachment<'_> {
     wgpu::RenderPassDepthStencilAttachment {
         view: &shared.depth_view,
         depth_ops: Some(wgpu::Operations {
-            load: wgpu::LoadOp::Clear(1.0),
+            load,
             store: wgpu::StoreOp::Store,
         }),
         stencil_ops: None,
@@ -205,6 +206,18 @@ pub(crate) fn begin_pass<'e>(
     encoder: &'e mut wgpu::CommandEncoder,
     label: &str,
 ) -> wgpu::RenderPass<'e> {
+    begin_pass_with_depth(shared, frame, encoder, label, wgpu::LoadOp::Clear(1.0))
+}
+
+/// [`begin_pass`] with the shared depth target loaded by `depth` (a pass
+/// after one that drew depth keeps it with `LoadOp::Load`).
+pub(crate) fn begin_pass_with_depth<'e>(
+    shared: &Shared,
+    frame: &Frame<'_>,
+    encoder: &'e mut wgpu::CommandEncoder,
+    label: &str,
+    depth: wgpu::LoadOp<f32>,
+) -> wgpu::RenderPass<'e> {
     encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
         label: Some(label),
         color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -216,7 +229,7 @@ pub(crate) fn begin_pass<'e>(
                 store: wgpu::StoreOp::Store,
             },
         })],
-        depth_stencil_attachment: Some(depth_attachment(shared)),
+        depth_stencil_attachment: Some(depth_attachment_with(shared, depth)),
         timestamp_writes: frame.timer.render(label),
         occlusion_query_set: None,
         multiview_mask: None,
@@ -251,7 +264,28 @@ pub(crate) fn draw_fullscreen(
     pipeline: &wgpu::RenderPipeline,
     group: &wgpu::BindGroup,
 ) {
-    let mut pass = begin_pass(shared, frame, encoder, label);
+    draw_fullscreen_with_depth(
+        shared,
+        frame,
+        encoder,
+        label,
+        pipeline,
+        group,
+        wgpu::LoadOp::Clear(1.0),
+    );
+}
+
+/// [`draw_fullscreen`] with the shared depth target loaded by `depth`.
+pub(crate) fn draw_fullscreen_with_depth(
+    shared: &Shared,
+    frame: &Frame<'_>,
+    encoder: &mut wgpu::CommandEncoder,
+    label: &str,
+    pipeline: &wgpu::RenderPipeline,
+    group: &wgpu::BindGroup,
+    depth: wgpu::LoadOp<f32>,
+) {
+    let mut pass = begin_pass_with_depth(shared, frame, encoder, label, depth);
     pass.set_pipeline(pipeline);
     pass.set_bind_group(0, &shared.frame_group, &[]);
     pass.set_bind_group(1, group, &[]);
@@ -305,33 +339,20 @@ fn depth_image(
     label: &str,
     layout: &wgpu::BindGroupLayout,
 ) -> (wgpu::Texture, wgpu::TextureView, wgpu::BindGroup) {
-    let device = &shared.device;
-    let depth = device.create_texture(&wgpu::TextureDescriptor {
-        label: Some(label),
-        size: wgpu::Extent3d {
-            width: shared.width,
-            height: shared.height,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: wgpu::TextureFormat::R32Float,
-        // COPY_SRC: `Renderer::read_depth` reads the frame's depth from here.
-        usage: wgpu::TextureUsages::STORAGE_BINDING
+    // COPY_SRC: `Renderer::read_depth` reads the frame's depth from here.
+    let (depth, view) = shared.target_texture(
+        label,
+        wgpu::TextureFormat::R32Float,
+        wgpu::TextureUsages::STORAGE_BINDING
             | wgpu::TextureUsages::TEXTURE_BINDING
             | wgpu::TextureUsages::COPY_SRC,
-        view_formats: &[],
-    });
-    let view = depth.create_view(&Default::default());
-    let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some(label),
+    );
+    let group = crate::frame::bind_group(
+        &shared.device,
+        label,
         layout,
-        entries: &[wgpu::BindGroupEntry {
-            binding: 0,
-            resource: wgpu::BindingResource::TextureView(&view),
-        }],
-    });
+        &[wgpu::BindingResource::TextureView(&view)],
+    );
     (depth, view, group)
 }
 
@@ -470,17 +491,15 @@ impl DepthCopy {
         self.record_with(shared, frame, encoder, label, false);
     }
 
-    /// The blit with its choices open (for measuring): `scissor` limits the
-    /// draw to 16x16 pixels (a wrong image: what the pass costs before its
-    /// fragments); `clear` false loads the old depth instead of clearing it
-    /// (the same image: the blit writes every pixel, compare `Always`).
+    /// The blit with its choice open (for measuring): `clear` false loads
+    /// the old depth instead of clearing it (the same image: the blit writes
+    /// every pixel, compare `Always`).
     pub(crate) fn record_blit(
         &self,
         shared: &Shared,
         frame: &Frame<'_>,
         encoder: &mut wgpu::CommandEncoder,
         label: &str,
-        scissor: bool,
         clear: bool,
     ) {
         if !frame.depth_attachment {
@@ -501,9 +520,6 @@ impl DepthCopy {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        if scissor {
-            pass.set_scissor_rect(0, 0, shared.width.min(16), shared.height.min(16));
-        }
         pass.set_pipeline(&self.blit);
         pass.set_bind_group(0, &self.blit_group, &[]);
         pass.draw(0..3, 0..1);

@@ -9,8 +9,9 @@
 //! rasterised (`bench/painted-indexed/`: 2.9x faster on the H200).
 
 use super::common::{begin_pass, forward_pipeline, index_buffer, uniform_binding};
+use super::contract::{Frame, Method, MethodSettings, RetainedBytes};
 use super::forward::{self, FootprintParams};
-use super::{Frame, Method, MethodSettings, RetainedBytes};
+use super::knobs::Sweep;
 use crate::frame::Shared;
 use strata_camera::Camera;
 use strata_level::Level;
@@ -120,3 +121,12 @@ impl Method for Painted {
         }
     }
 }
+
+/// `strata tune` measures it at its one setting.
+pub static SWEEP: Sweep = Sweep {
+    order: 5,
+    knob: "none",
+    full: &[],
+    quick: &[],
+    at_paper_size: false,
+};

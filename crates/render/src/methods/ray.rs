@@ -6,7 +6,8 @@
 //! where the paper tests only the sample point.
 
 use super::common::{draw_fullscreen, fullscreen_pipeline, uniform_binding};
-use super::{Frame, Method, MethodSettings, RetainedBytes};
+use super::contract::{Frame, Method, MethodSettings, RetainedBytes};
+use super::knobs::{Flag, Knobs, Slider, Sweep, count, plain};
 use crate::frame::Shared;
 use strata_level::Level;
 
@@ -96,3 +97,41 @@ impl Method for Ray {
         RetainedBytes { gpu: 16, cpu: 0 }
     }
 }
+
+/// `ray:N` (`ray-compute` too): N forward samples per ray.
+pub static KNOBS: Knobs = Knobs {
+    grammar: "N",
+    default: Some("128"),
+    parse: |text, s| {
+        s.ray_steps = plain(count(text))?;
+        Ok(())
+    },
+    describe: |s| format!("steps={}", s.ray_steps),
+    keep: |from, to| to.ray_steps = from.ray_steps,
+    sliders: &[Slider::count(
+        "ray-steps",
+        "ray steps",
+        (8, 512),
+        |s| s.ray_steps as f32,
+        |s, v| s.ray_steps = v as u32,
+    )],
+    flags: &[Flag {
+        long: "ray-steps",
+        value: Some("N"),
+        help: "`ray`, `ray-compute`: forward samples per ray.",
+        default: |s| s.ray_steps.to_string(),
+        apply: |text, s| {
+            s.ray_steps = count(text)?;
+            Ok(())
+        },
+    }],
+};
+
+/// `strata tune`'s sweep of the steps.
+pub static SWEEP: Sweep = Sweep {
+    order: 0,
+    knob: "steps",
+    full: &["16", "32", "64", "128", "256"],
+    quick: &["16", "128", "256"],
+    at_paper_size: false,
+};

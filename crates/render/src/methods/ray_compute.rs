@@ -6,8 +6,8 @@
 //! colour one). Both passes are timed; the copy is part of the method's cost.
 
 use super::common::{DepthCopy, compute_pipeline, dispatch_per_pixel};
+use super::contract::{Frame, Method, MethodSettings, RetainedBytes};
 use super::ray::{ray_params, update_ray_params};
-use super::{Frame, Method, MethodSettings, RetainedBytes};
 use crate::frame::{Shared, uniform_layout_entry};
 use strata_level::Level;
 

@@ -50,6 +50,7 @@ pub fn gpus() -> Vec<Gpu> {
         match Gpu::open(&AdapterChoice {
             backend,
             index: None,
+            name: std::env::var("WGPU_ADAPTER_NAME").ok(),
         }) {
             Ok(gpu) => {
                 eprintln!(
@@ -179,6 +180,22 @@ pub fn ray_steps() -> u32 {
 
 /// Pictures for a human: with `STRATA_TEST_OUT=/tmp/x cargo test ...`, the
 /// renderer's colour image goes to `/tmp/x/{name}.png`.
+/// `$STRATA_TEST_OUT`: where tests may leave pictures to look at.
+pub fn test_out_dir() -> Option<std::path::PathBuf> {
+    std::env::var_os("STRATA_TEST_OUT").map(std::path::PathBuf::from)
+}
+
+/// `WxH` from environment variable `var`, else `default`.
+pub fn env_size(var: &str, default: (u32, u32)) -> (u32, u32) {
+    std::env::var(var)
+        .ok()
+        .and_then(|s| {
+            let (a, b) = s.split_once('x')?;
+            Some((a.parse().ok()?, b.parse().ok()?))
+        })
+        .unwrap_or(default)
+}
+
 pub fn save_png(r: &strata_render::Renderer, name: &str, (w, h): (u32, u32)) {
     if let Ok(dir) = std::env::var("STRATA_TEST_OUT") {
         let path = std::path::Path::new(&dir).join(format!("{name}.png"));

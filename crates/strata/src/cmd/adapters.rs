@@ -3,7 +3,7 @@
 
 use crate::adapter_arg::parse_backend;
 use strata_render::BackendChoice;
-use strata_render::gpu::{AdapterListing, list_adapters};
+use strata_render::adapter::{AdapterListing, list_adapters};
 
 #[derive(clap::Args)]
 pub struct Args {

@@ -11,11 +11,13 @@ use crate::adapter_arg::AdapterArgs;
 use crate::world_arg::WorldArgs;
 use anyhow::Context;
 use std::path::PathBuf;
-use strata_bench::plan::{MethodChoice, parse_methods, parse_size, prepare_out_dir};
+use strata_bench::plan::{MethodChoice, every_method, parse_methods, parse_size, prepare_out_dir};
 use strata_bench::portability::{self, Input, SkippedAdapter, adapter_dir_name};
 use strata_bench::run::{EditMode, Options, Plan};
 use strata_level::{ViewSpec, World};
-use strata_render::gpu::{AdapterChoice, AdapterReport, Gpu, list_adapters};
+use strata_render::adapter::list_adapters;
+use strata_render::methods::METHODS;
+use strata_render::{AdapterChoice, AdapterReport, Gpu};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -113,7 +115,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     if args.all_adapters {
         return run_all_adapters(&args, prepared);
     }
-    let gpu = Gpu::open(&args.adapter.choice())?;
+    let gpu = args.adapter.open()?;
     announce(&gpu.report);
     let options = options_for(&args, &prepared, &gpu.report, args.out_dir());
     let plan = Plan::new(prepared.world, options)?;
@@ -125,16 +127,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 
 /// Cheap checks first, then the level; the GPU comes later.
 fn prepare(args: &Args) -> anyhow::Result<Prepared> {
-    let known = strata_render::methods::names();
     let mut methods = match &args.methods {
-        Some(list) => parse_methods(list, &known)?,
-        None => known
-            .iter()
-            .map(|n| MethodChoice {
-                name: (*n).to_string(),
-                setting: None,
-            })
-            .collect(),
+        Some(list) => parse_methods(list, METHODS)?,
+        None => every_method(),
     };
     if let Some(path) = &args.settings {
         strata_bench::tune::output::TunedSettings::read(path)?.apply(&mut methods);
@@ -305,6 +300,7 @@ fn run_all_adapters(args: &Args, prepared: Prepared) -> anyhow::Result<()> {
         let choice = AdapterChoice {
             backend,
             index: Some(listing.index),
+            name: None,
         };
         let skip = |error: String| SkippedAdapter {
             adapter: listing.name.clone(),
@@ -312,7 +308,10 @@ fn run_all_adapters(args: &Args, prepared: Prepared) -> anyhow::Result<()> {
             error,
         };
         let gpu = match Gpu::open(&choice) {
-            Ok(gpu) => gpu,
+            Ok(mut gpu) => {
+                gpu.options = crate::adapter_arg::render_options();
+                gpu
+            }
             Err(e) => {
                 eprintln!("skipped: {e:#}");
                 skipped.push(skip(format!("{e:#}")));

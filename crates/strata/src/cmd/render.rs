@@ -8,8 +8,9 @@ use anyhow::{Context, bail};
 use std::path::PathBuf;
 use strata_camera::Camera;
 use strata_level::{ViewSpec, views::parse_views};
+use strata_render::methods::{Flag, METHODS};
 use strata_render::report::{measure_view, write_outputs};
-use strata_render::{Gpu, MethodSettings, Renderer, TerrainColors};
+use strata_render::{MethodSettings, Renderer, TerrainColors};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -51,138 +52,91 @@ pub struct Args {
     pub json: bool,
 }
 
-/// Every method's setting as flags; `strata compare` (or anything else that
-/// builds a renderer) can `#[command(flatten)]` this. Defaults come from
-/// [`MethodSettings::default`], so the help text and the library agree.
-/// Values are checked here for their form (positive, in range); each method
-/// still checks its own field when it is built.
-#[derive(clap::Args, Clone, Debug)]
+/// Every method's knobs as flags, as each method's entry in
+/// `strata_render::methods::METHODS` declares them (`--ray-steps N`,
+/// `--mesh-quality Q`, ...), plus `--no-shadows`; `strata compare` (or
+/// anything else that builds a renderer) can `#[command(flatten)]` this.
+/// Defaults come from [`MethodSettings::default`], so the help text and the
+/// library agree. Values are checked here for their form (positive, in
+/// range); each method still checks its own field when it is built.
+#[derive(Clone, Debug)]
 pub struct MethodArgs {
-    /// `ray`, `ray-compute`: forward samples per ray.
-    #[arg(long, value_name = "N", value_parser = parse_positive,
-          default_value_t = MethodSettings::default().ray_steps)]
-    pub ray_steps: u32,
-    /// `voxel`, `voxel-compute`: occupancy voxel size in texels, X,Y,Z.
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_voxel_size,
-          default_value_t = Triple(MethodSettings::default().voxel_size))]
-    pub voxel_size: Triple<u32>,
-    /// `voxel`, `voxel-compute`: traversal step budget.
-    #[arg(long, value_name = "N", value_parser = parse_positive,
-          default_value_t = MethodSettings::default().voxel_steps)]
-    pub voxel_steps: u32,
-    /// `sliced`: horizontal slices.
-    #[arg(long, value_name = "N", value_parser = parse_positive,
-          default_value_t = MethodSettings::default().slices)]
-    pub slices: u32,
-    /// `sliced`: per pixel, the exact surface crossing on the ray up to the nearest kept slice (a full-screen pass after the slices).
-    #[arg(long)]
-    pub sliced_refine: bool,
-    /// `scattered`: grid density X,Y,Z in screen terms (4 → 1.25 samples per pixel across, 1 per pixel along, 1.25 per pixel of projected height), or one D for all three.
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_density,
-          default_value_t = Triple(MethodSettings::default().scatter_density))]
-    pub scatter_density: Triple<f32>,
-    /// `mesh`: fit quality q in [0, 1]; max error 2^(4(1-q)) height units.
-    #[arg(long, value_name = "Q", value_parser = parse_quality,
-          default_value_t = MethodSettings::default().mesh_quality)]
-    pub mesh_quality: f32,
-    /// `mesh`: constrain the fit to the single/double region outline.
-    #[arg(long)]
-    pub mesh_outline: bool,
-    /// `mesh`: LOD by projected error: the most a chunk's max error may cover on screen, in pixels.
-    #[arg(long, value_name = "PX", value_parser = parse_lod_pixels,
-          default_value_t = MethodSettings::default().mesh_lod_pixels)]
-    pub mesh_lod_pixels: f32,
-    /// `mesh`, a diagnostic: shade with the height-field gradient normal instead of the flat one.
-    #[arg(long)]
-    pub mesh_gradient_normal: bool,
-    /// Turn the shared shadow map off.
-    #[arg(long)]
-    pub no_shadows: bool,
+    settings: MethodSettings,
 }
 
 impl MethodArgs {
     pub fn settings(&self) -> MethodSettings {
-        MethodSettings {
-            ray_steps: self.ray_steps,
-            voxel_size: self.voxel_size.0,
-            voxel_steps: self.voxel_steps,
-            slices: self.slices,
-            sliced_refine: self.sliced_refine,
-            scatter_density: self.scatter_density.0,
-            mesh_quality: self.mesh_quality,
-            mesh_outline: self.mesh_outline,
-            mesh_lod_pixels: self.mesh_lod_pixels,
-            mesh_gradient_normal: self.mesh_gradient_normal,
-            shadows: !self.no_shadows,
+        self.settings.clone()
+    }
+}
+
+/// Every method's flags, each once (a method's variants share their knobs).
+fn flags() -> Vec<&'static Flag> {
+    let mut out: Vec<&'static Flag> = Vec::new();
+    for flag in METHODS.iter().flat_map(|m| m.knobs.flags) {
+        if !out.iter().any(|f| f.long == flag.long) {
+            out.push(flag);
         }
     }
+    out
 }
 
-/// Three values written `X,Y,Z` (clap shows defaults through `Display`).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Triple<T>(pub [T; 3]);
+const NO_SHADOWS: &str = "no-shadows";
 
-impl<T: std::fmt::Display> std::fmt::Display for Triple<T> {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let [x, y, z] = &self.0;
-        write!(f, "{x},{y},{z}")
+impl clap::Args for MethodArgs {
+    fn augment_args(mut cmd: clap::Command) -> clap::Command {
+        use clap::{Arg, ArgAction};
+        let defaults = MethodSettings::default();
+        for flag in flags() {
+            let arg = Arg::new(flag.long).long(flag.long).help(flag.help);
+            cmd = cmd.arg(match flag.value {
+                None => arg.action(ArgAction::SetTrue),
+                Some(name) => {
+                    // Checked when parsed, with the flag's own message.
+                    let check = move |text: &str| -> Result<String, String> {
+                        (flag.apply)(text, &mut MethodSettings::default())?;
+                        Ok(text.to_string())
+                    };
+                    let default: &'static str = Box::leak((flag.default)(&defaults).into());
+                    arg.value_name(name)
+                        .value_parser(check)
+                        .default_value(default)
+                }
+            });
+        }
+        cmd.arg(
+            Arg::new(NO_SHADOWS)
+                .long(NO_SHADOWS)
+                .action(ArgAction::SetTrue)
+                .help("Turn the shared shadow map off."),
+        )
+    }
+
+    fn augment_args_for_update(cmd: clap::Command) -> clap::Command {
+        Self::augment_args(cmd)
     }
 }
 
-fn parse_positive(text: &str) -> Result<u32, String> {
-    match text.trim().parse::<u32>() {
-        Ok(v) if v > 0 => Ok(v),
-        Ok(_) => Err("must be at least 1 (got 0)".into()),
-        Err(_) => Err(format!("`{text}` is not a positive whole number")),
+impl clap::FromArgMatches for MethodArgs {
+    fn from_arg_matches(matches: &clap::ArgMatches) -> Result<Self, clap::Error> {
+        let mut settings = MethodSettings::default();
+        for flag in flags() {
+            let value = match flag.value {
+                None => matches.get_flag(flag.long).then(|| "true".to_string()),
+                Some(_) => matches.get_one::<String>(flag.long).cloned(),
+            };
+            if let Some(value) = value {
+                (flag.apply)(&value, &mut settings)
+                    .map_err(|e| clap::Error::raw(clap::error::ErrorKind::ValueValidation, e))?;
+            }
+        }
+        settings.shadows = !matches.get_flag(NO_SHADOWS);
+        Ok(MethodArgs { settings })
     }
-}
 
-fn parse_positive_f32(text: &str) -> Result<f32, String> {
-    match text.trim().parse::<f32>() {
-        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
-        _ => Err(format!("`{text}` is not a positive number")),
-    }
-}
-
-fn parse_voxel_size(text: &str) -> Result<Triple<u32>, String> {
-    let parts: Vec<&str> = text.split(',').collect();
-    let [x, y, z] = parts[..] else {
-        return Err(format!(
-            "`{text}` is not X,Y,Z (three voxel sizes in texels, e.g. 4,8,2)"
-        ));
-    };
-    let size = |t| parse_positive(t).map_err(|e| format!("voxel size {e}"));
-    Ok(Triple([size(x)?, size(y)?, size(z)?]))
-}
-
-fn parse_density(text: &str) -> Result<Triple<f32>, String> {
-    let v = text
-        .split(',')
-        .map(|t| parse_positive_f32(t).map_err(|e| format!("density {e}")))
-        .collect::<Result<Vec<_>, _>>()?;
-    match v[..] {
-        [d] => Ok(Triple([d; 3])),
-        [x, y, z] => Ok(Triple([x, y, z])),
-        _ => Err(format!(
-            "`{text}` is not X,Y,Z or D (samples per unit, e.g. 4,4,4)"
-        )),
-    }
-}
-
-fn parse_quality(text: &str) -> Result<f32, String> {
-    match text.trim().parse::<f32>() {
-        Ok(q) if (0.0..=1.0).contains(&q) => Ok(q),
-        Ok(q) => Err(format!("mesh quality {q} is outside [0, 1]")),
-        Err(_) => Err(format!("`{text}` is not a number in [0, 1]")),
-    }
-}
-
-fn parse_lod_pixels(text: &str) -> Result<f32, String> {
-    match text.trim().parse::<f32>() {
-        Ok(p) if p.is_finite() && p > 0.0 => Ok(p),
-        _ => Err(format!(
-            "mesh LOD tolerance `{text}` is not a positive number of pixels"
-        )),
+    fn update_from_arg_matches(&mut self, matches: &clap::ArgMatches) -> Result<(), clap::Error> {
+        *self = Self::from_arg_matches(matches)?;
+        Ok(())
     }
 }
 
@@ -253,7 +207,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         })
         .collect::<anyhow::Result<Vec<_>>>()?;
     let settings = args.method_args.settings();
-    let gpu = Gpu::open(&args.adapter.choice())?;
+    let gpu = args.adapter.open()?;
     let mut renderer = Renderer::new(
         &gpu,
         &world.level,

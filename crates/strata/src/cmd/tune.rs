@@ -9,7 +9,6 @@ use anyhow::Context;
 use std::path::PathBuf;
 use strata_bench::plan::parse_size;
 use strata_bench::tune::{self, TuneOptions, output};
-use strata_render::gpu::Gpu;
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -89,7 +88,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             .as_ref()
             .map(|l| l.split(',').map(|m| m.trim().to_string()).collect()),
     };
-    let gpu = Gpu::open(&args.adapter.choice())?;
+    let gpu = args.adapter.open()?;
     eprintln!(
         "adapter: {} ({}); tuning {} view(s) at {}x{}",
         gpu.report.name,

@@ -9,11 +9,10 @@ use anyhow::Context;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-use strata_bench::plan::{MethodChoice, parse_methods, parse_size};
+use strata_bench::plan::{MethodChoice, every_method, parse_methods, parse_size};
 use strata_bench::video::encode::{self, Ffmpeg, FrameSink, PngDir};
 use strata_bench::video::path::{CameraPath, default_path};
 use strata_bench::video::{self, VideoOptions, tiles};
-use strata_render::Gpu;
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -100,7 +99,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         temporal: !args.no_temporal,
         overlap: None,
     };
-    let gpu = Gpu::open(&args.adapter.choice())?;
+    let gpu = args.adapter.open()?;
     eprintln!(
         "adapter: {} ({}); {} method(s) in {}x{} tiles, {} frames at {} fps",
         gpu.report.name,
@@ -145,16 +144,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 }
 
 fn choose_methods(list: Option<&str>) -> anyhow::Result<Vec<MethodChoice>> {
-    let known = strata_render::methods::names();
     match list {
-        Some(list) => parse_methods(list, &known),
-        None => Ok(known
-            .iter()
-            .map(|n| MethodChoice {
-                name: (*n).to_string(),
-                setting: None,
-            })
-            .collect()),
+        Some(list) => parse_methods(list, strata_render::methods::METHODS),
+        None => Ok(every_method()),
     }
 }
 

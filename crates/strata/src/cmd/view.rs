@@ -83,6 +83,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         script,
         vsync: !args.no_vsync,
         adapter: args.adapter.choice(),
+        render: crate::adapter_arg::render_options(),
         out: args.out,
         save: SaveOptions {
             policy: SavePolicy {

@@ -104,7 +104,10 @@ impl Viewer {
         let retained: Vec<_> = kept.iter().filter_map(|m| r.retained_bytes_of(m)).collect();
         let gpu = r.shared_gpu_bytes() + retained.iter().map(|b| b.gpu).sum::<u64>();
         let cpu: u64 = retained.iter().map(|b| b.cpu).sum();
-        let rss = crate::platform::rss_bytes().map_or("-".into(), |b| b.to_string());
+        let rss = self
+            .platform
+            .rss_bytes()
+            .map_or("-".into(), |b| b.to_string());
         format!(
             "memory frames={} rss_bytes={rss} gpu_bytes={gpu} method_cpu_bytes={cpu} \
              undo_bytes={} undo_depth={} kept={}",

@@ -18,6 +18,7 @@ use crate::knobs::{Knob, relevant};
 use crate::minimap::Minimap;
 use crate::overlay::{self, Action, Building, Drawn, Editable, Overlay, Status};
 use crate::physics::PhysicsToy;
+use crate::platform::Platform;
 use crate::present::{Compositor, WINDOW_FORMAT};
 use crate::save::Saver;
 use anyhow::{Context, bail};
@@ -125,6 +126,8 @@ pub struct Viewer {
     /// Edits made since the world was loaded or last saved.
     unsaved: bool,
     quit: bool,
+    /// Native window or browser page.
+    platform: Platform,
 }
 
 /// What a viewer leaves to the viewer of the next world ([`Viewer::hand_over`]).
@@ -187,8 +190,7 @@ impl Viewer {
                 options.size.0,
                 options.size.1,
             ));
-        #[cfg(target_arch = "wasm32")]
-        let attributes = crate::web::canvas_attributes(attributes);
+        let attributes = Platform.window_attributes(attributes);
         let window = Arc::new(
             event_loop
                 .create_window(attributes)
@@ -205,7 +207,7 @@ impl Viewer {
     pub fn new(
         window: Arc<Window>,
         surface: wgpu::Surface<'static>,
-        gpu: Gpu,
+        mut gpu: Gpu,
         options: Options,
     ) -> anyhow::Result<Self> {
         let Options {
@@ -218,10 +220,12 @@ impl Viewer {
             script,
             vsync,
             adapter: _,
+            render,
             out,
             save,
             physics,
         } = options;
+        gpu.options = render;
         let opened = Instant::now();
         let _ = size;
         methods::entry(&method)?;
@@ -344,6 +348,7 @@ impl Viewer {
             saver,
             unsaved: false,
             quit: false,
+            platform: Platform,
         };
         viewer.say(format!(
             "{} on {} ({}), render {}x{}; window, device and {FIRST_METHOD} ready in {:.2} s",
@@ -551,7 +556,7 @@ impl Viewer {
             .chain(self.split.clone())
             .collect();
         for name in shown {
-            if knob.methods().contains(&name.as_str()) && !self.make_current(&name)? {
+            if knob.read_by(&name) && !self.make_current(&name)? {
                 self.builds
                     .start(&self.renderer, &self.level, &name, &self.settings)?;
             }
@@ -603,8 +608,7 @@ impl Viewer {
         };
         let first = self.totals.is_empty();
         self.frames += 1;
-        #[cfg(target_arch = "wasm32")]
-        for script in crate::web::take_commands() {
+        for script in self.platform.take_commands() {
             self.player.get_or_insert_with(Player::waiting).push(script);
         }
         self.collect_builds()?;
@@ -724,13 +728,11 @@ impl Viewer {
         for action in actions {
             self.on_action(action)?;
         }
-        #[cfg(target_arch = "wasm32")]
-        crate::web::publish(self.page_state(), self.frames);
+        self.platform.publish(|| self.page_state(), self.frames);
         Ok(())
     }
 
     /// What the page's scripts (and the browser test) read after each frame.
-    #[cfg(target_arch = "wasm32")]
     fn page_state(&self) -> serde_json::Value {
         let building: Vec<_> = self.builds.running().into_iter().map(|(m, _)| m).collect();
         serde_json::json!({

@@ -112,7 +112,8 @@ impl Viewer {
         image
             .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
             .context("encoding the screenshot")?;
-        crate::platform::save_file(&path, &png)
+        self.platform
+            .save_file(&path, &png)
             .with_context(|| format!("writing the screenshot {}", path.display()))?;
         self.say(format!("screenshot {}", path.display()));
         Ok(())

@@ -3,7 +3,7 @@
 //! reference over several pitches, and the first frame after the crater
 //! edit against a fresh build. Small images: lavapipe is slow.
 
-use super::super::voxel_build::GpuPyramid;
+use super::pyramid::GpuPyramid;
 use crate::frame::{Shared, TerrainColors};
 use crate::{MethodSettings, Renderer};
 use strata_camera::Camera;
@@ -224,13 +224,7 @@ fn bad_settings_are_clear_errors() {
 #[ignore]
 fn fostral_sized_build_and_frame_times() {
     for gpu in common::gpus() {
-        let (iw, ih) = std::env::var("STRATA_VOXEL_BENCH")
-            .ok()
-            .and_then(|s| {
-                let (a, b) = s.split_once('x')?;
-                Some((a.parse().ok()?, b.parse().ok()?))
-            })
-            .unwrap_or((320, 200));
+        let (iw, ih) = common::env_size("STRATA_VOXEL_BENCH", (320, 200));
         let start = std::time::Instant::now();
         let w = world(2048, 16384);
         eprintln!("adapter: {} ({})", gpu.report.name, gpu.report.backend);
@@ -247,7 +241,7 @@ fn fostral_sized_build_and_frame_times() {
                 &shared,
                 &w.level,
                 voxel,
-                super::super::voxel_build::DEFAULT_BUDGET_TEXELS,
+                super::pyramid::DEFAULT_BUDGET_TEXELS,
             ) {
                 Ok(p) => {
                     let cpu = std::time::Instant::now();

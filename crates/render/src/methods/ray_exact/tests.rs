@@ -6,7 +6,7 @@
 //! the first frame after the crater against a fresh build. Small images:
 //! lavapipe is slow.
 
-use super::super::ray_exact_build::GpuMaxMip;
+use super::pyramid::GpuMaxMip;
 use super::*;
 use crate::frame::{Shared, TerrainColors};
 use crate::{MethodSettings, Renderer};
@@ -227,7 +227,7 @@ fn gpu_trace(gpu: &crate::Gpu, level: &Level, rays: &[TestRay]) -> Vec<[f32; 4]>
             },
         ],
     });
-    let frame_group = super::super::voxel_build::build_frame_group(&shared, level).unwrap();
+    let frame_group = super::super::voxel::pyramid::build_frame_group(&shared, level).unwrap();
     let pipeline = super::super::common::compute_pipeline(
         &shared,
         "ray-exact test",
@@ -246,7 +246,7 @@ fn gpu_trace(gpu: &crate::Gpu, level: &Level, rays: &[TestRay]) -> Vec<[f32; 4]>
         pass.dispatch_workgroups((rays.len() as u32).div_ceil(64), 1, 1);
     }
     shared.queue.submit([encoder.finish()]);
-    let words = read_buffer(device, &shared.queue, &hits).unwrap();
+    let words = read_words(device, &shared.queue, &hits, "hits").unwrap();
     gpu.errors.check().unwrap();
     bytemuck::cast_slice::<u32, [f32; 4]>(&words).to_vec()
 }
@@ -586,8 +586,8 @@ fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
         // The exact shadow map and the 128-step one shade nearly alike.
         for (v, (a, b)) in images[1].iter().zip(&images[2]).enumerate() {
             assert!(a.0 == b.0, "view {v}: the shadow map changed depth");
-            if let Ok(dir) = std::env::var("STRATA_TEST_OUT") {
-                let dir = std::path::Path::new(&dir);
+            if let Some(dir) = common::test_out_dir() {
+                let dir = dir.as_path();
                 std::fs::create_dir_all(dir).unwrap();
                 let exact = dir.join(format!("exact-shadow-{v}.png"));
                 crate::report::write_png(&exact, W, H, &a.1).unwrap();

@@ -11,8 +11,8 @@
 //! shading) and writes only the winning slice's rank into a private R32Uint
 //! image; the search runs once per covered pixel.
 
-use super::common::fullscreen_pipeline;
-use super::{Frame, RetainedBytes};
+use super::super::common::{draw_fullscreen_with_depth, fullscreen_pipeline};
+use super::super::contract::{Frame, RetainedBytes};
 use crate::frame::{Shared, texture_entry, uniform_layout_entry};
 
 /// Format of the slice marks: rank + 1 of the kept slice, 0 = none. An
@@ -35,36 +35,20 @@ struct Marks {
 
 impl Marks {
     fn new(shared: &Shared, layout: &wgpu::BindGroupLayout, params: &wgpu::Buffer) -> Self {
-        let device = &shared.device;
-        let texture = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("sliced marks"),
-            size: wgpu::Extent3d {
-                width: shared.width,
-                height: shared.height,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: MARK_FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-            view_formats: &[],
-        });
-        let view = texture.create_view(&Default::default());
-        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("sliced refine"),
+        let (_, view) = shared.target_texture(
+            "sliced marks",
+            MARK_FORMAT,
+            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+        );
+        let group = crate::frame::bind_group(
+            &shared.device,
+            "sliced refine",
             layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: params.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::TextureView(&view),
-                },
+            &[
+                params.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&view),
             ],
-        });
+        );
         Marks {
             view,
             group,
@@ -125,33 +109,16 @@ impl Refine {
     /// Record the refine pass: sky where no slice was kept (colour cleared,
     /// the slice pass's depth kept), the exact crossing elsewhere.
     pub fn record(&self, shared: &Shared, frame: &Frame<'_>, encoder: &mut wgpu::CommandEncoder) {
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("sliced refine"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &shared.color_view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(crate::frame::sky_clear()),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &shared.depth_view,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Load,
-                    store: wgpu::StoreOp::Store,
-                }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: frame.timer.render("sliced refine"),
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &shared.frame_group, &[]);
-        pass.set_bind_group(1, &self.marks.group, &[]);
-        pass.draw(0..3, 0..1);
+        // Sky where no slice was kept; the slice pass's depth stays.
+        draw_fullscreen_with_depth(
+            shared,
+            frame,
+            encoder,
+            "sliced refine",
+            &self.pipeline,
+            &self.marks.group,
+            wgpu::LoadOp::Load,
+        );
     }
 
     /// The marks image (4 bytes a pixel).

@@ -9,7 +9,7 @@
 //! the shadow map and the march read the pyramid, so the first post-edit
 //! frame equals a fresh build.
 
-use super::build_bindings::BuildBindings;
+use super::super::build_bindings::BuildBindings;
 use crate::frame::Shared;
 use crate::timing::PassTimer;
 use strata_level::{DirtyRect, Level};
@@ -77,7 +77,7 @@ impl GpuMaxMip {
             std::mem::size_of::<BuildParams>() as u64,
             MAX_SLOTS,
         );
-        let frame_group = super::voxel_build::build_frame_group(shared, level)?;
+        let frame_group = super::super::voxel::pyramid::build_frame_group(shared, level)?;
         let module = shared.shader("ray_exact_build.wgsl")?;
         let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some("ray-exact build"),
@@ -108,11 +108,7 @@ impl GpuMaxMip {
         shared.queue.submit([encoder.finish()]);
         crate::gpu::wait_idle(device)
             .map_err(|e| anyhow::anyhow!("waiting for the pyramid build failed: {e}"))?;
-        #[cfg(not(target_arch = "wasm32"))]
-        if shared.caps.timestamps {
-            let errors = crate::gpu::ErrorSink::default();
-            pyramid.build_gpu_ms = timer.read(device, &errors)?.0;
-        }
+        pyramid.build_gpu_ms = timer.read_blocking(device)?;
         Ok(pyramid)
     }
 
@@ -183,7 +179,12 @@ impl GpuMaxMip {
 
     /// Copy the whole buffer back (tests).
     pub fn read_back(&self, shared: &Shared) -> anyhow::Result<Vec<u32>> {
-        let words = read_buffer(&shared.device, &shared.queue, &self.buffer)?;
+        let words = crate::gpu::read_words(
+            &shared.device,
+            &shared.queue,
+            &self.buffer,
+            "ray-exact readback",
+        )?;
         Ok(words[..self.layout.bytes as usize / 4].to_vec())
     }
 
@@ -224,38 +225,4 @@ fn params(layout: &Layout, info: &LevelInfo, rect: &DirtyRect) -> BuildParams {
         child,
         rect,
     }
-}
-
-/// Copy a storage buffer back as words (tests and statistics).
-pub(crate) fn read_buffer(
-    device: &wgpu::Device,
-    queue: &wgpu::Queue,
-    buffer: &wgpu::Buffer,
-) -> anyhow::Result<Vec<u32>> {
-    let size = buffer.size();
-    let staging = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("ray-exact readback"),
-        size,
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    let mut encoder = device.create_command_encoder(&Default::default());
-    encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, size);
-    queue.submit([encoder.finish()]);
-    let slice = staging.slice(..);
-    let (tx, rx) = std::sync::mpsc::channel();
-    slice.map_async(wgpu::MapMode::Read, move |r| {
-        let _ = tx.send(r);
-    });
-    crate::gpu::wait_idle(device).map_err(|e| anyhow::anyhow!("ray-exact readback: {e}"))?;
-    rx.recv()
-        .map_err(|_| anyhow::anyhow!("ray-exact readback: map callback never ran"))?
-        .map_err(|e| anyhow::anyhow!("ray-exact readback: mapping failed: {e}"))?;
-    let words: Vec<u32> = bytemuck::pod_collect_to_vec(
-        &slice
-            .get_mapped_range()
-            .map_err(|e| anyhow::anyhow!("ray-exact readback: {e}"))?,
-    );
-    staging.unmap();
-    Ok(words)
 }

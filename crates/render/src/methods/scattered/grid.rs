@@ -3,12 +3,110 @@
 //! the density checks, and [`count_points`], a CPU twin of the scatter that
 //! counts its work. See the `scattered` module for the method itself.
 
-use super::forward::Z_MAX;
-use super::scattered::TopMax;
+use super::super::forward::Z_MAX;
+use super::super::forward::footprint_bounds;
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use strata_camera::Camera;
 use strata_level::Level;
+
+/// Side of the tiles of the level's column-top maximum, texels.
+const TILE: u32 = 16;
+/// The highest column top of each `TILE`² tile of a level, to bound how close
+/// the terrain of a footprint can come to the eye.
+#[derive(Clone, Debug)]
+pub struct TopMax {
+    pub(super) size: [u32; 2],
+    tiles: [u32; 2],
+    tile: [u32; 2],
+    top: Vec<u8>,
+}
+
+impl TopMax {
+    pub fn new(level: &Level) -> Self {
+        let size = [level.width(), level.height()];
+        let tile = [TILE.min(size[0]), TILE.min(size[1])];
+        let tiles = [size[0].div_ceil(tile[0]), size[1].div_ceil(tile[1])];
+        let mut m = TopMax {
+            size,
+            tiles,
+            tile,
+            top: vec![0u8; (tiles[0] * tiles[1]) as usize],
+        };
+        for ty in 0..tiles[1] {
+            for tx in 0..tiles[0] {
+                m.refresh(level, tx, ty);
+            }
+        }
+        m
+    }
+
+    /// Recompute tile (tx, ty) from the level.
+    fn refresh(&mut self, level: &Level, tx: u32, ty: u32) {
+        let mut t = 0u8;
+        for y in ty * self.tile[1]..((ty + 1) * self.tile[1]).min(self.size[1]) {
+            for x in tx * self.tile[0]..((tx + 1) * self.tile[0]).min(self.size[0]) {
+                t = t.max(level.column(i64::from(x), i64::from(y)).top());
+            }
+        }
+        self.top[(ty * self.tiles[0] + tx) as usize] = t;
+    }
+
+    /// Recompute the tiles `rect` touches (a pair's partner included).
+    pub fn update(&mut self, level: &Level, rect: &strata_level::DirtyRect) {
+        if rect.width == 0 || rect.height == 0 {
+            return;
+        }
+        let x0 = rect.x.saturating_sub(1).min(self.size[0] - 1) / self.tile[0];
+        let x1 = (rect.x + rect.width).min(self.size[0] - 1) / self.tile[0];
+        let y0 = rect.y.min(self.size[1] - 1) / self.tile[1];
+        let y1 = (rect.y + rect.height - 1).min(self.size[1] - 1) / self.tile[1];
+        for ty in y0..=y1 {
+            for tx in x0..=x1 {
+                self.refresh(level, tx, ty);
+            }
+        }
+    }
+
+    /// The highest column top in `camera`'s footprint and within
+    /// [`NEAR_RADIUS`] of its eye.
+    pub fn bounds(&self, camera: &Camera) -> (f32, f32) {
+        let Some((lo, hi)) = footprint_bounds(camera, camera.far) else {
+            return (0.0, 0.0);
+        };
+        let (e, r) = (camera.position, NEAR_RADIUS);
+        (
+            self.max_in(lo, hi),
+            self.max_in([e.x - r, e.y - r], [e.x + r, e.y + r]),
+        )
+    }
+
+    /// The highest column top with texel (x, y) in `lo..=hi` (wrapping).
+    pub fn max_in(&self, lo: [f32; 2], hi: [f32; 2]) -> f32 {
+        let range = |k: usize| {
+            let t = i64::from(self.tile[k]);
+            let (a, b) = (
+                (lo[k].floor() as i64).div_euclid(t),
+                (hi[k].floor() as i64).div_euclid(t),
+            );
+            let n = i64::from(self.tiles[k]);
+            let w = i64::from(self.size[k]);
+            if b - a + 1 >= n {
+                (0..n).collect::<Vec<_>>()
+            } else {
+                (a..=b).map(|i| (i * t).rem_euclid(w) / t).collect()
+            }
+        };
+        let (xs, ys) = (range(0), range(1));
+        let mut m = 0u8;
+        for &ty in &ys {
+            for &tx in &xs {
+                m = m.max(self.top[(ty * i64::from(self.tiles[0]) + tx) as usize]);
+            }
+        }
+        f32::from(m)
+    }
+}
 
 /// Most grid samples per frame (16 M).
 pub const MAX_GRID: u64 = 1 << 24;

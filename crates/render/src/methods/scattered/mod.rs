@@ -47,116 +47,20 @@
 //! edit shows in the next frame (edits refresh the tile maximum).
 //! [`count_points`] is a CPU twin of the scatter that counts its work.
 
-use super::forward::footprint_bounds;
-pub use super::scattered_grid::{
-    MAX_DENSITY, MAX_GRID, NEAR_RADIUS, PER_PIXEL, ScatterParams, checked_density, count_points,
-    scatter_grid, slab_points,
+mod grid;
+mod knobs;
+use super::contract::{Frame, Method, MethodSettings, RetainedBytes};
+use crate::frame::{COLOR_FORMAT, DEPTH_FORMAT, Shared, uniform_layout_entry};
+pub use grid::{
+    MAX_DENSITY, MAX_GRID, NEAR_RADIUS, PER_PIXEL, ScatterParams, TopMax, checked_density,
+    count_points, scatter_grid, slab_points,
 };
-use super::{Frame, Method, MethodSettings, RetainedBytes};
-use crate::frame::{COLOR_FORMAT, DEPTH_FORMAT, Shared, sky_clear, uniform_layout_entry};
+pub use knobs::{KNOBS, SWEEP};
 use strata_camera::Camera;
 use strata_level::Level;
 
-/// Side of the tiles of the level's column-top maximum, texels.
-const TILE: u32 = 16;
 /// Invocations per scatter workgroup (`WORKGROUP` in scattered.wgsl).
 const WORKGROUP: u32 = 64;
-
-/// The highest column top of each `TILE`² tile of a level, to bound how close
-/// the terrain of a footprint can come to the eye.
-#[derive(Clone, Debug)]
-pub struct TopMax {
-    size: [u32; 2],
-    tiles: [u32; 2],
-    tile: [u32; 2],
-    top: Vec<u8>,
-}
-
-impl TopMax {
-    pub fn new(level: &Level) -> Self {
-        let size = [level.width(), level.height()];
-        let tile = [TILE.min(size[0]), TILE.min(size[1])];
-        let tiles = [size[0].div_ceil(tile[0]), size[1].div_ceil(tile[1])];
-        let mut m = TopMax {
-            size,
-            tiles,
-            tile,
-            top: vec![0u8; (tiles[0] * tiles[1]) as usize],
-        };
-        for ty in 0..tiles[1] {
-            for tx in 0..tiles[0] {
-                m.refresh(level, tx, ty);
-            }
-        }
-        m
-    }
-
-    /// Recompute tile (tx, ty) from the level.
-    fn refresh(&mut self, level: &Level, tx: u32, ty: u32) {
-        let mut t = 0u8;
-        for y in ty * self.tile[1]..((ty + 1) * self.tile[1]).min(self.size[1]) {
-            for x in tx * self.tile[0]..((tx + 1) * self.tile[0]).min(self.size[0]) {
-                t = t.max(level.column(i64::from(x), i64::from(y)).top());
-            }
-        }
-        self.top[(ty * self.tiles[0] + tx) as usize] = t;
-    }
-
-    /// Recompute the tiles `rect` touches (a pair's partner included).
-    pub fn update(&mut self, level: &Level, rect: &strata_level::DirtyRect) {
-        if rect.width == 0 || rect.height == 0 {
-            return;
-        }
-        let x0 = rect.x.saturating_sub(1).min(self.size[0] - 1) / self.tile[0];
-        let x1 = (rect.x + rect.width).min(self.size[0] - 1) / self.tile[0];
-        let y0 = rect.y.min(self.size[1] - 1) / self.tile[1];
-        let y1 = (rect.y + rect.height - 1).min(self.size[1] - 1) / self.tile[1];
-        for ty in y0..=y1 {
-            for tx in x0..=x1 {
-                self.refresh(level, tx, ty);
-            }
-        }
-    }
-
-    /// The highest column top in `camera`'s footprint and within
-    /// [`NEAR_RADIUS`] of its eye.
-    pub fn bounds(&self, camera: &Camera) -> (f32, f32) {
-        let Some((lo, hi)) = footprint_bounds(camera, camera.far) else {
-            return (0.0, 0.0);
-        };
-        let (e, r) = (camera.position, NEAR_RADIUS);
-        (
-            self.max_in(lo, hi),
-            self.max_in([e.x - r, e.y - r], [e.x + r, e.y + r]),
-        )
-    }
-
-    /// The highest column top with texel (x, y) in `lo..=hi` (wrapping).
-    pub fn max_in(&self, lo: [f32; 2], hi: [f32; 2]) -> f32 {
-        let range = |k: usize| {
-            let t = i64::from(self.tile[k]);
-            let (a, b) = (
-                (lo[k].floor() as i64).div_euclid(t),
-                (hi[k].floor() as i64).div_euclid(t),
-            );
-            let n = i64::from(self.tiles[k]);
-            let w = i64::from(self.size[k]);
-            if b - a + 1 >= n {
-                (0..n).collect::<Vec<_>>()
-            } else {
-                (a..=b).map(|i| (i * t).rem_euclid(w) / t).collect()
-            }
-        };
-        let (xs, ys) = (range(0), range(1));
-        let mut m = 0u8;
-        for &ty in &ys {
-            for &tx in &xs {
-                m = m.max(self.top[(ty * i64::from(self.tiles[0]) + tx) as usize]);
-            }
-        }
-        f32::from(m)
-    }
-}
 
 pub struct Scattered {
     density: [f32; 3],
@@ -225,28 +129,18 @@ impl ScreenBuffer {
             usage: wgpu::BufferUsages::STORAGE,
             mapped_at_creation: false,
         });
-        let scatter_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("scattered"),
-            layout: scatter_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: params.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: screen.as_entire_binding(),
-                },
-            ],
-        });
-        let resolve_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("scattered resolve"),
-            layout: resolve_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: screen.as_entire_binding(),
-            }],
-        });
+        let scatter_group = crate::frame::bind_group(
+            device,
+            "scattered",
+            scatter_layout,
+            &[params.as_entire_binding(), screen.as_entire_binding()],
+        );
+        let resolve_group = crate::frame::bind_group(
+            device,
+            "scattered resolve",
+            resolve_layout,
+            &[screen.as_entire_binding()],
+        );
         Ok(ScreenBuffer {
             bytes,
             scatter_group,
@@ -422,33 +316,14 @@ impl Method for Scattered {
             pass.set_bind_group(1, &self.screen.scatter_group, &[]);
             pass.dispatch_workgroups(self.groups.0, self.groups.1, 1);
         }
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("scattered resolve"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &shared.color_view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(sky_clear()),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &shared.depth_view,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
-                    store: wgpu::StoreOp::Store,
-                }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: frame.timer.render("scattered resolve"),
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        pass.set_pipeline(&self.resolve);
-        pass.set_bind_group(0, &shared.frame_group, &[]);
-        pass.set_bind_group(1, &self.screen.resolve_group, &[]);
-        pass.draw(0..3, 0..1);
+        super::common::draw_fullscreen(
+            shared,
+            frame,
+            encoder,
+            "scattered resolve",
+            &self.resolve,
+            &self.screen.resolve_group,
+        );
     }
 
     fn retained_bytes(&self) -> RetainedBytes {

@@ -1,7 +1,7 @@
 //! `mesh` (§3.6): the greedy TIN of `strata-mesh`, rasterised.
 //!
 //! Setup fits the whole level (parallel, the method's preparation cost) and
-//! uploads every chunk's three LODs into one index pool (`mesh_pool`); the
+//! uploads every chunk's three LODs into one index pool (`pool.rs`); the
 //! fit itself is not kept. There is no vertex buffer: each u16 index names a
 //! grid sample of its chunk and an altitude kind, and `mesh.wgsl` reads the
 //! column from the shared terrain texture.
@@ -23,10 +23,13 @@
 //! edited level) and rewrite only their slots.
 
 use super::common::{begin_pass, forward_pipeline};
-use super::mesh_pool::{Fitted, IndexPool, Slot};
-use super::{Frame, Method, MethodSettings, RetainedBytes};
+mod knobs;
+mod pool;
+use super::contract::{Frame, Method, MethodSettings, RetainedBytes};
 use crate::frame::{Shared, uniform_layout_entry};
 use glam::{Vec3, Vec4};
+pub use knobs::{KNOBS, SWEEP};
+use pool::{Fitted, IndexPool, Slot};
 use strata_camera::Camera;
 use strata_level::model::decode_column;
 use strata_level::{DirtyRect, Level};
@@ -122,20 +125,12 @@ fn draws_binding(
         usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
         mapped_at_creation: false,
     });
-    let group = shared.device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("mesh"),
+    let group = crate::frame::bind_group(
+        &shared.device,
+        "mesh",
         layout,
-        entries: &[
-            wgpu::BindGroupEntry {
-                binding: 0,
-                resource: params.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 1,
-                resource: buffer.as_entire_binding(),
-            },
-        ],
-    });
+        &[params.as_entire_binding(), buffer.as_entire_binding()],
+    );
     (buffer, group)
 }
 
@@ -198,8 +193,10 @@ struct MeshSteps {
     fit: Option<FitInSteps>,
 }
 
-/// Start the mesh's build in slices: [`super::BuildSteps`].
-pub fn build_in_steps(settings: &MethodSettings) -> anyhow::Result<Box<dyn super::BuildSteps>> {
+/// Start the mesh's build in slices: [`super::contract::BuildSteps`].
+pub fn build_in_steps(
+    settings: &MethodSettings,
+) -> anyhow::Result<Box<dyn super::contract::BuildSteps>> {
     Ok(Box::new(MeshSteps {
         tolerance: tolerance_of(settings)?,
         options: options_of(settings),
@@ -209,7 +206,7 @@ pub fn build_in_steps(settings: &MethodSettings) -> anyhow::Result<Box<dyn super
     }))
 }
 
-impl super::BuildSteps for MeshSteps {
+impl super::contract::BuildSteps for MeshSteps {
     fn step(
         &mut self,
         shared: &Shared,

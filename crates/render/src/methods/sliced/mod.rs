@@ -3,22 +3,26 @@
 //! point where the decoded column is solid (floor column or slab) and
 //! discards it elsewhere. Depth-tested like any geometry. Each slice is drawn
 //! as one quad per 32 x 32 tile of the footprint, and tiles that are all air
-//! at the slice's altitude are dropped (`slice_tiles.rs`).
+//! at the slice's altitude are dropped (`tiles.rs`).
 //!
 //! `sliced:N/refine` draws the same slices into a marks image instead and
 //! adds one full-screen pass that puts the exact surface crossing behind
-//! each pixel's nearest kept slice (`sliced_refine.rs`).
+//! each pixel's nearest kept slice (`refine.rs`).
 
 use super::common::{
     begin_pass, begin_pass_into, forward_pipeline, forward_pipeline_into, index_buffer,
 };
 use super::forward::{self, Z_MAX};
-use super::slice_tiles::SliceTiles;
-use super::sliced_refine::{MARK_FORMAT, Refine};
-use super::{Frame, Method, MethodSettings, RetainedBytes};
+mod knobs;
+mod refine;
+mod tiles;
+use super::contract::{Frame, Method, MethodSettings, RetainedBytes};
 use crate::frame::{Shared, texture_entry, uniform_layout_entry};
+pub use knobs::{KNOBS, SWEEP};
+use refine::{MARK_FORMAT, Refine};
 use strata_camera::Camera;
 use strata_level::Level;
+use tiles::SliceTiles;
 
 /// More slices than this sample far below the 256 quantised altitudes and
 /// only multiply overdraw; refuse them rather than draw for seconds.
@@ -69,24 +73,16 @@ fn slices_binding(
             ),
         ],
     });
-    let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("sliced"),
-        layout: &layout,
-        entries: &[
-            wgpu::BindGroupEntry {
-                binding: 0,
-                resource: params.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 1,
-                resource: tiles.params.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 2,
-                resource: wgpu::BindingResource::TextureView(&tiles.view),
-            },
+    let group = crate::frame::bind_group(
+        device,
+        "sliced",
+        &layout,
+        &[
+            params.as_entire_binding(),
+            tiles.params.as_entire_binding(),
+            wgpu::BindingResource::TextureView(&tiles.view),
         ],
-    });
+    );
     (layout, group)
 }
 

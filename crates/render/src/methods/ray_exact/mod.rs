@@ -1,6 +1,6 @@
 //! `ray-exact` and `ray-exact-fragment`: the exact march (issue 15). A
 //! hierarchical 2D traversal over the max-height pyramid of column tops
-//! ([`ray_exact_build`], the twin of `strata_maxmip`), descending where the
+//! ([`pyramid`], the twin of `strata_maxmip`), descending where the
 //! ray dips to a tile's maximum, and at the finest level the exact
 //! segment–interval test of the CPU reference: no step budget, only a
 //! safety cap on iterations ([`ITERATION_CAP`]) whose hits are counted
@@ -37,23 +37,25 @@
 //! no other method reuses it. Frames that reuse a map, or have shadows off,
 //! march and shade in one pass.
 //!
-//! Measuring switches (environment, read at creation; H100 numbers in
-//! `bench/ray-exact.md`): `STRATA_EXACT_SHADOW=shared` keeps the renderer's
-//! shadow pass; `STRATA_EXACT_DEPTH=blit|points|scissor|scissor-load` picks
-//! the depth pass (the last two are diagnostics that draw a wrong image);
-//! `STRATA_EXACT_CLIMB=all`, `STRATA_EXACT_RATIO=4` change the traversal's
-//! climbing and level ratio (same image); `STRATA_EXACT_STATS=1` prints the
-//! iteration statistics, the build's and each update's GPU time to stderr
-//! when the method is dropped. `STRATA_SHADOW_REUSE=1` (the renderer's) keeps
-//! the shadow map while its frame and the terrain are unchanged.
+//! Measuring switches ([`ExactOptions`] and `exact_stats` in
+//! [`crate::options::RenderOptions`], read at creation from the shared
+//! frame; the `strata` binary sets them from `STRATA_EXACT_*`; H100 numbers
+//! in `bench/ray-exact.md`): `exact_shadow` off keeps the renderer's shadow
+//! pass; `depth` picks the depth pass (blit, points, or the blit loading
+//! the old depth); `climb`, `log_ratio` change the traversal's climbing and
+//! level ratio (same image); `exact_stats` prints the iteration statistics,
+//! the build's and each update's GPU time to stderr when the method is
+//! dropped. `shadow_reuse` (the renderer's) keeps the shadow map while its
+//! frame and the terrain are unchanged.
 //!
-//! [`ray_exact_build`]: super::ray_exact_build
+//! [`pyramid`]: pyramid
 
 use super::common::{DepthCopy, dispatch_per_pixel, fullscreen_pipeline};
-use super::ray_exact_build::{GpuMaxMip, read_buffer};
-use super::{Frame, Method, MethodSettings, RetainedBytes};
+pub mod pyramid;
+use super::contract::{Frame, Method, MethodSettings, RetainedBytes};
 use crate::frame::{SHADOW_SIZE, Shared, storage_texture_entry};
-use crate::renderer::env_is;
+use crate::gpu::read_words;
+use pyramid::GpuMaxMip;
 use serde::Serialize;
 use std::cell::Cell;
 use strata_camera::Camera;
@@ -135,111 +137,18 @@ pub struct RayExact {
     update_ms: Vec<f64>,
 }
 
-/// How the method is put together (the measuring switches).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct ExactOptions {
-    /// A compute dispatch (`ray-exact`), else a fragment pass.
-    pub compute: bool,
-    /// How depth reaches the shared depth target.
-    pub depth: DepthMode,
-    /// The shadow map by the exact march, else by the renderer's pass.
-    pub exact_shadow: bool,
-    /// Most levels the compute traversals climb per step (`EXACT_CLIMB`).
-    pub climb: u32,
-    /// log2 of the tile ratio between visited levels (`EXACT_LOG_RATIO`).
-    pub log_ratio: u32,
-}
-
-/// How the compute variant moves its depth image into the shared depth target.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum DepthMode {
-    /// The full-screen blit (`depth_blit.wgsl`, frag_depth), clearing first.
-    Blit,
-    /// One point per pixel through a depth-only pipeline (no fragment shader).
-    Points,
-    /// The blit loading the old depth instead of clearing it first (the same
-    /// image: it writes every pixel).
-    BlitLoad,
-    /// Diagnostic: the blit limited to a 16x16 scissor (wrong image; measures
-    /// what a render pass costs before its fragments).
-    Scissor,
-    /// Diagnostic: [`DepthMode::Scissor`] without the clear.
-    ScissorLoad,
-}
-
-impl ExactOptions {
-    /// The chosen configuration (H100 measurements in `bench/ray-exact.md`).
-    pub const DEFAULT: ExactOptions = ExactOptions {
-        compute: true,
-        depth: DepthMode::BlitLoad,
-        exact_shadow: true,
-        climb: 1,
-        // Every other level (4^l tiles, as the CPU reference visits them):
-        // the same image in fewer descents. On the H100 with the deferred
-        // frame: 0.198 ms mean against 0.202 visiting every level.
-        log_ratio: 2,
-    };
-}
-
-impl ExactOptions {
-    /// Which pyramid levels to keep: only those the traversals visit. The
-    /// compute pipelines take `log_ratio` as a constant; the fragment
-    /// variant's pipeline keeps the shader's default (every level).
-    pub fn pyramid_step(&self) -> u32 {
-        if self.compute { self.log_ratio } else { 1 }
-    }
-
-    /// The defaults, with the environment's measuring switches applied.
-    pub fn from_env(compute: bool) -> Self {
-        let d = ExactOptions::DEFAULT;
-        ExactOptions {
-            compute,
-            depth: if env_is("STRATA_EXACT_DEPTH", "points") {
-                DepthMode::Points
-            } else if env_is("STRATA_EXACT_DEPTH", "scissor") {
-                DepthMode::Scissor
-            } else if env_is("STRATA_EXACT_DEPTH", "load") {
-                DepthMode::BlitLoad
-            } else if env_is("STRATA_EXACT_DEPTH", "scissor-load") {
-                DepthMode::ScissorLoad
-            } else if env_is("STRATA_EXACT_DEPTH", "blit") {
-                DepthMode::Blit
-            } else {
-                d.depth
-            },
-            exact_shadow: if env_is("STRATA_EXACT_SHADOW", "shared") {
-                false
-            } else if env_is("STRATA_EXACT_SHADOW", "exact") {
-                true
-            } else {
-                d.exact_shadow
-            },
-            climb: if env_is("STRATA_EXACT_CLIMB", "all") {
-                8
-            } else {
-                d.climb
-            },
-            log_ratio: if env_is("STRATA_EXACT_RATIO", "4") {
-                2
-            } else if env_is("STRATA_EXACT_RATIO", "2") {
-                1
-            } else {
-                d.log_ratio
-            },
-        }
-    }
-}
+pub use crate::options::{DepthMode, ExactOptions};
 
 pub fn create(
     shared: &Shared,
     level: &Level,
     _settings: &MethodSettings,
 ) -> anyhow::Result<Box<dyn Method>> {
-    Ok(Box::new(build(
-        shared,
-        level,
-        ExactOptions::from_env(true),
-    )?))
+    let options = ExactOptions {
+        compute: true,
+        ..shared.options.exact
+    };
+    Ok(Box::new(build(shared, level, options)?))
 }
 
 pub fn create_fragment(
@@ -247,107 +156,11 @@ pub fn create_fragment(
     level: &Level,
     _settings: &MethodSettings,
 ) -> anyhow::Result<Box<dyn Method>> {
-    Ok(Box::new(build(
-        shared,
-        level,
-        ExactOptions::from_env(false),
-    )?))
-}
-
-fn buffer_entry(
-    binding: u32,
-    stages: wgpu::ShaderStages,
-    ty: wgpu::BufferBindingType,
-) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: stages,
-        ty: wgpu::BindingType::Buffer {
-            ty,
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
-}
-
-/// Layout entries 0..=2 of group 1: parameters, pyramid, statistics.
-fn core_entries(stages: wgpu::ShaderStages) -> Vec<wgpu::BindGroupLayoutEntry> {
-    vec![
-        buffer_entry(0, stages, wgpu::BufferBindingType::Uniform),
-        buffer_entry(
-            1,
-            stages,
-            wgpu::BufferBindingType::Storage { read_only: true },
-        ),
-        buffer_entry(
-            2,
-            stages,
-            wgpu::BufferBindingType::Storage { read_only: false },
-        ),
-    ]
-}
-
-fn core_bindings<'a>(
-    params: &'a wgpu::Buffer,
-    pyramid: &'a GpuMaxMip,
-    stats: &'a wgpu::Buffer,
-) -> Vec<wgpu::BindGroupEntry<'a>> {
-    vec![
-        wgpu::BindGroupEntry {
-            binding: 0,
-            resource: params.as_entire_binding(),
-        },
-        wgpu::BindGroupEntry {
-            binding: 1,
-            resource: pyramid.buffer.as_entire_binding(),
-        },
-        wgpu::BindGroupEntry {
-            binding: 2,
-            resource: stats.as_entire_binding(),
-        },
-    ]
-}
-
-fn march_group(
-    shared: &Shared,
-    layout: &wgpu::BindGroupLayout,
-    params: &wgpu::Buffer,
-    pyramid: &GpuMaxMip,
-    stats: &wgpu::Buffer,
-    depth: Option<&DepthCopy>,
-) -> wgpu::BindGroup {
-    let mut entries = core_bindings(params, pyramid, stats);
-    if let Some(depth) = depth {
-        entries.extend(depth.bindings(shared, 3));
-    }
-    shared.device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("ray-exact"),
-        layout,
-        entries: &entries,
-    })
-}
-
-/// A compute pipeline of the exact core with its traversal constants.
-fn exact_pipeline(
-    shared: &Shared,
-    label: &str,
-    shader: &str,
-    layout: &wgpu::PipelineLayout,
-    entry: &str,
-    options: ExactOptions,
-) -> anyhow::Result<wgpu::ComputePipeline> {
-    super::common::compute_pipeline_with_constants(
-        shared,
-        label,
-        shader,
-        layout,
-        entry,
-        &[
-            ("EXACT_CLIMB", f64::from(options.climb)),
-            ("EXACT_LOG_RATIO", f64::from(options.log_ratio)),
-        ],
-    )
+    let options = ExactOptions {
+        compute: false,
+        ..shared.options.exact
+    };
+    Ok(Box::new(build(shared, level, options)?))
 }
 
 /// The traversal's level table for `layout`.
@@ -466,8 +279,8 @@ pub fn build(shared: &Shared, level: &Level, options: ExactOptions) -> anyhow::R
         updated: Cell::new(false),
         device: device.clone(),
         queue: shared.queue.clone(),
-        print_stats: env_is("STRATA_EXACT_STATS", "1"),
-        update_timer: (env_is("STRATA_EXACT_STATS", "1") && shared.caps.timestamps)
+        print_stats: shared.options.exact_stats,
+        update_timer: (shared.options.exact_stats && shared.caps.timestamps)
             .then(|| crate::timing::PassTimer::new(device, &shared.queue, true)),
         update_timed: Cell::new(false),
         update_ms: Vec::new(),
@@ -543,7 +356,7 @@ impl RayExact {
 
     /// The march's counters since creation or the last reset.
     pub fn stats(&self) -> anyhow::Result<ExactStats> {
-        let w = read_buffer(&self.device, &self.queue, &self.stats)?;
+        let w = read_words(&self.device, &self.queue, &self.stats, "ray-exact stats")?;
         Ok(ExactStats {
             cap_hits: w[0],
             most_iterations: w[1],
@@ -561,12 +374,9 @@ impl RayExact {
     fn read_update_time(&mut self) -> anyhow::Result<()> {
         if let (Some(timer), true) = (&self.update_timer, self.update_timed.get()) {
             self.update_timed.set(false);
-            #[cfg(not(target_arch = "wasm32"))]
-            if let (Some(ms), _) = timer.read(&self.device, &crate::gpu::ErrorSink::default())? {
+            if let Some(ms) = timer.read_blocking(&self.device)? {
                 self.update_ms.push(ms);
             }
-            #[cfg(target_arch = "wasm32")]
-            let _ = timer;
         }
         Ok(())
     }
@@ -739,17 +549,9 @@ impl Method for RayExact {
                 }
                 let label = "ray-exact depth";
                 match mode {
-                    DepthMode::Blit => {
-                        depth.record_blit(shared, frame, encoder, label, false, true)
-                    }
+                    DepthMode::Blit => depth.record_blit(shared, frame, encoder, label, true),
                     DepthMode::Points => depth.record_with(shared, frame, encoder, label, true),
                     DepthMode::BlitLoad => depth.record(shared, frame, encoder, label),
-                    DepthMode::Scissor => {
-                        depth.record_blit(shared, frame, encoder, label, true, true)
-                    }
-                    DepthMode::ScissorLoad => {
-                        depth.record_blit(shared, frame, encoder, label, true, false)
-                    }
                 }
             }
             Variant::Fragment(pipeline) => super::common::draw_fullscreen(
@@ -811,10 +613,19 @@ impl Drop for RayExact {
     }
 }
 
-#[path = "ray_exact_deferred.rs"]
+mod bindings;
 mod deferred;
+use bindings::{buffer_entry, core_bindings, core_entries, exact_pipeline, march_group};
 use deferred::{Deferred, MARK_BLOCK, ShadowMarks, hits_image};
 
 #[cfg(test)]
-#[path = "ray_exact_tests.rs"]
 mod tests;
+
+/// `strata tune` measures it at its one configuration.
+pub static SWEEP: super::knobs::Sweep = super::knobs::Sweep {
+    order: 6,
+    knob: "none",
+    full: &[],
+    quick: &[],
+    at_paper_size: false,
+};

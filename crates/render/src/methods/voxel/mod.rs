@@ -1,18 +1,21 @@
 //! `voxel` and `voxel-compute`: the voxel-accelerated ray march (paper §3.2).
-//! A hierarchical DDA over the occupancy pyramid ([`voxel_build`]) skips
+//! A hierarchical DDA over the occupancy pyramid ([`pyramid`]) skips
 //! known-empty space; leaf voxels are sampled with the exact two-interval
 //! test. `voxel` is a full-screen fragment pass, `voxel-compute` one compute
 //! invocation per pixel plus the core's depth copy; both shade with the
 //! shared `shade` and write the same depth as `ray`.
 //!
-//! [`voxel_build`]: super::voxel_build
+//! [`pyramid`]: pyramid
 
 use super::common::{
     DepthCopy, compute_pipeline, dispatch_per_pixel, draw_fullscreen, fullscreen_pipeline,
 };
-use super::voxel_build::{DEFAULT_BUDGET_TEXELS, GpuPyramid};
-use super::{Frame, Method, MethodSettings, RetainedBytes};
+mod knobs;
+pub mod pyramid;
+use super::contract::{Frame, Method, MethodSettings, RetainedBytes};
 use crate::frame::Shared;
+pub use knobs::{KNOBS, SWEEP};
+use pyramid::{DEFAULT_BUDGET_TEXELS, GpuPyramid};
 use strata_camera::Camera;
 use strata_level::{DirtyRect, Level};
 use strata_occupancy::VoxelSize;
@@ -312,5 +315,4 @@ impl Method for Voxel {
 }
 
 #[cfg(test)]
-#[path = "voxel_tests.rs"]
 mod tests;

@@ -8,7 +8,7 @@
 //! queue their dirty tile columns and each frame takes what the budget
 //! allows, re-reducing the ancestors of exactly what it rebuilt.
 
-use super::build_bindings::BuildBindings;
+use super::super::build_bindings::BuildBindings;
 use crate::frame::{Globals, LevelShape, Shared};
 use std::collections::VecDeque;
 use strata_camera::Camera;
@@ -294,32 +294,12 @@ impl GpuPyramid {
 
     /// Copy the whole buffer back (tests and checks).
     pub fn read_back(&self, shared: &Shared) -> anyhow::Result<Vec<u32>> {
-        let size = self.layout.bytes();
-        let staging = shared.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("voxel readback"),
-            size,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let mut encoder = shared.device.create_command_encoder(&Default::default());
-        encoder.copy_buffer_to_buffer(&self.buffer, 0, &staging, 0, size);
-        shared.queue.submit([encoder.finish()]);
-        let slice = staging.slice(..);
-        let (tx, rx) = std::sync::mpsc::channel();
-        slice.map_async(wgpu::MapMode::Read, move |r| {
-            let _ = tx.send(r);
-        });
-        wait(&shared.device)?;
-        rx.recv()
-            .map_err(|_| anyhow::anyhow!("voxel readback: map callback never ran"))?
-            .map_err(|e| anyhow::anyhow!("voxel readback: mapping failed: {e}"))?;
-        let words: Vec<u32> = bytemuck::pod_collect_to_vec(
-            &slice
-                .get_mapped_range()
-                .map_err(|e| anyhow::anyhow!("voxel readback: {e}"))?,
-        );
-        staging.unmap();
-        Ok(words)
+        crate::gpu::read_words(
+            &shared.device,
+            &shared.queue,
+            &self.buffer,
+            "voxel readback",
+        )
     }
 
     /// GPU bytes: the pyramid plus the dispatch parameter slots.
@@ -346,26 +326,15 @@ pub(crate) fn build_frame_group(shared: &Shared, level: &Level) -> anyhow::Resul
     let shadow = crate::shadow::ShadowFrame::fit(&camera, false);
     let globals = Globals::new(&camera, &LevelShape::of(level), &shadow);
     let buffer = shared.uniform_buffer("voxel build globals", bytemuck::bytes_of(&globals));
-    Ok(shared.device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("voxel build frame"),
-        layout: &shared.frame_layout,
-        entries: &[
-            wgpu::BindGroupEntry {
-                binding: 0,
-                resource: buffer.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 1,
-                resource: shared.shading.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 2,
-                resource: wgpu::BindingResource::TextureView(&shared.terrain.view),
-            },
-            wgpu::BindGroupEntry {
-                binding: 3,
-                resource: wgpu::BindingResource::TextureView(&shared.shadow_view),
-            },
+    Ok(crate::frame::bind_group(
+        &shared.device,
+        "voxel build frame",
+        &shared.frame_layout,
+        &[
+            buffer.as_entire_binding(),
+            shared.shading.as_entire_binding(),
+            wgpu::BindingResource::TextureView(&shared.terrain.view),
+            wgpu::BindingResource::TextureView(&shared.shadow_view),
         ],
-    }))
+    ))
 }

@@ -3,10 +3,11 @@
 //! those, then a pass shades (`ray_exact_deferred.wgsl`; the why and the
 //! numbers are in the parent module's docs).
 
-use super::{
-    DepthCopy, ExactOptions, GpuMaxMip, buffer_entry, core_bindings, core_entries, exact_pipeline,
-};
+use super::bindings::{buffer_entry, core_bindings, core_entries, exact_pipeline};
+use super::pyramid::GpuMaxMip;
 use crate::frame::{Shared, storage_texture_entry, storage_texture_entry_with, texture_2d};
+use crate::methods::common::DepthCopy;
+use crate::options::ExactOptions;
 use wgpu::StorageTextureAccess::ReadWrite;
 
 /// The compute variant's frame on frames that cast the shadow map

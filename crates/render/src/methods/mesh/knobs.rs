@@ -1,0 +1,150 @@
+//! `mesh:Q[o][/PX][/gradient]`: the fit quality, the outline-constrained
+//! fit, the LOD tolerance in pixels and the gradient-normal diagnostic.
+
+use super::super::contract::MethodSettings;
+use super::super::knobs::{Flag, Knobs, Slider, SliderKind, Sweep, plain, positive};
+use anyhow::{Context, bail};
+
+pub static KNOBS: Knobs = Knobs {
+    grammar: "Q, q=Q or Qo, then /PX and /gradient",
+    default: Some("0.5"),
+    parse,
+    describe: |s| {
+        format!(
+            "q={}{} lod={}px{}",
+            s.mesh_quality,
+            if s.mesh_outline { " outline" } else { "" },
+            s.mesh_lod_pixels,
+            if s.mesh_gradient_normal {
+                " gradient-normal"
+            } else {
+                ""
+            }
+        )
+    },
+    keep: |from, to| {
+        to.mesh_quality = from.mesh_quality;
+        to.mesh_outline = from.mesh_outline;
+        to.mesh_lod_pixels = from.mesh_lod_pixels;
+        to.mesh_gradient_normal = from.mesh_gradient_normal;
+    },
+    sliders: &[
+        Slider {
+            name: "mesh-quality",
+            label: "mesh quality",
+            kind: SliderKind::Number { min: 0.0, max: 1.0 },
+            get: |s| s.mesh_quality,
+            put: |s, v| s.mesh_quality = v,
+            // A new fit, in the background: when the drag ends.
+            live: false,
+        },
+        Slider {
+            name: "mesh-outline",
+            label: "mesh outline-constrained (refits)",
+            kind: SliderKind::Toggle,
+            get: |s| f32::from(u8::from(s.mesh_outline)),
+            put: |s, v| s.mesh_outline = v != 0.0,
+            live: true,
+        },
+        Slider {
+            name: "mesh-lod-pixels",
+            label: "mesh LOD px",
+            kind: SliderKind::Number {
+                min: 0.25,
+                max: 16.0,
+            },
+            get: |s| s.mesh_lod_pixels,
+            put: |s, v| s.mesh_lod_pixels = v,
+            live: false,
+        },
+    ],
+    flags: &[
+        Flag {
+            long: "mesh-quality",
+            value: Some("Q"),
+            help: "`mesh`: fit quality q in [0, 1]; max error 2^(4(1-q)) height units.",
+            default: |s| s.mesh_quality.to_string(),
+            apply: |text, s| {
+                s.mesh_quality = match text.trim().parse::<f32>() {
+                    Ok(q) if (0.0..=1.0).contains(&q) => q,
+                    Ok(q) => return Err(format!("mesh quality {q} is outside [0, 1]")),
+                    Err(_) => return Err(format!("`{text}` is not a number in [0, 1]")),
+                };
+                Ok(())
+            },
+        },
+        Flag {
+            long: "mesh-outline",
+            value: None,
+            help: "`mesh`: constrain the fit to the single/double region outline.",
+            default: |_| String::new(),
+            apply: |_, s| {
+                s.mesh_outline = true;
+                Ok(())
+            },
+        },
+        Flag {
+            long: "mesh-lod-pixels",
+            value: Some("PX"),
+            help: "`mesh`: LOD by projected error: the most a chunk's max error may cover on screen, in pixels.",
+            default: |s| s.mesh_lod_pixels.to_string(),
+            apply: |text, s| {
+                s.mesh_lod_pixels = positive(text).map_err(|_| {
+                    format!("mesh LOD tolerance `{text}` is not a positive number of pixels")
+                })?;
+                Ok(())
+            },
+        },
+        Flag {
+            long: "mesh-gradient-normal",
+            value: None,
+            help: "`mesh`, a diagnostic: shade with the height-field gradient normal instead of the flat one.",
+            default: |_| String::new(),
+            apply: |_, s| {
+                s.mesh_gradient_normal = true;
+                Ok(())
+            },
+        },
+    ],
+};
+
+/// `Q`, `q=Q`, `Qo` (outline-constrained), then `/PX` (the LOD tolerance in
+/// pixels; `/`, as `,` separates methods) and `/gradient` (the
+/// gradient-normal diagnostic), in either order.
+fn parse(text: &str, s: &mut MethodSettings) -> anyhow::Result<()> {
+    let mut parts = text.split('/');
+    let q = parts.next().unwrap_or_default().trim();
+    let mut px = None;
+    for part in parts.map(str::trim) {
+        if part == "gradient" {
+            s.mesh_gradient_normal = true;
+        } else if px.replace(part).is_some() {
+            bail!("more than one LOD tolerance");
+        }
+    }
+    let q = q.trim_start_matches("q=");
+    let (q, outline) = match q.strip_suffix('o') {
+        Some(q) => (q, true),
+        None => (q, false),
+    };
+    s.mesh_quality = q
+        .trim()
+        .parse()
+        .ok()
+        .filter(|q: &f32| (0.0..=1.0).contains(q))
+        .context("mesh quality must be a number in [0, 1]")?;
+    s.mesh_outline = outline;
+    if let Some(px) = px {
+        s.mesh_lod_pixels = plain(positive(px.trim_start_matches("px=")))?;
+    }
+    Ok(())
+}
+
+/// `strata tune`'s sweep of the quality, also at the paper's picture size.
+pub static SWEEP: Sweep = Sweep {
+    order: 4,
+    knob: "q",
+    full: &["0", "0.25", "0.5", "0.75", "1"],
+    quick: &["0", "0.5", "1"],
+    at_paper_size: true,
+};

@@ -1,0 +1,87 @@
+//! `sliced:N` and `sliced:N/refine`: the slice count, and the refining pass.
+
+use super::super::contract::MethodSettings;
+use super::super::knobs::{Flag, Knobs, Slider, Sweep, count, plain};
+use anyhow::bail;
+
+pub static KNOBS: Knobs = Knobs {
+    grammar: "N or N/refine",
+    default: Some("512"),
+    parse,
+    describe: |s| {
+        if s.sliced_refine {
+            format!("slices={} refined", s.slices)
+        } else {
+            format!("slices={}", s.slices)
+        }
+    },
+    keep: |from, to| {
+        to.slices = from.slices;
+        to.sliced_refine = from.sliced_refine;
+    },
+    sliders: &[Slider::count(
+        "slices",
+        "slices",
+        (16, 2048),
+        |s| s.slices as f32,
+        |s, v| s.slices = v as u32,
+    )],
+    flags: &[
+        Flag {
+            long: "slices",
+            value: Some("N"),
+            help: "`sliced`: horizontal slices.",
+            default: |s| s.slices.to_string(),
+            apply: |text, s| {
+                s.slices = count(text)?;
+                Ok(())
+            },
+        },
+        Flag {
+            long: "sliced-refine",
+            value: None,
+            help: "`sliced`: per pixel, the exact surface crossing on the ray up to the nearest kept slice (a full-screen pass after the slices).",
+            default: |_| String::new(),
+            apply: |_, s| {
+                s.sliced_refine = true;
+                Ok(())
+            },
+        },
+    ],
+};
+
+/// `N` (the paper's plain slicer) or `N/refine`.
+fn parse(text: &str, s: &mut MethodSettings) -> anyhow::Result<()> {
+    let (n, refine) = match text.split_once('/') {
+        Some((n, "refine")) => (n, true),
+        Some((_, other)) => bail!("`{other}` is not `refine`"),
+        None => (text, false),
+    };
+    s.slices = plain(count(n))?;
+    s.sliced_refine = refine;
+    Ok(())
+}
+
+/// `strata tune`'s sweep. The refined slicer is a setting of the same
+/// method (its slices still decide coverage), so the rule weighs it against
+/// the paper's plain slicer at equal tuning.
+pub static SWEEP: Sweep = Sweep {
+    order: 2,
+    knob: "slices [/refine]",
+    full: &[
+        "32",
+        "64",
+        "128",
+        "256",
+        "512",
+        "1024",
+        "32/refine",
+        "64/refine",
+        "128/refine",
+        "256/refine",
+        "512/refine",
+        "1024/refine",
+    ],
+    quick: &["32", "512", "1024", "32/refine", "512/refine"],
+    at_paper_size: false,
+};

@@ -1,0 +1,91 @@
+//! What the caller decides about how the renderer measures and draws,
+//! beyond a method's settings: the measuring switches (a cached shadow map,
+//! the shadow cull, the depth copy every frame, `ray-exact`'s configuration
+//! and statistics) and the tests' hook that makes a build fail. The library
+//! reads no environment: the CLI and the test harnesses fill these in (the
+//! `strata` binary from `STRATA_*` variables) and hand them over on
+//! [`crate::Gpu::options`]. [`RenderOptions::default`] is the product.
+
+/// The renderer's measuring switches and test hooks.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct RenderOptions {
+    /// Skip the shadow pass while the map would come out the same (off: the
+    /// protocol pays for every frame's map).
+    pub shadow_reuse: bool,
+    /// Cast only the shadow texels the view can sample (off: the whole map,
+    /// to measure the cull).
+    pub shadow_cull: bool,
+    /// Fill the shared depth target every frame, also for the methods that
+    /// keep depth in an image of their own (to measure the copy).
+    pub depth_attachment: bool,
+    /// How `ray-exact` and `ray-exact-fragment` are put together.
+    pub exact: ExactOptions,
+    /// `ray-exact` prints its iteration statistics and GPU times to stderr
+    /// when dropped.
+    pub exact_stats: bool,
+    /// A test hook: this method's build also asks for a buffer over the
+    /// device's `max_buffer_size`, as a build too large for the GPU would.
+    pub oversize_build: Option<String>,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        RenderOptions {
+            shadow_reuse: false,
+            shadow_cull: true,
+            depth_attachment: false,
+            exact: ExactOptions::DEFAULT,
+            exact_stats: false,
+            oversize_build: None,
+        }
+    }
+}
+
+/// How `ray-exact` is put together (H100 measurements in `bench/ray-exact.md`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ExactOptions {
+    /// A compute dispatch (`ray-exact`), else a fragment pass (set by the
+    /// method's entry, whatever the caller passes).
+    pub compute: bool,
+    /// How depth reaches the shared depth target.
+    pub depth: DepthMode,
+    /// The shadow map by the exact march, else by the renderer's pass.
+    pub exact_shadow: bool,
+    /// Most levels the compute traversals climb per step (`EXACT_CLIMB`).
+    pub climb: u32,
+    /// log2 of the tile ratio between visited levels (`EXACT_LOG_RATIO`).
+    pub log_ratio: u32,
+}
+
+/// How the compute variant moves its depth image into the shared depth target.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DepthMode {
+    /// The full-screen blit (`depth_blit.wgsl`, frag_depth), clearing first.
+    Blit,
+    /// One point per pixel through a depth-only pipeline (no fragment shader).
+    Points,
+    /// The blit loading the old depth instead of clearing it first (the same
+    /// image: it writes every pixel).
+    BlitLoad,
+}
+
+impl ExactOptions {
+    /// The chosen configuration.
+    pub const DEFAULT: ExactOptions = ExactOptions {
+        compute: true,
+        depth: DepthMode::BlitLoad,
+        exact_shadow: true,
+        climb: 1,
+        // Every other level (4^l tiles, as the CPU reference visits them):
+        // the same image in fewer descents. On the H100 with the deferred
+        // frame: 0.198 ms mean against 0.202 visiting every level.
+        log_ratio: 2,
+    };
+
+    /// Which pyramid levels to keep: only those the traversals visit. The
+    /// compute pipelines take `log_ratio` as a constant; the fragment
+    /// variant's pipeline keeps the shader's default (every level).
+    pub fn pyramid_step(&self) -> u32 {
+        if self.compute { self.log_ratio } else { 1 }
+    }
+}
