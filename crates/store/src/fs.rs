@@ -118,6 +118,29 @@ impl DirStore {
     /// Write `world` as a new store at `dir` (which must not exist or be
     /// empty): written into a sibling temporary directory, renamed into place.
     pub fn create(dir: &Path, world: &World, layout: &Layout) -> Result<Self, StoreError> {
+        Self::create_in(dir, &|storage, what| {
+            WorldStore::create(storage, world, layout, what)
+        })
+    }
+
+    /// Write a world chunk by chunk as a new store at `dir` (see
+    /// [`WorldStore::create_with`]; same rules as [`Self::create`]).
+    pub fn create_with(
+        dir: &Path,
+        world: &World,
+        (width, height): (u32, u32),
+        layout: &Layout,
+        chunk: &(dyn Fn(u64, u64) -> Result<Chunk, StoreError> + Sync),
+    ) -> Result<Self, StoreError> {
+        Self::create_in(dir, &|storage, what| {
+            WorldStore::create_with(storage, world, width, height, layout, what, chunk)
+        })
+    }
+
+    fn create_in(
+        dir: &Path,
+        write: &dyn Fn(Storage, &str) -> Result<WorldStore, StoreError>,
+    ) -> Result<Self, StoreError> {
         if dir.exists() {
             let empty = dir.is_dir()
                 && std::fs::read_dir(dir)
@@ -144,12 +167,7 @@ impl DirStore {
         let temp = parent.join(format!(".{name}.creating-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&temp);
         std::fs::create_dir_all(&temp).map_err(|e| StoreError::io(&temp, e))?;
-        let made = WorldStore::create(
-            fs_storage(&temp)?,
-            world,
-            layout,
-            &dir.display().to_string(),
-        );
+        let made = write(fs_storage(&temp)?, &dir.display().to_string());
         if let Err(e) = made {
             let _ = std::fs::remove_dir_all(&temp);
             return Err(e);
