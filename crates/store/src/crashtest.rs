@@ -153,14 +153,16 @@ pub fn run_trials(
         let reader = std::thread::spawn(move || {
             let mut last = None;
             for line in BufReader::new(stdout).lines().map_while(Result::ok) {
-                if let Some(n) = line.strip_prefix("done ") {
+                // (Anywhere in the line: a test harness may print its
+                // "test NAME ... " on the same line first.)
+                if let Some(n) = line.split("done ").nth(1) {
                     last = n.trim().parse::<u64>().ok();
                 }
             }
             last
         });
-        // Most kills land mid-batch: a batch takes a few milliseconds.
-        std::thread::sleep(Duration::from_micros(2_000 + rng.below(60_000)));
+        // The child starts in ~10-20 ms, then saves a batch every few ms.
+        std::thread::sleep(Duration::from_micros(2_000 + rng.below(150_000)));
         let _ = child.kill();
         let status = child.wait().expect("waiting for the child");
         let last = reader.join().expect("reader");
@@ -189,8 +191,14 @@ pub fn run_trials(
             report.after += 1;
             low + 1
         } else {
+            extend(low + 8, &mut hashes);
+            let found = hashes.iter().position(|h| *h == got);
+            let mut err = String::new();
+            if let Some(mut e) = child.stderr.take() {
+                let _ = std::io::Read::read_to_string(&mut e, &mut err);
+            }
             panic!(
-                "trial {trial}: the store after the kill is neither the state after {low} batches nor after {}",
+                "trial {trial}: the store after the kill is neither the state after {low} batches nor after {} (it is the state after {found:?}; child said {last:?}, {status}: {err})",
                 low + 1
             )
         };

@@ -24,6 +24,11 @@ fn crash_child() {
 fn killed_saves_leave_the_state_before_or_after_the_batch() {
     let dir = std::env::temp_dir().join(format!("strata-store-crash-{}", std::process::id()));
     let exe = std::env::current_exe().unwrap();
+    // Odd trials: killed at a random moment. Even trials: the child aborts
+    // itself at an exact step of a commit (1: after the first journal
+    // object, then further on: more objects, the fsyncs, the commit
+    // rename, the renames into the store), so every phase is hit.
+    let trial = std::cell::Cell::new(0u64);
     let command = |dir: &Path, start: u64| {
         let mut c = Command::new(&exe);
         c.args([
@@ -35,10 +40,18 @@ fn killed_saves_leave_the_state_before_or_after_the_batch() {
         ])
         .env(CHILD_DIR, dir)
         .env(CHILD_START, start.to_string());
+        let t = trial.replace(trial.get() + 1);
+        if t % 2 == 0 {
+            c.env("STRATA_STORE_CRASH_AT", (1 + t * 2).to_string());
+        }
         c
     };
-    let report = run_trials(&dir, 6, 0x51ee9, &command);
+    let report = run_trials(&dir, 12, 0x51ee9, &command);
     eprintln!("{report:?}");
-    assert_eq!(report.kills, 6);
+    assert_eq!(report.kills, 12);
+    assert!(
+        report.after > 0,
+        "no trial reopened after a batch: {report:?}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }

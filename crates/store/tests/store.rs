@@ -343,3 +343,25 @@ fn create_refuses_a_non_empty_directory() {
     assert_eq!(files(&root).len(), 1);
     let _ = std::fs::remove_dir_all(&root);
 }
+
+#[test]
+fn edit_batches_report_every_texel_they_change() {
+    let w = strata_store::crashtest::start_world();
+    let mut level = w.level.clone();
+    for i in 0..300 {
+        let before = level.clone();
+        let dirty = batch(&mut level, i);
+        let (bh, bm) = (before.heights(), before.metas());
+        let (ah, am) = (level.heights(), level.metas());
+        let width = level.width() as usize;
+        for t in 0..ah.len() {
+            if bh[t] != ah[t] || bm[t] != am[t] {
+                let (x, y) = ((t % width) as u32, (t / width) as u32);
+                assert!(
+                    dirty.iter().any(|r| r.contains(x, y)),
+                    "batch {i}: texel ({x},{y}) changed outside its dirty rects {dirty:?}"
+                );
+            }
+        }
+    }
+}
