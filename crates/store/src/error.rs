@@ -68,6 +68,7 @@ pub enum StoreError {
 }
 
 impl StoreError {
+    #[cfg_attr(not(feature = "fs"), allow(dead_code))]
     pub(crate) fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
         StoreError::Io {
             path: path.into(),

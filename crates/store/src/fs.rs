@@ -130,7 +130,7 @@ impl DirStore {
         world: &World,
         (width, height): (u32, u32),
         layout: &Layout,
-        chunk: &(dyn Fn(u64, u64) -> Result<Chunk, StoreError> + Sync),
+        chunk: &crate::store::ChunkFn<'_>,
     ) -> Result<Self, StoreError> {
         Self::create_in(dir, &|storage, what| {
             WorldStore::create_with(storage, world, width, height, layout, what, chunk)

@@ -78,7 +78,22 @@
 //!
 //! # Other measurements (same machine, debug profile)
 //!
-//! BIG_PLACEHOLDER
+//! - **65536x65536 store, written chunk by chunk** (`examples/store_big.rs`:
+//!   a synthetic pattern, not the world generator, through
+//!   [`DirStore::create_with`], both cores): 65,536 chunks in 235.5 s, peak
+//!   RSS 33 MiB; 401 MB apparent, 771 MB allocated (the pattern compresses
+//!   better than terrain).
+//! - **`strata info` on it**: 0.044 s wall for the whole command (open 4.0
+//!   ms, the 65,536 summaries 13.1 ms; no chunk read).
+//! - **Fault injection** (`examples/store_crash.rs`, 200 SIGKILLs at random
+//!   moments of a child saving edit batches into a 256² store of 64²
+//!   chunks): every reopen was the state before or after the batch in
+//!   flight (178 before, 22 after, 17.8 s). The test
+//!   (`tests/crash.rs`) adds aborts at exact commit steps.
+//! - **wasm32**: `cargo check --target wasm32-unknown-unknown -p
+//!   strata-store --no-default-features` builds (zarrs with gzip, crc32c,
+//!   sharding; no filesystem store, one thread: zarrs' storage is not
+//!   Send/Sync there).
 //!
 //! # Not done yet (issue 32)
 //!

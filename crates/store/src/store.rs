@@ -7,6 +7,7 @@ use crate::format::{
     ChunkSummary, DECODING, FORMAT_NAME, FORMAT_VERSION, HEIGHTS, Layout, METAS, SUMMARY,
     SUMMARY_FIELDS, VPR, WorldAttrs, cut_chunk,
 };
+#[cfg(not(target_arch = "wasm32"))]
 use rayon::prelude::*;
 use std::path::Path;
 use std::sync::Arc;
@@ -22,6 +23,9 @@ use zarrs::storage::ReadableWritableListableStorageTraits;
 pub type Storage = Arc<dyn ReadableWritableListableStorageTraits>;
 /// One of the store's arrays.
 pub type StoreArray = Array<dyn ReadableWritableListableStorageTraits>;
+
+/// Makes the chunk at grid row `cy`, column `cx` (for [`WorldStore::create_with`]).
+pub type ChunkFn<'a> = dyn Fn(u64, u64) -> Result<Chunk, StoreError> + Sync + 'a;
 
 /// The attribute of the root group that holds [`WorldAttrs`].
 pub const ATTR: &str = "strata";
@@ -263,7 +267,7 @@ impl WorldStore {
         height: u32,
         layout: &Layout,
         what: &str,
-        chunk: &(dyn Fn(u64, u64) -> Result<Chunk, StoreError> + Sync),
+        chunk: &ChunkFn<'_>,
     ) -> Result<Self, StoreError> {
         let (w, h) = (width, height);
         let (ch, cw) = layout.chunk_for(w, h);
@@ -350,26 +354,23 @@ impl WorldStore {
             summary,
         };
         let cells: Vec<(u64, u64)> = (0..gy).flat_map(|y| (0..gx).map(move |x| (y, x))).collect();
-        let summaries: Vec<ChunkSummary> = cells
-            .par_iter()
-            .map(|&(cy, cx)| {
-                let c = chunk(cy, cx)?;
-                if (c.rows, c.cols) != (ch, cw) || c.bytes() != 2 * (ch * cw) as usize {
-                    return Err(StoreError::chunk(
-                        HEIGHTS,
-                        &[cy, cx],
-                        "made with the wrong size",
-                    ));
-                }
-                store.write_chunk_into(&store.heights, &store.metas, cy, cx, &c)?;
-                Ok(ChunkSummary::of(
-                    &c.heights,
-                    &c.metas,
-                    c.cols as usize,
-                    MidRule::Original,
-                ))
-            })
-            .collect::<Result<_, StoreError>>()?;
+        let summaries: Vec<ChunkSummary> = map_cells(&cells, &|&(cy, cx)| {
+            let c = chunk(cy, cx)?;
+            if (c.rows, c.cols) != (ch, cw) || c.bytes() != 2 * (ch * cw) as usize {
+                return Err(StoreError::chunk(
+                    HEIGHTS,
+                    &[cy, cx],
+                    "made with the wrong size",
+                ));
+            }
+            store.write_chunk_into(&store.heights, &store.metas, cy, cx, &c)?;
+            Ok(ChunkSummary::of(
+                &c.heights,
+                &c.metas,
+                c.cols as usize,
+                MidRule::Original,
+            ))
+        })?;
         store.write_summaries_into(&store.summary, &summaries, None)?;
         // The group last: a store with a root zarr.json is complete.
         group
@@ -588,23 +589,32 @@ impl WorldStore {
         let mut heights = vec![0u8; w * h];
         let mut metas = vec![0u8; w * h];
         let band = ch as usize * w;
+        let fill = |(cy, (hb, mb)): (usize, (&mut [u8], &mut [u8]))| -> Result<(), StoreError> {
+            for cx in 0..gx {
+                let c = self.read_chunk(cy as u64, cx)?;
+                let x0 = cx as usize * cw as usize;
+                for r in 0..ch as usize {
+                    let src = r * cw as usize..(r + 1) * cw as usize;
+                    let dst = r * w + x0..r * w + x0 + cw as usize;
+                    hb[dst.clone()].copy_from_slice(&c.heights[src.clone()]);
+                    mb[dst].copy_from_slice(&c.metas[src]);
+                }
+            }
+            Ok(())
+        };
+        // zarrs' storage is not Send/Sync on wasm32: one thread there.
+        #[cfg(not(target_arch = "wasm32"))]
         heights
             .par_chunks_mut(band)
             .zip(metas.par_chunks_mut(band))
             .enumerate()
-            .try_for_each(|(cy, (hb, mb))| -> Result<(), StoreError> {
-                for cx in 0..gx {
-                    let c = self.read_chunk(cy as u64, cx)?;
-                    let x0 = cx as usize * cw as usize;
-                    for r in 0..ch as usize {
-                        let src = r * cw as usize..(r + 1) * cw as usize;
-                        let dst = r * w + x0..r * w + x0 + cw as usize;
-                        hb[dst.clone()].copy_from_slice(&c.heights[src.clone()]);
-                        mb[dst].copy_from_slice(&c.metas[src]);
-                    }
-                }
-                Ok(())
-            })?;
+            .try_for_each(fill)?;
+        #[cfg(target_arch = "wasm32")]
+        heights
+            .chunks_mut(band)
+            .zip(metas.chunks_mut(band))
+            .enumerate()
+            .try_for_each(fill)?;
         debug_assert_eq!(gy as usize * ch as usize, h);
         Level::from_planes(w as u32, h as u32, heights, metas, mid_rule)
             .map_err(|e| StoreError::Invalid(e.to_string()))
@@ -661,6 +671,24 @@ fn grid_of(a: &WorldAttrs) -> (u64, u64) {
         u64::from(a.height / a.chunk[0]),
         u64::from(a.width / a.chunk[1]),
     )
+}
+
+/// `f` over every grid cell: in parallel, except on wasm32, where zarrs'
+/// storage is not Send/Sync.
+#[cfg(not(target_arch = "wasm32"))]
+type CellFn<'a, T> = dyn Fn(&(u64, u64)) -> Result<T, StoreError> + Sync + 'a;
+
+#[cfg(not(target_arch = "wasm32"))]
+fn map_cells<T: Send>(cells: &[(u64, u64)], f: &CellFn<'_, T>) -> Result<Vec<T>, StoreError> {
+    cells.par_iter().map(f).collect()
+}
+
+#[cfg(target_arch = "wasm32")]
+fn map_cells<T>(
+    cells: &[(u64, u64)],
+    f: &dyn Fn(&(u64, u64)) -> Result<T, StoreError>,
+) -> Result<Vec<T>, StoreError> {
+    cells.iter().map(f).collect()
 }
 
 /// Read one chunk of an array: a missing object is an error, not zeros.

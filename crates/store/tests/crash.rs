@@ -41,7 +41,7 @@ fn killed_saves_leave_the_state_before_or_after_the_batch() {
         .env(CHILD_DIR, dir)
         .env(CHILD_START, start.to_string());
         let t = trial.replace(trial.get() + 1);
-        if t % 2 == 0 {
+        if t.is_multiple_of(2) {
             c.env("STRATA_STORE_CRASH_AT", (1 + t * 2).to_string());
         }
         c
