@@ -33,6 +33,8 @@ struct Cli {
 enum Command {
     /// Write a generated Vangers-like world directory in the real file format.
     Generate(cmd::generate::Args),
+    /// Convert a Vangers world to a Strata store (Zarr v3) or back.
+    Convert(cmd::convert::Args),
     /// Print a world's size, dual fraction, height range, terrain types, roughness, decode time.
     Info(cmd::info::Args),
     /// CPU reference ray cast of one view (or every view of a file).
@@ -71,6 +73,7 @@ fn main() -> std::process::ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Generate(args) => cmd::generate::run(args),
+        Command::Convert(args) => cmd::convert::run(args),
         Command::Info(args) => cmd::info::run(args),
         Command::Reference(args) => cmd::reference::run(args),
         Command::Metrics(args) => cmd::metrics::run(args),

@@ -8,7 +8,7 @@ use strata_level::{MidRule, World, io};
 
 #[derive(clap::Args, Clone, Debug)]
 pub struct WorldArgs {
-    /// World directory (`world.ini` + map + palette). Default: the built-in generated world.
+    /// World directory: a Vangers world (`world.ini` + map + palette) or a Strata store (`zarr.json`). Default: the built-in generated world.
     #[arg(long, value_name = "DIR")]
     pub level: Option<PathBuf>,
     /// Derive the cave ceiling with vange-rs's `+0` convention instead of the original game's `+1`.
@@ -38,7 +38,8 @@ impl WorldArgs {
     pub fn load(&self) -> anyhow::Result<World> {
         let mid_rule = self.mid_rule();
         if let Some(dir) = &self.level {
-            return io::load_world(dir, mid_rule)
+            // A Vangers world or a Strata store, told apart by its files.
+            return strata_store::load_any(dir, mid_rule)
                 .with_context(|| format!("loading the world in {}", dir.display()));
         }
         let mut world = load_default(&GenerateParams::default(), cache_root().as_deref())?;

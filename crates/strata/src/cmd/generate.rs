@@ -27,6 +27,9 @@ pub struct Args {
     /// Factor on the floor's small relief (bumps, specks), 0 … 4 (default 1).
     #[arg(long, value_name = "R")]
     floor_roughness: Option<f64>,
+    /// Write a Vangers world directory or a Strata store (Zarr v3).
+    #[arg(long, value_enum, default_value = "vangers")]
+    to: super::convert::To,
     /// Overwrite a directory that already holds a world.
     #[arg(long)]
     force: bool,
@@ -58,6 +61,18 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         floor_roughness: args.floor_roughness,
     };
     knobs.check()?;
+    if args.to == super::convert::To::Store && args.out.exists() {
+        if !args.force {
+            bail!(
+                "{} already exists; pass --force to replace it",
+                args.out.display()
+            );
+        }
+        if args.out.join("zarr.json").exists() || args.out.join("world.ini").exists() {
+            std::fs::remove_dir_all(&args.out)
+                .with_context(|| format!("removing {}", args.out.display()))?;
+        }
+    }
     if args.out.join("world.ini").exists() && !args.force {
         bail!(
             "{} already holds a world (world.ini); pass --force to overwrite it",
@@ -72,8 +87,14 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let world = generate_with(&params, &knobs)?;
     let generate_s = t0.elapsed().as_secs_f64();
     let t1 = Instant::now();
-    io::write_world(&args.out, &world)
-        .with_context(|| format!("writing {}", args.out.display()))?;
+    match args.to {
+        super::convert::To::Vangers => io::write_world(&args.out, &world)
+            .with_context(|| format!("writing {}", args.out.display()))?,
+        super::convert::To::Store => {
+            strata_store::DirStore::create(&args.out, &world, &strata_store::Layout::default())
+                .with_context(|| format!("writing the store {}", args.out.display()))?;
+        }
+    }
     let write_s = t1.elapsed().as_secs_f64();
     let mut out_notes = String::new();
     if world.config.map_power_x != 11 {

@@ -197,6 +197,11 @@ fn map_file(
 }
 
 pub fn run(args: Args) -> anyhow::Result<()> {
+    if let Some(dir) = &args.world.level
+        && super::store_info::is_store(dir)
+    {
+        return super::store_info::run(dir, args.json);
+    }
     let mid_rule = args.world.mid_rule();
     let mut world_dir = args.world.level.clone();
     let (world, load) = match &args.world.level {

@@ -3,6 +3,7 @@
 pub mod adapters;
 pub mod collide;
 pub mod compare;
+pub mod convert;
 pub mod export;
 pub mod fit;
 pub mod generate;
@@ -14,6 +15,7 @@ pub mod reference;
 pub mod render;
 pub mod serve;
 pub mod soak;
+pub mod store_info;
 pub mod survey;
 pub mod tune;
 pub mod video;

@@ -1,0 +1,122 @@
+//! A Strata world as a chunked Zarr v3 store (DESIGN §10), with the
+//! [`zarrs`] crate: a directory (or any Zarr storage) that Python's `zarr`,
+//! xarray and Dask open without Strata, whose chunks a static web server or
+//! an object store can serve.
+//!
+//! # Layout
+//!
+//! ```text
+//! DIR/zarr.json           the root group; attribute `strata` (WorldAttrs):
+//!                         format "strata-world", format_version, width, height,
+//!                         chunk [rows, cols], name, world_ini (text), palette
+//!                         (the .pal's 768 bytes), water, views (views.txt text),
+//!                         edit (edit.txt text), decoding (how to decode, in words)
+//! DIR/heights/            uint8 [height, width], chunks [256, 256]
+//! DIR/metas/              uint8 [height, width], chunks [256, 256]
+//! DIR/summary/            uint32 [height/256, width/256, 8], chunks [64, 64, 8]:
+//!                         low_min, low_max, top_min, top_max, slab_bottom_min,
+//!                         slab_bottom_max, dual_texels, pair_disagreements
+//! DIR/vangers_vpr/        uint8 [bytes]: the .vpr (when the world has water levels)
+//! DIR/.strata-journal/    only while an edit batch is being saved (see [`fs`])
+//! ```
+//!
+//! Every array's codecs are `bytes` -> `gzip` (level 6) -> `crc32c`, so a
+//! corrupt or truncated chunk is an error naming the array and chunk
+//! ([`StoreError::Chunk`]); every chunk is stored (also one of all zeros),
+//! so a missing chunk object is an error too, never silent zeros.
+//!
+//! **Why the Vangers planes rather than decoded floor/slab/terrain arrays:**
+//! the two planes round-trip byte for byte (the meta byte's shadow bits and
+//! half-flagged pairs included, which decoded arrays would lose or need
+//! extra arrays for) at 2 bytes per texel decoded, where decoded `low`,
+//! `mid`, `high`, two terrain types and a dual flag are 6; the decoding
+//! (DESIGN §1) is a few lines, written into the `strata.decoding`
+//! attribute for Python users. The cave-ceiling rule is a load-time choice
+//! ([`strata_level::MidRule`]), as for a Vangers world, and not stored.
+//!
+//! # Chunk shape, codec, sharding: measured
+//!
+//! The default world (2048x16384, seed 1997; its `.vmc` is 0.563 B/texel),
+//! `examples/store_layouts.rs`, this 2-core machine shared with three other
+//! builds (load average 4-6), **debug profile** (this crate at opt-level 1,
+//! dependencies at 2 as the workspace sets). "Allocated" is the file
+//! system's 4 KiB blocks; "sharded" is what the same inner chunks would take
+//! packed in 2048x2048 `sharding_indexed` shards (16 B index per chunk,
+//! computed from the measured chunk sizes). Decode is one thread reading
+//! every chunk of both planes in order (MB of decoded samples per second);
+//! the random read opens the store afresh (metadata read and checked) and
+//! reads one chunk of both planes, files in the page cache (median of 9).
+//!
+//! | chunk | gzip | objects | B/texel apparent | allocated | sharded | write s | decode MB/s/core | random chunk ms |
+//! |---|---|---|---|---|---|---|---|---|
+//! | 64² | 1 | 16394 | 0.567 | 2.004 | 0.577 | 13.4 | 31 | 0.18 |
+//! | 64² | 6 | 16394 | 0.443 | 2.003 | 0.453 | 44.9 | 39 | 0.18 |
+//! | 64² | 9 | 16394 | 0.441 | 2.003 | 0.451 | 26.6 | 26 | 0.17 |
+//! | 128² | 1 | 4104 | 0.583 | 0.806 | 0.587 | 7.3 | 66 | 0.28 |
+//! | 128² | 6 | 4104 | 0.433 | 0.750 | 0.437 | 16.6 | 59 | 0.22 |
+//! | 128² | 9 | 4104 | 0.430 | 0.750 | 0.434 | 23.5 | 63 | 0.24 |
+//! | 256² | 1 | 1031 | 0.616 | 0.678 | 0.618 | 4.3 | 66 | 0.64 |
+//! | **256²** | **6** | 1031 | **0.444** | **0.507** | 0.446 | 8.9 | **118** | **0.43** |
+//! | 256² | 9 | 1031 | 0.438 | 0.500 | 0.440 | 15.3 | 100 | 0.42 |
+//! | 512² | 1 | 263 | 0.632 | 0.648 | 0.633 | 1.7 | 86 | 6.12 |
+//! | 512² | 6 | 263 | 0.451 | 0.468 | 0.453 | 9.9 | 87 | 1.24 |
+//! | 512² | 9 | 263 | 0.442 | 0.458 | 0.444 | 20.1 | 130 | 1.36 |
+//!
+//! The choice, [`Layout::default`]: **256x256 chunks, gzip 6, no sharding**:
+//! 0.444 B/texel of chunk bytes (0.507 allocated) against the target 1.0
+//! and the `.vmc`'s 0.563 — gzip over 256-texel rows finds the terrain's
+//! repetition better than the `.vmc`'s per-row Huffman code; what is left
+//! above the apparent size is block rounding of the ~30 KB objects, the
+//! metadata and the summary. Smaller chunks waste blocks (64²: 2.0
+//! B/texel allocated) and decode slower per byte; 512² reads 4x the bytes
+//! for one random chunk; gzip 9 saves 1 % for twice the write time.
+//! Sharding would save the block rounding (0.507 -> 0.446) but makes an
+//! edit rewrite a whole 2048² shard object; at 256² a 65536² world is
+//! 131,072 objects, which file systems and object stores hold well, and
+//! 65,536 summaries (DESIGN §10). The numbers are noisy (shared cores):
+//! treat decode speed as ±30 %.
+//!
+//! # Other measurements (same machine, debug profile)
+//!
+//! - **65536x65536 store, written chunk by chunk** (`examples/store_big.rs`:
+//!   a synthetic pattern, not the world generator, through
+//!   [`DirStore::create_with`], both cores): 65,536 chunks in 235.5 s, peak
+//!   RSS 33 MiB; 401 MB apparent, 771 MB allocated (the pattern compresses
+//!   better than terrain).
+//! - **`strata info` on it**: 0.044 s wall for the whole command (open 4.0
+//!   ms, the 65,536 summaries 13.1 ms; no chunk read).
+//! - **Fault injection** (`examples/store_crash.rs`, 200 SIGKILLs at random
+//!   moments of a child saving edit batches into a 256² store of 64²
+//!   chunks): every reopen was the state before or after the batch in
+//!   flight (178 before, 22 after, 17.8 s). The test
+//!   (`tests/crash.rs`) adds aborts at exact commit steps.
+//! - **wasm32**: `cargo check --target wasm32-unknown-unknown -p
+//!   strata-store --no-default-features` builds (zarrs with gzip, crc32c,
+//!   sharding; no filesystem store, one thread: zarrs' storage is not
+//!   Send/Sync there).
+//!
+//! # Not done yet (issue 32)
+//!
+//! Generation straight into a store by the world generator (the writer,
+//! [`DirStore::create_with`], exists and is bounded in memory; the
+//! generator still makes whole maps), the CPU reference, `fit`, `export`
+//! and `metrics` reading through [`ChunkCache`], the paged renderer.
+
+#![warn(missing_docs)]
+
+pub mod cache;
+#[cfg(feature = "fs")]
+#[doc(hidden)]
+pub mod crashtest;
+pub mod error;
+pub mod format;
+#[cfg(feature = "fs")]
+pub mod fs;
+pub mod store;
+
+pub use cache::{CacheStats, ChunkCache};
+pub use error::StoreError;
+pub use format::{ChunkSummary, FORMAT_VERSION, Layout, WorldAttrs};
+#[cfg(feature = "fs")]
+pub use fs::{DirKind, DirStore, dir_kind, load_any};
+pub use store::{Chunk, Storage, WorldStore};
