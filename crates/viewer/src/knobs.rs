@@ -33,13 +33,6 @@ impl std::fmt::Debug for Knob {
 
 const SHADOWS: &str = "shadows";
 
-#[allow(non_upper_case_globals)]
-impl Knob {
-    /// `ray-steps`, by the name `script.rs`'s tests use (until the script
-    /// language moves to its own crate and names knobs by their names).
-    pub const RaySteps: Knob = Knob::Method(&strata_render::methods::ray::KNOBS.sliders[0]);
-}
-
 impl Knob {
     /// Every knob, each once, in the order of `METHODS` (shadows last).
     pub fn all() -> Vec<Knob> {

@@ -37,7 +37,7 @@ mod tests {
         assert_eq!(
             script.commands,
             [
-                (1, Command::Set(Knob::RaySteps, 64.0)),
+                (1, Command::Set(Knob::parse("ray-steps").unwrap(), 64.0)),
                 (2, Command::Drop(Drop::Sphere, 0.5, 0.5))
             ]
         );
