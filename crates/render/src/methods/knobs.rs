@@ -153,7 +153,7 @@ pub struct Sweep {
 pub fn count(text: &str) -> Result<u32, String> {
     match text.trim().parse::<u32>() {
         Ok(v) if v > 0 => Ok(v),
-        Ok(_) => Err("must be at least 1 (got 0)".into()),
+        Ok(_) => Err("must be a positive whole number, at least 1 (got 0)".into()),
         Err(_) => Err(format!("`{}` is not a positive whole number", text.trim())),
     }
 }
