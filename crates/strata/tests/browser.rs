@@ -242,7 +242,21 @@ async fn canvas_pixels(client: &Client) -> image::RgbaImage {
         .await
         .expect("the canvas's rectangle");
     let r: Vec<f64> = serde_json::from_value(rect).expect("numbers");
-    let png = client.screenshot().await.expect("a screenshot");
+    // SwiftShader draws on the CPU: on a loaded 2-core machine the renderer
+    // can miss chromedriver's 10 s screenshot deadline while a frame is in
+    // flight (seen twice while builds ran beside the test). Ask again.
+    let mut attempt = 0;
+    let png = loop {
+        match client.screenshot().await {
+            Ok(png) => break png,
+            Err(e) if attempt < 3 => {
+                attempt += 1;
+                eprintln!("screenshot attempt {attempt} failed ({e}); retrying");
+                tokio::time::sleep(Duration::from_secs(2)).await;
+            }
+            Err(e) => panic!("a screenshot: {e}"),
+        }
+    };
     let shot = image::load_from_memory(&png)
         .expect("a PNG screenshot")
         .to_rgba8();
