@@ -2,12 +2,12 @@
 //! caller's targets ([`TargetViews`]), the formats it draws into, why it
 //! refuses a target ([`TargetError`]), and the full-screen pass that writes
 //! the frame's colour and depth into them (one pipeline per format pair and
-//! sample count, kept in [`CompositeCache`]). See `embed.rs` for the
+//! sample count, kept in a cache on the renderer). See `embed.rs` for the
 //! depth convention.
 
 use wgpu::TextureFormat as F;
 
-/// The caller's targets for [`Renderer::render_into`]: a colour view and a
+/// The caller's targets for [`Renderer::render_into`](crate::Renderer::render_into): a colour view and a
 /// depth view of one size, which must be the renderer's size (the camera's).
 #[derive(Clone, Copy, Debug)]
 pub struct TargetViews<'a> {
@@ -36,7 +36,7 @@ impl<'a> TargetViews<'a> {
     }
 }
 
-/// Colour formats [`Renderer::render_into`] draws into. Strata's colours are
+/// Colour formats [`Renderer::render_into`](crate::Renderer::render_into) draws into. Strata's colours are
 /// sRGB-encoded bytes: the UNORM formats receive those bytes as they are, the
 /// `...Srgb` formats end up storing the same bytes (the pass decodes, the
 /// target encodes), the float formats receive linear values.
@@ -49,7 +49,7 @@ pub const COLOR_TARGET_FORMATS: &[wgpu::TextureFormat] = &[
     F::Rgba16Float,
 ];
 
-/// Depth formats [`Renderer::render_into`] draws into (`Depth32FloatStencil8`
+/// Depth formats [`Renderer::render_into`](crate::Renderer::render_into) draws into (`Depth32FloatStencil8`
 /// where the device has that feature).
 pub const DEPTH_TARGET_FORMATS: &[wgpu::TextureFormat] = &[
     F::Depth32Float,
@@ -59,7 +59,7 @@ pub const DEPTH_TARGET_FORMATS: &[wgpu::TextureFormat] = &[
     F::Depth16Unorm,
 ];
 
-/// Why [`Renderer::render_into`] refused the caller's targets (nothing was
+/// Why [`Renderer::render_into`](crate::Renderer::render_into) refused the caller's targets (nothing was
 /// drawn).
 #[derive(Clone, Debug, thiserror::Error, PartialEq, Eq)]
 pub enum TargetError {

@@ -178,7 +178,7 @@ pub type StepsConstructor = fn(&MethodSettings) -> anyhow::Result<Box<dyn BuildS
 
 /// A method built a slice at a time on the calling thread: a browser page
 /// has one thread, so it builds between frames and keeps drawing. Natively
-/// a build runs whole on a thread of its own ([`create`]).
+/// a build runs whole on a thread of its own ([`create`](super::create)).
 pub trait BuildSteps {
     /// Work for about `budget_ms` (at least one unit of work); the method
     /// once built. `level` must be the level of the first call.
