@@ -9,6 +9,7 @@ use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
+use strata_markdown::{Align, Table};
 
 /// `settings.json`: the chosen setting per method, in `--methods name:setting`
 /// syntax (`"ray": "64"`). Methods without a knob are absent.
@@ -141,19 +142,27 @@ pub fn markdown(t: &Tuning, plots: &[(String, String)]) -> String {
         },
         t.seconds
     );
-    md.push_str("## Chosen settings\n\n| method | size | ours | paper | combined % (ours) | combined % (paper) | ms (ours) | ms (paper) |\n|---|---|---|---|---:|---:|---:|---:|\n");
+    md.push_str("## Chosen settings\n\n");
+    let mut chosen = Table::new()
+        .columns(["method", "size", "ours", "paper"], Align::Left)
+        .columns(
+            [
+                "combined % (ours)",
+                "combined % (paper)",
+                "ms (ours)",
+                "ms (paper)",
+            ],
+            Align::Right,
+        );
     for m in &t.methods {
         let ours = m.chosen.map(|i| &m.points[i]);
         let paper = m
             .paper_setting
             .as_ref()
             .and_then(|p| m.points.iter().find(|q| q.setting.as_deref() == Some(p)));
-        let _ = writeln!(
-            md,
-            "| {} | {}x{} | {} | {} | {} | {} | {} | {} |",
-            m.method,
-            m.size[0],
-            m.size[1],
+        chosen.row([
+            m.method.clone(),
+            format!("{}x{}", m.size[0], m.size[1]),
             ours.map_or("—".into(), |p| p.label.clone()),
             m.paper_setting
                 .clone()
@@ -162,12 +171,24 @@ pub fn markdown(t: &Tuning, plots: &[(String, String)]) -> String {
             paper.map_or("—".into(), |p| fmt(p.combined, 2)),
             ours.map_or("—".into(), |p| fmt(p.cost_ms, 3)),
             paper.map_or("—".into(), |p| fmt(p.cost_ms, 3)),
-        );
+        ]);
     }
-    md.push('\n');
+    let _ = writeln!(md, "{chosen}");
     for m in &t.methods {
         let _ = writeln!(md, "## {} ({})\n", title(m), m.knob);
-        md.push_str("| setting | see-through % | covers-sky % | coherence % | combined % | ms | |\n|---|---:|---:|---:|---:|---:|---|\n");
+        let mut sweep = Table::new()
+            .left("setting")
+            .columns(
+                [
+                    "see-through %",
+                    "covers-sky %",
+                    "coherence %",
+                    "combined %",
+                    "ms",
+                ],
+                Align::Right,
+            )
+            .left("");
         for (i, p) in m.points.iter().enumerate() {
             let bold = |s: String| {
                 if m.chosen == Some(i) {
@@ -186,22 +207,23 @@ pub fn markdown(t: &Tuning, plots: &[(String, String)]) -> String {
             if p.setting.is_some() && p.setting == m.paper_setting {
                 notes.push("paper");
             }
-            let _ = writeln!(
-                md,
-                "| {} | {} | {} | {} | {} | {} | {}{} |",
+            sweep.row([
                 bold(p.label.clone()),
                 bold(fmt(p.see_through, 2)),
                 bold(fmt(p.covers_sky, 2)),
                 bold(fmt(p.coherence, 2)),
                 bold(fmt(p.combined, 2)),
                 bold(fmt(p.cost_ms, 3)),
-                notes.join(", "),
-                p.error.as_ref().map_or(String::new(), |e| format!(
-                    " failed: {}",
-                    e.replace('|', "/")
-                ))
-            );
+                format!(
+                    "{}{}",
+                    notes.join(", "),
+                    p.error
+                        .as_ref()
+                        .map_or(String::new(), |e| format!(" failed: {e}"))
+                ),
+            ]);
         }
+        let _ = write!(md, "{sweep}");
         if let Some((png, svg)) = plots
             .iter()
             .find(|(png, _)| png.contains(&super::plot::file_stem(m)))
