@@ -166,9 +166,28 @@ impl Camera {
         width: u32,
         height: u32,
     ) -> Result<Self, CameraError> {
-        let x = view.x.rem_euclid(level.width() as f32);
-        let y = view.y.rem_euclid(level.height() as f32);
-        let column = level.column_at(x, y);
+        Self::from_view_over(
+            (level.width(), level.height()),
+            |x, y| level.column_at(x, y),
+            view,
+            width,
+            height,
+        )
+    }
+
+    /// [`Camera::from_view`] over a map of `size` (width, height) whose
+    /// columns `column_at` reads, for worlds not held whole in memory (a
+    /// store: one chunk is read).
+    pub fn from_view_over(
+        size: (u32, u32),
+        column_at: impl FnOnce(f32, f32) -> strata_level::model::Column,
+        view: &ViewSpec,
+        width: u32,
+        height: u32,
+    ) -> Result<Self, CameraError> {
+        let x = view.x.rem_euclid(size.0 as f32);
+        let y = view.y.rem_euclid(size.1 as f32);
+        let column = column_at(x, y);
         let base = if view.under { column.low } else { column.top() };
         let z = f32::from(base) + view.eye;
         if column.is_solid(z) {

@@ -20,7 +20,9 @@ fn cs_ray_exact(
 ) {
     let size = vec2<u32>(globals.screen.xy);
     if (all(id.xy < size)) {
+        page_pixel_begin();
         let s = exact_pixel(f32(id.x) + 0.5, f32(id.y) + 0.5);
+        page_pixel_end(page_pixel_missed());
         textureStore(color_out, id.xy, s.color);
         textureStore(depth_out, id.xy, vec4<f32>(s.depth, 0.0, 0.0, 0.0));
         if (s.capped) {

@@ -14,6 +14,7 @@
 #include "frame.wgsl"
 #include "surface.wgsl"
 #include "column_segment.wgsl"
+#include "exact_levels.wgsl"
 
 // Twin of `methods::ray_exact::ExactParams`.
 struct ExactParams {
@@ -25,7 +26,6 @@ struct ExactParams {
 }
 
 @group(1) @binding(0) var<uniform> xparams: ExactParams;
-@group(1) @binding(1) var<storage, read> maxmip: array<u32>;
 // [0] camera rays that hit the cap, [1] most iterations of a camera ray,
 // [2] shadow rays that hit the cap, [3] most iterations of a shadow ray
 @group(1) @binding(2) var<storage, read_write> xstats: array<atomic<u32>, 4>;
@@ -54,13 +54,6 @@ struct ExactHit {
     hit_class: u32,
     iterations: u32,
     capped: bool,
-}
-
-// Max top of tile (tx, ty) of level k, wrapping around the map.
-fn maxmip_get(k: u32, tx: i32, ty: i32) -> f32 {
-    let l = xparams.levels[k];
-    let i = l.x + (u32(tx) & l.z) + ((u32(ty) & l.w) << l.y);
-    return f32((maxmip[i >> 2u] >> ((i & 3u) << 3u)) & 0xffu);
 }
 
 // The first solid point of o + t d, t in [t0, t1], with o relative to `base`

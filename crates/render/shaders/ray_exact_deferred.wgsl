@@ -91,12 +91,16 @@ fn cs_exact_march_hits(
 ) {
     let size = vec2<u32>(globals.screen.xy);
     if (all(id.xy < size)) {
+        page_pixel_begin();
         let h = exact_pixel_hit(f32(id.x) + 0.5, f32(id.y) + 0.5);
         var packed = HIT_NONE;
         if (h.hit) {
             let rel = h.column - exact_base(globals.eye.xy) + vec2<i32>(32768);
             packed = u32(rel.x) | (u32(rel.y) << 16u);
-            textureStore(depth_io, id.xy, vec4<f32>(h.t, 0.0, 0.0, 0.0));
+            // A hit on a missing page's box carries its pending mark to the
+            // shading as a negative t (t >= 0 otherwise).
+            let t_kept = select(h.t, -1.0 - h.t, page_pixel_missed());
+            textureStore(depth_io, id.xy, vec4<f32>(t_kept, 0.0, 0.0, 0.0));
             if (globals.light_dir.w != 0.0 && globals.shadow_cover_count.x != 0u) {
                 let d = camera_ray(f32(id.x) + 0.5, f32(id.y) + 0.5);
                 mark_shadow_blocks(globals.eye.xyz + d * h.t);
@@ -125,12 +129,17 @@ fn cs_exact_shade(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let packed = textureLoad(hits, id.xy).x;
     var s = exact_pixel_sky();
+    page_pixel_begin();
+    var marched_missing = false;
     if (packed != HIT_NONE) {
         let rel = vec2<i32>(vec2<u32>(packed & 0xffffu, packed >> 16u)) - vec2<i32>(32768);
         let column = exact_base(globals.eye.xy) + rel;
-        let t = textureLoad(depth_io, id.xy).x;
+        var t = textureLoad(depth_io, id.xy).x;
+        marched_missing = t < 0.0;
+        t = select(t, -1.0 - t, marched_missing);
         s = exact_pixel_shade(f32(id.x) + 0.5, f32(id.y) + 0.5, t, column);
     }
+    page_pixel_end(marched_missing || page_pixel_missed());
     textureStore(color_out, id.xy, s.color);
     textureStore(depth_io, id.xy, vec4<f32>(s.depth, 0.0, 0.0, 0.0));
 }

@@ -15,7 +15,9 @@ struct FragOut {
 
 @fragment
 fn fs_ray_exact(@builtin(position) pos: vec4<f32>) -> FragOut {
+    page_pixel_begin();
     let s = exact_pixel(pos.x, pos.y);
+    page_pixel_end(page_pixel_missed());
     if (s.capped) {
         atomicAdd(&xstats[0], 1u);
     }

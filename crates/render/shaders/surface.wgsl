@@ -1,6 +1,7 @@
 // Surface decode: the GPU twin of `strata_level::model::decode_column`.
 // Needs frame.wgsl (globals.level, terrain).
 #include "frame.wgsl"
+#include "terrain_fetch.wgsl"
 
 const META_DOUBLE_LEVEL: u32 = 0x40u;
 const MAX_ALTITUDE: f32 = 255.0;
@@ -12,17 +13,6 @@ struct Column {
     dual: bool,
     lower_type: u32,
     upper_type: u32,
-}
-
-// The pair texel holding texel (x, y), wrapping in both directions.
-fn terrain_pair(x: i32, y: i32) -> vec4<u32> {
-    // u32(i32) reinterprets the bits, so masking wraps negatives correctly.
-    let px = (u32(x) & (globals.level.x - 1u)) >> 1u;
-    let yy = u32(y) & (globals.level.y - 1u);
-    let shift = globals.level.z;
-    let layer = yy >> shift;
-    let row = yy & ((1u << shift) - 1u);
-    return textureLoad(terrain, vec2<u32>(px, row), layer, 0);
 }
 
 fn decode_column(x: i32, y: i32) -> Column {

@@ -492,6 +492,20 @@ impl Shared {
         height: u32,
     ) -> anyhow::Result<Self> {
         let terrain = TerrainTexture::new(device, queue, level)?;
+        Self::with_terrain(device, queue, caps, terrain, colors, width, height)
+    }
+
+    /// The shared frame over a terrain texture made elsewhere (the page
+    /// atlas of `crate::paged`).
+    pub(crate) fn with_terrain(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        caps: &Capabilities,
+        terrain: TerrainTexture,
+        colors: &TerrainColors,
+        width: u32,
+        height: u32,
+    ) -> anyhow::Result<Self> {
         let shadow_usage = match caps.shadow_pass() {
             Some(ShadowPassKind::Compute) => wgpu::TextureUsages::STORAGE_BINDING,
             Some(ShadowPassKind::Fragment) => wgpu::TextureUsages::RENDER_ATTACHMENT,

@@ -83,6 +83,7 @@ pub mod fullscreen;
 pub mod gpu;
 pub mod methods;
 pub mod options;
+pub mod paged;
 pub mod renderer;
 #[doc(hidden)]
 pub mod report;

@@ -148,6 +148,153 @@ impl Renderer {
         Ok(renderer)
     }
 
+    /// Draw the world of `source` through a fixed GPU budget (`crate::paged`,
+    /// issue 33): only pages the view needs are resident, streamed from
+    /// `source` by reader threads. The method must be one that draws paged
+    /// terrain ([`crate::paged::PAGED_METHODS`]); the others are refused,
+    /// naming those that can.
+    #[allow(clippy::too_many_arguments)]
+    pub fn new_paged(
+        gpu: &Gpu,
+        source: Arc<dyn crate::paged::PageSource>,
+        colors: &TerrainColors,
+        method: &(impl MethodId + ?Sized),
+        settings: &MethodSettings,
+        width: u32,
+        height: u32,
+        paging: crate::paged::PagedOptions,
+    ) -> anyhow::Result<Self> {
+        let start = Instant::now();
+        methods::check_support(method, &gpu.caps)?;
+        let entry = method.entry()?;
+        let compute = match entry.name {
+            "ray-exact" => true,
+            "ray-exact-fragment" => false,
+            other => anyhow::bail!(
+                "`{other}` draws whole worlds only; paged worlds (past the whole-world limits, or with a GPU budget) are drawn by {}",
+                crate::paged::PAGED_METHODS.join(", ")
+            ),
+        };
+        let options = crate::options::ExactOptions {
+            compute,
+            ..gpu.options.exact
+        };
+        let step = options.pyramid_step();
+        let (atlas, plan) =
+            crate::paged::PagedTerrain::atlas(&gpu.device, source.as_ref(), &paging, step)?;
+        let (w, h) = source.size();
+        let mut shared = Shared::with_terrain(
+            &gpu.device,
+            &gpu.queue,
+            &gpu.caps,
+            atlas,
+            colors,
+            width,
+            height,
+        )?;
+        shared.options = gpu.options.clone();
+        let shared = Arc::new(shared);
+        let level_shape = LevelShape {
+            width: w,
+            height: h,
+            mid_rule: source.mid_rule(),
+        };
+        let paged = crate::paged::PagedTerrain::new(&shared, source, plan, paging, step)?;
+        let method: Box<dyn Method> =
+            Box::new(methods::ray_exact::build_paged(&shared, paged, options)?);
+        let shadow = ShadowPass::new(&shared)?;
+        let depth_reader = DepthReader::new(&gpu.device, &gpu.caps)?;
+        let timer = PassTimer::new(&gpu.device, &gpu.queue, gpu.report.timestamps);
+        let mut renderer = Renderer {
+            shared,
+            methods: vec![Built {
+                method,
+                settings: settings.clone(),
+            }],
+            active: 0,
+            shadow,
+            timer,
+            errors: gpu.errors.clone(),
+            level_shape,
+            frames: 0,
+            last_submission: None,
+            adapter: gpu.report.clone(),
+            setup_ms: 0.0,
+            shadow_reuse: gpu.options.shadow_reuse,
+            shadow_drawn: None,
+            shadow_cull: gpu.options.shadow_cull,
+            depth_attachment: gpu.options.depth_attachment,
+            depth_target_current: false,
+            depth_reader,
+            edit_listener: None,
+            composite: Default::default(),
+        };
+        wait_device(&renderer.shared.device, &renderer.errors)?;
+        renderer.setup_ms = ms(start);
+        Ok(renderer)
+    }
+
+    /// Whether this renderer draws paged terrain ([`Renderer::new_paged`]).
+    pub fn is_paged(&mut self) -> bool {
+        self.paged_terrain().is_some()
+    }
+
+    /// The active method's paged terrain, if it draws one: its statistics,
+    /// [`crate::paged::PagedTerrain::refresh`] after an edit of its source,
+    /// [`crate::paged::PagedTerrain::settle`].
+    pub fn paged_terrain(&mut self) -> Option<&mut crate::paged::PagedTerrain> {
+        self.methods[self.active].method.paged_terrain()
+    }
+
+    /// The paged terrain's source changed inside `chunks` (an edit batch
+    /// written to its store, the cache told): refresh their coarse level and
+    /// resident pages, so the next frame shows the edit.
+    pub fn refresh_pages(&mut self, chunks: &[u32]) -> anyhow::Result<()> {
+        let shared = Arc::clone(&self.shared);
+        let paged = self.methods[self.active]
+            .method
+            .paged_terrain()
+            .ok_or_else(|| anyhow::anyhow!("this renderer draws a whole world: use apply_edit"))?;
+        paged.refresh(&shared, chunks)?;
+        self.shadow_drawn = None;
+        Ok(())
+    }
+
+    /// Draw `camera`'s frame until no pixel of it is pending (paged
+    /// terrain: every page it reads resident), at most `most` frames; the
+    /// frames it took. A whole world is converged at once (0). An error when
+    /// it does not converge: the budget is smaller than the view reads, or
+    /// pages fail to read.
+    pub fn converge(&mut self, camera: &Camera, most: u32) -> anyhow::Result<u32> {
+        if !self.is_paged() {
+            return Ok(0);
+        }
+        for frame in 1..=most {
+            self.render_frame(camera)?;
+            let stats = self.paged_terrain().map(|p| p.stats()).unwrap_or_default();
+            // The first frame's feedback may predate its own uploads.
+            if frame > 1 && stats.converged() {
+                return Ok(frame);
+            }
+            if stats.in_flight > 0 {
+                // Let the readers catch up rather than spin on the GPU.
+                std::thread::sleep(std::time::Duration::from_millis(1));
+            }
+        }
+        let stats = self.paged_terrain().map(|p| p.stats()).unwrap_or_default();
+        anyhow::bail!(
+            "the view did not converge in {most} frames: {} pixels and {} shadow texels still pending with {} of {} slots resident{}",
+            stats.pending_pixels,
+            stats.pending_shadow_texels,
+            stats.resident_pages,
+            stats.slots,
+            stats
+                .first_error
+                .map(|e| format!("; {e}"))
+                .unwrap_or_else(|| " (a larger --gpu-budget holds more of the view)".into())
+        )
+    }
+
     /// The active method's name.
     pub fn method_name(&self) -> &'static str {
         self.methods[self.active].method.name()
@@ -337,6 +484,7 @@ impl Renderer {
         let submit_start = Instant::now();
         wait_device(&self.shared.device, &self.errors)?;
         let cpu_ms = ms(submit_start);
+        self.methods[self.active].method.frame_done(&self.shared)?;
 
         let (gpu_ms, passes) = self.timer.read(&self.shared.device, &self.errors)?;
         Ok(FrameTimings {
@@ -504,6 +652,11 @@ impl Renderer {
     /// # Ok(()) }
     /// ```
     pub fn apply_edit(&mut self, level: &Level, rects: &[DirtyRect]) -> anyhow::Result<()> {
+        if self.is_paged() {
+            anyhow::bail!(
+                "this renderer draws paged terrain: write the edit to its store, then PagedTerrain::refresh the chunks"
+            );
+        }
         self.shared
             .terrain
             .upload(&self.shared.queue, level, rects)?;

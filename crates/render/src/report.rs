@@ -50,6 +50,13 @@ pub struct RenderReport {
     pub cpu_bytes: u64,
     /// Bytes of the shared resources (terrain, uniforms, shadow map, targets).
     pub shared_gpu_bytes: u64,
+    /// Paged terrain (`--gpu-budget`): the budget, the bytes it keeps (in
+    /// `gpu_bytes` too), pages resident and uploaded, pending pixels of the
+    /// last frame. `null` for a whole world.
+    pub paging: Option<crate::paged::PagingStats>,
+    /// Frames drawn before the timed ones until no pixel was pending (paged
+    /// terrain only).
+    pub converge_frames: Option<u32>,
 }
 
 /// Write `rgba` (row-major RGBA8) as a PNG.
@@ -143,6 +150,8 @@ pub fn measure_view(
         gpu_bytes: retained.gpu,
         cpu_bytes: retained.cpu,
         shared_gpu_bytes: renderer.shared_gpu_bytes(),
+        paging: renderer.paged_terrain().map(|p| p.stats()),
+        converge_frames: None,
     };
     let color = renderer.read_color()?;
     let depth = renderer.read_depth()?;

@@ -9,6 +9,23 @@
 pub const SOURCES: &[(&str, &str)] = &[
     ("frame.wgsl", include_str!("../shaders/frame.wgsl")),
     ("surface.wgsl", include_str!("../shaders/surface.wgsl")),
+    (
+        "terrain_fetch.wgsl",
+        include_str!("../shaders/terrain_fetch.wgsl"),
+    ),
+    (
+        "exact_levels.wgsl",
+        include_str!("../shaders/exact_levels.wgsl"),
+    ),
+    ("paged.wgsl", include_str!("../shaders/paged.wgsl")),
+    (
+        "paged_fetch.wgsl",
+        include_str!("../shaders/paged_fetch.wgsl"),
+    ),
+    (
+        "paged_levels.wgsl",
+        include_str!("../shaders/paged_levels.wgsl"),
+    ),
     ("shading.wgsl", include_str!("../shaders/shading.wgsl")),
     (
         "column_segment.wgsl",
@@ -129,6 +146,20 @@ pub const ENTRY_SHADERS: &[&str] = &[
     "ray_exact_depth.wgsl",
     "ray_exact_build.wgsl",
     "ray_exact_test.wgsl",
+    "paged:ray_exact.wgsl",
+    "paged:ray_exact_fragment.wgsl",
+    "paged:ray_exact_shadow.wgsl",
+    "paged:ray_exact_deferred.wgsl",
+];
+
+/// The name prefix that composes a shader over paged terrain (`paged/`).
+pub const PAGED: &str = "paged:";
+
+/// What a paged shader reads instead: the modules that fetch texel pairs and
+/// pyramid levels from the whole map, and their page-table twins.
+const PAGED_SWAPS: &[(&str, &str)] = &[
+    ("terrain_fetch.wgsl", "paged_fetch.wgsl"),
+    ("exact_levels.wgsl", "paged_levels.wgsl"),
 ];
 
 #[derive(Debug, thiserror::Error, PartialEq, Eq)]
@@ -147,15 +178,31 @@ fn source(name: &str) -> Result<&'static str, ShaderError> {
         .ok_or_else(|| ShaderError::Unknown(name.to_string()))
 }
 
-/// The full WGSL text of shader `name`, includes resolved.
+/// The full WGSL text of shader `name`, includes resolved. A name with the
+/// [`PAGED`] prefix composes the same shader over paged terrain: each module
+/// of `PAGED_SWAPS` is replaced by its paged twin (a link-time choice, so the
+/// march and shading stay one source).
 pub fn compose(name: &str) -> Result<String, ShaderError> {
     let mut out = String::new();
     let mut seen = Vec::new();
-    compose_into(name, &mut out, &mut seen)?;
+    let (name, swaps) = match name.strip_prefix(PAGED) {
+        Some(rest) => (rest, PAGED_SWAPS),
+        None => (name, &[][..]),
+    };
+    compose_into(name, swaps, &mut out, &mut seen)?;
     Ok(out)
 }
 
-fn compose_into(name: &str, out: &mut String, seen: &mut Vec<String>) -> Result<(), ShaderError> {
+fn compose_into(
+    name: &str,
+    swaps: &[(&str, &str)],
+    out: &mut String,
+    seen: &mut Vec<String>,
+) -> Result<(), ShaderError> {
+    let name = swaps
+        .iter()
+        .find(|(from, _)| *from == name)
+        .map_or(name, |(_, to)| *to);
     if seen.iter().any(|s| s == name) {
         return Ok(());
     }
@@ -171,7 +218,7 @@ fn compose_into(name: &str, out: &mut String, seen: &mut Vec<String>) -> Result<
                     file: name.to_string(),
                     line: i + 1,
                 })?;
-            compose_into(inner, out, seen)?;
+            compose_into(inner, swaps, out, seen)?;
         } else {
             out.push_str(line);
             out.push('\n');
@@ -223,6 +270,16 @@ mod tests {
         let text = compose("ray.wgsl").unwrap();
         assert_eq!(text.matches("struct Globals").count(), 1);
         assert!(!text.contains("#include"));
+    }
+
+    #[test]
+    fn paged_shaders_swap_the_fetch_modules() {
+        let whole = compose("ray_exact.wgsl").unwrap();
+        let paged = compose("paged:ray_exact.wgsl").unwrap();
+        assert!(whole.contains("textureLoad(terrain, vec2<u32>(px, row)"));
+        assert!(!whole.contains("page_table"));
+        assert!(paged.contains("page_table"));
+        assert!(!paged.contains("textureLoad(terrain, vec2<u32>(px, row)"));
     }
 
     #[test]

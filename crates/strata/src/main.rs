@@ -2,6 +2,7 @@
 
 mod adapter_arg;
 mod cmd;
+mod paged_arg;
 mod world_arg;
 
 use std::sync::LazyLock;

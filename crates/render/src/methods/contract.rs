@@ -155,6 +155,17 @@ pub trait Method: Send {
         false
     }
 
+    /// The frame recorded last was submitted and the GPU is done with it
+    /// (`Renderer::render_frame`): read back what it recorded for the CPU.
+    fn frame_done(&mut self, _shared: &Shared) -> anyhow::Result<()> {
+        Ok(())
+    }
+
+    /// The paged terrain this method draws, if any (`crate::paged`).
+    fn paged_terrain(&mut self) -> Option<&mut crate::paged::PagedTerrain> {
+        None
+    }
+
     /// Record this frame's passes.
     fn record(&self, shared: &Shared, frame: &Frame<'_>, encoder: &mut wgpu::CommandEncoder);
 

@@ -3,6 +3,7 @@
 //! 1.0 = sky) and `render.json` per view; `--json` prints one line per view.
 
 use crate::adapter_arg::AdapterArgs;
+use crate::paged_arg::{PagedArgs, PagedWorld, open_paged};
 use crate::world_arg::WorldArgs;
 use anyhow::{Context, bail};
 use std::path::PathBuf;
@@ -44,6 +45,12 @@ pub struct Args {
     pub method_args: MethodArgs,
     #[command(flatten)]
     pub adapter: AdapterArgs,
+    #[command(flatten)]
+    pub paged: PagedArgs,
+    /// Paged terrain: most frames drawn per view before the timed ones,
+    /// waiting for every page the view reads.
+    #[arg(long, default_value_t = 600)]
+    pub converge_frames: u32,
     /// Output directory (one sub-directory per view when there are several).
     #[arg(long, default_value = "render-out")]
     pub out: PathBuf,
@@ -158,7 +165,7 @@ pub fn parse_size(text: &str) -> Result<(u32, u32), String> {
     Ok((w, h))
 }
 
-fn select_views(args: &Args, world: &strata_level::World) -> anyhow::Result<Vec<ViewSpec>> {
+fn select_views(args: &Args, world_views: &[ViewSpec]) -> anyhow::Result<Vec<ViewSpec>> {
     let views = match (&args.view, &args.views, &args.view_name) {
         (Some(spec), _, _) => {
             let pitch = args.pitch.context("--view needs --pitch DEG")?;
@@ -170,8 +177,8 @@ fn select_views(args: &Args, world: &strata_level::World) -> anyhow::Result<Vec<
             parse_views(&text).with_context(|| format!("views file {}", file.display()))?
         }
         (None, None, Some(name)) => {
-            let v = world.views.iter().find(|v| &v.name == name).cloned();
-            let names: Vec<&str> = world.views.iter().map(|v| v.name.as_str()).collect();
+            let v = world_views.iter().find(|v| &v.name == name).cloned();
+            let names: Vec<&str> = world_views.iter().map(|v| v.name.as_str()).collect();
             vec![v.with_context(|| {
                 format!(
                     "the world has no view `{name}`; it has: {}",
@@ -179,7 +186,7 @@ fn select_views(args: &Args, world: &strata_level::World) -> anyhow::Result<Vec<
                 )
             })?]
         }
-        (None, None, None) => world.views.clone(),
+        (None, None, None) => world_views.to_vec(),
     };
     if views.is_empty() {
         bail!("no views: give --view SPEC --pitch DEG, --views FILE or --view-name NAME");
@@ -197,8 +204,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         bail!("--frames must be at least 1");
     }
     strata_render::methods::entry(&args.method)?;
+    if let Some(paged) = open_paged(&args.world, &args.paged)? {
+        return run_paged(&args, &paged);
+    }
     let world = args.world.load()?;
-    let views = select_views(&args, &world)?;
+    let views = select_views(&args, &world.views)?;
     let (w, h) = args.size;
     let cameras = views
         .iter()
@@ -264,6 +274,87 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                 report.prep.first_frame_ms,
                 setup_ms,
                 report.gpu_bytes
+            );
+        }
+    }
+    Ok(())
+}
+
+/// `render` over paged terrain: per view, frames until nothing is pending,
+/// then the timed frames (the camera is still: no uploads among them).
+fn run_paged(args: &Args, world: &PagedWorld) -> anyhow::Result<()> {
+    let views = select_views(args, &world.views)?;
+    let (w, h) = args.size;
+    let cameras = views
+        .iter()
+        .map(|v| world.camera(v, w, h))
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    let gpu = args.adapter.open()?;
+    let mut renderer = Renderer::new_paged(
+        &gpu,
+        world.source.clone(),
+        &world.colors,
+        &args.method,
+        &args.method_args.settings(),
+        w,
+        h,
+        PagedWorld::options(&args.paged),
+    )?;
+    let plan = *renderer.paged_terrain().expect("a paged renderer").plan();
+    if !args.json {
+        let r = &gpu.report;
+        println!(
+            "adapter: {} ({}, driver {} {})",
+            r.name, r.backend, r.driver, r.driver_info
+        );
+        println!(
+            "paged: {}x{} world, {} chunks; budget {} B: {} slots, {} B kept on the GPU",
+            world.size.0,
+            world.size.1,
+            plan.chunks,
+            plan.budget,
+            plan.slots,
+            plan.total()
+        );
+        println!(
+            "{:<14} {:>10} {:>10} {:>9} {:>9} {:>12}",
+            "view", "gpu ms", "cpu ms", "converge", "resident", "paged bytes"
+        );
+    }
+    for (view, camera) in views.iter().zip(&cameras) {
+        let frames = renderer
+            .converge(camera, args.converge_frames)
+            .with_context(|| format!("view `{}`", view.name))?;
+        let (mut report, color, depth) = measure_view(
+            &mut renderer,
+            &world.name,
+            view,
+            camera,
+            args.warmup,
+            args.frames,
+        )?;
+        report.converge_frames = Some(frames);
+        let dir = if views.len() == 1 {
+            args.out.clone()
+        } else {
+            args.out.join(&view.name)
+        };
+        write_outputs(&dir, &report, &color, &depth)?;
+        if args.json {
+            println!("{}", serde_json::to_string(&report)?);
+        } else {
+            let paging = report.paging.clone().unwrap_or_default();
+            println!(
+                "{:<14} {:>10} {:>10.3} {:>9} {:>9} {:>12}",
+                view.name,
+                report
+                    .gpu_ms
+                    .map(|s| format!("{:.3}", s.mean))
+                    .unwrap_or_else(|| "n/a".into()),
+                report.cpu_ms.mean,
+                frames,
+                paging.resident_pages,
+                paging.gpu_bytes
             );
         }
     }

@@ -6,6 +6,7 @@ use super::pyramid::GpuMaxMip;
 use crate::frame::Shared;
 use crate::methods::common::DepthCopy;
 use crate::options::ExactOptions;
+use crate::paged::PagedTerrain;
 
 pub(super) fn buffer_entry(
     binding: u32,
@@ -24,9 +25,46 @@ pub(super) fn buffer_entry(
     }
 }
 
-/// Layout entries 0..=2 of group 1: parameters, pyramid, statistics.
-pub(super) fn core_entries(stages: wgpu::ShaderStages) -> Vec<wgpu::BindGroupLayoutEntry> {
-    vec![
+/// The pyramid the march reads: the whole map's, or paged terrain's coarse
+/// level and page pyramids (with its page table, feedback and parameters).
+pub enum Levels {
+    /// The whole map's pyramid, built and updated on the GPU.
+    Whole(GpuMaxMip),
+    /// Pages of a world of any size (`crate::paged`).
+    Paged(Box<PagedTerrain>),
+}
+
+impl Levels {
+    /// The buffer `maxmip` binds.
+    fn buffer(&self) -> &wgpu::Buffer {
+        match self {
+            Levels::Whole(p) => &p.buffer,
+            Levels::Paged(p) => &p.levels,
+        }
+    }
+
+    /// Whether the march reads pages (shaders composed `paged:`).
+    pub fn is_paged(&self) -> bool {
+        matches!(self, Levels::Paged(_))
+    }
+
+    /// The shader name to compose for `name` over these levels.
+    pub fn shader(&self, name: &str) -> String {
+        if self.is_paged() {
+            format!("{}{name}", crate::shaders::PAGED)
+        } else {
+            name.to_string()
+        }
+    }
+}
+
+/// Layout entries 0..=2 of group 1: parameters, pyramid, statistics; and
+/// for paged levels 9..=11: page table, feedback, paging parameters.
+pub(super) fn core_entries(
+    stages: wgpu::ShaderStages,
+    paged: bool,
+) -> Vec<wgpu::BindGroupLayoutEntry> {
+    let mut entries = vec![
         buffer_entry(0, stages, wgpu::BufferBindingType::Uniform),
         buffer_entry(
             1,
@@ -38,39 +76,64 @@ pub(super) fn core_entries(stages: wgpu::ShaderStages) -> Vec<wgpu::BindGroupLay
             stages,
             wgpu::BufferBindingType::Storage { read_only: false },
         ),
-    ]
+    ];
+    if paged {
+        entries.extend([
+            buffer_entry(
+                9,
+                stages,
+                wgpu::BufferBindingType::Storage { read_only: true },
+            ),
+            buffer_entry(
+                10,
+                stages,
+                wgpu::BufferBindingType::Storage { read_only: false },
+            ),
+            buffer_entry(11, stages, wgpu::BufferBindingType::Uniform),
+        ]);
+    }
+    entries
 }
 
 pub(super) fn core_bindings<'a>(
     params: &'a wgpu::Buffer,
-    pyramid: &'a GpuMaxMip,
+    levels: &'a Levels,
     stats: &'a wgpu::Buffer,
 ) -> Vec<wgpu::BindGroupEntry<'a>> {
-    vec![
+    let mut entries = vec![
         wgpu::BindGroupEntry {
             binding: 0,
             resource: params.as_entire_binding(),
         },
         wgpu::BindGroupEntry {
             binding: 1,
-            resource: pyramid.buffer.as_entire_binding(),
+            resource: levels.buffer().as_entire_binding(),
         },
         wgpu::BindGroupEntry {
             binding: 2,
             resource: stats.as_entire_binding(),
         },
-    ]
+    ];
+    if let Levels::Paged(p) = levels {
+        for (binding, buffer) in [(9, &p.table), (10, &p.feedback), (11, &p.params)] {
+            entries.push(wgpu::BindGroupEntry {
+                binding,
+                resource: buffer.as_entire_binding(),
+            });
+        }
+    }
+    entries
 }
 
 pub(super) fn march_group(
     shared: &Shared,
     layout: &wgpu::BindGroupLayout,
     params: &wgpu::Buffer,
-    pyramid: &GpuMaxMip,
+    levels: &Levels,
     stats: &wgpu::Buffer,
     depth: Option<&DepthCopy>,
 ) -> wgpu::BindGroup {
-    let mut entries = core_bindings(params, pyramid, stats);
+    let mut entries = core_bindings(params, levels, stats);
     if let Some(depth) = depth {
         entries.extend(depth.bindings(shared, 3));
     }

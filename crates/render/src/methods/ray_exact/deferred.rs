@@ -3,8 +3,8 @@
 //! those, then a pass shades (`ray_exact_deferred.wgsl`; the why and the
 //! numbers are in the parent module's docs).
 
+use super::bindings::Levels;
 use super::bindings::{buffer_entry, core_bindings, core_entries, exact_pipeline};
-use super::pyramid::GpuMaxMip;
 use crate::frame::{Shared, storage_texture_entry, storage_texture_entry_with, texture_2d};
 use crate::methods::common::DepthCopy;
 use crate::options::ExactOptions;
@@ -76,14 +76,14 @@ impl Deferred {
     pub(super) fn new(
         shared: &Shared,
         params: &wgpu::Buffer,
-        pyramid: &GpuMaxMip,
+        levels: &Levels,
         stats: &wgpu::Buffer,
         marks: &ShadowMarks,
         depth: &DepthCopy,
         options: ExactOptions,
     ) -> anyhow::Result<Self> {
         let device = &shared.device;
-        let mut entries = core_entries(wgpu::ShaderStages::COMPUTE);
+        let mut entries = core_entries(wgpu::ShaderStages::COMPUTE, levels.is_paged());
         entries.extend([
             storage_texture_entry(3, crate::frame::COLOR_FORMAT),
             storage_texture_entry_with(4, wgpu::TextureFormat::R32Float, ReadWrite),
@@ -105,7 +105,7 @@ impl Deferred {
             exact_pipeline(
                 shared,
                 label,
-                "ray_exact_deferred.wgsl",
+                &levels.shader("ray_exact_deferred.wgsl"),
                 &pipeline_layout,
                 entry,
                 options,
@@ -117,7 +117,7 @@ impl Deferred {
         let group = Self::group(
             shared,
             &layout,
-            (params, pyramid, stats, marks),
+            (params, levels, stats, marks),
             depth,
             &hits,
         );
@@ -133,11 +133,11 @@ impl Deferred {
     pub(super) fn group(
         shared: &Shared,
         layout: &wgpu::BindGroupLayout,
-        (params, pyramid, stats, marks): (&wgpu::Buffer, &GpuMaxMip, &wgpu::Buffer, &ShadowMarks),
+        (params, levels, stats, marks): (&wgpu::Buffer, &Levels, &wgpu::Buffer, &ShadowMarks),
         depth: &DepthCopy,
         hits: &wgpu::TextureView,
     ) -> wgpu::BindGroup {
-        let mut entries = core_bindings(params, pyramid, stats);
+        let mut entries = core_bindings(params, levels, stats);
         entries.extend(depth.bindings(shared, 3));
         entries.push(wgpu::BindGroupEntry {
             binding: 5,

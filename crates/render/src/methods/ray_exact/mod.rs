@@ -111,7 +111,7 @@ struct ExactShadow {
 
 pub struct RayExact {
     name: &'static str,
-    pyramid: GpuMaxMip,
+    levels: Levels,
     params: wgpu::Buffer,
     stats: wgpu::Buffer,
     /// The deferred frame's stamped shadow blocks and their list.
@@ -182,10 +182,41 @@ fn exact_params(layout: &strata_maxmip::Layout) -> ExactParams {
 
 /// Build the method with explicit options.
 pub fn build(shared: &Shared, level: &Level, options: ExactOptions) -> anyhow::Result<RayExact> {
-    let compute = options.compute;
-    let device = &shared.device;
     let pyramid = GpuMaxMip::new(shared, level, options.pyramid_step())?;
     let table = exact_params(&pyramid.layout);
+    build_on(shared, Levels::Whole(pyramid), table, options)
+}
+
+/// Build the method over paged terrain (`crate::paged`): the shared frame's
+/// terrain texture must be `paged`'s atlas, made with this method's pyramid
+/// step ([`ExactOptions::pyramid_step`]).
+pub fn build_paged(
+    shared: &Shared,
+    paged: PagedTerrain,
+    options: ExactOptions,
+) -> anyhow::Result<RayExact> {
+    if !options.exact_shadow {
+        anyhow::bail!(
+            "paged terrain needs the exact shadow map (the renderer's own shadow pass reads the whole map)"
+        );
+    }
+    // The march starts at the 256-texel tile: the coarse level, one byte
+    // per page; the finer levels are the pages' own.
+    let table = ExactParams {
+        config: [strata_maxmip::MAX_LEVEL, ITERATION_CAP, 0, 0],
+        levels: [[0; 4]; 9],
+    };
+    build_on(shared, Levels::Paged(Box::new(paged)), table, options)
+}
+
+fn build_on(
+    shared: &Shared,
+    levels: Levels,
+    table: ExactParams,
+    options: ExactOptions,
+) -> anyhow::Result<RayExact> {
+    let compute = options.compute;
+    let device = &shared.device;
     // The deferred frame (compute, exact shadow map) lists shadow blocks.
     let deferred_frame = compute && options.exact_shadow && shared.caps.compute;
     let params = shared.uniform_buffer("ray-exact params", bytemuck::bytes_of(&table));
@@ -209,7 +240,7 @@ pub fn build(shared: &Shared, level: &Level, options: ExactOptions) -> anyhow::R
     } else {
         wgpu::ShaderStages::FRAGMENT
     };
-    let mut entries = core_entries(stages);
+    let mut entries = core_entries(stages, levels.is_paged());
     let depth = if compute {
         let depth = DepthCopy::new(shared, name, "ray-exact depth")?;
         Some(if options.depth == DepthMode::Points {
@@ -227,14 +258,14 @@ pub fn build(shared: &Shared, level: &Level, options: ExactOptions) -> anyhow::R
         label: Some(name),
         entries: &entries,
     });
-    let group = march_group(shared, &layout, &params, &pyramid, &stats, depth.as_ref());
+    let group = march_group(shared, &layout, &params, &levels, &stats, depth.as_ref());
     let pipeline_layout = shared.pipeline_layout(name, &[&layout]);
     let variant = match depth {
         Some(depth) => Variant::Compute {
             march: exact_pipeline(
                 shared,
                 name,
-                "ray_exact.wgsl",
+                &levels.shader("ray_exact.wgsl"),
                 &pipeline_layout,
                 "cs_ray_exact",
                 options,
@@ -242,7 +273,7 @@ pub fn build(shared: &Shared, level: &Level, options: ExactOptions) -> anyhow::R
             mode: options.depth,
             deferred: if deferred_frame {
                 Some(Box::new(Deferred::new(
-                    shared, &params, &pyramid, &stats, &marks, &depth, options,
+                    shared, &params, &levels, &stats, &marks, &depth, options,
                 )?))
             } else {
                 None
@@ -252,21 +283,21 @@ pub fn build(shared: &Shared, level: &Level, options: ExactOptions) -> anyhow::R
         None => Variant::Fragment(fullscreen_pipeline(
             shared,
             name,
-            "ray_exact_fragment.wgsl",
+            &levels.shader("ray_exact_fragment.wgsl"),
             &pipeline_layout,
             "fs_ray_exact",
         )?),
     };
     let shadow = if shared.caps.compute && options.exact_shadow {
         Some(exact_shadow(
-            shared, &params, &pyramid, &stats, &marks, options,
+            shared, &params, &levels, &stats, &marks, options,
         )?)
     } else {
         None
     };
     Ok(RayExact {
         name,
-        pyramid,
+        levels,
         params,
         stats,
         marks,
@@ -292,7 +323,7 @@ pub fn build(shared: &Shared, level: &Level, options: ExactOptions) -> anyhow::R
 fn exact_shadow(
     shared: &Shared,
     params: &wgpu::Buffer,
-    pyramid: &GpuMaxMip,
+    levels: &Levels,
     stats: &wgpu::Buffer,
     marks: &ShadowMarks,
     options: ExactOptions,
@@ -300,7 +331,7 @@ fn exact_shadow(
     let device = &shared.device;
     let (frame_layout, frame_group) =
         crate::shadow::frame_without_shadow_map(shared, "ray-exact shadow frame");
-    let mut entries = core_entries(wgpu::ShaderStages::COMPUTE);
+    let mut entries = core_entries(wgpu::ShaderStages::COMPUTE, levels.is_paged());
     entries.push(storage_texture_entry(3, wgpu::TextureFormat::R32Float));
     entries.push(buffer_entry(
         4,
@@ -311,7 +342,7 @@ fn exact_shadow(
         label: Some("ray-exact shadow"),
         entries: &entries,
     });
-    let mut bindings = core_bindings(params, pyramid, stats);
+    let mut bindings = core_bindings(params, levels, stats);
     bindings.push(wgpu::BindGroupEntry {
         binding: 3,
         resource: wgpu::BindingResource::TextureView(&shared.shadow_view),
@@ -334,7 +365,7 @@ fn exact_shadow(
         exact_pipeline(
             shared,
             "ray-exact shadow",
-            "ray_exact_shadow.wgsl",
+            &levels.shader("ray_exact_shadow.wgsl"),
             &pipeline_layout,
             entry,
             options,
@@ -349,9 +380,37 @@ fn exact_shadow(
 }
 
 impl RayExact {
-    /// The GPU pyramid (tests compare it with `strata_maxmip`).
-    pub fn pyramid(&self) -> &GpuMaxMip {
-        &self.pyramid
+    /// GPU bytes of the pyramid, or of the whole paged terrain.
+    fn levels_bytes(&self) -> u64 {
+        match &self.levels {
+            Levels::Whole(p) => p.gpu_bytes(),
+            Levels::Paged(p) => p.plan().total(),
+        }
+    }
+
+    /// The GPU pyramid (tests compare it with `strata_maxmip`); `None` over
+    /// paged terrain.
+    pub fn pyramid(&self) -> Option<&GpuMaxMip> {
+        match &self.levels {
+            Levels::Whole(p) => Some(p),
+            Levels::Paged(_) => None,
+        }
+    }
+
+    /// The paged terrain, if the method draws one.
+    pub fn paged(&self) -> Option<&PagedTerrain> {
+        match &self.levels {
+            Levels::Paged(p) => Some(p),
+            Levels::Whole(_) => None,
+        }
+    }
+
+    /// The paged terrain, to refresh after an edit or settle (tests).
+    pub fn paged_mut(&mut self) -> Option<&mut PagedTerrain> {
+        match &mut self.levels {
+            Levels::Paged(p) => Some(p),
+            Levels::Whole(_) => None,
+        }
     }
 
     /// The march's counters since creation or the last reset.
@@ -409,16 +468,17 @@ impl RayExact {
 
     /// Record the queued pyramid update once per frame, before anything reads it.
     fn record_update(&self, frame: &Frame<'_>, encoder: &mut wgpu::CommandEncoder) {
-        if !self.updated.get() && self.pyramid.has_work() {
+        if let Levels::Whole(pyramid) = &self.levels
+            && !self.updated.get()
+            && pyramid.has_work()
+        {
             if let Some(timer) = &self.update_timer {
                 timer.reset();
-                self.pyramid
-                    .record(encoder, timer.compute("ray-exact pyramid update"));
+                pyramid.record(encoder, timer.compute("ray-exact pyramid update"));
                 timer.resolve(encoder);
                 self.update_timed.set(true);
             } else {
-                self.pyramid
-                    .record(encoder, frame.timer.compute("ray-exact pyramid update"));
+                pyramid.record(encoder, frame.timer.compute("ray-exact pyramid update"));
             }
         }
         self.updated.set(true);
@@ -436,8 +496,16 @@ impl Method for RayExact {
         _level: &Level,
         rects: &[DirtyRect],
     ) -> anyhow::Result<()> {
-        self.pyramid.enqueue(rects);
-        Ok(())
+        match &mut self.levels {
+            Levels::Whole(pyramid) => {
+                pyramid.enqueue(rects);
+                Ok(())
+            }
+            Levels::Paged(_) => anyhow::bail!(
+                "{} draws paged terrain: edits reach it through its store (PagedTerrain::refresh)",
+                self.name
+            ),
+        }
     }
 
     fn update_settings(&mut self, _: &Shared, _: &MethodSettings) -> anyhow::Result<bool> {
@@ -453,14 +521,14 @@ impl Method for RayExact {
             depth.resize(shared);
             if let Some(d) = deferred {
                 d.hits = hits_image(shared);
-                let buffers = (&self.params, &self.pyramid, &self.stats, &self.marks);
+                let buffers = (&self.params, &self.levels, &self.stats, &self.marks);
                 d.group = Deferred::group(shared, &d.layout, buffers, depth, &d.hits);
             }
             self.group = march_group(
                 shared,
                 &self.layout,
                 &self.params,
-                &self.pyramid,
+                &self.levels,
                 &self.stats,
                 Some(depth),
             );
@@ -468,13 +536,16 @@ impl Method for RayExact {
         Ok(())
     }
 
-    fn prepare(&mut self, shared: &Shared, _camera: &Camera) -> anyhow::Result<()> {
+    fn prepare(&mut self, shared: &Shared, camera: &Camera) -> anyhow::Result<()> {
         self.read_update_time()?;
-        self.pyramid.prepare(shared);
         self.updated.set(false);
         self.shadow_due.set(false);
         // A new stamp each frame: last frame's marks no longer count.
         self.stamp = self.stamp.wrapping_add(1).max(1);
+        match &mut self.levels {
+            Levels::Whole(pyramid) => pyramid.prepare(shared),
+            Levels::Paged(paged) => paged.begin_frame(shared, camera, self.stamp)?,
+        }
         shared
             .queue
             .write_buffer(&self.params, 8, bytemuck::bytes_of(&self.stamp));
@@ -563,6 +634,20 @@ impl Method for RayExact {
                 &self.group,
             ),
         }
+        if let Levels::Paged(paged) = &self.levels {
+            paged.record_feedback(encoder);
+        }
+    }
+
+    fn frame_done(&mut self, shared: &Shared) -> anyhow::Result<()> {
+        match &mut self.levels {
+            Levels::Paged(paged) => paged.read_feedback(shared),
+            Levels::Whole(_) => Ok(()),
+        }
+    }
+
+    fn paged_terrain(&mut self) -> Option<&mut PagedTerrain> {
+        self.paged_mut()
     }
 
     fn retained_bytes(&self) -> RetainedBytes {
@@ -577,7 +662,7 @@ impl Method for RayExact {
             Variant::Fragment(_) => self.marks.bytes(),
         };
         RetainedBytes {
-            gpu: self.pyramid.gpu_bytes()
+            gpu: self.levels_bytes()
                 + std::mem::size_of::<ExactParams>() as u64
                 + self.stats.size()
                 + depth,
@@ -604,9 +689,9 @@ impl Drop for RayExact {
                 "{} stats: {} build_gpu_ms {:?} update_gpu_ms {:?} pyramid_bytes {}",
                 self.name,
                 serde_json::to_string(&s).unwrap_or_default(),
-                self.pyramid.build_gpu_ms,
+                self.pyramid().and_then(|p| p.build_gpu_ms),
                 self.update_ms,
-                self.pyramid.layout.bytes
+                self.pyramid().map_or(0, |p| p.layout.bytes)
             ),
             Err(e) => eprintln!("{} stats: {e}", self.name),
         }
@@ -615,6 +700,8 @@ impl Drop for RayExact {
 
 mod bindings;
 mod deferred;
+use crate::paged::PagedTerrain;
+pub use bindings::Levels;
 use bindings::{buffer_entry, core_bindings, core_entries, exact_pipeline, march_group};
 use deferred::{Deferred, MARK_BLOCK, ShadowMarks, hits_image};
 

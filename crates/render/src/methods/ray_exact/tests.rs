@@ -163,6 +163,7 @@ fn gpu_trace(gpu: &crate::Gpu, level: &Level, rays: &[TestRay]) -> Vec<[f32; 4]>
         "test params",
         bytemuck::bytes_of(&exact_params(&pyramid.layout)),
     );
+    let pyramid = Levels::Whole(pyramid);
     let stats = device.create_buffer(&wgpu::BufferDescriptor {
         label: None,
         size: 16,
@@ -191,7 +192,7 @@ fn gpu_trace(gpu: &crate::Gpu, level: &Level, rays: &[TestRay]) -> Vec<[f32; 4]>
     });
     let core_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: None,
-        entries: &core_entries(wgpu::ShaderStages::COMPUTE),
+        entries: &core_entries(wgpu::ShaderStages::COMPUTE, false),
     });
     let core_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: None,

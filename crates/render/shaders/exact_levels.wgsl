@@ -1,0 +1,27 @@
+// The max-height pyramid the exact march reads (`ray_exact_core.wgsl`): the
+// whole map's, built by `ray_exact_build.wgsl` and laid out by `xparams.levels`
+// (`strata_maxmip::Layout`). A paged shader swaps this module for
+// `paged_levels.wgsl`, whose levels below the 256-texel tile live per page.
+
+@group(1) @binding(1) var<storage, read> maxmip: array<u32>;
+
+// Max top of tile (tx, ty) of level k, wrapping around the map.
+fn maxmip_get(k: u32, tx: i32, ty: i32) -> f32 {
+    let l = xparams.levels[k];
+    let i = l.x + (u32(tx) & l.z) + ((u32(ty) & l.w) << l.y);
+    return f32((maxmip[i >> 2u] >> ((i & 3u) << 3u)) & 0xffu);
+}
+
+// Hooks for the paged variant, which counts pixels drawn from pages not yet
+// resident: the whole map is always resident.
+fn page_pixel_begin() {}
+
+fn page_pixel_missed() -> bool {
+    return false;
+}
+
+// Count the pixel as pending (paged only).
+fn page_pixel_end(missed: bool) {}
+
+// Count a shadow texel cast through a missing page (paged only).
+fn page_shadow_end(missed: bool) {}

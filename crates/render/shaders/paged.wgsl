@@ -1,0 +1,101 @@
+// Paged terrain (`paged/`): the world lives in fixed-size pages of 256x256
+// texels, a few of them resident in the terrain texture (the atlas) at a time.
+// Shared by `paged_fetch.wgsl` and `paged_levels.wgsl`, which a paged shader
+// puts in place of `terrain_fetch.wgsl` and `exact_levels.wgsl`. Needs
+// `ray_exact_core.wgsl` (xparams: the frame's stamp) and `frame.wgsl`.
+//
+// A chunk that is not resident reads as its coarse-level box: every column as
+// high as the chunk's highest top (`paged_chunk_top`), so a ray can stop on it
+// but never passes through terrain it has not seen: no sky through a missing
+// page. A ray that goes down into such a chunk marks the pixel pending and
+// asks for the page (once per chunk and frame).
+#include "frame.wgsl"
+
+// Twin of `paged::gpu::PagedParams`.
+struct PagedParams {
+    // x log2 chunks across, y first byte of the slot pyramids in `maxmip`
+    // (after the chunk tops), z bytes per slot pyramid, w request list length
+    grid: vec4<u32>,
+    // x log2 pages across an atlas layer, y log2 pages per layer, z first word
+    // of the slot stamps in `page_feedback`, w first word of the chunk stamps
+    atlas: vec4<u32>,
+    // first byte of page pyramid level k within a slot's pyramid, at
+    // [k / 4][k % 4]
+    offsets: array<vec4<u32>, 2>,
+}
+
+// Per chunk: its slot + 1, 0 while not resident.
+@group(1) @binding(9) var<storage, read> page_table: array<u32>;
+// [0] pending pixels, [1] requests, [2] pending shadow texels, [3 ..) the
+// requested chunks, then one
+// stamp per slot (the last frame that read it) and one per chunk (the last
+// frame that asked for it).
+@group(1) @binding(10) var<storage, read_write> page_feedback: array<atomic<u32>>;
+@group(1) @binding(11) var<uniform> paged: PagedParams;
+// The coarse level and the slot pyramids, bytes in words.
+@group(1) @binding(1) var<storage, read> maxmip: array<u32>;
+
+// Whether this invocation read a chunk that was not resident.
+var<private> page_missed: bool;
+
+fn page_pixel_begin() {
+    page_missed = false;
+}
+
+fn page_pixel_missed() -> bool {
+    return page_missed;
+}
+
+fn paged_byte(i: u32) -> u32 {
+    return (maxmip[i >> 2u] >> ((i & 3u) << 3u)) & 0xffu;
+}
+
+// The chunk holding texel (x, y), wrapped.
+fn paged_chunk(x: i32, y: i32) -> u32 {
+    let xx = u32(x) & (globals.level.x - 1u);
+    let yy = u32(y) & (globals.level.y - 1u);
+    return (xx >> 8u) + ((yy >> 8u) << paged.grid.x);
+}
+
+// The highest top of `chunk` (always resident).
+fn paged_chunk_top(chunk: u32) -> u32 {
+    return paged_byte(chunk);
+}
+
+// `chunk`'s slot + 1, or 0 after asking for it.
+fn paged_slot(chunk: u32) -> u32 {
+    let e = page_table[chunk];
+    let stamp = xparams.config.z;
+    if (e == 0u) {
+        page_missed = true;
+        let s = paged.atlas.w + chunk;
+        // Most rays find it asked for already: read before the exchange.
+        if (atomicLoad(&page_feedback[s]) != stamp && atomicExchange(&page_feedback[s], stamp) != stamp) {
+            let n = atomicAdd(&page_feedback[1], 1u);
+            if (n < paged.grid.w) {
+                atomicStore(&page_feedback[3u + n], chunk);
+            }
+        }
+    } else {
+        let u = paged.atlas.z + e - 1u;
+        if (atomicLoad(&page_feedback[u]) != stamp) {
+            atomicStore(&page_feedback[u], stamp);
+        }
+    }
+    return e;
+}
+
+// Count the pixel as pending when it read a missing chunk.
+fn page_pixel_end(missed: bool) {
+    if (missed) {
+        atomicAdd(&page_feedback[0], 1u);
+    }
+}
+
+// Count a shadow-map texel cast through a missing chunk (the pixels that
+// sample it are not marked: the frame is not converged while any is).
+fn page_shadow_end(missed: bool) {
+    if (missed) {
+        atomicAdd(&page_feedback[2], 1u);
+    }
+}

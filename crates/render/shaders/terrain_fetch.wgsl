@@ -1,0 +1,16 @@
+// Where a texel pair comes from: the whole map in the shared terrain texture
+// (`terrain.rs`'s layout). A paged shader (`shaders::compose`, prefix
+// `paged:`) swaps this module for `paged_fetch.wgsl`, which reads the same pair
+// through the page table.
+#include "frame.wgsl"
+
+// The pair texel holding texel (x, y), wrapping in both directions.
+fn terrain_pair(x: i32, y: i32) -> vec4<u32> {
+    // u32(i32) reinterprets the bits, so masking wraps negatives correctly.
+    let px = (u32(x) & (globals.level.x - 1u)) >> 1u;
+    let yy = u32(y) & (globals.level.y - 1u);
+    let shift = globals.level.z;
+    let layer = yy >> shift;
+    let row = yy & ((1u << shift) - 1u);
+    return textureLoad(terrain, vec2<u32>(px, row), layer, 0);
+}

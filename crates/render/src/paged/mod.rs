@@ -1,0 +1,621 @@
+//! Paged terrain: worlds of any size through a fixed GPU budget (issue 33).
+//!
+//! The world is cut into pages of 256x256 texels (a store's chunks). A few
+//! are resident at a time in an atlas, which stands in for the whole-map
+//! terrain texture of the shared frame, so every shader that includes
+//! `frame.wgsl` still binds it. Shaders composed with the `paged:` prefix
+//! (`shaders::compose`) read texel pairs and the exact march's pyramid through
+//! a page table instead of the whole map:
+//!
+//! - **always resident**: the coarse level (each chunk's highest top, from a
+//!   store's summaries without reading a chunk), the page table, and the
+//!   feedback buffer; their size follows the number of chunks (9 bytes per
+//!   chunk: 0.6 MB for a 65536² world);
+//! - **per page**: the texels (128 KiB in the atlas) and the page's own
+//!   pyramid below the 256-texel tile;
+//! - **no holes**: a ray that goes down into a chunk that is not resident
+//!   meets the chunk's coarse box (every column at its highest top), so it
+//!   stops there rather than showing sky through terrain it has not seen; the
+//!   pixel counts as *pending*, and the chunk is asked for;
+//! - **feedback**: each frame records the chunks its rays asked for (camera
+//!   rays and the shadow map's alike) and the frame stamp of every slot it
+//!   read; [`PagedTerrain`] reads that back after the frame, has the
+//!   [`Streamer`] read the asked-for pages (nearest the eye first, with the
+//!   view's footprint prefetched), and uploads at most
+//!   [`PagedOptions::upload_pages`] a frame into free slots or the least
+//!   recently read ones (never a slot the last read-back frame used);
+//! - **budget**: [`BudgetPlan`] turns `--gpu-budget` into slots, counting every
+//!   byte above (the atlas, the levels, the table, the feedback and its
+//!   read-back copy, the parameters). The frame's own targets and shadow map
+//!   are the renderer's, the same for every world, and reported apart.
+//!
+//! With the camera still, pending pixels fall to zero within a few frames and
+//! the image then equals the whole-world render bit for bit: the march and
+//! shading are the same WGSL over the same bytes (tested on lavapipe).
+
+pub mod residency;
+pub mod source;
+pub mod streamer;
+
+pub use residency::{BudgetPlan, Residency};
+pub use source::{LevelPages, PAGE, PageData, PageSource, StorePages, page_pyramid_layout};
+pub use streamer::Streamer;
+
+use crate::frame::Shared;
+use crate::terrain::{TerrainLayout, TerrainTexture};
+use residency::{FEEDBACK_HEADER, MAX_REQUESTS};
+use serde::Serialize;
+use std::collections::HashMap;
+use std::sync::Arc;
+use strata_camera::Camera;
+
+/// The methods that draw paged terrain ([`crate::Renderer::new_paged`]).
+pub const PAGED_METHODS: &[&str] = &["ray-exact", "ray-exact-fragment"];
+
+/// How a paged renderer spends its GPU memory and upload bandwidth.
+#[derive(Clone, Debug)]
+pub struct PagedOptions {
+    /// Bytes the paged terrain may keep on the GPU (everything that grows
+    /// with the world or the pages; see [`BudgetPlan`]).
+    pub gpu_budget: u64,
+    /// Most pages uploaded per frame.
+    pub upload_pages: u32,
+    /// Reader threads (0: read on the render thread, between frames).
+    pub threads: usize,
+    /// Tries before a chunk that fails to read is given up (its pixels stay
+    /// pending; the error is reported once).
+    pub read_tries: u32,
+}
+
+impl Default for PagedOptions {
+    fn default() -> Self {
+        PagedOptions {
+            gpu_budget: DEFAULT_GPU_BUDGET,
+            upload_pages: 64,
+            threads: std::thread::available_parallelism().map_or(1, |n| n.get().clamp(1, 4)),
+            read_tries: 3,
+        }
+    }
+}
+
+/// `--gpu-budget`'s default natively: 256 MiB.
+pub const DEFAULT_GPU_BUDGET: u64 = 256 << 20;
+
+/// Twin of `PagedParams` in `paged.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+struct PagedParams {
+    grid: [u32; 4],
+    atlas: [u32; 4],
+    offsets: [[u32; 4]; 2],
+}
+
+/// What the paging did, for reports and the viewer's overlay.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct PagingStats {
+    /// The budget, bytes.
+    pub gpu_budget: u64,
+    /// Bytes the paged terrain keeps on the GPU (≤ the budget).
+    pub gpu_bytes: u64,
+    /// Slots in the atlas.
+    pub slots: u32,
+    /// Pages resident now.
+    pub resident_pages: u32,
+    /// Bytes of the resident pages (texels and pyramids).
+    pub resident_bytes: u64,
+    /// Pages uploaded before the last frame.
+    pub uploaded_pages: u32,
+    /// Bytes uploaded before the last frame (texels, pyramids, table entries).
+    pub uploaded_bytes: u64,
+    /// Pixels of the last read-back frame drawn from a missing page.
+    pub pending_pixels: u32,
+    /// Shadow-map texels of that frame cast through a missing page (the
+    /// pixels that sample them are not counted above).
+    pub pending_shadow_texels: u32,
+    /// Chunks that frame asked for.
+    pub requests: u32,
+    /// Chunks queued or being read.
+    pub in_flight: u32,
+    /// Pages placed since creation.
+    pub total_uploads: u64,
+    /// Pages evicted since creation.
+    pub total_evictions: u64,
+    /// Chunks that failed to read (after retries), and the first error.
+    pub read_errors: u32,
+    /// The first read error, naming the chunk.
+    pub first_error: Option<String>,
+}
+
+/// The paged terrain's GPU data, its residency and its streamer.
+pub struct PagedTerrain {
+    plan: BudgetPlan,
+    source: Arc<dyn PageSource>,
+    /// Chunks across and down.
+    grid: (u32, u32),
+    step: u32,
+    options: PagedOptions,
+    atlas: wgpu::Texture,
+    /// The coarse level then the slot pyramids (`maxmip` in `paged.wgsl`).
+    pub(crate) levels: wgpu::Buffer,
+    pub(crate) table: wgpu::Buffer,
+    pub(crate) feedback: wgpu::Buffer,
+    pub(crate) params: wgpu::Buffer,
+    readback: wgpu::Buffer,
+    residency: Residency,
+    tops: Vec<u8>,
+    streamer: Streamer,
+    /// The stamp of the frame being recorded, and of the newest frame whose
+    /// feedback was read (pages it read are kept).
+    stamp: u32,
+    read_stamp: u32,
+    /// A frame copied its feedback to `readback`, not yet read.
+    readback_due: std::cell::Cell<bool>,
+    /// The eye's map position this frame (placement prefers near pages).
+    eye: glam::Vec2,
+    /// Tries so far per failing chunk.
+    failures: HashMap<u32, u32>,
+    /// Chunks an edit changed while a read of them was in flight: that
+    /// read's page is old and is dropped when it arrives.
+    stale: std::collections::HashSet<u32>,
+    /// The last read-back frame's requests, most wanted first.
+    requested: Vec<u32>,
+    stats: PagingStats,
+}
+
+impl PagingStats {
+    /// Whether the last read-back frame drew nothing from a missing page
+    /// (its pixels, or the shadow texels they sample).
+    pub fn converged(&self) -> bool {
+        self.pending_pixels == 0 && self.pending_shadow_texels == 0
+    }
+}
+
+impl PagedTerrain {
+    /// The atlas for `source` at `options.gpu_budget`, and the plan. The
+    /// atlas goes into the shared frame as its terrain texture (see the
+    /// module docs); `step` is the pyramid step of the method reading it.
+    pub fn atlas(
+        device: &wgpu::Device,
+        source: &dyn PageSource,
+        options: &PagedOptions,
+        step: u32,
+    ) -> anyhow::Result<(TerrainTexture, BudgetPlan)> {
+        let (w, h) = source.size();
+        let chunks = (w / PAGE) * (h / PAGE);
+        let limits = device.limits();
+        let plan = BudgetPlan::new(
+            options.gpu_budget,
+            chunks,
+            page_pyramid_layout(step).bytes,
+            std::mem::size_of::<PagedParams>() as u64,
+            limits.max_texture_array_layers,
+            limits
+                .max_storage_buffer_binding_size
+                .min(limits.max_buffer_size),
+        )
+        .map_err(anyhow::Error::msg)?;
+        let (across, down) = plan.layer_pages();
+        let layout = TerrainLayout {
+            map_width: w,
+            map_height: h,
+            pairs: across * PAGE / 2,
+            layer_rows: down * PAGE,
+            layers: plan.layers,
+        };
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("page atlas"),
+            size: wgpu::Extent3d {
+                width: layout.pairs,
+                height: layout.layer_rows,
+                depth_or_array_layers: layout.layers,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba8Uint,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        let view = texture.create_view(&wgpu::TextureViewDescriptor {
+            label: Some("page atlas"),
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
+        Ok((
+            TerrainTexture {
+                layout,
+                texture,
+                view,
+            },
+            plan,
+        ))
+    }
+
+    /// The paged terrain over `shared` (whose terrain texture is the atlas
+    /// [`PagedTerrain::atlas`] made with `plan`).
+    pub fn new(
+        shared: &Shared,
+        source: Arc<dyn PageSource>,
+        plan: BudgetPlan,
+        options: PagedOptions,
+        step: u32,
+    ) -> anyhow::Result<Self> {
+        let device = &shared.device;
+        let (w, h) = source.size();
+        let grid = (w / PAGE, h / PAGE);
+        let tops = source
+            .chunk_tops()
+            .map_err(|e| anyhow::anyhow!("reading the coarse level: {e}"))?;
+        if tops.len() != (grid.0 * grid.1) as usize {
+            anyhow::bail!(
+                "the coarse level has {} entries for {}x{} chunks",
+                tops.len(),
+                grid.0,
+                grid.1
+            );
+        }
+        use wgpu::BufferUsages as U;
+        let buffer = |label: &str, size: u64, usage: U| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: size.max(4),
+                usage,
+                mapped_at_creation: false,
+            })
+        };
+        let levels = buffer("page levels", plan.levels_bytes, U::STORAGE | U::COPY_DST);
+        let table = buffer("page table", plan.table_bytes, U::STORAGE | U::COPY_DST);
+        let feedback_words = FEEDBACK_HEADER + MAX_REQUESTS + plan.slots + plan.chunks;
+        let feedback = buffer(
+            "page feedback",
+            4 * u64::from(feedback_words),
+            U::STORAGE | U::COPY_DST | U::COPY_SRC,
+        );
+        let readback = buffer(
+            "page feedback read-back",
+            4 * u64::from(FEEDBACK_HEADER + MAX_REQUESTS + plan.slots),
+            U::MAP_READ | U::COPY_DST,
+        );
+        let layout = page_pyramid_layout(step);
+        let mut offsets = [[0u32; 4]; 2];
+        for info in &layout.levels {
+            let k = info.log2_tile as usize;
+            if k < 8 {
+                offsets[k / 4][k % 4] = info.offset;
+            }
+        }
+        let params = PagedParams {
+            grid: [
+                grid.0.ilog2(),
+                plan.chunks.div_ceil(4) * 4,
+                plan.pyramid_stride,
+                MAX_REQUESTS,
+            ],
+            atlas: [
+                plan.across_log2,
+                plan.per_layer_log2,
+                FEEDBACK_HEADER + MAX_REQUESTS,
+                FEEDBACK_HEADER + MAX_REQUESTS + plan.slots,
+            ],
+            offsets,
+        };
+        let params = shared.uniform_buffer("paged params", bytemuck::bytes_of(&params));
+        let mut padded = tops.clone();
+        padded.resize(tops.len().div_ceil(4) * 4, 0);
+        shared.queue.write_buffer(&levels, 0, &padded);
+        // Buffers start zeroed: nothing resident, nothing asked for.
+        let streamer = Streamer::new(source.clone(), step, options.threads);
+        let stats = PagingStats {
+            gpu_budget: plan.budget,
+            gpu_bytes: plan.total(),
+            slots: plan.slots,
+            ..Default::default()
+        };
+        Ok(PagedTerrain {
+            plan,
+            source,
+            grid,
+            step,
+            options,
+            atlas: shared.terrain.texture.clone(),
+            levels,
+            table,
+            feedback,
+            params,
+            readback,
+            residency: Residency::new(plan.chunks, plan.slots),
+            tops,
+            streamer,
+            stamp: 0,
+            read_stamp: 0,
+            readback_due: std::cell::Cell::new(false),
+            eye: glam::Vec2::ZERO,
+            failures: HashMap::new(),
+            stale: Default::default(),
+            requested: Vec::new(),
+            stats,
+        })
+    }
+
+    /// The plan the budget became.
+    pub fn plan(&self) -> &BudgetPlan {
+        &self.plan
+    }
+
+    /// What the paging did up to the last read-back frame.
+    pub fn stats(&self) -> PagingStats {
+        let mut s = self.stats.clone();
+        s.resident_pages = self.residency.resident() as u32;
+        s.resident_bytes = u64::from(s.resident_pages)
+            * (residency::PAGE_ATLAS_BYTES + u64::from(self.plan.pyramid_stride));
+        s.in_flight = self.streamer.in_flight() as u32;
+        s
+    }
+
+    /// The page table as the GPU holds it (tests).
+    pub fn residency(&self) -> &Residency {
+        &self.residency
+    }
+
+    /// Before recording the frame stamped `stamp`: read the last frame's
+    /// feedback if not yet read, want what it asked for and what the view's
+    /// footprint holds, upload finished pages, and clear the counters.
+    pub fn begin_frame(
+        &mut self,
+        shared: &Shared,
+        camera: &Camera,
+        stamp: u32,
+    ) -> anyhow::Result<()> {
+        self.read_feedback(shared)?;
+        self.stamp = stamp;
+        self.eye = camera.position.truncate();
+        let wanted = self.wanted(camera);
+        self.streamer.want(&wanted);
+        self.upload(shared, self.options.upload_pages as usize, 4.0);
+        shared
+            .queue
+            .write_buffer(&self.feedback, 0, &[0u8; 4 * FEEDBACK_HEADER as usize]);
+        Ok(())
+    }
+
+    /// Record the copy of this frame's feedback for [`PagedTerrain::read_feedback`].
+    pub fn record_feedback(&self, encoder: &mut wgpu::CommandEncoder) {
+        encoder.copy_buffer_to_buffer(&self.feedback, 0, &self.readback, 0, self.readback.size());
+        self.readback_due.set(true);
+    }
+
+    /// Read the recorded frame's feedback (blocks until that frame is done):
+    /// pending pixels, requests, and which slots it read.
+    pub fn read_feedback(&mut self, shared: &Shared) -> anyhow::Result<()> {
+        if !self.readback_due.replace(false) {
+            return Ok(());
+        }
+        let raw = crate::gpu::read_buffer(
+            &shared.device,
+            &crate::gpu::ErrorSink::default(),
+            &self.readback,
+            self.readback.size(),
+        )?;
+        let words: &[u32] = bytemuck::cast_slice(&raw);
+        let n = (words[1]).min(MAX_REQUESTS) as usize;
+        self.stats.pending_pixels = words[0];
+        self.stats.requests = words[1];
+        self.stats.pending_shadow_texels = words[2];
+        let list = &words[FEEDBACK_HEADER as usize..FEEDBACK_HEADER as usize + n];
+        self.requested = list
+            .iter()
+            .copied()
+            .filter(|&c| c < self.plan.chunks)
+            .collect();
+        let first_stamp = (FEEDBACK_HEADER + MAX_REQUESTS) as usize;
+        for (slot, &s) in words[first_stamp..].iter().enumerate() {
+            if s != 0 {
+                self.residency.touch(slot as u32, s);
+            }
+        }
+        self.read_stamp = self.stamp;
+        Ok(())
+    }
+
+    /// The chunks to read, most wanted first: what the last frame asked for
+    /// (nearest the eye first), then the view's footprint, none resident,
+    /// none given up, at most what the atlas can take.
+    fn wanted(&self, camera: &Camera) -> Vec<u32> {
+        let eye = camera.position.truncate();
+        let dist = |c: u32| chunk_distance(self.grid, eye, c);
+        let usable = |c: &u32| {
+            self.residency.slot_of(*c).is_none()
+                && self
+                    .failures
+                    .get(c)
+                    .is_none_or(|&n| n < self.options.read_tries)
+        };
+        let mut asked: Vec<u32> = self.requested.iter().copied().filter(usable).collect();
+        asked.sort_by(|a, b| dist(*a).total_cmp(&dist(*b)));
+        let mut footprint: Vec<u32> = self.footprint(camera).into_iter().filter(usable).collect();
+        footprint.sort_by(|a, b| dist(*a).total_cmp(&dist(*b)));
+        let cap = (self.plan.slots as usize / 2).max(1);
+        let mut seen = std::collections::HashSet::new();
+        asked
+            .into_iter()
+            .chain(footprint)
+            .filter(|c| seen.insert(*c))
+            .take(cap)
+            .collect()
+    }
+
+    /// The chunks under the view's frustum up to its far plane (a box around
+    /// the eye and the far corners), wrapped.
+    fn footprint(&self, camera: &Camera) -> Vec<u32> {
+        let eye = camera.position;
+        let (w, h) = (camera.width as f32, camera.height as f32);
+        let scale = camera.far / camera.focal_px;
+        let mut lo = glam::Vec2::new(eye.x, eye.y);
+        let mut hi = lo;
+        for (px, py) in [(0.0, 0.0), (w, 0.0), (0.0, h), (w, h)] {
+            let p = eye + camera.image_direction(px, py) * scale;
+            lo = lo.min(p.truncate());
+            hi = hi.max(p.truncate());
+        }
+        let page = PAGE as f32;
+        let (x0, x1) = ((lo.x / page).floor() as i64, (hi.x / page).floor() as i64);
+        let (y0, y1) = ((lo.y / page).floor() as i64, (hi.y / page).floor() as i64);
+        let (gx, gy) = (i64::from(self.grid.0), i64::from(self.grid.1));
+        // No more than the grid: a far plane past the world sees it whole.
+        let (x1, y1) = (x1.min(x0 + gx - 1), y1.min(y0 + gy - 1));
+        let mut out = Vec::new();
+        for cy in y0..=y1 {
+            for cx in x0..=x1 {
+                out.push((cy.rem_euclid(gy) * gx + cx.rem_euclid(gx)) as u32);
+            }
+        }
+        out
+    }
+
+    /// Upload up to `most` finished pages.
+    fn upload(&mut self, shared: &Shared, most: usize, budget_ms: f64) {
+        self.stats.uploaded_pages = 0;
+        self.stats.uploaded_bytes = 0;
+        for (chunk, page) in self.streamer.poll(most, budget_ms) {
+            if self.stale.remove(&chunk) || self.residency.slot_of(chunk).is_some() {
+                // Read before an edit, or placed meanwhile (by `refresh`).
+                continue;
+            }
+            match page {
+                Ok(page) => self.place(shared, chunk, &page),
+                Err(e) => {
+                    let tries = self.failures.entry(chunk).or_insert(0);
+                    *tries += 1;
+                    if *tries == self.options.read_tries {
+                        self.stats.read_errors += 1;
+                        if self.stats.first_error.is_none() {
+                            let (cx, cy) = (chunk % self.grid.0, chunk / self.grid.0);
+                            self.stats.first_error =
+                                Some(format!("chunk ({cx}, {cy}) failed to read: {e}"));
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// Put `page` (chunk `chunk`) in a slot, if one is free or unused.
+    fn place(&mut self, shared: &Shared, chunk: u32, page: &PageData) {
+        let keep_from = self.read_stamp;
+        let eye = self.eye;
+        let grid = self.grid;
+        let distance = move |c: u32| chunk_distance(grid, eye, c);
+        let Some(placed) = self.residency.place(chunk, self.stamp, keep_from, distance) else {
+            return;
+        };
+        if let Some(old) = placed.evicted {
+            self.write_entry(shared, old);
+            self.stats.total_evictions += 1;
+        }
+        self.write_page(shared, placed.slot, page);
+        self.write_entry(shared, chunk);
+        self.stats.uploaded_pages += 1;
+        self.stats.uploaded_bytes += page.bytes() as u64 + 8;
+        self.stats.total_uploads += 1;
+    }
+
+    fn write_page(&self, shared: &Shared, slot: u32, page: &PageData) {
+        let (layer, x, y) = self.plan.slot_origin(slot);
+        shared.queue.write_texture(
+            wgpu::TexelCopyTextureInfo {
+                texture: &self.atlas,
+                mip_level: 0,
+                origin: wgpu::Origin3d { x, y, z: layer },
+                aspect: wgpu::TextureAspect::All,
+            },
+            &page.pairs,
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(PAGE / 2 * 4),
+                rows_per_image: Some(PAGE),
+            },
+            wgpu::Extent3d {
+                width: PAGE / 2,
+                height: PAGE,
+                depth_or_array_layers: 1,
+            },
+        );
+        let offset = u64::from(self.plan.chunks.div_ceil(4) * 4)
+            + u64::from(slot) * u64::from(self.plan.pyramid_stride);
+        shared
+            .queue
+            .write_buffer(&self.levels, offset, &page.pyramid);
+    }
+
+    fn write_entry(&self, shared: &Shared, chunk: u32) {
+        let e = self.residency.table()[chunk as usize];
+        shared
+            .queue
+            .write_buffer(&self.table, 4 * u64::from(chunk), bytemuck::bytes_of(&e));
+    }
+
+    /// The source changed inside `chunks` (an edit, already written there):
+    /// refresh their coarse level and the resident pages now, so the next
+    /// frame shows the edit.
+    pub fn refresh(&mut self, shared: &Shared, chunks: &[u32]) -> anyhow::Result<()> {
+        for &chunk in chunks {
+            if chunk >= self.plan.chunks {
+                anyhow::bail!(
+                    "chunk {chunk} is outside the {}-chunk world",
+                    self.plan.chunks
+                );
+            }
+            let (cx, cy) = (chunk % self.grid.0, chunk / self.grid.0);
+            let page = self
+                .source
+                .read_page(cx, cy, self.step)
+                .map_err(|e| anyhow::anyhow!("re-reading chunk ({cx}, {cy}) after an edit: {e}"))?;
+            let top = page.top(self.step);
+            if self.tops[chunk as usize] != top {
+                self.tops[chunk as usize] = top;
+                // Rewrite the word holding it.
+                let w = (chunk / 4 * 4) as usize;
+                let mut word = [0u8; 4];
+                for (i, b) in word.iter_mut().enumerate() {
+                    *b = self.tops.get(w + i).copied().unwrap_or(0);
+                }
+                shared.queue.write_buffer(&self.levels, w as u64, &word);
+            }
+            if let Some(slot) = self.residency.slot_of(chunk) {
+                self.write_page(shared, slot, &page);
+            } else if self.streamer.is_in_flight(chunk) {
+                self.stale.insert(chunk);
+            }
+            self.failures.remove(&chunk);
+        }
+        Ok(())
+    }
+
+    /// Read until every chunk the view wants is resident or nothing more
+    /// can be placed: a still camera's frames then converge (tests, and a
+    /// `render` that must equal the whole-world image).
+    pub fn settle(&mut self, shared: &Shared) {
+        for (chunk, page) in self.streamer.drain() {
+            if self.stale.remove(&chunk) || self.residency.slot_of(chunk).is_some() {
+                continue;
+            }
+            if let Ok(page) = page {
+                self.place(shared, chunk, &page);
+            }
+        }
+    }
+}
+
+/// Squared distance from `eye` to the nearest wrapped copy of chunk `c`'s
+/// centre, on a grid of `grid` chunks.
+fn chunk_distance(grid: (u32, u32), eye: glam::Vec2, c: u32) -> f32 {
+    let (cx, cy) = (c % grid.0, c / grid.0);
+    let axis = |i: u32, n: u32, e: f32| {
+        let span = (n * PAGE) as f32;
+        let d = (i * PAGE + PAGE / 2) as f32 - e;
+        d - span * (d / span).round()
+    };
+    let dx = axis(cx, grid.0, eye.x);
+    let dy = axis(cy, grid.1, eye.y);
+    dx * dx + dy * dy
+}

@@ -1,0 +1,279 @@
+//! Where pages come from: a [`PageSource`] hands out one 256x256 chunk of
+//! the world at a time, already in the GPU's layout ([`PageData`]), and the
+//! coarse level every ray starts from (each chunk's highest top).
+//!
+//! Two sources: [`LevelPages`] over a world in memory (tests; the
+//! whole-world image a paged render must converge to) and [`StorePages`]
+//! over a Zarr store's [`ChunkCache`] (worlds of any size).
+
+use std::sync::Arc;
+use strata_level::model::decode_column;
+use strata_level::{Level, MidRule};
+use strata_maxmip::Layout;
+use strata_store::ChunkCache;
+
+/// Texels per side of a page: the store's chunk, and the coarsest tile of
+/// the exact march's pyramid (`strata_maxmip::MAX_LEVEL`), so a page is
+/// exactly one tile of the always-resident coarse level.
+pub const PAGE: u32 = 256;
+
+/// A page in the GPU's layout.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct PageData {
+    /// `PAGE / 2 * PAGE` pair texels, `(height even, meta even, height odd,
+    /// meta odd)` row-major: the terrain texture's layout (`terrain.rs`).
+    pub pairs: Vec<u8>,
+    /// The page's own max-height pyramid, levels 1..8 of a 256x256 map laid
+    /// out by [`page_pyramid_layout`].
+    pub pyramid: Vec<u8>,
+}
+
+/// The layout of a page's pyramid: that of a 256x256 map, with `step`
+/// ([`strata_maxmip::Layout::with_step`]) as the method builds.
+pub fn page_pyramid_layout(step: u32) -> Layout {
+    Layout::with_step(PAGE, PAGE, step)
+}
+
+impl PageData {
+    /// A page from the chunk's two planes (`PAGE * PAGE` bytes each).
+    pub fn from_planes(
+        heights: &[u8],
+        metas: &[u8],
+        mid_rule: MidRule,
+        step: u32,
+    ) -> Result<Self, String> {
+        let n = (PAGE * PAGE) as usize;
+        if heights.len() != n || metas.len() != n {
+            return Err(format!(
+                "a page needs {n} bytes per plane, got {} and {}",
+                heights.len(),
+                metas.len()
+            ));
+        }
+        let mut pairs = Vec::with_capacity(2 * n);
+        for (h, m) in heights.chunks_exact(2).zip(metas.chunks_exact(2)) {
+            pairs.extend_from_slice(&[h[0], m[0], h[1], m[1]]);
+        }
+        Ok(PageData {
+            pairs,
+            pyramid: page_pyramid(heights, metas, mid_rule, step),
+        })
+    }
+
+    /// The page's highest top: its tile of the coarse level (the pyramid's
+    /// last level, one 256-texel tile).
+    pub fn top(&self, step: u32) -> u8 {
+        let layout = page_pyramid_layout(step);
+        self.pyramid[layout.level(layout.top()).offset as usize]
+    }
+
+    /// Bytes of the page as uploaded.
+    pub fn bytes(&self) -> usize {
+        self.pairs.len() + self.pyramid.len()
+    }
+}
+
+/// The page's max-height pyramid on the calling thread, the same bytes as
+/// `strata_maxmip::Pyramid::with_step` over the page (tested). Not that
+/// build: it fans out over rayon's pool, where a page reader would wait
+/// behind whatever else the process runs there.
+fn page_pyramid(heights: &[u8], metas: &[u8], mid_rule: MidRule, step: u32) -> Vec<u8> {
+    let layout = page_pyramid_layout(step);
+    let mut data = vec![0u8; layout.bytes as usize];
+    let side = PAGE as usize;
+    let mut below: Vec<u8> = (0..side * side)
+        .map(|i| {
+            let row = i / side * side..(i / side + 1) * side;
+            decode_column(&heights[row.clone()], &metas[row], i % side, mid_rule).top()
+        })
+        .collect();
+    let mut n = side;
+    for k in 1..=strata_maxmip::MAX_LEVEL {
+        n /= 2;
+        let level: Vec<u8> = (0..n * n)
+            .map(|i| {
+                let (x, y) = (2 * (i % n), 2 * (i / n));
+                let w = 2 * n;
+                below[y * w + x]
+                    .max(below[y * w + x + 1])
+                    .max(below[(y + 1) * w + x])
+                    .max(below[(y + 1) * w + x + 1])
+            })
+            .collect();
+        if k % step == 0 {
+            let info = layout.level(k);
+            data[info.offset as usize..info.offset as usize + level.len()].copy_from_slice(&level);
+        }
+        below = level;
+    }
+    data
+}
+
+/// A world, a page at a time. `Send + Sync`: the streamer reads on a thread
+/// of its own.
+pub trait PageSource: Send + Sync {
+    /// World width and height, texels (powers of two, at least [`PAGE`]).
+    fn size(&self) -> (u32, u32);
+
+    /// How the mid byte is read.
+    fn mid_rule(&self) -> MidRule;
+
+    /// The highest top of every chunk, row-major over the chunk grid: the
+    /// always-resident coarse level (from a store's summaries, without
+    /// reading a chunk).
+    fn chunk_tops(&self) -> Result<Vec<u8>, String>;
+
+    /// Chunk (`cx`, `cy`) as a page, its pyramid built with `step`.
+    fn read_page(&self, cx: u32, cy: u32, step: u32) -> Result<PageData, String>;
+}
+
+/// Pages cut from a world in memory.
+pub struct LevelPages {
+    level: Arc<Level>,
+}
+
+impl LevelPages {
+    /// Pages of `level` (refused below one page a side).
+    pub fn new(level: Arc<Level>) -> anyhow::Result<Self> {
+        check_size(level.width(), level.height())?;
+        Ok(LevelPages { level })
+    }
+
+    /// The world.
+    pub fn level(&self) -> &Arc<Level> {
+        &self.level
+    }
+
+    fn planes(&self, cx: u32, cy: u32) -> (Vec<u8>, Vec<u8>) {
+        let w = self.level.width() as usize;
+        let (x0, y0) = ((cx * PAGE) as usize, (cy * PAGE) as usize);
+        let mut heights = Vec::with_capacity((PAGE * PAGE) as usize);
+        let mut metas = Vec::with_capacity((PAGE * PAGE) as usize);
+        for y in y0..y0 + PAGE as usize {
+            let row = y * w + x0..y * w + x0 + PAGE as usize;
+            heights.extend_from_slice(&self.level.heights()[row.clone()]);
+            metas.extend_from_slice(&self.level.metas()[row]);
+        }
+        (heights, metas)
+    }
+}
+
+impl PageSource for LevelPages {
+    fn size(&self) -> (u32, u32) {
+        (self.level.width(), self.level.height())
+    }
+
+    fn mid_rule(&self) -> MidRule {
+        self.level.mid_rule
+    }
+
+    fn chunk_tops(&self) -> Result<Vec<u8>, String> {
+        let (gx, gy) = (self.level.width() / PAGE, self.level.height() / PAGE);
+        let mut tops = vec![0u8; (gx * gy) as usize];
+        for cy in 0..gy {
+            for cx in 0..gx {
+                let mut top = 0;
+                for y in cy * PAGE..(cy + 1) * PAGE {
+                    for x in cx * PAGE..(cx + 1) * PAGE {
+                        top = top.max(self.level.column(i64::from(x), i64::from(y)).top());
+                    }
+                }
+                tops[(cy * gx + cx) as usize] = top;
+            }
+        }
+        Ok(tops)
+    }
+
+    fn read_page(&self, cx: u32, cy: u32, step: u32) -> Result<PageData, String> {
+        let (heights, metas) = self.planes(cx, cy);
+        PageData::from_planes(&heights, &metas, self.level.mid_rule, step)
+    }
+}
+
+/// Pages read through a store's chunk cache (the cache's byte budget bounds
+/// the CPU memory; the GPU budget is the renderer's).
+pub struct StorePages {
+    cache: Arc<ChunkCache>,
+    mid_rule: MidRule,
+}
+
+impl StorePages {
+    /// Pages of the store behind `cache`; its chunks must be pages.
+    pub fn new(cache: Arc<ChunkCache>, mid_rule: MidRule) -> anyhow::Result<Self> {
+        let store = cache.store();
+        check_size(store.width(), store.height())?;
+        if store.chunk_shape() != (PAGE, PAGE) {
+            anyhow::bail!(
+                "paged rendering reads {PAGE}x{PAGE} chunks; store `{}` has {}x{} chunks (rewrite it with `strata convert`)",
+                store.what(),
+                store.chunk_shape().1,
+                store.chunk_shape().0
+            );
+        }
+        Ok(StorePages { cache, mid_rule })
+    }
+
+    /// The cache pages are read through.
+    pub fn cache(&self) -> &Arc<ChunkCache> {
+        &self.cache
+    }
+}
+
+impl PageSource for StorePages {
+    fn size(&self) -> (u32, u32) {
+        let s = self.cache.store();
+        (s.width(), s.height())
+    }
+
+    fn mid_rule(&self) -> MidRule {
+        self.mid_rule
+    }
+
+    fn chunk_tops(&self) -> Result<Vec<u8>, String> {
+        let summaries = self.cache.store().summaries().map_err(|e| e.to_string())?;
+        Ok(summaries.iter().map(|s| s.top_max).collect())
+    }
+
+    fn read_page(&self, cx: u32, cy: u32, step: u32) -> Result<PageData, String> {
+        let chunk = self
+            .cache
+            .chunk(u64::from(cy), u64::from(cx))
+            .map_err(|e| e.to_string())?;
+        PageData::from_planes(&chunk.heights, &chunk.metas, self.mid_rule(), step)
+    }
+}
+
+/// Paged worlds are whole pages, powers of two a side.
+fn check_size(width: u32, height: u32) -> anyhow::Result<()> {
+    if width < PAGE || height < PAGE || !width.is_power_of_two() || !height.is_power_of_two() {
+        anyhow::bail!(
+            "paged rendering needs a world of at least {PAGE}x{PAGE} texels, powers of two a side; this one is {width}x{height}"
+        );
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_page_pyramid_is_the_maxmip_twin() {
+        let world = strata_level::generate::generate(&strata_level::generate::GenerateParams {
+            seed: 3,
+            width: 512,
+            height: 512,
+        })
+        .unwrap();
+        let pages = LevelPages::new(Arc::new(world.level.clone())).unwrap();
+        for step in [1, 2] {
+            for (cx, cy) in [(0, 0), (1, 0), (1, 1)] {
+                let page = pages.read_page(cx, cy, step).unwrap();
+                let (h, m) = pages.planes(cx, cy);
+                let level = Level::from_planes(PAGE, PAGE, h, m, world.level.mid_rule).unwrap();
+                let twin = strata_maxmip::Pyramid::with_step(&level, step).data;
+                assert_eq!(page.pyramid, twin, "step {step} chunk ({cx}, {cy})");
+            }
+        }
+    }
+}
