@@ -44,6 +44,8 @@ enum Command {
     Metrics(cmd::metrics::Args),
     /// Render one view with one method on the GPU.
     Render(cmd::render::Args),
+    /// Fly a path over paged terrain: per-frame GPU/CPU ms, pending pixels, uploads, resident bytes.
+    Fly(cmd::fly::Args),
     /// Fit the TIN mesh and report its size, causes, time and memory.
     Fit(cmd::fit::Args),
     /// Fit a grid of generated worlds (or given ones) at five qualities: table, correlations, causes, plots.
@@ -80,6 +82,7 @@ fn main() -> std::process::ExitCode {
         Command::Metrics(args) => cmd::metrics::run(args),
         Command::Render(args) => cmd::render::run(args),
         Command::Fit(args) => cmd::fit::run(args),
+        Command::Fly(args) => cmd::fly::run(args),
         Command::Collide(args) => cmd::collide::run(args),
         Command::Export(args) => cmd::export::run(args),
         Command::Compare(args) => cmd::compare::run(args),

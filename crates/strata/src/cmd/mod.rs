@@ -6,6 +6,7 @@ pub mod compare;
 pub mod convert;
 pub mod export;
 pub mod fit;
+pub mod fly;
 pub mod generate;
 pub mod info;
 pub mod merge;
