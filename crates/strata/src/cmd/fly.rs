@@ -120,6 +120,10 @@ pub struct FlyReport {
     /// The renderer's own targets and shadow map (every world alike).
     pub frame_gpu_bytes: u64,
     pub setup_ms: f64,
+    /// Frames and wall ms at the start pose until nothing was pending
+    /// (before the flight; `null`: it did not converge in 600 frames).
+    pub start_frames: Option<u32>,
+    pub start_ms: f64,
     pub frames: u32,
     pub gpu_ms: Option<Summary>,
     pub cpu_ms: Summary,
@@ -170,8 +174,21 @@ fn fly_one(args: &Args, world_args: &WorldArgs, out: &Path) -> anyhow::Result<Fl
         PagedWorld::options(&paged_args),
     )?;
     let plan = *renderer.paged_terrain().expect("paged").plan();
+    // The start pose first, until nothing is pending (a loading screen):
+    // the flight then measures streaming as the camera moves, not the
+    // empty atlas of the first frame.
+    let start = std::time::Instant::now();
+    let start_frames = match renderer.converge(&cameras[0], 600) {
+        Ok(n) => Some(n),
+        Err(e) => {
+            eprintln!("fly: the start pose did not converge: {e:#}");
+            None
+        }
+    };
+    let start_ms = start.elapsed().as_secs_f64() * 1e3;
     let mut frames = Vec::with_capacity(cameras.len());
     let pixels = f64::from(w) * f64::from(h);
+    let mut reported_error: Option<String> = None;
     for (i, camera) in cameras.iter().enumerate() {
         let t = renderer.render_frame(camera)?;
         let stats = renderer.paged_terrain().expect("paged").stats();
@@ -183,10 +200,9 @@ fn fly_one(args: &Args, world_args: &WorldArgs, out: &Path) -> anyhow::Result<Fl
             uploaded_bytes: stats.uploaded_bytes,
             resident_bytes: stats.resident_bytes,
         });
-        if let Some(e) = &stats.first_error {
-            if i == 0 || frames.len() == 1 {
-                eprintln!("fly: {e}");
-            }
+        if let (Some(e), true) = (&stats.first_error, reported_error.is_none()) {
+            eprintln!("fly: frame {i}: {e}");
+            reported_error = Some(e.clone());
         }
     }
     let gpu_ms: Vec<f64> = frames.iter().filter_map(|f| f.gpu_ms).collect();
@@ -205,6 +221,8 @@ fn fly_one(args: &Args, world_args: &WorldArgs, out: &Path) -> anyhow::Result<Fl
         paged_gpu_bytes: plan.total(),
         frame_gpu_bytes: renderer.shared_gpu_bytes(),
         setup_ms: renderer.setup_ms(),
+        start_frames,
+        start_ms,
         frames: frames.len() as u32,
         gpu_ms: (gpu_ms.len() == frames.len()).then(|| Summary::of(&gpu_ms)),
         cpu_ms: Summary::of(&cpu_ms),
@@ -399,12 +417,16 @@ fn print_summary(r: &FlyReport) {
         .map(|g| format!("{:.3} / {:.3} / {:.3}", g.mean, g.p99, g.max))
         .unwrap_or_else(|| "n/a".into());
     println!(
-        "{}x{} {} on {} ({}): {} frames; GPU ms mean/p99/max {g}; CPU ms mean/p99/max {:.3} / {:.3} / {:.3}; pending % mean {:.3} max {:.2}; paged GPU {} B of {} B; uploaded {:.1} MiB; RSS peak {}",
+        "{}x{} {} on {} ({}): start converged in {} frames ({:.0} ms); {} frames; GPU ms mean/p99/max {g}; CPU ms mean/p99/max {:.3} / {:.3} / {:.3}; pending % mean {:.3} max {:.2}; paged GPU {} B of {} B; uploaded {:.1} MiB; RSS peak {}",
         r.world_size[0],
         r.world_size[1],
         r.method,
         r.adapter,
         r.backend,
+        r.start_frames
+            .map(|n| n.to_string())
+            .unwrap_or_else(|| "(not)".into()),
+        r.start_ms,
         r.frames,
         r.cpu_ms.mean,
         r.cpu_ms.p99,
