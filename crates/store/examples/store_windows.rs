@@ -87,7 +87,7 @@ fn main() {
         .min(h);
     let (ch, cw) = store.store().chunk_shape();
     assert!(
-        side.is_power_of_two() && side % ch == 0 && side % cw == 0,
+        side.is_power_of_two() && side.is_multiple_of(ch) && side.is_multiple_of(cw),
         "SIDE must be a power of two, whole chunks"
     );
 

@@ -133,7 +133,12 @@ impl Chunked {
         let n = cols as usize * rows as usize;
         let inside = u64::from(x0) + u64::from(cols) <= u64::from(w)
             && u64::from(y0) + u64::from(rows) <= u64::from(h);
-        if !inside || x0 % 2 != 0 || cols % 2 != 0 || heights.len() != n || metas.len() != n {
+        if !inside
+            || !x0.is_multiple_of(2)
+            || !cols.is_multiple_of(2)
+            || heights.len() != n
+            || metas.len() != n
+        {
             return Err(GenerateError::Rect {
                 x0,
                 y0,

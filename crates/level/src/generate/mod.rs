@@ -380,7 +380,7 @@ fn fill_span(
     hrow: &mut [u8],
     mrow: &mut [u8],
 ) {
-    debug_assert!(x0 % 2 == 0 && hrow.len() % 2 == 0 && hrow.len() == mrow.len());
+    debug_assert!(x0.is_multiple_of(2) && hrow.len().is_multiple_of(2) && hrow.len() == mrow.len());
     let x1 = x0 + hrow.len() as u32;
     let sites: Vec<&landmarks::Landmark> = layout
         .list
