@@ -4,7 +4,11 @@
 //! overhangs, roofs) and ten named landmarks with twelve default views.
 //!
 //! Every texel is a pure function of (seed, size, x, y), evaluated row by row
-//! in parallel, so the bytes are the same at any thread count.
+//! in parallel, so the bytes are the same at any thread count. Nothing needs
+//! the whole map: [`generate`] makes worlds that fit in memory (up to 2^28
+//! texels), [`Chunked`] any rectangle of a world up to 65536x65536 on its
+//! own (what `strata generate --to store` writes chunk by chunk), the same
+//! bytes wherever both apply.
 
 mod assets;
 pub mod chunked;
