@@ -49,7 +49,13 @@ pub fn palette() -> Palette {
 /// `world.ini` of a generated world of the given size.
 pub fn world_config(width: u32, height: u32) -> Result<WorldConfig, GenerateError> {
     super::check_size(width, height)?;
-    Ok(WorldConfig {
+    Ok(config_of(width, height))
+}
+
+/// `world.ini` of a generated world of a size checked by the caller (a
+/// store's may exceed what a Vangers world directory allows).
+pub(crate) fn config_of(width: u32, height: u32) -> WorldConfig {
+    WorldConfig {
         map_power_x: width.trailing_zeros(),
         map_power_y: height.trailing_zeros(),
         compressed: true,
@@ -58,5 +64,5 @@ pub fn world_config(width: u32, height: u32) -> Result<WorldConfig, GenerateErro
         begin_colors: BEGIN_COLORS,
         end_colors: END_COLORS,
         ..WorldConfig::default()
-    })
+    }
 }

@@ -80,7 +80,15 @@ impl SlabMask {
         let threshold = if fraction <= 0.0 {
             f32::INFINITY
         } else {
-            let step = 8;
+            // Every 8th texel each way up to 2^28 texels (the in-memory
+            // worlds, whose bytes must not move), then sparser, so that a
+            // world of any size samples at most 2^22 points.
+            let texels = u64::from(width) * u64::from(height);
+            let mut step = 8;
+            while texels / (step * step) > 1 << 22 {
+                step *= 2;
+            }
+            let step = step as usize;
             let mut vs: Vec<f32> = (0..height)
                 .step_by(step)
                 .flat_map(|y| (0..width).step_by(step).map(move |x| (x, y)))

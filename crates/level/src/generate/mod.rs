@@ -4,9 +4,14 @@
 //! overhangs, roofs) and ten named landmarks with twelve default views.
 //!
 //! Every texel is a pure function of (seed, size, x, y), evaluated row by row
-//! in parallel, so the bytes are the same at any thread count.
+//! in parallel, so the bytes are the same at any thread count. Nothing needs
+//! the whole map: [`generate`] makes worlds that fit in memory (up to 2^28
+//! texels), [`Chunked`] any rectangle of a world up to 65536x65536 on its
+//! own (what `strata generate --to store` writes chunk by chunk), the same
+//! bytes wherever both apply.
 
 mod assets;
+pub mod chunked;
 pub mod knobs;
 // The generator's designs, public only between its own modules.
 #[doc(hidden)]
@@ -23,6 +28,7 @@ use crate::model::{
 use rayon::prelude::*;
 
 pub use assets::{BEGIN_COLORS, END_COLORS, palette, world_config};
+pub use chunked::{Chunked, MAX_CHUNKED_SIDE, check_chunked_size};
 pub use knobs::{Knobs, MAX_DUAL_FRACTION, MAX_FLOOR_ROUGHNESS};
 pub use terrain::SEA;
 
@@ -92,6 +98,21 @@ pub enum GenerateError {
         value: String,
         /// The accepted range.
         range: String,
+    },
+    /// [`Chunked::fill`] or [`Chunked::patch`] was asked for a rectangle it
+    /// cannot make.
+    #[error("rectangle {cols}x{rows} at ({x0}, {y0}): {reason}")]
+    Rect {
+        /// Left column asked for.
+        x0: u32,
+        /// Top row asked for.
+        y0: u32,
+        /// Columns asked for.
+        cols: u32,
+        /// Rows asked for.
+        rows: u32,
+        /// Which rule it breaks.
+        reason: String,
     },
     /// The planes could not form a [`Level`] (a bug if it happens: sizes are checked first).
     #[error(transparent)]
@@ -349,7 +370,27 @@ fn fill_row(
     hrow: &mut [u8],
     mrow: &mut [u8],
 ) {
-    let sites: Vec<&landmarks::Landmark> = layout.list.iter().filter(|l| l.covers_row(y)).collect();
+    fill_span(terrain, layout, mask, y, 0, hrow, mrow);
+}
+
+/// Texels `x0 .. x0 + hrow.len()` of row `y` (`x0` and the length even:
+/// whole pairs), the same bytes as that part of [`fill_row`].
+fn fill_span(
+    terrain: &terrain::Terrain,
+    layout: &landmarks::Layout,
+    mask: Option<&knobs::SlabMask>,
+    y: u32,
+    x0: u32,
+    hrow: &mut [u8],
+    mrow: &mut [u8],
+) {
+    debug_assert!(x0.is_multiple_of(2) && hrow.len().is_multiple_of(2) && hrow.len() == mrow.len());
+    let x1 = x0 + hrow.len() as u32;
+    let sites: Vec<&landmarks::Landmark> = layout
+        .list
+        .iter()
+        .filter(|l| l.covers_row(y) && l.x0 < x1 && x0 < l.x0 + l.w)
+        .collect();
     let row = terrain.row(y);
     let texel = |x: u32| {
         let t = match sites.iter().find(|l| l.covers_x(x)) {
@@ -361,8 +402,8 @@ fn fill_row(
             None => t,
         }
     };
-    for x in (0..terrain.width).step_by(2) {
-        let i = x as usize;
+    for (i, x) in (x0..x1).step_by(2).enumerate() {
+        let i = 2 * i;
         encode_pair(
             texel(x),
             texel(x + 1),

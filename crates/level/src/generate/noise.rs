@@ -49,13 +49,36 @@ impl ValueNoise {
         }
     }
 
+    /// The four corner hashes of cell (`ix`, `iy`): (0,0), (1,0), (0,1),
+    /// (1,1). Remembered per thread (see [`CORNERS`]): consecutive texels
+    /// of a row mostly fall in the cell of the one before, and the hashes
+    /// are most of the noise's cost.
     #[inline]
-    fn corner(&self, ix: i32, iy: i32) -> f32 {
-        // One hash of premixed coordinates: plenty for value noise, and the
-        // corner lookups are most of the generator's time.
+    fn corners(&self, ix: i32, iy: i32) -> [u32; 4] {
+        let key = [
+            ix as u32,
+            iy as u32,
+            self.seed,
+            self.mask_x | (self.mask_y << 16),
+        ];
         let a = (ix as u32 & self.mask_x).wrapping_mul(0x8da6_b343);
         let b = (iy as u32 & self.mask_y).wrapping_mul(0xd816_3841);
-        unit(hash32(a ^ b ^ self.seed))
+        let slot = ((a ^ b ^ self.seed) >> (32 - CORNER_SLOTS_LOG2)) as usize;
+        CORNERS.with(|memo| {
+            let cell = &memo[slot];
+            let known = cell.get();
+            if known.key == key {
+                return known.hashes;
+            }
+            let h = |dx: i32, dy: i32| {
+                let a = ((ix + dx) as u32 & self.mask_x).wrapping_mul(0x8da6_b343);
+                let b = ((iy + dy) as u32 & self.mask_y).wrapping_mul(0xd816_3841);
+                hash32(a ^ b ^ self.seed)
+            };
+            let hashes = [h(0, 0), h(1, 0), h(0, 1), h(1, 1)];
+            cell.set(Corners { key, hashes });
+            hashes
+        })
     }
 
     /// Two independent noises from one set of corner hashes (high and low
@@ -66,12 +89,7 @@ impl ValueNoise {
         let fy = y * self.inv_cell;
         let (ix, iy) = (fast_floor(fx), fast_floor(fy));
         let (tx, ty) = (smooth(fx - ix as f32), smooth(fy - iy as f32));
-        let h = |dx: i32, dy: i32| {
-            let a = ((ix + dx) as u32 & self.mask_x).wrapping_mul(0x8da6_b343);
-            let b = ((iy + dy) as u32 & self.mask_y).wrapping_mul(0xd816_3841);
-            hash32(a ^ b ^ self.seed)
-        };
-        let (a, b, c, d) = (h(0, 0), h(1, 0), h(0, 1), h(1, 1));
+        let [a, b, c, d] = self.corners(ix, iy);
         let lerp = |a: f32, b: f32, c: f32, d: f32| {
             let top = a + (b - a) * tx;
             top + (c + (d - c) * tx - top) * ty
@@ -90,38 +108,75 @@ impl ValueNoise {
         let fy = y * self.inv_cell;
         let (ix, iy) = (fast_floor(fx), fast_floor(fy));
         let (tx, ty) = (smooth(fx - ix as f32), smooth(fy - iy as f32));
-        let a = self.corner(ix, iy);
-        let b = self.corner(ix + 1, iy);
-        let c = self.corner(ix, iy + 1);
-        let d = self.corner(ix + 1, iy + 1);
+        let [a, b, c, d] = self.corners(ix, iy).map(unit);
         let top = a + (b - a) * tx;
         let bottom = c + (d - c) * tx;
         top + (bottom - top) * ty
     }
 }
 
+/// A cell's corner hashes and what they are the hashes of: the cell's
+/// unwrapped coordinates, the noise's seed and its wrap masks, which
+/// together decide all four hashes, so a remembered entry is exact.
+#[derive(Clone, Copy)]
+struct Corners {
+    key: [u32; 4],
+    hashes: [u32; 4],
+}
+
+const CORNER_SLOTS_LOG2: u32 = 6;
+
+thread_local! {
+    /// Corner hashes of recently sampled cells, per thread, direct-mapped
+    /// by the cell's hash (so the several noises and offsets a texel
+    /// samples mostly keep their own entries). The initial key (cell
+    /// i32::MIN, seed 0, masks 0) is never asked for: cells are near the map.
+    static CORNERS: [std::cell::Cell<Corners>; 1 << CORNER_SLOTS_LOG2] = const {
+        [const {
+            std::cell::Cell::new(Corners {
+                key: [i32::MIN as u32, i32::MIN as u32, 0, 0],
+                hashes: [0; 4],
+            })
+        }; 1 << CORNER_SLOTS_LOG2]
+    };
+}
+
 /// A smooth field sampled every `2^step_log2` texels and interpolated
 /// bilinearly: for low-frequency inputs (warps, masks, regions) it is
 /// indistinguishable from evaluating them per texel, at a fraction of the cost.
 /// `N` fields share one grid so one lookup interpolates them all.
-#[derive(Clone, Debug)]
+///
+/// The lattice covers the whole (wrapping) map, but only a *window* of it
+/// is held: the whole map for a world made in memory, a chunk and its
+/// margins for one generated chunk by chunk. A lattice value outside the
+/// window is computed on the spot by the same function at the same point,
+/// so every lookup gives the same bits whatever the window: the window
+/// decides the speed, never the bytes.
+#[derive(Clone)]
 pub struct Coarse<const N: usize = 1> {
     values: Vec<[f32; N]>,
+    /// The whole map's lattice (powers of two).
     cols: usize,
     rows: usize,
+    /// The window: first lattice column and row held, and how many.
+    i0: usize,
+    j0: usize,
+    wcols: usize,
+    wrows: usize,
     step_log2: u32,
+    f: std::sync::Arc<dyn Fn(f32, f32) -> [f32; N] + Send + Sync>,
+}
+
+impl<const N: usize> std::fmt::Debug for Coarse<N> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Coarse")
+            .field("lattice", &(self.cols, self.rows))
+            .field("window", &(self.i0, self.j0, self.wcols, self.wrows))
+            .finish()
+    }
 }
 
 impl Coarse<1> {
-    pub fn new(
-        width: u32,
-        height: u32,
-        step_log2: u32,
-        f: impl Fn(f32, f32) -> f32 + Sync,
-    ) -> Self {
-        Self::many(width, height, step_log2, move |x, y| [f(x, y)])
-    }
-
     #[inline]
     pub fn at(&self, x: f32, y: f32) -> f32 {
         self.all(x, y)[0]
@@ -129,35 +184,95 @@ impl Coarse<1> {
 }
 
 impl<const N: usize> Coarse<N> {
-    pub fn many(
+    /// The field with an empty window: every lookup computes its lattice
+    /// values (for the few lookups made before any chunk is generated).
+    pub fn lazy(
         width: u32,
         height: u32,
         step_log2: u32,
-        f: impl Fn(f32, f32) -> [f32; N] + Sync,
+        f: impl Fn(f32, f32) -> [f32; N] + Send + Sync + 'static,
     ) -> Self {
-        use rayon::prelude::*;
         let step_log2 = step_log2
             .min(width.trailing_zeros())
             .min(height.trailing_zeros());
-        let (cols, rows) = (
-            (width >> step_log2) as usize,
-            (height >> step_log2) as usize,
-        );
-        let step = (1u32 << step_log2) as f32;
-        let mut values = vec![[0f32; N]; cols * rows];
-        values
-            .par_chunks_mut(cols)
-            .enumerate()
-            .for_each(|(j, row)| {
-                for (i, v) in row.iter_mut().enumerate() {
-                    *v = f(i as f32 * step, j as f32 * step);
-                }
-            });
         Coarse {
-            values,
-            cols,
-            rows,
+            values: Vec::new(),
+            cols: (width >> step_log2) as usize,
+            rows: (height >> step_log2) as usize,
+            i0: 0,
+            j0: 0,
+            wcols: 0,
+            wrows: 0,
             step_log2,
+            f: std::sync::Arc::new(f),
+        }
+    }
+
+    /// The same field holding the lattice values that lookups at texel
+    /// positions `x0 .. x1`, `y0 .. y1` (any integers; they wrap) need.
+    pub fn window(&self, x0: i64, y0: i64, x1: i64, y1: i64) -> Self {
+        let s = self.step_log2;
+        // Cells [floor(x0 / step), floor((x1 - 1) / step)] and one more corner.
+        let (ci0, cj0) = (x0 >> s, y0 >> s);
+        let wcols = (((x1 - 1) >> s) - ci0 + 2).clamp(0, self.cols as i64) as usize;
+        let wrows = (((y1 - 1) >> s) - cj0 + 2).clamp(0, self.rows as i64) as usize;
+        let mut c = Coarse {
+            values: Vec::new(),
+            cols: self.cols,
+            rows: self.rows,
+            i0: 0,
+            j0: 0,
+            wcols: 0,
+            wrows: 0,
+            step_log2: s,
+            f: self.f.clone(),
+        };
+        c.fill(
+            ci0.rem_euclid(self.cols as i64) as usize,
+            cj0.rem_euclid(self.rows as i64) as usize,
+            wcols,
+            wrows,
+        );
+        c
+    }
+
+    /// Compute the window of `wcols x wrows` lattice values from (i0, j0).
+    fn fill(&mut self, i0: usize, j0: usize, wcols: usize, wrows: usize) {
+        use rayon::prelude::*;
+        let step = (1u32 << self.step_log2) as f32;
+        let (cols, rows) = (self.cols, self.rows);
+        let mut values = vec![[0f32; N]; wcols * wrows];
+        let f = &*self.f;
+        let row = |(j, row): (usize, &mut [[f32; N]])| {
+            let gj = (j0 + j) & (rows - 1);
+            for (i, v) in row.iter_mut().enumerate() {
+                let gi = (i0 + i) & (cols - 1);
+                *v = f(gi as f32 * step, gj as f32 * step);
+            }
+        };
+        // A whole map's lattice is worth all cores; a chunk's window is
+        // made inside a parallel loop over chunks already.
+        if wcols * wrows >= 1 << 16 {
+            values
+                .par_chunks_mut(wcols.max(1))
+                .enumerate()
+                .for_each(row);
+        } else {
+            values.chunks_mut(wcols.max(1)).enumerate().for_each(row);
+        }
+        (self.values, self.i0, self.j0, self.wcols, self.wrows) = (values, i0, j0, wcols, wrows);
+    }
+
+    /// The lattice value at global lattice column `gi`, row `gj`.
+    #[inline]
+    fn value(&self, gi: usize, gj: usize) -> [f32; N] {
+        let li = gi.wrapping_sub(self.i0) & (self.cols - 1);
+        let lj = gj.wrapping_sub(self.j0) & (self.rows - 1);
+        if li < self.wcols && lj < self.wrows {
+            self.values[lj * self.wcols + li]
+        } else {
+            let step = (1u32 << self.step_log2) as f32;
+            (self.f)(gi as f32 * step, gj as f32 * step)
         }
     }
 
@@ -170,15 +285,25 @@ impl<const N: usize> Coarse<N> {
         // Both counts are powers of two: wrap with masks.
         let (mx, my) = (self.cols - 1, self.rows - 1);
         let (i0, j0) = (x0 as usize & mx, y0 as usize & my);
-        let (i1, j1) = ((i0 + 1) & mx, (j0 + 1) & my);
-        let (a, b) = (
-            self.values[j0 * self.cols + i0],
-            self.values[j0 * self.cols + i1],
-        );
-        let (c, d) = (
-            self.values[j1 * self.cols + i0],
-            self.values[j1 * self.cols + i1],
-        );
+        let (li, lj) = (i0.wrapping_sub(self.i0) & mx, j0.wrapping_sub(self.j0) & my);
+        let (a, b, c, d) = if li + 1 < self.wcols && lj + 1 < self.wrows {
+            // All four corners in the window, side by side (the usual case).
+            let k = lj * self.wcols + li;
+            (
+                self.values[k],
+                self.values[k + 1],
+                self.values[k + self.wcols],
+                self.values[k + self.wcols + 1],
+            )
+        } else {
+            let (i1, j1) = ((i0 + 1) & mx, (j0 + 1) & my);
+            (
+                self.value(i0, j0),
+                self.value(i1, j0),
+                self.value(i0, j1),
+                self.value(i1, j1),
+            )
+        };
         std::array::from_fn(|k| {
             let top = a[k] + (b[k] - a[k]) * tx;
             let bottom = c[k] + (d[k] - c[k]) * tx;

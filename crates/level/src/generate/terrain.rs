@@ -36,7 +36,12 @@ enum District {
     Hangars,
 }
 
-/// Everything the per-texel functions need, built once per world.
+/// Everything the per-texel functions need. Built once per world for a
+/// world made in memory ([`Terrain::new`]); for a world made chunk by
+/// chunk, a cheap [`Terrain::lazy`] is built once and each chunk takes a
+/// [`Terrain::window`] of it, which precomputes only what that chunk reads.
+/// Every texel is the same bits either way.
+#[derive(Clone)]
 pub struct Terrain {
     pub seed: u32,
     pub width: u32,
@@ -54,14 +59,25 @@ pub struct Terrain {
     river_phase: [f32; 2],
     river_waves: [f32; 2],
     district_log2: u32,
-    /// Per district: its kind, pattern rectangle and flat floor.
+    /// Per district: its kind, pattern rectangle and flat floor, for the
+    /// districts of `district_window` (column, row, columns, rows); others
+    /// are planned when asked for.
     districts: Vec<DistrictPlan>,
+    district_window: [u32; 4],
     road_period_y: i32,
     road_period_x: i32,
     /// `--floor-roughness`: the small relief's amplitude factor; `None` is
     /// the default world's formula, kept as written so its bytes never move.
     fine_scale: Option<f32>,
 }
+
+/// How far past a texel its lookups of the coarse fields reach, texels:
+/// the domain warp (32 + 3.5), a road's centre line (5), and the valley
+/// overhang's sample at (+91, +45). A window with these margins computes
+/// nothing on the spot (the bytes do not depend on it, only the speed).
+const REACH_BEFORE: i64 = 48;
+const REACH_AFTER_X: i64 = 96;
+const REACH_AFTER_Y: i64 = 56;
 
 #[derive(Clone, Copy, Debug)]
 struct DistrictPlan {
@@ -88,7 +104,20 @@ pub fn ring_delta(a: f32, b: f32, n: f32) -> f32 {
 }
 
 impl Terrain {
+    /// The terrain of a whole map held in memory: every coarse field and
+    /// district computed now.
     pub fn new(seed: u64, width: u32, height: u32) -> Self {
+        let mut t = Self::lazy(seed, width, height);
+        t.base_broad = t.base_broad.window(0, 0, width.into(), height.into());
+        t.fields = t.fields.window(0, 0, width.into(), height.into());
+        t.plan_districts(0, 0, width, height);
+        t
+    }
+
+    /// The same terrain with nothing precomputed (a few kilobytes whatever
+    /// the map size): for the river, the landmarks' placement and the
+    /// views, and as the source of each chunk's [`window`](Self::window).
+    pub fn lazy(seed: u64, width: u32, height: u32) -> Self {
         let s = hash32(seed as u32 ^ hash32((seed >> 32) as u32));
         let vn =
             |k: u32, cell: u32| ValueNoise::new(s.wrapping_add(k * 0x9e37), cell, width, height);
@@ -100,16 +129,16 @@ impl Terrain {
         let district_log2 = 7
             .min(width.trailing_zeros())
             .min(height.trailing_zeros() - 1);
-        let mut t = Terrain {
+        Terrain {
             seed: s,
             width,
             height,
             base_broad: {
                 let broad = Fbm::octaves(s ^ 0xba5e, 8, 0..2, 4, width, height);
-                Coarse::new(width, height, 3, move |x, y| broad.at(x, y))
+                Coarse::lazy(width, height, 3, move |x, y| [broad.at(x, y)])
             },
             base_fine: Fbm::octaves(s ^ 0xba5e, 8, 2..4, 4, width, height),
-            fields: Coarse::many(width, height, 3, move |x, y| {
+            fields: Coarse::lazy(width, height, 3, move |x, y| {
                 let [a, b, c, d] = smooth.map(|n| n.at(x, y));
                 [a, b, c, d, regions.at(x, y)]
             }),
@@ -121,44 +150,75 @@ impl Terrain {
             river_waves: [waves, waves * 3.0],
             district_log2,
             districts: Vec::new(),
+            district_window: [0; 4],
             road_period_y: 512.min(height as i32 / 2),
             road_period_x: 1024.min(width as i32),
             fine_scale: None,
-        };
-        t.districts = t.plan_districts();
+        }
+    }
+
+    /// This terrain with what the texels `x0 .. x0 + cols`, `y0 .. y0 +
+    /// rows` read precomputed: the coarse fields over them and their
+    /// margins, and their districts. Texels outside still come out right,
+    /// only slower.
+    pub fn window(&self, x0: u32, y0: u32, cols: u32, rows: u32) -> Self {
+        let (x, y) = (i64::from(x0), i64::from(y0));
+        let (x1, y1) = (x + i64::from(cols), y + i64::from(rows));
+        let (bx0, by0) = (x - REACH_BEFORE, y - REACH_BEFORE);
+        let (bx1, by1) = (x1 + REACH_AFTER_X, y1 + REACH_AFTER_Y);
+        let mut t = self.clone();
+        t.base_broad = self.base_broad.window(bx0, by0, bx1, by1);
+        t.fields = self.fields.window(bx0, by0, bx1, by1);
+        t.plan_districts(x0, y0, cols, rows);
         t
     }
 
-    fn plan_districts(&self) -> Vec<DistrictPlan> {
+    /// Plan the districts holding texels `x0 .. x0 + cols`, `y0 .. y0 + rows`.
+    fn plan_districts(&mut self, x0: u32, y0: u32, cols: u32, rows: u32) {
+        let l = self.district_log2;
+        let (dx0, dy0) = (x0 >> l, y0 >> l);
+        let dcols = ((x0 + cols - 1) >> l) - dx0 + 1;
+        let drows = ((y0 + rows - 1) >> l) - dy0 + 1;
+        self.districts = (dy0..dy0 + drows)
+            .flat_map(|dy| (dx0..dx0 + dcols).map(move |dx| (dx, dy)))
+            .map(|(dx, dy)| self.plan_district(dx, dy))
+            .collect();
+        self.district_window = [dx0, dy0, dcols, drows];
+    }
+
+    fn plan_district(&self, dx: u32, dy: u32) -> DistrictPlan {
         let size = 1i32 << self.district_log2;
-        let (cols, rows) = (
-            self.width >> self.district_log2,
-            self.height >> self.district_log2,
-        );
-        (0..rows)
-            .flat_map(|dy| (0..cols).map(move |dx| (dx, dy)))
-            .map(|(dx, dy)| {
-                let hash = hash2(self.seed ^ 0xd15c, dx, dy);
-                let kind = match hash % 100 {
-                    0..=41 => District::Natural,
-                    42..=55 => District::Pits,
-                    56..=72 => District::Furrows,
-                    73..=91 => District::Hall,
-                    _ => District::Hangars,
-                };
-                // A pattern covers a random part of its district, not all of it.
-                let m = |k: u32| 12 + (hash32(hash ^ k) % (size as u32 / 5)) as i32;
-                let rect = [m(1), m(2), size - m(3), size - m(4)];
-                let c = |d: u32| (d as i32 * size + size / 2) as f32;
-                let floor = LEVELS[Self::band(self.base_noise(c(dx), c(dy))).max(1)];
-                DistrictPlan {
-                    kind,
-                    hash,
-                    rect,
-                    floor,
-                }
-            })
-            .collect()
+        let hash = hash2(self.seed ^ 0xd15c, dx, dy);
+        let kind = match hash % 100 {
+            0..=41 => District::Natural,
+            42..=55 => District::Pits,
+            56..=72 => District::Furrows,
+            73..=91 => District::Hall,
+            _ => District::Hangars,
+        };
+        // A pattern covers a random part of its district, not all of it.
+        let m = |k: u32| 12 + (hash32(hash ^ k) % (size as u32 / 5)) as i32;
+        let rect = [m(1), m(2), size - m(3), size - m(4)];
+        let c = |d: u32| (d as i32 * size + size / 2) as f32;
+        let floor = LEVELS[Self::band(self.base_noise(c(dx), c(dy))).max(1)];
+        DistrictPlan {
+            kind,
+            hash,
+            rect,
+            floor,
+        }
+    }
+
+    /// The plan of district (dx, dy): planned already, or now.
+    #[inline]
+    fn district_plan(&self, dx: u32, dy: u32) -> DistrictPlan {
+        let [wx, wy, wc, wr] = self.district_window;
+        let (i, j) = (dx.wrapping_sub(wx), dy.wrapping_sub(wy));
+        if i < wc && j < wr {
+            self.districts[(j * wc + i) as usize]
+        } else {
+            self.plan_district(dx, dy)
+        }
     }
 
     /// The per-row context for [`texel`](Self::texel).
@@ -401,8 +461,7 @@ impl Terrain {
     fn district(&self, t: Texel, x: u32, y: u32) -> Texel {
         let size = 1i32 << self.district_log2;
         let (dx, dy) = (x >> self.district_log2, y >> self.district_log2);
-        let cols = self.width >> self.district_log2;
-        let plan = self.districts[(dy * cols + dx) as usize];
+        let plan = self.district_plan(dx, dy);
         let (lx, ly) = ((x as i32) & (size - 1), (y as i32) & (size - 1));
         let [x0, y0, x1, y1] = plan.rect;
         if lx < x0 || ly < y0 || lx >= x1 || ly >= y1 {
