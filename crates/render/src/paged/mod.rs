@@ -444,14 +444,16 @@ impl PagedTerrain {
             .collect()
     }
 
-    /// The chunks under the view's frustum up to its far plane (a box around
-    /// the eye and the far corners), wrapped.
+    /// The chunks within the far plane's reach around the eye, in any
+    /// direction (a turn of the camera then finds its pages resident), and
+    /// under the frustum's far corners, wrapped.
     fn footprint(&self, camera: &Camera) -> Vec<u32> {
         let eye = camera.position;
         let (w, h) = (camera.width as f32, camera.height as f32);
         let scale = camera.far / camera.focal_px;
-        let mut lo = glam::Vec2::new(eye.x, eye.y);
-        let mut hi = lo;
+        let reach = glam::Vec2::splat(camera.far);
+        let mut lo = eye.truncate() - reach;
+        let mut hi = eye.truncate() + reach;
         for (px, py) in [(0.0, 0.0), (w, 0.0), (0.0, h), (w, h)] {
             let p = eye + camera.image_direction(px, py) * scale;
             lo = lo.min(p.truncate());
