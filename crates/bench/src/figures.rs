@@ -77,6 +77,64 @@ enum Chart<'a> {
     FrameTime(&'a [RunResults]),
     Preparation(&'a RunResults),
     Memory(&'a RunResults),
+    /// Lines over world size (texels, log scale): caption, y axis, series.
+    BySize(&'a str, &'a str, &'a [(String, Vec<(f64, f64)>)]),
+}
+
+/// `strata fly --scale`'s figure `name` (`.svg` and `.png` in `dir`): each
+/// series a line of (world texels, value), x on a log scale.
+pub fn by_world_size(
+    dir: &Path,
+    name: &str,
+    caption: &str,
+    y_desc: &str,
+    series: &[(String, Vec<(f64, f64)>)],
+) -> anyhow::Result<Figure> {
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    plot(dir, name, caption, Chart::BySize(caption, y_desc, series))
+}
+
+fn by_size<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    caption: &str,
+    y_desc: &str,
+    series: &[(String, Vec<(f64, f64)>)],
+) -> anyhow::Result<()> {
+    let labels: Vec<String> = series.iter().map(|(l, _)| l.clone()).collect();
+    let area = with_legend(area, &labels, Swatch::Line)?;
+    let points = || series.iter().flat_map(|(_, s)| s.iter().copied());
+    let (x_lo, x_hi) = points().fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.0), b.max(p.0)));
+    let y_hi = points().fold(0.0f64, |m, p| m.max(p.1));
+    let (x_lo, x_hi) = if x_lo < x_hi {
+        (x_lo / 2.0, x_hi * 2.0)
+    } else {
+        (1.0, 10.0)
+    };
+    let mut chart = ChartBuilder::on(&area)
+        .caption(caption, ("sans-serif", 18))
+        .margin(10)
+        .x_label_area_size(X_LABEL_AREA)
+        .y_label_area_size(Y_LABEL_AREA)
+        .build_cartesian_2d((x_lo..x_hi).log_scale(), 0.0..(y_hi * 1.15).max(1e-3))
+        .map_err(plot_error)?;
+    chart
+        .configure_mesh()
+        .x_desc("world texels")
+        .y_desc(y_desc)
+        .x_label_formatter(&|x| format!("{x:.0e}"))
+        .y_label_formatter(&|y| tick(*y))
+        .draw()
+        .map_err(plot_error)?;
+    for (i, (_, line)) in series.iter().enumerate() {
+        let c = colour(i);
+        chart
+            .draw_series(LineSeries::new(line.clone(), c.stroke_width(2)))
+            .map_err(plot_error)?;
+        chart
+            .draw_series(line.iter().map(|p| Circle::new(*p, 3, c.filled())))
+            .map_err(plot_error)?;
+    }
+    Ok(())
 }
 
 impl Chart<'_> {
@@ -86,6 +144,7 @@ impl Chart<'_> {
             Chart::FrameTime(runs) => frame_time_by_pitch(area, runs)?,
             Chart::Preparation(run) => preparation(area, run)?,
             Chart::Memory(run) => memory(area, run)?,
+            Chart::BySize(caption, y_desc, series) => by_size(area, caption, y_desc, series)?,
         }
         area.present().map_err(plot_error)
     }

@@ -269,10 +269,9 @@ impl Default for WorldConfig {
     }
 }
 
-/// Map powers above this are refused: 2^16 a side is the largest world a
-/// store holds (65536², read chunk by chunk; issue 32), far beyond any
-/// Vangers world.
-const MAX_POWER: u32 = 16;
+/// Map powers above this are refused: 2^15 rows of 2^15 texels is already
+/// 2 GiB of planes, far beyond any Vangers world.
+const MAX_POWER: u32 = 15;
 
 impl WorldConfig {
     /// Map width in texels, `2^Map Power X`.

@@ -251,3 +251,45 @@ fn a_budget_too_small_is_refused_with_the_smallest_that_works() {
         assert!(format!("{err:#}").contains("ray-exact"), "{err:#}");
     }
 }
+
+#[test]
+fn a_chunk_that_fails_to_read_stays_pending_and_is_reported_once() {
+    let gpus = common::gpus();
+    if gpus.is_empty() {
+        return;
+    }
+    let w = world();
+    let colors = TerrainColors::from_world(&w);
+    let dir = std::env::temp_dir().join(format!("strata-paged-bad-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let store = strata_store::DirStore::create(&dir, &w, &strata_store::Layout::default()).unwrap();
+    let site = w.edit.clone().expect("an edit site");
+    let camera = Camera::from_view(&w.level, &site.camera, W, H).unwrap();
+    // Truncate the chunk under the crater: its checksum no longer holds.
+    let (cx, cy) = (site.centre_x / 256, site.centre_y / 256);
+    let chunk_file = dir.join(format!("heights/c/{cy}/{cx}"));
+    let bytes = std::fs::read(&chunk_file).unwrap();
+    std::fs::write(&chunk_file, &bytes[..bytes.len() / 2]).unwrap();
+    for gpu in gpus {
+        let cache = Arc::new(strata_store::ChunkCache::new(
+            store.store().clone(),
+            64 << 20,
+            MidRule::Original,
+        ));
+        let source: Arc<dyn PageSource> =
+            Arc::new(StorePages::new(cache, MidRule::Original).unwrap());
+        let mut r = paged(&gpu, source, &colors, "ray-exact", 16 << 20).unwrap();
+        let err = r.converge(&camera, 60).err().expect("never converges");
+        let text = format!("{err:#}");
+        eprintln!("{text}");
+        assert!(text.contains(&format!("chunk ({cx}, {cy})")), "{text}");
+        // The renderer keeps drawing, the failed chunk's pixels pending,
+        // and the error counted once.
+        let t = r.render_frame(&camera);
+        assert!(t.is_ok(), "{t:?}");
+        let stats = r.paged_terrain().unwrap().stats();
+        assert!(stats.pending_pixels > 0, "{stats:?}");
+        assert_eq!(stats.read_errors, 1, "{stats:?}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

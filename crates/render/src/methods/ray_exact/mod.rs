@@ -380,11 +380,12 @@ fn exact_shadow(
 }
 
 impl RayExact {
-    /// GPU bytes of the pyramid, or of the whole paged terrain.
+    /// GPU bytes of the pyramid, or of the paged terrain but its atlas (the
+    /// shared frame's terrain texture, counted there).
     fn levels_bytes(&self) -> u64 {
         match &self.levels {
             Levels::Whole(p) => p.gpu_bytes(),
-            Levels::Paged(p) => p.plan().total(),
+            Levels::Paged(p) => p.plan().total() - p.plan().atlas_bytes,
         }
     }
 
