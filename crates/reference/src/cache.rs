@@ -136,7 +136,9 @@ impl ReferenceCache {
             Some((h, p)) if *h == hash => Tracer::with_pyramid(level, p.clone()),
             _ => {
                 let t = Tracer::new(level);
-                *last = Some((hash.clone(), t.pyramid().clone()));
+                if let Some(p) = t.pyramid() {
+                    *last = Some((hash.clone(), p.clone()));
+                }
                 t
             }
         };

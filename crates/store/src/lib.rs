@@ -112,9 +112,10 @@ pub mod error;
 pub mod format;
 #[cfg(feature = "fs")]
 pub mod fs;
+pub mod read;
 pub mod store;
 
-pub use cache::{CacheStats, ChunkCache};
+pub use cache::{CacheStats, CachedChunk, ChunkCache};
 pub use error::StoreError;
 pub use format::{ChunkSummary, FORMAT_VERSION, Layout, WorldAttrs};
 #[cfg(feature = "fs")]
