@@ -126,7 +126,10 @@ pub trait ColumnSource: Sync {
         let y = (y & i64::from(h - 1)) as u64;
         let tile = self.tile(y / u64::from(rows), x / u64::from(cols))?;
         let (heights, metas) = tile.planes();
-        let (ry, rx) = ((y % u64::from(rows)) as usize, (x % u64::from(cols)) as usize);
+        let (ry, rx) = (
+            (y % u64::from(rows)) as usize,
+            (x % u64::from(cols)) as usize,
+        );
         let row = ry * cols as usize..(ry + 1) * cols as usize;
         Ok(decode_column(
             &heights[row.clone()],
@@ -254,7 +257,13 @@ mod tests {
         let (w, h) = (32u32, 16u32);
         let heights = (0..w * h).map(|i| (i * 37 % 251) as u8).collect();
         let metas = (0..w * h)
-            .map(|i| if (i / 2) % 3 == 0 { 0x40 | (i as u8 & 3) } else { 0 })
+            .map(|i| {
+                if (i / 2) % 3 == 0 {
+                    0x40 | (i as u8 & 3)
+                } else {
+                    0
+                }
+            })
             .collect();
         Level::from_planes(w, h, heights, metas, MidRule::Original).unwrap()
     }

@@ -17,6 +17,18 @@
 //! [`ReferenceCache::get_or_compute`] re-hashes the level (64 MiB for a
 //! Fostral-sized map) and rebuilds the pyramid on every miss.
 //!
+//! # Worlds larger than memory
+//!
+//! [`Tracer::over`] traces any [`strata_level::ColumnSource`]: a [`Level`]
+//! takes the in-memory path above; a store's chunk cache
+//! (`strata_store::ChunkCache`) is read a chunk at a time, the pyramid's
+//! coarsest level coming from the chunk summaries and the finer ones built
+//! per chunk when a ray first enters it and cached with the chunk, so no
+//! whole-map array is ever built and memory stays within the cache's
+//! budget. The pictures are bit-identical (`tests/store.rs`). Read errors
+//! stop the rays and come back from [`Tracer::try_render`];
+//! [`camera_for_view`] resolves a view against any source.
+//!
 //! Command line: `strata reference --out DIR [--view SPEC --pitch DEG |
 //! --views FILE] [--size WxH] [--json] [--no-cache]`, then `strata metrics
 //! --reference DIR/<view> --render RENDER_DIR [--json]`.
@@ -57,8 +69,8 @@
 //!
 //! # Stability
 //!
-//! The stable surface is [`Tracer`] (`new`, `unaccelerated`, `render`,
-//! `trace`), [`RayHit`], [`Reference`], [`HitClass`] (and its stored codes),
+//! The stable surface is [`Tracer`] (`new`, `unaccelerated`, `over`,
+//! `render`, `try_render`, `trace`), [`RayHit`], [`Reference`], [`HitClass`] (and its stored codes),
 //! [`ReferenceSettings`], [`render_reference`], [`Metrics`] with [`compare`] /
 //! [`metrics::try_compare`], and the on-disk view format of [`output`]
 //! (`reference.json` plus the raw files). The colour reference ([`shading`],

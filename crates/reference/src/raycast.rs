@@ -66,10 +66,7 @@ impl ErrorSlot {
         self.failed.load(Ordering::Acquire)
     }
     pub(crate) fn get(&self) -> Option<SourceError> {
-        self.first
-            .lock()
-            .unwrap_or_else(|p| p.into_inner())
-            .clone()
+        self.first.lock().unwrap_or_else(|p| p.into_inner()).clone()
     }
 }
 

@@ -10,9 +10,9 @@ use crate::raycast::{ErrorSlot, Tracer};
 use crate::shadow_map::ShadowMap;
 use glam::Vec3;
 use rayon::prelude::*;
+use std::sync::Arc;
 use strata_camera::Camera;
 use strata_camera::light::{SKY, ShadowFrame};
-use std::sync::Arc;
 use strata_level::source::{ColumnSource, SourceError};
 use strata_level::{Column, World};
 

@@ -149,7 +149,12 @@ impl<'a> TiledGrid<'a> {
 
     /// Make the cursor hold tile (ty, tx).
     #[inline]
-    fn enter<'c>(&self, cur: &'c mut TileCursor<'a>, ty: u64, tx: u64) -> Option<&'c TileCursor<'a>> {
+    fn enter<'c>(
+        &self,
+        cur: &'c mut TileCursor<'a>,
+        ty: u64,
+        tx: u64,
+    ) -> Option<&'c TileCursor<'a>> {
         if cur.tile.is_none() || cur.key != (ty, tx) {
             match self.source.tile(ty, tx) {
                 Ok(t) => {
@@ -282,7 +287,11 @@ mod tests {
                             m = m.max(level.column(x, y).top());
                         }
                     }
-                    assert_eq!(p.levels[l - 1][(cy * across + cx) as usize], m, "{l} {cx} {cy}");
+                    assert_eq!(
+                        p.levels[l - 1][(cy * across + cx) as usize],
+                        m,
+                        "{l} {cx} {cy}"
+                    );
                 }
             }
         }

@@ -53,7 +53,11 @@ fn reference_over_a_store_equals_the_reference_in_memory() {
         assert_eq!(got.class, want.class, "view {k} {}: class", view.name);
         assert_eq!(got.terrain, want.terrain, "view {k}: terrain");
         let bits = |d: &[f32]| d.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
-        assert_eq!(bits(&got.distance), bits(&want.distance), "view {k}: distance");
+        assert_eq!(
+            bits(&got.distance),
+            bits(&want.distance),
+            "view {k}: distance"
+        );
         if k % 3 == 0 {
             let shadows = k % 2 == 0;
             let c_want = render_color(&memory, &ramps, &cam, shadows);

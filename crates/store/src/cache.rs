@@ -223,13 +223,7 @@ impl ChunkCache {
         if let Some(t) = &*tops {
             return Ok(t.clone());
         }
-        let t: Arc<Vec<u8>> = Arc::new(
-            self.store
-                .summaries()?
-                .iter()
-                .map(|s| s.top_max)
-                .collect(),
-        );
+        let t: Arc<Vec<u8>> = Arc::new(self.store.summaries()?.iter().map(|s| s.top_max).collect());
         *tops = Some(t.clone());
         Ok(t)
     }
