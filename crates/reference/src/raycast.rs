@@ -185,6 +185,7 @@ impl<'a> Tracer<'a> {
             .zip(terrain.par_chunks_mut(w))
             .enumerate()
             .for_each(|(j, ((dist_row, class_row), terrain_row))| {
+                let mut state = self.ray_state();
                 for i in 0..w {
                     let dir = camera
                         .image_direction(i as f32 + 0.5, j as f32 + 0.5)
@@ -192,7 +193,8 @@ impl<'a> Tracer<'a> {
                     // Far is along the view axis: the ray's length to it
                     // grows with its angle off the axis.
                     let t_max = far * dir.length() / focal;
-                    if let Some(hit) = self.trace(origin, dir.normalize(), t_max, settings) {
+                    let unit = dir.normalize();
+                    if let Some(hit) = self.trace_in(&mut state, origin, unit, t_max, settings) {
                         dist_row[i] = hit.distance as f32;
                         class_row[i] = hit.class;
                         terrain_row[i] = hit.terrain;
@@ -233,14 +235,43 @@ impl<'a> Tracer<'a> {
         t_max: f64,
         settings: &ReferenceSettings,
     ) -> Option<RayHit> {
+        self.trace_in(&mut self.ray_state(), origin, dir, t_max, settings)
+    }
+
+    /// State kept between the rays of one thread (the tile being read):
+    /// consecutive rays mostly stay in the same chunks, so keeping it saves
+    /// a cache lookup (a lock) per ray.
+    pub(crate) fn ray_state(&self) -> RayState<'a> {
         match &self.inner {
-            Inner::Memory(m) => march(m, &mut (), origin, dir, t_max, settings),
-            Inner::Tiled(t) => {
+            Inner::Memory(_) => RayState::Memory,
+            Inner::Tiled(_) => RayState::Tiled(TileCursor::default()),
+        }
+    }
+
+    /// [`Tracer::trace`] with a thread's [`RayState`].
+    #[inline]
+    pub(crate) fn trace_in(
+        &self,
+        state: &mut RayState<'a>,
+        origin: DVec3,
+        dir: DVec3,
+        t_max: f64,
+        settings: &ReferenceSettings,
+    ) -> Option<RayHit> {
+        match (&self.inner, state) {
+            (Inner::Memory(m), _) => march(m, &mut (), origin, dir, t_max, settings),
+            (Inner::Tiled(t), state) => {
                 if self.error.failed() {
                     return None;
                 }
-                let mut cursor = TileCursor::default();
-                let hit = march(t, &mut cursor, origin, dir, t_max, settings);
+                if let RayState::Memory = state {
+                    // A state made for another tracer: start a cursor.
+                    *state = RayState::Tiled(TileCursor::default());
+                }
+                let RayState::Tiled(cursor) = state else {
+                    return None;
+                };
+                let hit = march(t, cursor, origin, dir, t_max, settings);
                 if let Some(e) = cursor.error.take() {
                     self.error.record(e);
                     return None;
@@ -249,6 +280,14 @@ impl<'a> Tracer<'a> {
             }
         }
     }
+}
+
+/// What one thread keeps between rays (see [`Tracer::ray_state`]).
+pub(crate) enum RayState<'a> {
+    /// Nothing: a level in memory.
+    Memory,
+    /// The tile being read.
+    Tiled(TileCursor<'a>),
 }
 
 /// What the traversal reads: the pyramid's levels and the columns. `None`

@@ -245,13 +245,20 @@ impl<'a> Shader<'a> {
         let focal = f64::from(camera.focal_px);
         let sky = SKY.map(unorm8);
         rgb.par_chunks_mut(3 * w).enumerate().for_each(|(j, row)| {
+            let mut state = tracer.ray_state();
             for i in 0..w {
                 let dir = camera
                     .image_direction(i as f32 + 0.5, j as f32 + 0.5)
                     .as_dvec3();
                 let t_max = far * dir.length() / focal;
                 let unit = dir.normalize();
-                let px = match tracer.trace(origin, unit, t_max, &ReferenceSettings::default()) {
+                let px = match tracer.trace_in(
+                    &mut state,
+                    origin,
+                    unit,
+                    t_max,
+                    &ReferenceSettings::default(),
+                ) {
                     Some(hit) => {
                         let p = (origin + unit * hit.distance).as_vec3();
                         let [x, y] = hit.column;

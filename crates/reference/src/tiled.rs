@@ -147,67 +147,75 @@ impl<'a> TiledGrid<'a> {
         })
     }
 
-    /// Make the cursor hold tile (ty, tx).
+    /// Make tile (ty, tx) the cursor's current one (its first slot).
     #[inline]
-    fn enter<'c>(
-        &self,
-        cur: &'c mut TileCursor<'a>,
-        ty: u64,
-        tx: u64,
-    ) -> Option<&'c TileCursor<'a>> {
-        if cur.tile.is_none() || cur.key != (ty, tx) {
-            match self.source.tile(ty, tx) {
-                Ok(t) => {
-                    cur.tile = Some(t);
-                    cur.key = (ty, tx);
-                    cur.pyramid = None;
+    fn enter(&self, cur: &mut TileCursor<'a>, ty: u64, tx: u64) -> Option<()> {
+        match cur.slots.iter().position(|s| s.key == (ty, tx)) {
+            Some(0) => {}
+            Some(i) => cur.slots[..=i].rotate_right(1),
+            None => match self.source.tile(ty, tx) {
+                Ok(tile) => {
+                    if cur.slots.len() == CURSOR_TILES {
+                        cur.slots.pop();
+                    }
+                    cur.slots.insert(
+                        0,
+                        Slot {
+                            key: (ty, tx),
+                            tile,
+                            pyramid: None,
+                        },
+                    );
                 }
                 Err(e) => {
                     cur.error = Some(e);
                     return None;
                 }
-            }
+            },
         }
-        Some(cur)
+        Some(())
     }
 
-    /// The pyramid of the cursor's tile (built on first use, kept with the tile).
-    fn pyramid(&self, cur: &mut TileCursor<'a>) -> Arc<TilePyramid> {
-        if let Some(p) = &cur.pyramid {
-            return p.clone();
+    /// The pyramid of the cursor's current tile (built on first use, kept
+    /// with the tile in the source's cache). Borrowed, not cloned: the
+    /// `Arc`'s count is shared between threads, so touching it per step
+    /// would bounce its cache line between cores.
+    #[inline]
+    fn pyramid<'c>(&self, cur: &'c mut TileCursor<'a>) -> &'c TilePyramid {
+        let slot = &mut cur.slots[0];
+        if slot.pyramid.is_none() {
+            let (rows, cols, top) = (self.rows, self.cols, self.top);
+            let tile = &slot.tile;
+            let make = || {
+                let (h, m) = tile.planes();
+                TilePyramid::build(h, m, rows, cols, top)
+            };
+            slot.pyramid = Some(match tile.derived() {
+                Some(d) => d.get_or_make(TilePyramid::bytes(rows, cols, top), make),
+                None => Arc::new(make()),
+            });
         }
-        let tile = cur.tile.as_ref().expect("entered a tile first");
-        let (rows, cols, top) = (self.rows, self.cols, self.top);
-        let make = || {
-            let (h, m) = tile.planes();
-            TilePyramid::build(h, m, rows, cols, top)
-        };
-        let p = match tile.derived() {
-            Some(slot) => slot.get_or_make(TilePyramid::bytes(rows, cols, top), make),
-            None => Arc::new(make()),
-        };
-        cur.pyramid = Some(p.clone());
-        p
+        slot.pyramid.as_deref().expect("set above")
     }
 }
 
-/// Per ray: the tile being read and its pyramid, and a read error.
-pub(crate) struct TileCursor<'a> {
+/// Tiles a cursor keeps at hand: a ray crosses a few chunks, and the next
+/// ray of the same thread mostly the same ones. They are held outside the
+/// source's budget (at most this many chunks per thread).
+const CURSOR_TILES: usize = 4;
+
+struct Slot<'a> {
     key: (u64, u64),
-    tile: Option<Arc<dyn SourceTile + 'a>>,
+    tile: Arc<dyn SourceTile + 'a>,
     pyramid: Option<Arc<TilePyramid>>,
-    pub(crate) error: Option<SourceError>,
 }
 
-impl Default for TileCursor<'_> {
-    fn default() -> Self {
-        TileCursor {
-            key: (0, 0),
-            tile: None,
-            pyramid: None,
-            error: None,
-        }
-    }
+/// Per thread: the tiles being read (most recent first), their pyramids,
+/// and a read error.
+#[derive(Default)]
+pub(crate) struct TileCursor<'a> {
+    slots: Vec<Slot<'a>>,
+    pub(crate) error: Option<SourceError>,
 }
 
 impl<'a> Grid for TiledGrid<'a> {
@@ -247,8 +255,8 @@ impl<'a> Grid for TiledGrid<'a> {
     fn column(&self, cur: &mut TileCursor<'a>, x: i64, y: i64) -> Option<Column> {
         let (x, y) = (x & self.wmask, y & self.hmask);
         let (tx, ty) = ((x >> self.cols_log) as u64, (y >> self.rows_log) as u64);
-        let cur = self.enter(cur, ty, tx)?;
-        let (h, m) = cur.tile.as_ref().expect("entered").planes();
+        self.enter(cur, ty, tx)?;
+        let (h, m) = cur.slots[0].tile.planes();
         let cols = self.cols as usize;
         let start = (y & i64::from(self.rows - 1)) as usize * cols;
         Some(decode_column(

@@ -631,7 +631,7 @@ impl WorldStore {
     pub fn world_with_level(&self, level: Level) -> Result<World, StoreError> {
         let a = &self.attrs;
         let what = Path::new(&self.what);
-        let config = strata_level::WorldConfig::parse_bytes(
+        let config = strata_level::WorldConfig::parse_store_bytes(
             a.world_ini.as_bytes(),
             &what.join("zarr.json#strata.world_ini"),
         )?;

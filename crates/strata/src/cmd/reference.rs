@@ -176,7 +176,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             "view", "sky %", "min", "median", "max", "seconds"
         )?;
     }
-    let ramps = TerrainRamps::from_world(&world);
+    let ramps = TerrainRamps::from_world(world);
     let shadows = !args.no_shadows;
     for (view, camera) in views.iter().zip(&cameras) {
         let start = Instant::now();
