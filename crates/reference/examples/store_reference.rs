@@ -7,6 +7,10 @@
 //! DIR [WxH] [BUDGET_MIB] [memory|store]`
 //!
 //! DIR is a Vangers world or a store (`memory` loads a store whole).
+//! `spread` as a fifth argument moves view k by whole periods of the
+//! default world (k·5 mod 32 times 2048 in x, k mod 4 times 16384 in y):
+//! on a store tiled from it (`store_tile`) the pictures stay the same but
+//! the views lie far apart, so each reads its own chunks.
 
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -71,8 +75,15 @@ fn main() {
         },
         world.views.len()
     );
+    let spread = args.get(4).map(String::as_str) == Some("spread");
     let mut total = 0.0;
-    for view in &world.views {
+    for (k, view) in world.views.iter().enumerate() {
+        let mut view = view.clone();
+        if spread {
+            view.x += ((k * 5) % 32 * 2048) as f32;
+            view.y += ((k % 4) * 16384) as f32;
+        }
+        let view = &view;
         let camera = camera_for_view(source, view, w, h).expect("the camera");
         let t = Instant::now();
         let r = tracer

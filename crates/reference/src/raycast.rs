@@ -333,7 +333,7 @@ impl Grid for MemoryGrid<'_> {
 
 /// The traversal: a hierarchical 2D grid walk over `grid`'s pyramid,
 /// intersecting the ray with each texel column it crosses.
-#[inline]
+#[inline(never)]
 fn march<G: Grid>(
     grid: &G,
     cur: &mut G::Cursor,
