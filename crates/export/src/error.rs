@@ -27,4 +27,7 @@ pub enum ExportError {
     /// The region holds no triangles.
     #[error("the region holds no triangles")]
     Empty,
+    /// The map could not be read (a store's chunk missing or corrupt).
+    #[error("reading the map: {0}")]
+    Source(#[from] strata_level::SourceError),
 }

@@ -25,11 +25,16 @@ pub struct Region {
 impl Region {
     /// The whole map.
     pub fn whole(level: &Level) -> Self {
+        Self::whole_of(level.width(), level.height())
+    }
+
+    /// The whole of a `width x height` map.
+    pub fn whole_of(width: u32, height: u32) -> Self {
         Region {
             x0: 0,
             y0: 0,
-            x1: i64::from(level.width()),
-            y1: i64::from(level.height()),
+            x1: i64::from(width),
+            y1: i64::from(height),
         }
     }
 
@@ -49,6 +54,11 @@ impl Region {
     /// assert_eq!(Region::whole(&level).x1, 256);
     /// ```
     pub fn parse(text: &str, level: &Level) -> Result<Self, ExportError> {
+        Self::parse_in(text, level.width(), level.height())
+    }
+
+    /// [`Region::parse`] against a `width x height` map (one not in memory).
+    pub fn parse_in(text: &str, width: u32, height: u32) -> Result<Self, ExportError> {
         let v: Vec<i64> = text
             .split(',')
             .map(|s| s.trim().parse::<i64>())
@@ -57,12 +67,12 @@ impl Region {
         let [x0, y0, x1, y1] = v[..] else {
             return Err(ExportError::RegionSyntax(text.to_string()));
         };
-        let (w, h) = (i64::from(level.width()), i64::from(level.height()));
+        let (w, h) = (i64::from(width), i64::from(height));
         let bad = |why| ExportError::RegionBounds {
             text: text.to_string(),
             why,
-            width: level.width(),
-            height: level.height(),
+            width,
+            height,
         };
         if x0 >= x1 || y0 >= y1 {
             return Err(bad("empty (X1 must exceed X0 and Y1 exceed Y0)"));

@@ -3,10 +3,11 @@
 use crate::color::type_colors;
 use crate::error::ExportError;
 use crate::region::Region;
-use rayon::prelude::*;
 use std::collections::HashMap;
 use strata_level::World;
-use strata_mesh::{ChunkFitter, ChunkLayout, ChunkMesh, decode, tolerance_for_quality};
+use strata_level::source::ColumnSource;
+use strata_mesh::region::{cell_chunk, fit_chunks_from, layout_for, region_cells};
+use strata_mesh::{ChunkMesh, FitOptions, decode, tolerance_for_quality};
 
 /// The fitted mesh (finest LOD) of a region, ready to write: whole
 /// triangles whose centroid lies in the region, vertices shared within a
@@ -26,36 +27,29 @@ impl TerrainSoup {
     /// Fit the chunks under `region` at quality `q` and collect their
     /// triangles.
     pub fn build(world: &World, region: Region, q: f64) -> Result<Self, ExportError> {
+        Self::build_from(&world.level, world, region, q)
+    }
+
+    /// [`TerrainSoup::build`] over the map `source` reads (a store's chunk
+    /// cache: only the chunks under the region are read), with `world`'s
+    /// colours (its level is not read). Equal to the in-memory export.
+    pub fn build_from(
+        source: &dyn ColumnSource,
+        world: &World,
+        region: Region,
+        q: f64,
+    ) -> Result<Self, ExportError> {
         let tol = tolerance_for_quality(q).ok_or(ExportError::Quality(q))?;
-        let level = &world.level;
-        let layout = ChunkLayout::of(level);
+        let (w, h) = source.size();
+        let layout = layout_for(w, h);
         let (sx, sy) = (i64::from(layout.size_x), i64::from(layout.size_y));
-        // Chunk squares start at texel centres (+0.5): cell g covers
-        // [g*size + 0.5, (g+1)*size + 0.5].
-        let cells = |lo: i64, hi: i64, s: i64| {
-            let first = (lo as f64 - 0.5).div_euclid(s as f64) as i64;
-            let last = (hi as f64 - 0.5).div_euclid(s as f64) as i64;
-            first..=last
-        };
-        let cell_list: Vec<(i64, i64)> = cells(region.y0, region.y1, sy)
-            .flat_map(|gy| cells(region.x0, region.x1, sx).map(move |gx| (gx, gy)))
-            .collect();
-        let chunk_of = |gx: i64, gy: i64| {
-            layout.index(
-                gx.rem_euclid(i64::from(layout.chunks_x)) as u32,
-                gy.rem_euclid(i64::from(layout.chunks_y)) as u32,
-            )
-        };
+        let cell_list = region_cells(&layout, region.x0, region.y0, region.x1, region.y1);
+        let chunk_of = |gx: i64, gy: i64| cell_chunk(&layout, gx, gy);
         let mut ids: Vec<usize> = cell_list.iter().map(|&(x, y)| chunk_of(x, y)).collect();
         ids.sort_unstable();
         ids.dedup();
-        let meshes: HashMap<usize, ChunkMesh> = ids
-            .par_iter()
-            .map_init(ChunkFitter::default, |f, &i| {
-                let (cx, cy) = layout.coords(i);
-                (i, f.fit(level, &layout, cx, cy, tol))
-            })
-            .collect();
+        let fitted = fit_chunks_from(source, &layout, &ids, tol, FitOptions::default())?;
+        let meshes: HashMap<usize, ChunkMesh> = ids.into_iter().zip(fitted).collect();
         let colors = type_colors(world);
         let mut soup = TerrainSoup {
             positions: Vec::new(),
@@ -83,7 +77,7 @@ impl TerrainSoup {
                     let s = &mut slot[usize::from(i)];
                     if *s == u32::MAX {
                         let (wx, wy) = (ox + i64::from(x), oy + i64::from(y));
-                        let c = level.column(wx, wy);
+                        let c = source.column(wx, wy)?;
                         let (z, ty) = match kind {
                             0 => (c.low, c.lower_type),
                             1 => (c.high, c.upper_type),

@@ -273,6 +273,10 @@ impl Default for WorldConfig {
 /// 2 GiB of planes, far beyond any Vangers world.
 const MAX_POWER: u32 = 15;
 
+/// Map powers a Strata store may declare (it is read a chunk at a time, so
+/// its size is not bounded by memory): 65536 x 65536 texels.
+pub const MAX_STORE_POWER: u32 = 16;
+
 impl WorldConfig {
     /// Map width in texels, `2^Map Power X`.
     pub fn width(&self) -> u32 {
@@ -311,7 +315,20 @@ impl WorldConfig {
         Self::from_ini(ini, path)
     }
 
+    /// [`WorldConfig::parse_bytes`] for a Strata store's `world.ini`, whose
+    /// map powers may go up to [`MAX_STORE_POWER`] (a Vangers world's stop
+    /// at 15: it is loaded whole).
+    pub fn parse_store_bytes(bytes: &[u8], path: &Path) -> Result<Self, LevelError> {
+        let ini = Ini::parse_bytes(bytes)
+            .map_err(|(line, msg)| LevelError::format(path, format!("line {line}: {msg}")))?;
+        Self::from_ini_max(ini, path, MAX_STORE_POWER)
+    }
+
     fn from_ini(ini: Ini, path: &Path) -> Result<Self, LevelError> {
+        Self::from_ini_max(ini, path, MAX_POWER)
+    }
+
+    fn from_ini_max(ini: Ini, path: &Path, max_power: u32) -> Result<Self, LevelError> {
         let err = |section: &str, key: &str, msg: String| LevelError::Ini {
             path: path.to_path_buf(),
             section: section.to_string(),
@@ -327,8 +344,8 @@ impl WorldConfig {
             let p: u32 = v
                 .parse()
                 .map_err(|_| err(GLOBAL, key, format!("`{v}` is not a whole number")))?;
-            if !(1..=MAX_POWER).contains(&p) {
-                return Err(err(GLOBAL, key, format!("{p} is outside 1..={MAX_POWER}")));
+            if !(1..=max_power).contains(&p) {
+                return Err(err(GLOBAL, key, format!("{p} is outside 1..={max_power}")));
             }
             Ok(p)
         };

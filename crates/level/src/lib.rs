@@ -97,6 +97,7 @@ pub mod lcg;
 pub mod model;
 pub mod palette;
 pub mod save;
+pub mod source;
 pub mod stats;
 pub mod views;
 pub mod vmc;
@@ -108,6 +109,7 @@ pub use edit::DirtyRect;
 pub use error::LevelError;
 pub use model::{Column, Level, MidRule};
 pub use palette::Palette;
+pub use source::{ColumnSource, SourceError};
 pub use views::{EditSite, ViewSpec};
 
 use std::sync::Arc;

@@ -144,28 +144,36 @@ impl LevelMesh {
     /// Level-wide totals.
     pub fn stats(&self) -> MeshStats {
         let mut s = MeshStats {
-            chunks: self.chunks.len(),
             tolerance: self.tolerance(),
             ..MeshStats::default()
         };
         for c in &self.chunks {
-            s.planar_vertices += u64::from(c.stats.planar_vertices);
-            s.gpu_indices += u64::from(c.stats.indices);
-            for k in 0..LODS {
-                let l = &c.stats.lods[k];
-                s.lods[k].planar += u64::from(l.planar);
-                s.lods[k].slab += u64::from(l.slab);
-                s.lods[k].wall += u64::from(l.wall);
-                s.lods[k].border_walls += u64::from(l.border_walls);
-                s.lods[k].emitted += u64::from(l.emitted());
-            }
-            for k in 0..CAUSES {
-                s.causes[k] += u64::from(c.stats.causes[k]);
-            }
+            s.add_chunk(c);
         }
-        s.gpu_bytes = s.gpu_indices * 2;
-        s.cpu_bytes = (self.chunks.len() * std::mem::size_of::<ChunkRange>()) as u64;
         s
+    }
+}
+
+impl MeshStats {
+    /// Count one more chunk's mesh in (for fits that keep only totals,
+    /// e.g. a store's region fitted in bounded memory).
+    pub fn add_chunk(&mut self, c: &ChunkMesh) {
+        self.chunks += 1;
+        self.planar_vertices += u64::from(c.stats.planar_vertices);
+        self.gpu_indices += u64::from(c.stats.indices);
+        for k in 0..LODS {
+            let l = &c.stats.lods[k];
+            self.lods[k].planar += u64::from(l.planar);
+            self.lods[k].slab += u64::from(l.slab);
+            self.lods[k].wall += u64::from(l.wall);
+            self.lods[k].border_walls += u64::from(l.border_walls);
+            self.lods[k].emitted += u64::from(l.emitted());
+        }
+        for k in 0..CAUSES {
+            self.causes[k] += u64::from(c.stats.causes[k]);
+        }
+        self.gpu_bytes = self.gpu_indices * 2;
+        self.cpu_bytes = (self.chunks * std::mem::size_of::<ChunkRange>()) as u64;
     }
 }
 

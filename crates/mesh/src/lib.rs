@@ -95,6 +95,7 @@ pub mod fit;
 pub mod level_mesh;
 pub mod lod;
 pub mod predicates;
+pub mod region;
 pub mod samples;
 pub mod synthetic;
 pub mod triangulation;

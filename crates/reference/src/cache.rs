@@ -136,7 +136,9 @@ impl ReferenceCache {
             Some((h, p)) if *h == hash => Tracer::with_pyramid(level, p.clone()),
             _ => {
                 let t = Tracer::new(level);
-                *last = Some((hash.clone(), t.pyramid().clone()));
+                if let Some(p) = t.pyramid() {
+                    *last = Some((hash.clone(), p.clone()));
+                }
                 t
             }
         };
@@ -159,7 +161,11 @@ impl ReferenceCache {
             return Ok((r, true));
         }
         let r = tracer.render(camera, &ReferenceSettings::default());
-        self.put(level_hash, camera, &r)?;
+        // A source that failed to read gives no reference to keep (the
+        // caller finds the error in `tracer.error()`).
+        if tracer.error().is_none() {
+            self.put(level_hash, camera, &r)?;
+        }
         Ok((r, false))
     }
 }
@@ -222,6 +228,9 @@ impl ReferenceCache {
         }
         let path = self.color_path(level_hash, camera, ramps, shadows);
         let c = render_color(tracer, ramps, camera, shadows);
+        if tracer.error().is_some() {
+            return Ok((c, false));
+        }
         let io_err = |path: &Path| {
             let path = path.to_path_buf();
             move |source| CacheError::Io { path, source }

@@ -17,6 +17,18 @@
 //! [`ReferenceCache::get_or_compute`] re-hashes the level (64 MiB for a
 //! Fostral-sized map) and rebuilds the pyramid on every miss.
 //!
+//! # Worlds larger than memory
+//!
+//! [`Tracer::over`] traces any [`strata_level::ColumnSource`]: a [`Level`]
+//! takes the in-memory path above; a store's chunk cache
+//! (`strata_store::ChunkCache`) is read a chunk at a time, the pyramid's
+//! coarsest level coming from the chunk summaries and the finer ones built
+//! per chunk when a ray first enters it and cached with the chunk, so no
+//! whole-map array is ever built and memory stays within the cache's
+//! budget. The pictures are bit-identical (`tests/store.rs`). Read errors
+//! stop the rays and come back from [`Tracer::try_render`];
+//! [`camera_for_view`] resolves a view against any source.
+//!
 //! Command line: `strata reference --out DIR [--view SPEC --pitch DEG |
 //! --views FILE] [--size WxH] [--json] [--no-cache]`, then `strata metrics
 //! --reference DIR/<view> --render RENDER_DIR [--json]`.
@@ -57,8 +69,8 @@
 //!
 //! # Stability
 //!
-//! The stable surface is [`Tracer`] (`new`, `unaccelerated`, `render`,
-//! `trace`), [`RayHit`], [`Reference`], [`HitClass`] (and its stored codes),
+//! The stable surface is [`Tracer`] (`new`, `unaccelerated`, `over`,
+//! `render`, `try_render`, `trace`), [`RayHit`], [`Reference`], [`HitClass`] (and its stored codes),
 //! [`ReferenceSettings`], [`render_reference`], [`Metrics`] with [`compare`] /
 //! [`metrics::try_compare`], and the on-disk view format of [`output`]
 //! (`reference.json` plus the raw files). The colour reference ([`shading`],
@@ -75,15 +87,17 @@ mod pyramid;
 mod raycast;
 pub mod shading;
 pub mod shadow_map;
+mod tiled;
 
 use serde::{Deserialize, Serialize};
 use strata_camera::Camera;
-use strata_level::Level;
+use strata_level::source::{ColumnSource, SourceError};
+use strata_level::{Level, ViewSpec};
 
 pub use cache::{ReferenceCache, default_cache_dir};
 pub use metrics::{Metrics, compare, distance_from_depth};
 pub use raycast::{RayHit, Tracer};
-pub use shading::{ColorImage, TerrainRamps, render_color};
+pub use shading::{ColorImage, TerrainRamps, render_color, render_color_checked};
 pub use shadow_map::ShadowMap;
 
 /// Bumped whenever the reference's output for the same level and camera can
@@ -196,6 +210,55 @@ impl Default for ReferenceSettings {
             accelerate: true,
         }
     }
+}
+
+/// A view could not be resolved against a column source.
+#[derive(Debug, thiserror::Error)]
+pub enum ViewError {
+    /// The column under the view could not be read.
+    #[error(transparent)]
+    Source(#[from] SourceError),
+    /// The view itself is bad (eye in solid terrain, bad pitch or size).
+    #[error(transparent)]
+    Camera(#[from] strata_camera::CameraError),
+}
+
+/// [`Camera::from_view`] against any column source (one column is read):
+/// the same wrap, eye height and checks, for a map that is not in memory.
+pub fn camera_for_view(
+    source: &dyn ColumnSource,
+    view: &ViewSpec,
+    width: u32,
+    height: u32,
+) -> Result<Camera, ViewError> {
+    if let Some(level) = source.as_level() {
+        return Ok(Camera::from_view(level, view, width, height)?);
+    }
+    let (w, h) = source.size();
+    let x = view.x.rem_euclid(w as f32);
+    let y = view.y.rem_euclid(h as f32);
+    let column = source.column(x.floor() as i64, y.floor() as i64)?;
+    let base = if view.under { column.low } else { column.top() };
+    let z = f32::from(base) + view.eye;
+    if column.is_solid(z) {
+        return Err(strata_camera::CameraError::EyeInSolid {
+            name: view.name.clone(),
+            x,
+            y,
+            z,
+            low: column.low,
+            mid: column.mid,
+            high: column.high,
+        }
+        .into());
+    }
+    Ok(Camera::new(
+        glam::Vec3::new(x, y, z),
+        view.yaw,
+        view.pitch,
+        width,
+        height,
+    )?)
 }
 
 /// The reference image of `level` seen through `camera`.

@@ -6,13 +6,15 @@
 //! Keep each function in step with its namesake in `shading.wgsl`.
 
 use crate::ReferenceSettings;
-use crate::raycast::Tracer;
+use crate::raycast::{ErrorSlot, Tracer};
 use crate::shadow_map::ShadowMap;
 use glam::Vec3;
 use rayon::prelude::*;
+use std::sync::Arc;
 use strata_camera::Camera;
 use strata_camera::light::{SKY, ShadowFrame};
-use strata_level::{Column, Level, World};
+use strata_level::source::{ColumnSource, SourceError};
+use strata_level::{Column, World};
 
 const AMBIENT: f32 = 0.45;
 const CAVE_AMBIENT: f32 = 0.25;
@@ -87,7 +89,9 @@ fn unorm8(v: f32) -> u8 {
 
 /// Everything the shading of one view needs.
 pub struct Shader<'a> {
-    level: &'a Level,
+    source: &'a dyn ColumnSource,
+    /// The tracer's: a column that cannot be read is kept there.
+    errors: Arc<ErrorSlot>,
     ramps: &'a TerrainRamps,
     camera: &'a Camera,
     light: Vec3,
@@ -104,7 +108,8 @@ impl<'a> Shader<'a> {
     ) -> Self {
         let frame = ShadowFrame::fit(camera, shadows);
         Shader {
-            level: tracer.level(),
+            source: tracer.source(),
+            errors: tracer.error_slot().clone(),
             ramps,
             camera,
             light: frame.light,
@@ -115,6 +120,26 @@ impl<'a> Shader<'a> {
     /// The CPU shadow map, when shadows are on.
     pub fn shadow_map(&self) -> Option<&ShadowMap> {
         self.shadow.as_ref()
+    }
+
+    /// The column at (x, y); a read error is kept (the image is then not
+    /// the reference: [`render_color_checked`] returns it) and the column
+    /// taken as empty ground.
+    fn column(&self, x: i64, y: i64) -> Column {
+        if let Some(level) = self.source.as_level() {
+            return level.column(x, y);
+        }
+        self.source.column(x, y).unwrap_or_else(|e| {
+            self.errors.record(e);
+            Column {
+                low: 0,
+                mid: 0,
+                high: 0,
+                dual: false,
+                lower_type: 0,
+                upper_type: 0,
+            }
+        })
     }
 
     fn surface_kind(c: &Column, z: f32, dir_z: f32) -> Surface {
@@ -129,7 +154,7 @@ impl<'a> Shader<'a> {
     }
 
     fn interval_field(&self, x: i64, y: i64, kind: Surface, fallback: f32) -> f32 {
-        let c = self.level.column(x, y);
+        let c = self.column(x, y);
         match kind {
             Surface::Floor => f32::from(c.low),
             _ if !c.dual => fallback,
@@ -187,7 +212,7 @@ impl<'a> Shader<'a> {
     /// `shade_column`: the colour of surface point `p` of column (x, y),
     /// found along a ray of direction `dir`.
     pub fn shade_column(&self, p: Vec3, x: i64, y: i64, dir: Vec3) -> Vec3 {
-        let c = self.level.column(x, y);
+        let c = self.column(x, y);
         let kind = Self::surface_kind(&c, p.z, dir.z);
         let here = f32::from(if kind == Surface::Ceiling {
             c.mid
@@ -220,13 +245,20 @@ impl<'a> Shader<'a> {
         let focal = f64::from(camera.focal_px);
         let sky = SKY.map(unorm8);
         rgb.par_chunks_mut(3 * w).enumerate().for_each(|(j, row)| {
+            let mut state = tracer.ray_state();
             for i in 0..w {
                 let dir = camera
                     .image_direction(i as f32 + 0.5, j as f32 + 0.5)
                     .as_dvec3();
                 let t_max = far * dir.length() / focal;
                 let unit = dir.normalize();
-                let px = match tracer.trace(origin, unit, t_max, &ReferenceSettings::default()) {
+                let px = match tracer.trace_in(
+                    &mut state,
+                    origin,
+                    unit,
+                    t_max,
+                    &ReferenceSettings::default(),
+                ) {
                     Some(hit) => {
                         let p = (origin + unit * hit.distance).as_vec3();
                         let [x, y] = hit.column;
@@ -257,9 +289,24 @@ pub fn render_color(
     Shader::new(tracer, ramps, camera, shadows).render(tracer)
 }
 
+/// [`render_color`], failing when the tracer's source could not be read.
+pub fn render_color_checked(
+    tracer: &Tracer,
+    ramps: &TerrainRamps,
+    camera: &Camera,
+    shadows: bool,
+) -> Result<ColorImage, SourceError> {
+    let image = render_color(tracer, ramps, camera, shadows);
+    match tracer.error() {
+        Some(e) => Err(e),
+        None => Ok(image),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use strata_level::Level;
 
     fn ramps() -> TerrainRamps {
         let mut palette = [[0u8; 3]; 256];

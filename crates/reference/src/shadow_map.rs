@@ -34,6 +34,7 @@ impl ShadowMap {
             .par_chunks_mut(side as usize)
             .enumerate()
             .for_each(|(j, row)| {
+                let mut state = tracer.ray_state();
                 for (i, texel) in row.iter_mut().enumerate() {
                     // Texels no visible point samples hold a miss, as on the GPU.
                     if !frame.casts(i as u32, j as u32) {
@@ -43,7 +44,13 @@ impl ShadowMap {
                     let o = frame.origin
                         + frame.u * ((i as f32 + 0.5) * frame.texel)
                         + frame.v * ((j as f32 + 0.5) * frame.texel);
-                    let hit = tracer.trace(o.as_dvec3(), light, 1e6, &ReferenceSettings::default());
+                    let hit = tracer.trace_in(
+                        &mut state,
+                        o.as_dvec3(),
+                        light,
+                        1e6,
+                        &ReferenceSettings::default(),
+                    );
                     if let Some(hit) = hit {
                         *texel = hit.distance as f32;
                     }

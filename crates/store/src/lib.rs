@@ -95,12 +95,50 @@
 //!   sharding; no filesystem store, one thread: zarrs' storage is not
 //!   Send/Sync there).
 //!
+//! # Reading in bounded memory (issue 32)
+//!
+//! [`ChunkCache`] is a [`strata_level::ColumnSource`]: the CPU reference
+//! (`strata_reference::Tracer::over`), the region fit
+//! (`strata_mesh::region`) and the export read a store through it, chunk by
+//! chunk within its byte budget (`--store-cache MIB`, default 512), and
+//! give exactly what they give on the same world loaded whole. The tracer
+//! takes its coarsest pyramid level from the summaries' `top_max` and builds
+//! each chunk's finer levels when a ray first enters it, kept with the chunk
+//! in the cache ([`CachedChunk`], counted in the budget). [`read`] streams
+//! the map's content hash (equal to `Level::content_hash`) and gives the
+//! world without its map. Measured (`bench/store-read/`, release build, this
+//! 2-core machine shared with other builds, load average 4-6): a 65536²
+//! store tiled from the default world (`examples/store_tile.rs`; 1.8 GB
+//! apparent, 2.1 GB allocated, written in 776 s at 54 % of a core, peak
+//! RSS 104 MiB):
+//!
+//! - **CPU reference, 320x200, the default world's 12 views**: traced over
+//!   the store 0.51-0.80 s in all (2-4 chunks per view, 17-22 misses, hit
+//!   rate 99.3 % with one cache lookup per chunk change), against 0.33-0.66 s
+//!   in memory on the default world (2048x16384): 1.2-1.8x, within the 2x
+//!   target; whole runs 0.52-0.84 s against 0.83-1.51 s (the in-memory run
+//!   loads the world, 0.28-0.44 s, and builds its whole-map pyramid,
+//!   0.22-0.48 s). **Peak RSS 9 MiB** over the store (chunk cache peak
+//!   1.9-2.3 MiB) against 105 MiB in memory. Views spread over the store,
+//!   page cache dropped first: 0.82 s, still 9 MiB.
+//! - **Cold random chunk read** (page cache dropped with `echo 3 >
+//!   /proc/sys/vm/drop_caches`, 50 random chunks, both planes checked and
+//!   decoded, `examples/store_cold.rs`): median 1.84 ms, p90 3.98 ms; the
+//!   same chunks again (warm) median 0.39 ms.
+//! - `strata fit --region` of 1024² texels (81 fit chunks, 36 store chunks
+//!   read) 1.37 s, 31 MiB RSS; `strata export --region` of 1000² across the
+//!   map's corner 1.31 s, 56 MiB RSS (debug build).
+//!
+//! Whole-world commands (`view`, `render`, `compare`, `collide`, ...) load a
+//! store whole and refuse one above half the available memory (at most 4
+//! GiB), naming its size and the commands that read it in bounded memory.
+//!
 //! # Not done yet (issue 32)
 //!
-//! Generation straight into a store by the world generator (the writer,
-//! [`DirStore::create_with`], exists and is bounded in memory; the
-//! generator still makes whole maps), the CPU reference, `fit`, `export`
-//! and `metrics` reading through [`ChunkCache`], the paged renderer.
+//! The paged renderer (page table, atlas, streamer); the colour reference
+//! reads a store a column per lookup for its normals (correct, a lock per
+//! lookup); a store above 2^28 texels is not content-hashed, so its
+//! references are computed rather than cached.
 
 #![warn(missing_docs)]
 
@@ -112,9 +150,10 @@ pub mod error;
 pub mod format;
 #[cfg(feature = "fs")]
 pub mod fs;
+pub mod read;
 pub mod store;
 
-pub use cache::{CacheStats, ChunkCache};
+pub use cache::{CacheStats, CachedChunk, ChunkCache};
 pub use error::StoreError;
 pub use format::{ChunkSummary, FORMAT_VERSION, Layout, WorldAttrs};
 #[cfg(feature = "fs")]

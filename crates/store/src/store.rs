@@ -622,10 +622,16 @@ impl WorldStore {
 
     /// The whole world in memory: the level, config, palette, water, views, edit.
     pub fn read_world(&self, mid_rule: MidRule) -> Result<World, StoreError> {
-        let level = self.read_level(mid_rule)?;
+        self.world_with_level(self.read_level(mid_rule)?)
+    }
+
+    /// The world's config, palette, water, views and edit around `level`
+    /// (this store's map, or a stand-in where the map is read through a
+    /// [`crate::ChunkCache`] instead).
+    pub fn world_with_level(&self, level: Level) -> Result<World, StoreError> {
         let a = &self.attrs;
         let what = Path::new(&self.what);
-        let config = strata_level::WorldConfig::parse_bytes(
+        let config = strata_level::WorldConfig::parse_store_bytes(
             a.world_ini.as_bytes(),
             &what.join("zarr.json#strata.world_ini"),
         )?;

@@ -149,7 +149,7 @@ fn open_store(
 ) -> anyhow::Result<PagedWorld> {
     let mid_rule = world.mid_rule();
     let attrs = store.store().attrs().clone();
-    let config = WorldConfig::parse_bytes(attrs.world_ini.as_bytes(), &dir.join("zarr.json"))
+    let config = WorldConfig::parse_store_bytes(attrs.world_ini.as_bytes(), &dir.join("zarr.json"))
         .with_context(|| format!("the world.ini of the store in {}", dir.display()))?;
     let palette = strata_level::Palette::from_bytes(&attrs.palette, &dir.join("zarr.json"))
         .with_context(|| format!("the palette of the store in {}", dir.display()))?;

@@ -1,10 +1,21 @@
 //! `--level DIR`: the world a command works on; the built-in generated world
 //! when absent, so a newcomer needs no setup.
 
-use anyhow::Context;
+use anyhow::{Context, bail};
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use strata_level::generate::{GENERATOR_VERSION, GenerateParams, generate};
+use strata_level::source::ColumnSource;
 use strata_level::{MidRule, World, io};
+use strata_store::fs::{DirKind, dir_kind};
+use strata_store::{ChunkCache, DirStore};
+
+/// The commands that read a store through its chunk cache in bounded
+/// memory (named when a whole-world command refuses a large store).
+pub const BOUNDED_COMMANDS: &str = "reference, fit, export --region, info, metrics";
+
+/// Default byte budget of a store's chunk cache, MiB.
+pub const DEFAULT_STORE_CACHE_MIB: u32 = 512;
 
 #[derive(clap::Args, Clone, Debug)]
 pub struct WorldArgs {
@@ -14,6 +25,74 @@ pub struct WorldArgs {
     /// Derive the cave ceiling with vange-rs's `+0` convention instead of the original game's `+1`.
     #[arg(long)]
     pub vange_rs_mid: bool,
+    /// Byte budget, MiB, of the chunk cache through which commands that read a store in bounded memory (reference, fit, export) read it.
+    #[arg(long, value_name = "MIB", default_value_t = DEFAULT_STORE_CACHE_MIB, value_parser = clap::value_parser!(u32).range(1..=1 << 20))]
+    pub store_cache: u32,
+}
+
+/// A world opened for a command that reads a store in bounded memory.
+pub enum Opened {
+    /// A Vangers world (or the default world), loaded whole.
+    Memory(World),
+    /// A store, read through its chunk cache.
+    Store(StoreWorld),
+}
+
+/// A store opened for reading through its chunk cache.
+pub struct StoreWorld {
+    /// The store.
+    pub store: DirStore,
+    /// Its chunk cache (the budget of `--store-cache`).
+    pub cache: ChunkCache,
+    /// Everything of the world but its map (a 2x1 stand-in level).
+    pub shell: World,
+}
+
+impl Opened {
+    /// Everything of the world but (for a store) its map.
+    pub fn world(&self) -> &World {
+        match self {
+            Opened::Memory(w) => w,
+            Opened::Store(s) => &s.shell,
+        }
+    }
+
+    /// Where the map's columns are read.
+    pub fn source(&self) -> &dyn ColumnSource {
+        match self {
+            Opened::Memory(w) => &w.level,
+            Opened::Store(s) => &s.cache,
+        }
+    }
+
+    /// The store's chunk cache, when a store was opened.
+    pub fn cache(&self) -> Option<&ChunkCache> {
+        match self {
+            Opened::Memory(_) => None,
+            Opened::Store(s) => Some(&s.cache),
+        }
+    }
+}
+
+/// The most bytes of map a whole-world command loads: half the memory
+/// available now (`/proc/meminfo`), at most 4 GiB; 4 GiB where that cannot
+/// be read. `STRATA_WHOLE_WORLD_LIMIT_MIB` sets it (tests, large machines).
+pub fn whole_world_limit() -> u64 {
+    if let Some(mib) = std::env::var("STRATA_WHOLE_WORLD_LIMIT_MIB")
+        .ok()
+        .and_then(|v| v.trim().parse::<u64>().ok())
+    {
+        return mib << 20;
+    }
+    let cap = 4u64 << 30;
+    std::fs::read_to_string("/proc/meminfo")
+        .ok()
+        .and_then(|text| {
+            text.lines()
+                .find_map(|l| l.strip_prefix("MemAvailable:"))
+                .and_then(|v| v.trim().trim_end_matches("kB").trim().parse::<u64>().ok())
+        })
+        .map_or(cap, |kb| (kb * 1024 / 2).min(cap))
 }
 
 impl WorldArgs {
@@ -38,7 +117,17 @@ impl WorldArgs {
     pub fn load(&self) -> anyhow::Result<World> {
         let mid_rule = self.mid_rule();
         if let Some(dir) = &self.level {
-            // A Vangers world or a Strata store, told apart by its files.
+            // A Vangers world or a Strata store, told apart by its files; a
+            // store too large to load whole is refused before any chunk is read.
+            if let Ok(DirKind::Store) = dir_kind(dir) {
+                let store = DirStore::open(dir)
+                    .with_context(|| format!("opening the store in {}", dir.display()))?;
+                check_whole_world(dir, store.store(), whole_world_limit())?;
+                return store
+                    .store()
+                    .read_world(mid_rule)
+                    .with_context(|| format!("loading the world in {}", dir.display()));
+            }
             return strata_store::load_any(dir, mid_rule)
                 .with_context(|| format!("loading the world in {}", dir.display()));
         }
@@ -46,6 +135,58 @@ impl WorldArgs {
         world.level.mid_rule = mid_rule;
         Ok(world)
     }
+}
+
+impl WorldArgs {
+    /// The world for a command that reads a store in bounded memory: a
+    /// store is opened (its metadata and nothing else) with a chunk cache
+    /// of `--store-cache` MiB; a Vangers world or the default world is
+    /// loaded whole, as [`WorldArgs::load`] does.
+    pub fn open(&self) -> anyhow::Result<Opened> {
+        if let Some(dir) = &self.level
+            && let Ok(DirKind::Store) = dir_kind(dir)
+        {
+            let store = DirStore::open(dir)
+                .with_context(|| format!("opening the store in {}", dir.display()))?;
+            let shell = store
+                .store()
+                .world_shell()
+                .with_context(|| format!("reading the world in {}", dir.display()))?;
+            let cache = ChunkCache::new(
+                Arc::clone(store.store()),
+                (self.store_cache as usize) << 20,
+                self.mid_rule(),
+            );
+            return Ok(Opened::Store(StoreWorld {
+                store,
+                cache,
+                shell,
+            }));
+        }
+        Ok(Opened::Memory(self.load()?))
+    }
+}
+
+/// Refuse to load a store whose map is above `limit` bytes, naming its size
+/// and the commands that read it in bounded memory.
+pub fn check_whole_world(
+    dir: &Path,
+    store: &strata_store::WorldStore,
+    limit: u64,
+) -> anyhow::Result<()> {
+    let bytes = store.map_bytes();
+    if bytes > limit {
+        let gib = |b: u64| b as f64 / f64::from(1u32 << 30);
+        bail!(
+            "the store in {} is {}x{} texels ({:.1} GiB loaded whole), more than this command may load here ({:.1} GiB: half the available memory, at most 4; STRATA_WHOLE_WORLD_LIMIT_MIB sets it). This command needs the whole world in memory; these read a store in bounded memory: {BOUNDED_COMMANDS}",
+            dir.display(),
+            store.width(),
+            store.height(),
+            gib(bytes),
+            gib(limit)
+        );
+    }
+    Ok(())
 }
 
 /// `$STRATA_CACHE_DIR`, else `$XDG_CACHE_HOME/strata`, else `~/.cache/strata`.

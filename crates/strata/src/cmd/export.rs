@@ -1,5 +1,6 @@
 //! `strata export`: the fitted mesh with terrain colours as glTF or OBJ.
 
+use crate::world_arg::{Opened, check_whole_world, whole_world_limit};
 use anyhow::Context;
 use std::path::PathBuf;
 use strata_export::{Format, Region, TerrainSoup};
@@ -55,15 +56,26 @@ fn format_for(format: Option<&str>, out: &std::path::Path) -> anyhow::Result<For
 
 pub fn run(args: Args) -> anyhow::Result<()> {
     let format = format_for(args.format.as_deref(), &args.out)?;
-    let world = args.world.load()?;
+    // A store is read through its chunk cache: only the chunks under the
+    // region. The whole map of a store is a mesh as large as the map, so a
+    // store too large to load is refused without --region.
+    let opened = args.world.open()?;
+    let source = opened.source();
+    let (w, h) = source.size();
     let region = match &args.region {
-        Some(text) => Region::parse(text, &world.level)?,
-        None => Region::whole(&world.level),
+        Some(text) => Region::parse_in(text, w, h)?,
+        None => {
+            if let Opened::Store(s) = &opened {
+                check_whole_world(s.store.dir(), s.store.store(), whole_world_limit())
+                    .context("export of the whole map (give --region X0,Y0,X1,Y1)")?;
+            }
+            Region::whole_of(w, h)
+        }
     };
     // Open the file first: an unwritable path fails before the fit.
     let file = std::fs::File::create(&args.out)
         .with_context(|| format!("cannot write the export to {}", args.out.display()))?;
-    let soup = TerrainSoup::build(&world, region, args.quality)?;
+    let soup = TerrainSoup::build_from(source, opened.world(), region, args.quality)?;
     let mut out = std::io::BufWriter::new(file);
     soup.write(format, &mut out)
         .with_context(|| format!("writing {}", args.out.display()))?;

@@ -3,9 +3,12 @@
 
 use anyhow::{Context, bail};
 use serde::Serialize;
+use strata_export::Region;
 use strata_level::Level;
+use strata_mesh::region::{cell_chunk, fit_stats_from, layout_for, region_cells};
 use strata_mesh::synthetic::synthetic_level;
 use strata_mesh::{FitOptions, LODS, MeshStats, fit_on_threads_with, tolerance_for_quality};
+use strata_store::fs::{DirKind, dir_kind};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -26,6 +29,9 @@ pub struct Args {
     /// Constrain the triangulation to the single/double region outline (issue 17).
     #[arg(long)]
     outline: bool,
+    /// Fit only the chunks under texels X0,Y0,X1,Y1 (half-open; X1/Y1 may pass the map edge, it wraps). A store is read through its chunk cache either way (bounded memory).
+    #[arg(long, value_name = "X0,Y0,X1,Y1", conflicts_with = "synthetic")]
+    region: Option<String>,
 }
 
 #[derive(Serialize)]
@@ -58,6 +64,12 @@ struct Report {
     world: String,
     width: u32,
     height: u32,
+    /// The texels fitted, `X0,Y0,X1,Y1`, when not the whole map.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    region: Option<String>,
+    /// A store's chunk cache after the fit (absent for a world in memory).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    store_cache: Option<strata_store::CacheStats>,
     quality: f64,
     max_error: f64,
     /// The outline-constrained fit.
@@ -113,39 +125,124 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let Some(tolerance) = tolerance_for_quality(args.quality) else {
         bail!("--quality {} is outside [0, 1]", args.quality);
     };
-    let (name, level) = load(&args)?;
     let options = FitOptions {
         outline: args.outline,
     };
+    // A store, or any world with --region: the chunks under the region,
+    // read through the source (a store's chunk cache: bounded memory),
+    // keeping only the totals.
+    let store = args.synthetic.is_none()
+        && args
+            .world
+            .level
+            .as_deref()
+            .is_some_and(|d| matches!(dir_kind(d), Ok(DirKind::Store)));
+    if store || args.region.is_some() {
+        return run_region(&args, tolerance, options);
+    }
+    let (name, level) = load(&args)?;
     let (mesh, timing) = fit_on_threads_with(&level, tolerance, args.threads.unwrap_or(0), options)
         .context("starting the worker threads")?;
     let (seconds, cpu, threads) = (timing.wall_seconds, timing.cpu_seconds, timing.threads);
     let report = report(
         &name,
-        &level,
+        (level.width(), level.height()),
         args.quality,
         &mesh.stats(),
         (seconds, cpu, threads),
         args.outline,
     );
-    if args.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
+    print(&report, args.json)
+}
+
+fn print(report: &Report, json: bool) -> anyhow::Result<()> {
+    if json {
+        println!("{}", serde_json::to_string_pretty(report)?);
     } else {
-        print_text(&report);
+        print_text(report);
+    }
+    Ok(())
+}
+
+/// Chunks fitted per batch in a region fit: only their totals are kept.
+const REGION_BATCH: usize = 256;
+
+fn run_region(args: &Args, tolerance: f64, options: FitOptions) -> anyhow::Result<()> {
+    let opened = args.world.open()?;
+    let source = opened.source();
+    let (w, h) = source.size();
+    let region = match &args.region {
+        Some(text) => Region::parse_in(text, w, h)?,
+        None => Region::whole_of(w, h),
+    };
+    let layout = layout_for(w, h);
+    let mut ids: Vec<usize> = region_cells(&layout, region.x0, region.y0, region.x1, region.y1)
+        .into_iter()
+        .map(|(gx, gy)| cell_chunk(&layout, gx, gy))
+        .collect();
+    // Row-major: neighbouring fits share the store's chunks in the cache.
+    ids.sort_unstable();
+    ids.dedup();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(args.threads.unwrap_or(0))
+        .build()
+        .context("starting the worker threads")?;
+    pool.broadcast(|_| ());
+    let (stats, seconds, cpu, threads) = pool.install(|| {
+        let cpu0 = strata_mesh::cpu_time::process_cpu_seconds();
+        let start = std::time::Instant::now();
+        let stats = fit_stats_from(source, &layout, &ids, tolerance, options, REGION_BATCH);
+        let seconds = start.elapsed().as_secs_f64();
+        let cpu = strata_mesh::cpu_time::process_cpu_seconds()
+            .zip(cpu0)
+            .map(|(b, a)| b - a);
+        (stats, seconds, cpu, rayon::current_num_threads())
+    });
+    let stats = stats.context("reading the map")?;
+    let mut report = report(
+        &opened.world().name,
+        (w, h),
+        args.quality,
+        &stats,
+        (seconds, cpu, threads),
+        args.outline,
+    );
+    report.full_grid_triangles =
+        2 * stats.chunks as u64 * u64::from(layout.size_x) * u64::from(layout.size_y);
+    let tris = report.footprint_triangles;
+    report.reduction = if tris == 0 {
+        0.0
+    } else {
+        report.full_grid_triangles as f64 / tris as f64
+    };
+    report.region = args.region.clone();
+    report.store_cache = opened.cache().map(|c| c.stats());
+    print(&report, args.json)?;
+    if let (Some(c), false) = (opened.cache(), args.json) {
+        let st = c.stats();
+        println!(
+            "store cache: {} hits, {} misses ({:.1} % hit), {} evictions, peak {:.1} of {} MiB",
+            st.hits,
+            st.misses,
+            st.hit_rate(),
+            st.evictions,
+            st.peak_bytes as f64 / f64::from(1u32 << 20),
+            c.budget() >> 20
+        );
     }
     Ok(())
 }
 
 fn report(
     name: &str,
-    level: &Level,
+    (width, height): (u32, u32),
     quality: f64,
     s: &MeshStats,
     (seconds, cpu, threads): (f64, Option<f64>, usize),
     outline: bool,
 ) -> Report {
     let footprints = |k: usize| s.lods[k].planar + if outline { s.lods[k].slab / 2 } else { 0 };
-    let full = 2 * u64::from(level.width()) * u64::from(level.height());
+    let full = 2 * u64::from(width) * u64::from(height);
     // Reduction and rates count every planar triangle drawn.
     let tris = footprints(0);
     let total: u64 = s.causes.iter().sum();
@@ -165,8 +262,10 @@ fn report(
     };
     Report {
         world: name.to_string(),
-        width: level.width(),
-        height: level.height(),
+        width,
+        height,
+        region: None,
+        store_cache: None,
         quality,
         max_error: s.tolerance,
         outline,
@@ -212,10 +311,13 @@ fn report(
 fn print_text(r: &Report) {
     let mib = |b: u64| b as f64 / (1024.0 * 1024.0);
     println!(
-        "{} ({}x{}), q={} (max error {}){}, {} chunks",
+        "{} ({}x{}{}), q={} (max error {}){}, {} chunks",
         r.world,
         r.width,
         r.height,
+        r.region
+            .as_ref()
+            .map_or(String::new(), |t| format!(", region {t}")),
         r.quality,
         r.max_error,
         if r.outline {

@@ -3,18 +3,24 @@
 //! `--out/<view name>/` (see `strata_reference::output`), served from the
 //! reference cache when it has them.
 
-use crate::world_arg::WorldArgs;
+use crate::world_arg::{Opened, WorldArgs};
 use anyhow::{Context, bail};
 use serde::Serialize;
 use std::io::Write;
 use std::path::PathBuf;
 use std::time::Instant;
-use strata_camera::Camera;
 use strata_level::{ViewSpec, views::parse_views};
 use strata_reference::output::{FORMAT_NOTE, ViewHeader, write_color, write_view};
 use strata_reference::{
-    REFERENCE_VERSION, ReferenceCache, ReferenceSettings, TerrainRamps, Tracer, render_color,
+    REFERENCE_VERSION, ReferenceCache, ReferenceSettings, TerrainRamps, Tracer, camera_for_view,
+    render_color_checked,
 };
+
+/// Stores up to this many texels are hashed (streamed, a few seconds) so
+/// their references are cached like a loaded world's (the key is the same
+/// content hash); larger ones are computed each time (hashing would read
+/// the whole store).
+const HASHED_STORE_TEXELS: u64 = 1 << 28;
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -74,6 +80,9 @@ struct ViewSummary<'a> {
     width: u32,
     height: u32,
     out: String,
+    /// A store's chunk cache after this view (absent for a world in memory).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    store_cache: Option<strata_store::CacheStats>,
 }
 
 /// `WxH` with both positive.
@@ -99,7 +108,10 @@ pub fn parse_image_size(text: &str) -> Result<(u32, u32), String> {
 pub fn run(args: Args) -> anyhow::Result<()> {
     // Written, not println!ed: a closed pipe (`| head`) is an error, not a panic.
     let mut out = std::io::stdout().lock();
-    let world = args.world.load()?;
+    // A store is read through its chunk cache; a Vangers world is loaded.
+    let opened = args.world.open()?;
+    let world = opened.world();
+    let source = opened.source();
     let views: Vec<ViewSpec> = match (&args.view, &args.views) {
         (Some(spec), _) => {
             let pitch = args.pitch.context("--view needs --pitch DEG")?;
@@ -126,10 +138,32 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     // Resolve every camera first, so a bad view fails before any work.
     let cameras = views
         .iter()
-        .map(|v| Camera::from_view(&world.level, v, w, h).context("resolving the camera"))
+        .map(|v| camera_for_view(source, v, w, h).context("resolving the camera"))
         .collect::<anyhow::Result<Vec<_>>>()?;
-    let level_hash = world.level.content_hash();
-    let tracer = Tracer::new(&world.level);
+    // The cache key: the map's content hash (a store's streamed, equal to
+    // the same map's loaded whole), or none for a store too large to hash.
+    let level_hash = match &opened {
+        Opened::Memory(world) => Some(world.level.content_hash()),
+        Opened::Store(s) => {
+            let texels = u64::from(s.store.store().width()) * u64::from(s.store.store().height());
+            if texels <= HASHED_STORE_TEXELS && !args.no_cache {
+                Some(
+                    s.store
+                        .store()
+                        .content_hash(args.world.mid_rule())
+                        .context("hashing the store's map")?,
+                )
+            } else {
+                if !args.no_cache {
+                    eprintln!(
+                        "note: a {texels}-texel store is not hashed (that would read all of it), so its references are computed, not cached"
+                    );
+                }
+                None
+            }
+        }
+    };
+    let tracer = Tracer::over(source).context("preparing the tracer")?;
     let cache = ReferenceCache::new(
         args.cache_dir
             .clone()
@@ -142,26 +176,34 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             "view", "sky %", "min", "median", "max", "seconds"
         )?;
     }
-    let ramps = TerrainRamps::from_world(&world);
+    let ramps = TerrainRamps::from_world(world);
     let shadows = !args.no_shadows;
     for (view, camera) in views.iter().zip(&cameras) {
         let start = Instant::now();
-        let (reference, color, from_cache) = if args.no_cache {
-            (
-                tracer.render(camera, &ReferenceSettings::default()),
-                render_color(&tracer, &ramps, camera, shadows),
+        let context = "reference cache (use --no-cache to bypass)";
+        let (reference, color, from_cache) = match (&level_hash, args.no_cache) {
+            (Some(level_hash), false) => {
+                let (r, r_hit) = cache
+                    .get_or_compute_traced(&tracer, level_hash, camera)
+                    .context(context)?;
+                let (c, c_hit) = cache
+                    .get_or_compute_color(&tracer, level_hash, camera, &ramps, shadows)
+                    .context(context)?;
+                (r, c, r_hit && c_hit)
+            }
+            _ => (
+                tracer
+                    .try_render(camera, &ReferenceSettings::default())
+                    .with_context(|| format!("view {}", view.name))?,
+                render_color_checked(&tracer, &ramps, camera, shadows)
+                    .with_context(|| format!("view {}", view.name))?,
                 false,
-            )
-        } else {
-            let context = "reference cache (use --no-cache to bypass)";
-            let (r, r_hit) = cache
-                .get_or_compute_traced(&tracer, &level_hash, camera)
-                .context(context)?;
-            let (c, c_hit) = cache
-                .get_or_compute_color(&tracer, &level_hash, camera, &ramps, shadows)
-                .context(context)?;
-            (r, c, r_hit && c_hit)
+            ),
         };
+        // A store read failing under the cached path is caught here.
+        if let Some(e) = tracer.error() {
+            bail!("view {}: {e}", view.name);
+        }
         let seconds = if from_cache {
             0.0
         } else {
@@ -173,7 +215,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             height: h,
             camera: *camera,
             view: Some(view.clone()),
-            level_hash: level_hash.clone(),
+            level_hash: level_hash
+                .clone()
+                .unwrap_or_else(|| "not hashed (a large store)".into()),
             reference_version: REFERENCE_VERSION,
             sky_fraction: reference.sky_fraction(),
             distance_min: summary.map(|s| s.0),
@@ -198,6 +242,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                 width: w,
                 height: h,
                 out: dir.display().to_string(),
+                store_cache: opened.cache().map(|c| c.stats()),
             };
             writeln!(out, "{}", serde_json::to_string(&line)?)?;
         } else {
@@ -214,6 +259,19 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                 if from_cache { "hit" } else { "computed" }
             )?;
         }
+    }
+    if let (Some(c), false) = (opened.cache(), args.json) {
+        let st = c.stats();
+        writeln!(
+            out,
+            "store cache: {} hits, {} misses ({:.1} % hit), {} evictions, peak {:.1} of {} MiB",
+            st.hits,
+            st.misses,
+            st.hit_rate(),
+            st.evictions,
+            st.peak_bytes as f64 / f64::from(1u32 << 20),
+            c.budget() >> 20
+        )?;
     }
     Ok(())
 }

@@ -135,6 +135,7 @@ impl Viewer {
             return Ok(());
         }
         self.unsaved = true;
+        self.saver.record_edit(dirty);
         self.builds.record_edit(dirty);
         self.renderer.apply_edit(&self.level, dirty)?;
         // The physics world's ground changes in the same call: exactly the
