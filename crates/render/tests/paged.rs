@@ -279,7 +279,7 @@ fn a_chunk_that_fails_to_read_stays_pending_and_is_reported_once() {
         let source: Arc<dyn PageSource> =
             Arc::new(StorePages::new(cache, MidRule::Original).unwrap());
         let mut r = paged(&gpu, source, &colors, "ray-exact", 16 << 20).unwrap();
-        let err = r.converge(&camera, 60).err().expect("never converges");
+        let err = r.converge(&camera, 60).expect_err("never converges");
         let text = format!("{err:#}");
         eprintln!("{text}");
         assert!(text.contains(&format!("chunk ({cx}, {cy})")), "{text}");

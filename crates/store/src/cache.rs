@@ -15,7 +15,9 @@ use std::collections::{BTreeMap, HashMap};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, Weak};
 use strata_level::model::{Column, MidRule, decode_column};
-use strata_level::source::{ColumnSource, DerivedSlot, SourceError, SourceTile};
+#[cfg(not(target_arch = "wasm32"))]
+use strata_level::source::{ColumnSource, SourceError};
+use strata_level::source::{DerivedSlot, SourceTile};
 
 /// How the cache has been used.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
@@ -245,10 +247,14 @@ impl ChunkCache {
     }
 }
 
+#[cfg(not(target_arch = "wasm32"))]
 fn source_error(e: StoreError) -> SourceError {
     SourceError(e.to_string())
 }
 
+// zarrs' storage is neither Send nor Sync on wasm32 (one thread there), and
+// column sources are shared between threads.
+#[cfg(not(target_arch = "wasm32"))]
 impl ColumnSource for ChunkCache {
     fn size(&self) -> (u32, u32) {
         (self.store.width(), self.store.height())

@@ -690,10 +690,10 @@ fn map_cells<T: Send>(cells: &[(u64, u64)], f: &CellFn<'_, T>) -> Result<Vec<T>,
 }
 
 #[cfg(target_arch = "wasm32")]
-fn map_cells<T>(
-    cells: &[(u64, u64)],
-    f: &dyn Fn(&(u64, u64)) -> Result<T, StoreError>,
-) -> Result<Vec<T>, StoreError> {
+type CellFn<'a, T> = dyn Fn(&(u64, u64)) -> Result<T, StoreError> + 'a;
+
+#[cfg(target_arch = "wasm32")]
+fn map_cells<T>(cells: &[(u64, u64)], f: &CellFn<'_, T>) -> Result<Vec<T>, StoreError> {
     cells.iter().map(f).collect()
 }
 

@@ -38,7 +38,9 @@ pub mod source;
 pub mod streamer;
 
 pub use residency::{BudgetPlan, Residency};
-pub use source::{LevelPages, PAGE, PageData, PageSource, StorePages, page_pyramid_layout};
+#[cfg(not(target_arch = "wasm32"))]
+pub use source::StorePages;
+pub use source::{LevelPages, PAGE, PageData, PageSource, page_pyramid_layout};
 pub use streamer::Streamer;
 
 use crate::frame::Shared;

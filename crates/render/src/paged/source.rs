@@ -10,6 +10,7 @@ use std::sync::Arc;
 use strata_level::model::decode_column;
 use strata_level::{Level, MidRule};
 use strata_maxmip::Layout;
+#[cfg(not(target_arch = "wasm32"))]
 use strata_store::ChunkCache;
 
 /// Texels per side of a page: the store's chunk, and the coarsest tile of
@@ -191,12 +192,16 @@ impl PageSource for LevelPages {
 }
 
 /// Pages read through a store's chunk cache (the cache's byte budget bounds
-/// the CPU memory; the GPU budget is the renderer's).
+/// the CPU memory; the GPU budget is the renderer's). Native only: zarrs'
+/// storage is neither Send nor Sync on wasm32, where a page reader over
+/// HTTP is issue 34's.
+#[cfg(not(target_arch = "wasm32"))]
 pub struct StorePages {
     cache: Arc<ChunkCache>,
     mid_rule: MidRule,
 }
 
+#[cfg(not(target_arch = "wasm32"))]
 impl StorePages {
     /// Pages of the store behind `cache`; its chunks must be pages.
     pub fn new(cache: Arc<ChunkCache>, mid_rule: MidRule) -> anyhow::Result<Self> {
@@ -219,6 +224,7 @@ impl StorePages {
     }
 }
 
+#[cfg(not(target_arch = "wasm32"))]
 impl PageSource for StorePages {
     fn size(&self) -> (u32, u32) {
         let s = self.cache.store();

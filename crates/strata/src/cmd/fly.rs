@@ -340,7 +340,7 @@ fn run_scale(args: &Args) -> anyhow::Result<()> {
         }
         let world_args = WorldArgs {
             level: Some(dir),
-            vange_rs_mid: args.world.vange_rs_mid,
+            ..args.world.clone()
         };
         let report = fly_one(args, &world_args, &args.out.join(format!("{w}x{h}")))?;
         print_summary(&report);
