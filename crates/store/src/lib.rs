@@ -135,8 +135,9 @@
 //!
 //! # Not done yet (issue 32)
 //!
-//! The paged renderer (page table, atlas, streamer); the colour reference
-//! reads a store a column per lookup for its normals (correct, a lock per
+//! The paged renderer reads stores through this cache
+//! (`strata_render::paged::StorePages`; issue 33, `bench/paged/`). Not yet:
+//! the colour reference reads a store a column per lookup for its normals (correct, a lock per
 //! lookup); a store above 2^28 texels is not content-hashed, so its
 //! references are computed rather than cached.
 
