@@ -135,10 +135,10 @@
 //!
 //! # Not done yet (issue 32)
 //!
-//! The paged renderer (page table, atlas, streamer); the colour reference
-//! reads a store a column per lookup for its normals (correct, a lock per
-//! lookup); a store above 2^28 texels is not content-hashed, so its
-//! references are computed rather than cached.
+//! The paged renderer (page table, atlas, streamer); a store above 2^28
+//! texels is not content-hashed (that would read all of it), so its
+//! references are computed rather than cached; a whole fit of a 65536²
+//! store runs in bounded memory but takes the time of 262,144 chunk fits.
 
 #![warn(missing_docs)]
 
