@@ -13,7 +13,8 @@ use rayon::prelude::*;
 use std::sync::Arc;
 use strata_camera::Camera;
 use strata_camera::light::{SKY, ShadowFrame};
-use strata_level::source::{ColumnSource, SourceError};
+use strata_level::model::decode_column;
+use strata_level::source::{ColumnSource, SourceError, SourceTile};
 use strata_level::{Column, World};
 
 const AMBIENT: f32 = 0.45;
@@ -87,6 +88,13 @@ fn unorm8(v: f32) -> u8 {
     (v.clamp(0.0, 1.0) * 255.0).round() as u8
 }
 
+/// The last tile a thread's shading read.
+#[derive(Default)]
+struct Memo<'a> {
+    key: (u64, u64),
+    tile: Option<Arc<dyn SourceTile + 'a>>,
+}
+
 /// Everything the shading of one view needs.
 pub struct Shader<'a> {
     source: &'a dyn ColumnSource,
@@ -124,22 +132,47 @@ impl<'a> Shader<'a> {
 
     /// The column at (x, y); a read error is kept (the image is then not
     /// the reference: [`render_color_checked`] returns it) and the column
-    /// taken as empty ground.
-    fn column(&self, x: i64, y: i64) -> Column {
+    /// taken as empty ground. `memo` keeps the last tile read, so that a
+    /// pixel's neighbours do not each ask the source's cache (a lock).
+    fn column(&self, memo: &mut Memo<'a>, x: i64, y: i64) -> Column {
         if let Some(level) = self.source.as_level() {
             return level.column(x, y);
         }
-        self.source.column(x, y).unwrap_or_else(|e| {
-            self.errors.record(e);
-            Column {
+        let (w, h) = self.source.size();
+        let (rows, cols) = self.source.tile_shape();
+        let (x, y) = ((x & i64::from(w - 1)) as u64, (y & i64::from(h - 1)) as u64);
+        let key = (y / u64::from(rows), x / u64::from(cols));
+        if memo.tile.is_none() || memo.key != key {
+            match self.source.tile(key.0, key.1) {
+                Ok(t) => {
+                    memo.tile = Some(t);
+                    memo.key = key;
+                }
+                Err(e) => {
+                    self.errors.record(e);
+                    memo.tile = None;
+                }
+            }
+        }
+        let Some(tile) = &memo.tile else {
+            return Column {
                 low: 0,
                 mid: 0,
                 high: 0,
                 dual: false,
                 lower_type: 0,
                 upper_type: 0,
-            }
-        })
+            };
+        };
+        let (hs, ms) = tile.planes();
+        let start = (y % u64::from(rows)) as usize * cols as usize;
+        let row = start..start + cols as usize;
+        decode_column(
+            &hs[row.clone()],
+            &ms[row],
+            (x % u64::from(cols)) as usize,
+            self.source.mid_rule(),
+        )
     }
 
     fn surface_kind(c: &Column, z: f32, dir_z: f32) -> Surface {
@@ -153,8 +186,15 @@ impl<'a> Shader<'a> {
         }
     }
 
-    fn interval_field(&self, x: i64, y: i64, kind: Surface, fallback: f32) -> f32 {
-        let c = self.column(x, y);
+    fn interval_field(
+        &self,
+        memo: &mut Memo<'a>,
+        x: i64,
+        y: i64,
+        kind: Surface,
+        fallback: f32,
+    ) -> f32 {
+        let c = self.column(memo, x, y);
         match kind {
             Surface::Floor => f32::from(c.low),
             _ if !c.dual => fallback,
@@ -163,8 +203,15 @@ impl<'a> Shader<'a> {
         }
     }
 
-    fn surface_normal(&self, x: i64, y: i64, kind: Surface, here: f32) -> Vec3 {
-        let f = |dx, dy| self.interval_field(x + dx, y + dy, kind, here);
+    fn surface_normal(
+        &self,
+        memo: &mut Memo<'a>,
+        x: i64,
+        y: i64,
+        kind: Surface,
+        here: f32,
+    ) -> Vec3 {
+        let mut f = |dx, dy| self.interval_field(memo, x + dx, y + dy, kind, here);
         let gx = 0.5 * (f(1, 0) - f(-1, 0));
         let gy = 0.5 * (f(0, 1) - f(0, -1));
         if kind == Surface::Ceiling {
@@ -212,14 +259,18 @@ impl<'a> Shader<'a> {
     /// `shade_column`: the colour of surface point `p` of column (x, y),
     /// found along a ray of direction `dir`.
     pub fn shade_column(&self, p: Vec3, x: i64, y: i64, dir: Vec3) -> Vec3 {
-        let c = self.column(x, y);
+        self.shade_column_in(&mut Memo::default(), p, x, y, dir)
+    }
+
+    fn shade_column_in(&self, memo: &mut Memo<'a>, p: Vec3, x: i64, y: i64, dir: Vec3) -> Vec3 {
+        let c = self.column(memo, x, y);
         let kind = Self::surface_kind(&c, p.z, dir.z);
         let here = f32::from(if kind == Surface::Ceiling {
             c.mid
         } else {
             c.high
         });
-        let n = self.surface_normal(x, y, kind, here);
+        let n = self.surface_normal(memo, x, y, kind, here);
         let t = if kind == Surface::Floor {
             c.lower_type
         } else {
@@ -246,6 +297,7 @@ impl<'a> Shader<'a> {
         let sky = SKY.map(unorm8);
         rgb.par_chunks_mut(3 * w).enumerate().for_each(|(j, row)| {
             let mut state = tracer.ray_state();
+            let mut memo = Memo::default();
             for i in 0..w {
                 let dir = camera
                     .image_direction(i as f32 + 0.5, j as f32 + 0.5)
@@ -262,7 +314,7 @@ impl<'a> Shader<'a> {
                     Some(hit) => {
                         let p = (origin + unit * hit.distance).as_vec3();
                         let [x, y] = hit.column;
-                        self.shade_column(p, x, y, unit.as_vec3())
+                        self.shade_column_in(&mut memo, p, x, y, unit.as_vec3())
                             .to_array()
                             .map(unorm8)
                     }

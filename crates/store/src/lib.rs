@@ -137,9 +137,10 @@
 //!
 //! The paged renderer reads stores through this cache
 //! (`strata_render::paged::StorePages`; issue 33, `bench/paged/`). Not yet:
-//! the colour reference reads a store a column per lookup for its normals (correct, a lock per
-//! lookup); a store above 2^28 texels is not content-hashed, so its
-//! references are computed rather than cached.
+//! a store above 2^28 texels is not content-hashed (that would read all of
+//! it), so its references are computed rather than cached; a whole fit of a
+//! 65536² store runs in bounded memory but takes the time of 262,144 chunk
+//! fits.
 
 #![warn(missing_docs)]
 
