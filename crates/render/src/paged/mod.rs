@@ -453,7 +453,12 @@ impl PagedTerrain {
         let eye = camera.position;
         let (w, h) = (camera.width as f32, camera.height as f32);
         let scale = camera.far / camera.focal_px;
-        let reach = glam::Vec2::splat(camera.far);
+        // Around the eye, no farther than half the atlas covers as a disc:
+        // a far plane of thousands of texels would otherwise keep the whole
+        // atlas churning (the frustum's far corners and the frames' own
+        // requests still reach past it).
+        let disc = PAGE as f32 * (self.plan.slots as f32 / (2.0 * std::f32::consts::PI)).sqrt();
+        let reach = glam::Vec2::splat(camera.far.min(disc));
         let mut lo = eye.truncate() - reach;
         let mut hi = eye.truncate() + reach;
         for (px, py) in [(0.0, 0.0), (w, 0.0), (0.0, h), (w, h)] {
