@@ -40,7 +40,14 @@ fn a_generated_store_is_the_generated_world() {
     let d = scratch("same");
     let (store, vangers, back) = (d.join("store"), d.join("vangers"), d.join("back"));
     let png = d.join("preview.png");
-    let common = ["--size", "512x1024", "--seed", "11", "--dual-fraction", "0.2"];
+    let common = [
+        "--size",
+        "512x1024",
+        "--seed",
+        "11",
+        "--dual-fraction",
+        "0.2",
+    ];
     let out = strata(
         &[
             &["generate", "--to", "store", "--out", p(&store)][..],
