@@ -194,7 +194,7 @@ fn chunked(
             .fill(rect, &mut heights, &mut metas)
             .map_err(|e| StoreError::Invalid(e.to_string()))?;
         let k = done.fetch_add(1, Ordering::Relaxed) + 1;
-        if tell && k % (total / 10) == 0 {
+        if tell && k.is_multiple_of(total / 10) {
             eprintln!("  {k}/{total} chunks, {:.0} s", t0.elapsed().as_secs_f64());
         }
         Ok(Chunk {
