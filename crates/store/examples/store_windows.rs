@@ -4,8 +4,8 @@
 //! roughness (`strata_level::stats`) against the default world's
 //! (2048x16384, seed 1997, generated here in memory: the whole world and
 //! its eight 2048x2048 windows), and checks that no two windows have the
-//! same bytes. Exits 1 when two windows are equal or a window's figures
-//! are off by more than the tolerances below.
+//! same bytes. Exits 1 when two windows are equal or a window's figures,
+//! or their mean, are off by more than the tolerances below.
 //!
 //! `cargo run --release -p strata-store --example store_windows -- DIR [WINDOWS] [SIDE]`
 //! (`strata generate --to store --size 65536x65536 --out DIR` makes one).
@@ -18,10 +18,17 @@ use strata_level::{Level, MidRule};
 use strata_store::DirStore;
 
 /// Largest relative difference from the default world's whole-map figure
-/// a window may show: the default world's own 2048² windows spread about
-/// ±6 % in dual fraction and ±4 % in roughness around it.
-const DUAL_TOLERANCE: f64 = 0.20;
+/// a window may show. The default world's own 2048² windows spread about
+/// ±6 % in dual fraction and ±5 % in roughness around it; a big world's
+/// spread wider and sit higher in dual fraction (+6 % on average for
+/// 65536², bench/store-gen): most of its windows have no river valley,
+/// which crosses every window of the 2048-wide default world and holds
+/// fewer slabs than the districts it displaces.
+const DUAL_TOLERANCE: f64 = 0.25;
 const ROUGHNESS_TOLERANCE: f64 = 0.10;
+/// The same for the mean over all windows.
+const MEAN_DUAL_TOLERANCE: f64 = 0.10;
+const MEAN_ROUGHNESS_TOLERANCE: f64 = 0.05;
 
 /// A window of the store as a level (wrapping at its own edges, which
 /// moves the roughness by well under 0.1 %).
@@ -170,13 +177,23 @@ fn main() {
         rel(sum_rough / n, reference.roughness_floor) * 100.0,
         hashes.len()
     );
+    let (mean_dual, mean_rough) = (
+        rel(sum_dual / n, reference.dual_percent),
+        rel(sum_rough / n, reference.roughness_floor),
+    );
+    if mean_dual.abs() > MEAN_DUAL_TOLERANCE || mean_rough.abs() > MEAN_ROUGHNESS_TOLERANCE {
+        println!("the mean is off by more than the tolerances");
+        bad += 1;
+    }
     if bad > 0 {
         println!("FAIL: {bad} windows equal or off by more than the tolerances");
         std::process::exit(1);
     }
     println!(
-        "OK: all windows distinct, within {:.0} % (dual) and {:.0} % (roughness) of the default world",
+        "OK: all windows distinct, each within {:.0} % (dual) and {:.0} % (roughness) of the default world, the mean within {:.0} % and {:.0} %",
         DUAL_TOLERANCE * 100.0,
-        ROUGHNESS_TOLERANCE * 100.0
+        ROUGHNESS_TOLERANCE * 100.0,
+        MEAN_DUAL_TOLERANCE * 100.0,
+        MEAN_ROUGHNESS_TOLERANCE * 100.0
     );
 }

@@ -49,36 +49,13 @@ impl ValueNoise {
         }
     }
 
-    /// The four corner hashes of cell (`ix`, `iy`): (0,0), (1,0), (0,1),
-    /// (1,1). Remembered per thread (see [`CORNERS`]): consecutive texels
-    /// of a row mostly fall in the cell of the one before, and the hashes
-    /// are most of the noise's cost.
     #[inline]
-    fn corners(&self, ix: i32, iy: i32) -> [u32; 4] {
-        let key = [
-            ix as u32,
-            iy as u32,
-            self.seed,
-            self.mask_x | (self.mask_y << 16),
-        ];
+    fn corner(&self, ix: i32, iy: i32) -> f32 {
+        // One hash of premixed coordinates: plenty for value noise, and the
+        // corner lookups are most of the generator's time.
         let a = (ix as u32 & self.mask_x).wrapping_mul(0x8da6_b343);
         let b = (iy as u32 & self.mask_y).wrapping_mul(0xd816_3841);
-        let slot = ((a ^ b ^ self.seed) >> (32 - CORNER_SLOTS_LOG2)) as usize;
-        CORNERS.with(|memo| {
-            let cell = &memo[slot];
-            let known = cell.get();
-            if known.key == key {
-                return known.hashes;
-            }
-            let h = |dx: i32, dy: i32| {
-                let a = ((ix + dx) as u32 & self.mask_x).wrapping_mul(0x8da6_b343);
-                let b = ((iy + dy) as u32 & self.mask_y).wrapping_mul(0xd816_3841);
-                hash32(a ^ b ^ self.seed)
-            };
-            let hashes = [h(0, 0), h(1, 0), h(0, 1), h(1, 1)];
-            cell.set(Corners { key, hashes });
-            hashes
-        })
+        unit(hash32(a ^ b ^ self.seed))
     }
 
     /// Two independent noises from one set of corner hashes (high and low
@@ -89,7 +66,12 @@ impl ValueNoise {
         let fy = y * self.inv_cell;
         let (ix, iy) = (fast_floor(fx), fast_floor(fy));
         let (tx, ty) = (smooth(fx - ix as f32), smooth(fy - iy as f32));
-        let [a, b, c, d] = self.corners(ix, iy);
+        let h = |dx: i32, dy: i32| {
+            let a = ((ix + dx) as u32 & self.mask_x).wrapping_mul(0x8da6_b343);
+            let b = ((iy + dy) as u32 & self.mask_y).wrapping_mul(0xd816_3841);
+            hash32(a ^ b ^ self.seed)
+        };
+        let (a, b, c, d) = (h(0, 0), h(1, 0), h(0, 1), h(1, 1));
         let lerp = |a: f32, b: f32, c: f32, d: f32| {
             let top = a + (b - a) * tx;
             top + (c + (d - c) * tx - top) * ty
@@ -108,37 +90,14 @@ impl ValueNoise {
         let fy = y * self.inv_cell;
         let (ix, iy) = (fast_floor(fx), fast_floor(fy));
         let (tx, ty) = (smooth(fx - ix as f32), smooth(fy - iy as f32));
-        let [a, b, c, d] = self.corners(ix, iy).map(unit);
+        let a = self.corner(ix, iy);
+        let b = self.corner(ix + 1, iy);
+        let c = self.corner(ix, iy + 1);
+        let d = self.corner(ix + 1, iy + 1);
         let top = a + (b - a) * tx;
         let bottom = c + (d - c) * tx;
         top + (bottom - top) * ty
     }
-}
-
-/// A cell's corner hashes and what they are the hashes of: the cell's
-/// unwrapped coordinates, the noise's seed and its wrap masks, which
-/// together decide all four hashes, so a remembered entry is exact.
-#[derive(Clone, Copy)]
-struct Corners {
-    key: [u32; 4],
-    hashes: [u32; 4],
-}
-
-const CORNER_SLOTS_LOG2: u32 = 6;
-
-thread_local! {
-    /// Corner hashes of recently sampled cells, per thread, direct-mapped
-    /// by the cell's hash (so the several noises and offsets a texel
-    /// samples mostly keep their own entries). The initial key (cell
-    /// i32::MIN, seed 0, masks 0) is never asked for: cells are near the map.
-    static CORNERS: [std::cell::Cell<Corners>; 1 << CORNER_SLOTS_LOG2] = const {
-        [const {
-            std::cell::Cell::new(Corners {
-                key: [i32::MIN as u32, i32::MIN as u32, 0, 0],
-                hashes: [0; 4],
-            })
-        }; 1 << CORNER_SLOTS_LOG2]
-    };
 }
 
 /// A smooth field sampled every `2^step_log2` texels and interpolated
