@@ -116,6 +116,19 @@ impl Renderer {
         shared.options = gpu.options.clone();
         let shared = Arc::new(shared);
         let method = methods::create(method, &shared, level, settings)?;
+        Self::assemble(gpu, shared, method, settings, LevelShape::of(level), start)
+    }
+
+    /// The renderer around a shared frame and its first method, once the
+    /// GPU has finished building them (`setup_ms` counts from `start`).
+    fn assemble(
+        gpu: &Gpu,
+        shared: Arc<Shared>,
+        method: Box<dyn Method>,
+        settings: &MethodSettings,
+        level_shape: LevelShape,
+        start: Instant,
+    ) -> anyhow::Result<Self> {
         let shadow = ShadowPass::new(&shared)?;
         let depth_reader = DepthReader::new(&gpu.device, &gpu.caps)?;
         let timer = PassTimer::new(&gpu.device, &gpu.queue, gpu.report.timestamps);
@@ -129,7 +142,7 @@ impl Renderer {
             shadow,
             timer,
             errors: gpu.errors.clone(),
-            level_shape: LevelShape::of(level),
+            level_shape,
             frames: 0,
             last_submission: None,
             adapter: gpu.report.clone(),
@@ -202,36 +215,7 @@ impl Renderer {
         let paged = crate::paged::PagedTerrain::new(&shared, source, plan, paging, step)?;
         let method: Box<dyn Method> =
             Box::new(methods::ray_exact::build_paged(&shared, paged, options)?);
-        let shadow = ShadowPass::new(&shared)?;
-        let depth_reader = DepthReader::new(&gpu.device, &gpu.caps)?;
-        let timer = PassTimer::new(&gpu.device, &gpu.queue, gpu.report.timestamps);
-        let mut renderer = Renderer {
-            shared,
-            methods: vec![Built {
-                method,
-                settings: settings.clone(),
-            }],
-            active: 0,
-            shadow,
-            timer,
-            errors: gpu.errors.clone(),
-            level_shape,
-            frames: 0,
-            last_submission: None,
-            adapter: gpu.report.clone(),
-            setup_ms: 0.0,
-            shadow_reuse: gpu.options.shadow_reuse,
-            shadow_drawn: None,
-            shadow_cull: gpu.options.shadow_cull,
-            depth_attachment: gpu.options.depth_attachment,
-            depth_target_current: false,
-            depth_reader,
-            edit_listener: None,
-            composite: Default::default(),
-        };
-        wait_device(&renderer.shared.device, &renderer.errors)?;
-        renderer.setup_ms = ms(start);
-        Ok(renderer)
+        Self::assemble(gpu, shared, method, settings, level_shape, start)
     }
 
     /// Whether this renderer draws paged terrain ([`Renderer::new_paged`]).
