@@ -223,9 +223,8 @@ impl Renderer {
         self.paged_terrain().is_some()
     }
 
-    /// The active method's paged terrain, if it draws one: its statistics,
-    /// [`crate::paged::PagedTerrain::refresh`] after an edit of its source,
-    /// [`crate::paged::PagedTerrain::settle`].
+    /// The active method's paged terrain, if it draws one: its statistics
+    /// and plan ([`Renderer::refresh_pages`] after an edit of its source).
     pub fn paged_terrain(&mut self) -> Option<&mut crate::paged::PagedTerrain> {
         self.methods[self.active].method.paged_terrain()
     }

@@ -599,20 +599,6 @@ impl PagedTerrain {
         }
         Ok(())
     }
-
-    /// Read until every chunk the view wants is resident or nothing more
-    /// can be placed: a still camera's frames then converge (tests, and a
-    /// `render` that must equal the whole-world image).
-    pub fn settle(&mut self, shared: &Shared) {
-        for (chunk, page) in self.streamer.drain() {
-            if self.stale.remove(&chunk) || self.residency.slot_of(chunk).is_some() {
-                continue;
-            }
-            if let Ok(page) = page {
-                self.place(shared, chunk, &page);
-            }
-        }
-    }
 }
 
 /// Squared distance from `eye` to the nearest wrapped copy of chunk `c`'s

@@ -124,22 +124,6 @@ impl Streamer {
         }
         taken
     }
-
-    /// Wait until nothing is queued or being read (tests, `render`'s
-    /// convergence), then return what finished.
-    pub fn drain(&self) -> Vec<PageResult> {
-        loop {
-            let idle = {
-                let q = self.shared.queue.lock().expect("page queue");
-                q.wanted.is_empty() && q.reading.is_empty()
-            };
-            if idle || self.workers.is_empty() {
-                break;
-            }
-            std::thread::sleep(std::time::Duration::from_millis(1));
-        }
-        self.poll(usize::MAX, f64::INFINITY)
-    }
 }
 
 impl Drop for Streamer {
