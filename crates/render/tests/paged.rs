@@ -26,6 +26,29 @@ fn world() -> World {
     .expect("generated world")
 }
 
+/// `w` written as a store in a fresh temporary directory named for `what`.
+fn temp_store(w: &World, what: &str) -> (std::path::PathBuf, strata_store::DirStore) {
+    let dir = std::env::temp_dir().join(format!("strata-paged-{what}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let store = strata_store::DirStore::create(&dir, w, &strata_store::Layout::default()).unwrap();
+    (dir, store)
+}
+
+/// Pages of `store` through a fresh 64 MiB chunk cache (returned too, to
+/// invalidate after an edit).
+fn store_pages(
+    store: &strata_store::DirStore,
+) -> (Arc<strata_store::ChunkCache>, Arc<dyn PageSource>) {
+    let cache = Arc::new(strata_store::ChunkCache::new(
+        store.store().clone(),
+        64 << 20,
+        MidRule::Original,
+    ));
+    let source: Arc<dyn PageSource> =
+        Arc::new(StorePages::new(cache.clone(), MidRule::Original).unwrap());
+    (cache, source)
+}
+
 fn paged(
     gpu: &strata_render::Gpu,
     source: Arc<dyn PageSource>,
@@ -151,19 +174,8 @@ fn an_edit_of_the_store_shows_on_the_next_frame() {
     }
     let w = world();
     let colors = TerrainColors::from_world(&w);
-    let dir = std::env::temp_dir().join(format!("strata-paged-edit-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    let store = strata_store::DirStore::create(&dir, &w, &strata_store::Layout::default()).unwrap();
-    let open = || {
-        let cache = Arc::new(strata_store::ChunkCache::new(
-            store.store().clone(),
-            64 << 20,
-            MidRule::Original,
-        ));
-        let source: Arc<dyn PageSource> =
-            Arc::new(StorePages::new(cache.clone(), MidRule::Original).unwrap());
-        (cache, source)
-    };
+    let (dir, store) = temp_store(&w, "edit");
+    let open = || store_pages(&store);
     let site = w.edit.clone().expect("an edit site");
     let camera = Camera::from_view(&w.level, &site.camera, W, H).unwrap();
     let settings = MethodSettings::default();
@@ -260,9 +272,7 @@ fn a_chunk_that_fails_to_read_stays_pending_and_is_reported_once() {
     }
     let w = world();
     let colors = TerrainColors::from_world(&w);
-    let dir = std::env::temp_dir().join(format!("strata-paged-bad-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    let store = strata_store::DirStore::create(&dir, &w, &strata_store::Layout::default()).unwrap();
+    let (dir, store) = temp_store(&w, "bad");
     let site = w.edit.clone().expect("an edit site");
     let camera = Camera::from_view(&w.level, &site.camera, W, H).unwrap();
     // Truncate the chunk under the crater: its checksum no longer holds.
@@ -271,13 +281,7 @@ fn a_chunk_that_fails_to_read_stays_pending_and_is_reported_once() {
     let bytes = std::fs::read(&chunk_file).unwrap();
     std::fs::write(&chunk_file, &bytes[..bytes.len() / 2]).unwrap();
     for gpu in gpus {
-        let cache = Arc::new(strata_store::ChunkCache::new(
-            store.store().clone(),
-            64 << 20,
-            MidRule::Original,
-        ));
-        let source: Arc<dyn PageSource> =
-            Arc::new(StorePages::new(cache, MidRule::Original).unwrap());
+        let (_, source) = store_pages(&store);
         let mut r = paged(&gpu, source, &colors, "ray-exact", 16 << 20).unwrap();
         let err = r.converge(&camera, 60).expect_err("never converges");
         let text = format!("{err:#}");
