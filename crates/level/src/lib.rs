@@ -94,6 +94,7 @@ pub mod generate;
 pub mod huffman;
 pub mod io;
 pub mod lcg;
+pub mod lod;
 pub mod model;
 pub mod palette;
 pub mod save;

@@ -21,7 +21,8 @@
 
 use crate::error::StoreError;
 use crate::format::{ChunkSummary, HEIGHTS, Layout, METAS, SUMMARY};
-use crate::store::{Chunk, Storage, StoreArray, WorldStore};
+use crate::lod::lod_name;
+use crate::store::{Chunk, Storage, StoreArray, WorldStore, write_cell};
 use std::fs::File;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -176,6 +177,16 @@ impl DirStore {
         Self::open(dir)
     }
 
+    /// Write the store's level-of-detail levels (replacing any; see
+    /// [`crate::lod`]) and open it again. `progress(k, levels)` after each.
+    pub fn build_lods(dir: &Path, progress: &dyn Fn(u32, u32)) -> Result<Self, StoreError> {
+        let opened = Self::open(dir)?;
+        drop(opened);
+        let mut store = WorldStore::open(fs_storage(dir)?, &dir.display().to_string())?;
+        store.build_lods(progress)?;
+        Self::open(dir)
+    }
+
     /// The directory.
     pub fn dir(&self) -> &Path {
         &self.dir
@@ -261,6 +272,19 @@ impl DirStore {
             );
             keys.push(store.heights.chunk_key(&[*cy, *cx]).to_string());
             keys.push(store.metas.chunk_key(&[*cy, *cx]).to_string());
+        }
+        // The coarse levels over the batch's chunks, in the same batch.
+        for (k, cy, cx, chunk) in store.lod_updates(chunks)? {
+            let (lh, lm) = store.lod_arrays(k);
+            let (jlh, jlm) = (
+                twin(lh, &lod_name(k, HEIGHTS))?,
+                twin(lm, &lod_name(k, METAS))?,
+            );
+            write_cell(&jlh, &lod_name(k, HEIGHTS), &[cy, cx], &chunk.heights)?;
+            write_cell(&jlm, &lod_name(k, METAS), &[cy, cx], &chunk.metas)?;
+            crash_point();
+            keys.push(lh.chunk_key(&[cy, cx]).to_string());
+            keys.push(lm.chunk_key(&[cy, cx]).to_string());
         }
         let cells: Vec<(u64, u64)> = chunks.iter().map(|&(y, x, _)| (y, x)).collect();
         for idx in store.write_summaries_into(&js, &all, Some(&cells))? {

@@ -67,6 +67,8 @@ pub struct WorldStore {
     pub(crate) heights: StoreArray,
     pub(crate) metas: StoreArray,
     pub(crate) summary: StoreArray,
+    /// Complete level-of-detail levels 1.. (`lod.rs`).
+    pub(crate) lods: Vec<crate::lod::LodArrays>,
 }
 
 impl std::fmt::Debug for WorldStore {
@@ -216,6 +218,7 @@ impl WorldStore {
             SUMMARY_FIELDS as u64,
         ];
         check_array(&summary, SUMMARY, "uint32", &sshape, &schunk)?;
+        let lods = crate::lod::open_levels(&storage, (w, h, (ch, cw)))?;
         Ok(WorldStore {
             storage,
             what: what.into(),
@@ -223,6 +226,7 @@ impl WorldStore {
             heights,
             metas,
             summary,
+            lods,
         })
     }
 
@@ -345,13 +349,14 @@ impl WorldStore {
                 .store_chunk_opt(&[0], bytes, &write_options())
                 .map_err(|e| StoreError::chunk(VPR, &[0], e))?;
         }
-        let store = WorldStore {
+        let mut store = WorldStore {
             storage,
             what: what.into(),
             attrs,
             heights,
             metas,
             summary,
+            lods: Vec::new(),
         };
         let cells: Vec<(u64, u64)> = (0..gy).flat_map(|y| (0..gx).map(move |x| (y, x))).collect();
         let summaries: Vec<ChunkSummary> = map_cells(&cells, &|&(cy, cx)| {
@@ -372,6 +377,7 @@ impl WorldStore {
             ))
         })?;
         store.write_summaries_into(&store.summary, &summaries, None)?;
+        store.build_lods(&|_, _| {})?;
         // The group last: a store with a root zarr.json is complete.
         group
             .store_metadata()
@@ -682,18 +688,21 @@ fn grid_of(a: &WorldAttrs) -> (u64, u64) {
 /// `f` over every grid cell: in parallel, except on wasm32, where zarrs'
 /// storage is not Send/Sync.
 #[cfg(not(target_arch = "wasm32"))]
-type CellFn<'a, T> = dyn Fn(&(u64, u64)) -> Result<T, StoreError> + Sync + 'a;
+pub(crate) type CellFn<'a, T> = dyn Fn(&(u64, u64)) -> Result<T, StoreError> + Sync + 'a;
 
 #[cfg(not(target_arch = "wasm32"))]
-fn map_cells<T: Send>(cells: &[(u64, u64)], f: &CellFn<'_, T>) -> Result<Vec<T>, StoreError> {
+pub(crate) fn map_cells<T: Send>(
+    cells: &[(u64, u64)],
+    f: &CellFn<'_, T>,
+) -> Result<Vec<T>, StoreError> {
     cells.par_iter().map(f).collect()
 }
 
 #[cfg(target_arch = "wasm32")]
-type CellFn<'a, T> = dyn Fn(&(u64, u64)) -> Result<T, StoreError> + 'a;
+pub(crate) type CellFn<'a, T> = dyn Fn(&(u64, u64)) -> Result<T, StoreError> + 'a;
 
 #[cfg(target_arch = "wasm32")]
-fn map_cells<T>(cells: &[(u64, u64)], f: &CellFn<'_, T>) -> Result<Vec<T>, StoreError> {
+pub(crate) fn map_cells<T>(cells: &[(u64, u64)], f: &CellFn<'_, T>) -> Result<Vec<T>, StoreError> {
     cells.iter().map(f).collect()
 }
 
