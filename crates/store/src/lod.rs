@@ -7,8 +7,9 @@
 //!
 //! The `lod` group's attribute `strata_lod` (`{"levels": K}`) is written
 //! last: a store whose build stopped part-way reads as having none. A store
-//! without the group (older, or converted without them) opens as before;
-//! `strata convert --lod DIR` adds them. Edit batches rewrite the coarse
+//! without the group opens as before. They are built on demand
+//! ([`crate::DirStore::build_lods`]); the paged renderer's level of detail
+//! that reads them is not on `main` yet. Edit batches rewrite the coarse
 //! chunks over the edited ones in the same all-or-nothing batch (`fs.rs`).
 //!
 //! They are written with gzip level 1: a 65536² world adds a third of its

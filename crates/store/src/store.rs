@@ -349,7 +349,7 @@ impl WorldStore {
                 .store_chunk_opt(&[0], bytes, &write_options())
                 .map_err(|e| StoreError::chunk(VPR, &[0], e))?;
         }
-        let mut store = WorldStore {
+        let store = WorldStore {
             storage,
             what: what.into(),
             attrs,
@@ -377,7 +377,6 @@ impl WorldStore {
             ))
         })?;
         store.write_summaries_into(&store.summary, &summaries, None)?;
-        store.build_lods(&|_, _| {})?;
         // The group last: a store with a root zarr.json is complete.
         group
             .store_metadata()

@@ -61,6 +61,8 @@ fn coarse_levels_equal_the_halved_map_and_follow_edits() {
     .unwrap();
     let dir = root.join("s");
     let store = DirStore::create(&dir, &world, &Layout::default()).unwrap();
+    assert_eq!(store.store().lod_levels(), 0, "levels are built on demand");
+    let store = DirStore::build_lods(&dir, &|_, _| {}).unwrap();
     assert_eq!(store.store().possible_lod_levels(), 2);
     check(&store, &world.level);
     // Edit batches rewrite the coarse chunks over them in the same batch.
@@ -101,6 +103,7 @@ fn a_store_whose_levels_never_completed_reads_as_having_none() {
     .unwrap();
     let dir = root.join("s");
     DirStore::create(&dir, &world, &Layout::default()).unwrap();
+    DirStore::build_lods(&dir, &|_, _| {}).unwrap();
     // The group attribute is written last: without it, the levels do not count.
     let group = dir.join("lod").join("zarr.json");
     let mut json: serde_json::Value =
