@@ -33,7 +33,7 @@ pub fn pair_top(h_even: u8, h_odd: u8, m_even: u8, m_odd: u8) -> u8 {
 /// top), (left, bottom), (right, bottom).
 pub fn halve(heights: &[u8], metas: &[u8], width: usize, height: usize) -> (Vec<u8>, Vec<u8>) {
     assert!(
-        width % 4 == 0 && height % 2 == 0,
+        width.is_multiple_of(4) && height.is_multiple_of(2),
         "halve needs a width that is a multiple of 4 and an even height, got {width}x{height}"
     );
     assert!(heights.len() == width * height && metas.len() == width * height);
