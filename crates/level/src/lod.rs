@@ -58,6 +58,22 @@ pub fn halve(heights: &[u8], metas: &[u8], width: usize, height: usize) -> (Vec<
     (out_h, out_m)
 }
 
+/// Most coarse levels kept: level 8 stands one texel for a 256-texel tile,
+/// the coarsest tile the renderers' pyramids keep anyway.
+pub const MAX_LOD: u32 = 8;
+
+/// Coarse levels a map of `width` x `height` texels in chunks of
+/// `chunk_width` x `chunk_height` can have: until a level is one chunk
+/// across or down, at most [`MAX_LOD`]; none when the chunk width is not a
+/// multiple of 4 or its height odd (pairs are halved).
+pub fn possible_levels(width: u32, height: u32, chunk_width: u32, chunk_height: u32) -> u32 {
+    if !chunk_width.is_multiple_of(4) || !chunk_height.is_multiple_of(2) || chunk_width == 0 {
+        return 0;
+    }
+    let (gy, gx) = (height / chunk_height, width / chunk_width);
+    gy.min(gx).max(1).ilog2().min(MAX_LOD)
+}
+
 /// One `side` x `side` chunk of a coarser level from the four chunks of the
 /// level below it covers, `[top-left, top-right, bottom-left,
 /// bottom-right]`, each `side` x `side` planes `(heights, metas)`.

@@ -25,3 +25,20 @@ fn page_pixel_end(missed: bool) {}
 
 // Count a shadow texel cast through a missing page (paged only).
 fn page_shadow_end(missed: bool) {}
+
+// Level of detail (paged only): the whole map is marched and shaded at its
+// texels.
+fn lod_camera_rays() {}
+
+fn lod_shadow_rays() {}
+
+// Called at each step of the march at ray parameter `t`: the level of
+// detail there.
+fn exact_lod_at(t: f32) -> u32 {
+    return 0u;
+}
+
+// The level a hit at `t` is shaded at.
+fn exact_shade_level(t: f32) -> u32 {
+    return 0u;
+}

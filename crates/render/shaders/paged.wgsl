@@ -22,18 +22,34 @@ struct PagedParams {
     // first byte of page pyramid level k within a slot's pyramid, at
     // [k / 4][k % 4]
     offsets: array<vec4<u32>, 2>,
+    // level of detail: x pixels of footprint per unit of a camera ray's t
+    // (1 / the LOD's pixel tolerance; 0: off), y the same per shadow-map
+    // texel, z/w unused
+    lod: vec4<f32>,
+    // the first page id of level k, at [k / 4][k % 4] (level 0: the chunks);
+    // [2].w: the coarsest level kept
+    lod_pages: array<vec4<u32>, 3>,
 }
 
-// Per chunk: its slot + 1, 0 while not resident.
+// Per page (the chunks, then each coarser level's pages): its slot + 1, 0
+// while not resident.
 @group(1) @binding(9) var<storage, read> page_table: array<u32>;
 // [0] pending pixels, [1] requests, [2] pending shadow texels, [3 ..) the
-// requested chunks, then one
-// stamp per slot (the last frame that read it) and one per chunk (the last
+// requested pages, then one
+// stamp per slot (the last frame that read it) and one per page (the last
 // frame that asked for it).
 @group(1) @binding(10) var<storage, read_write> page_feedback: array<atomic<u32>>;
-@group(1) @binding(11) var<uniform> paged: PagedParams;
+// A storage buffer, not a uniform: lavapipe (Mesa 22.3) specialises shaders
+// on the values of small uniform buffers that steer their control flow, and
+// the march over pages took it to a crash there (every GPU reads it as
+// cheaply either way).
+@group(1) @binding(11) var<storage, read> paged: PagedParams;
 // The coarse level and the slot pyramids, bytes in words.
 @group(1) @binding(1) var<storage, read> maxmip: array<u32>;
+
+// The level of detail the exact march reads columns at now
+// (`paged_levels.wgsl`'s `exact_leaf`; 0: the map's texels).
+var<private> page_lod: u32 = 0u;
 
 // Whether this invocation read a chunk that was not resident.
 var<private> page_missed: bool;
@@ -57,19 +73,26 @@ fn paged_byte(i: u32) -> u32 {
     return (maxmip[i >> 2u] >> ((i & 3u) << 3u)) & 0xffu;
 }
 
-// The chunk holding texel (x, y), wrapped.
-fn paged_chunk(x: i32, y: i32) -> u32 {
-    let xx = u32(x) & (globals.level.x - 1u);
-    let yy = u32(y) & (globals.level.y - 1u);
-    return (xx >> 8u) + ((yy >> 8u) << paged.grid.x);
-}
-
 // The highest top of `chunk` (always resident).
 fn paged_chunk_top(chunk: u32) -> u32 {
     return paged_byte(chunk);
 }
 
-// `chunk`'s slot + 1, or 0 after asking for it.
+// The page of level `level` holding its texel (bx, by) (already wrapped to
+// the level's size: the map's halved `level` times).
+fn paged_page(level: u32, bx: u32, by: u32) -> u32 {
+    let first = paged.lod_pages[level >> 2u][level & 3u];
+    return first + (bx >> 8u) + ((by >> 8u) << (paged.grid.x - level));
+}
+
+// The chunk (level-0 page) holding texel (bx, by) of level `level` (<= 8).
+fn paged_chunk_of(level: u32, bx: u32, by: u32) -> u32 {
+    let s = 8u - level;
+    return (bx >> s) + ((by >> s) << paged.grid.x);
+}
+
+// Page `chunk`'s slot + 1 (a chunk's, or a coarser level's page), or 0
+// after asking for it.
 fn paged_slot(chunk: u32) -> u32 {
     if (chunk == page_cached_chunk) {
         if (page_cached_entry == 0u) {

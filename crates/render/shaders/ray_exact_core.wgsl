@@ -86,13 +86,18 @@ fn exact_march(o: vec3<f32>, base: vec2<i32>, d: vec3<f32>, t0: f32, t1: f32) ->
             return r;
         }
         r.iterations = r.iterations + 1u;
+        // Paged terrain: the level of detail at t (0 on the whole map). Tiles
+        // no larger than its texels are columns: a coarse texel's column
+        // stands for its whole block, so descending into it finds nothing
+        // new (and a grazing ray would step its plateau texel by texel).
+        let leaf = exact_lod_at(t);
         let shift = lvl * ratio;
         let size = f32(1u << shift);
         let edge = vec2<f32>(cell + far_side) * size;
         let tb = select((edge - o.xy) * inv, vec2<f32>(EXACT_BIG), still);
         let t_exit = min(tb.x, tb.y);
         let t_out = min(t_exit, t1);
-        if (lvl > 0u) {
+        if (lvl > 0u && shift > leaf) {
             let z_min = min(o.z + d.z * t, o.z + d.z * t_out);
             let tile = (base >> vec2<u32>(shift)) + cell;
             if (z_min <= maxmip_get(shift, tile.x, tile.y)) {
@@ -104,7 +109,8 @@ fn exact_march(o: vec3<f32>, base: vec2<i32>, d: vec3<f32>, t0: f32, t1: f32) ->
                 continue;
             }
         } else {
-            let column = base + cell;
+            // The tile's first texel (the tile itself at level 0).
+            let column = base + (cell << vec2<u32>(shift));
             let c = decode_column(column.x, column.y);
             let e = column_entry(c, o.z, d.z, t, t_out);
             if (e.x >= 0.0) {

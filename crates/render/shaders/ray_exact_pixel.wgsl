@@ -21,6 +21,7 @@ struct ExactPixel {
 // The march of pixel (px, py): the hit (its `t` along `camera_ray`, column
 // absolute) or a miss.
 fn exact_pixel_hit(px: f32, py: f32) -> ExactHit {
+    lod_camera_rays();
     let eye = globals.eye.xyz;
     let d = camera_ray(px, py);
     let focal = globals.eye.w;
@@ -35,7 +36,10 @@ fn exact_pixel_shade(px: f32, py: f32, t: f32, column: vec2<i32>) -> ExactPixel 
     let d = camera_ray(px, py);
     let p = globals.eye.xyz + d * t;
     var out: ExactPixel;
-    out.color = vec4<f32>(shade_column(p, column.x, column.y, d), 1.0);
+    // Paged terrain shades far hits from the coarse copy the march read there.
+    let level = exact_shade_level(t);
+    let block = column >> vec2<u32>(level);
+    out.color = vec4<f32>(shade_column_at(p, level, block.x, block.y, d), 1.0);
     out.depth = view_z_to_depth(t * globals.eye.w);
     return out;
 }

@@ -31,6 +31,7 @@ fn cast_texel(id: vec2<u32>) {
     let base = exact_base(p.xy);
     let rel = vec3<f32>(p.xy - vec2<f32>(base), p.z);
     page_pixel_begin();
+    lod_shadow_rays();
     let h = exact_march(rel, base, d, 0.0, t_out - t_in);
     page_shadow_end(page_pixel_missed());
     textureStore(shadow_out, id, vec4<f32>(select(SHADOW_MISS, t_in + h.t, h.hit), 0.0, 0.0, 0.0));

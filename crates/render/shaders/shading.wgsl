@@ -45,7 +45,11 @@ fn surface_kind(c: Column, z: f32, dir_z: f32) -> u32 {
 // The altitude field of one interval at texel (x, y); where a neighbour has
 // no slab, the slab fields take `fallback` so its edge does not tilt.
 fn interval_field(x: i32, y: i32, kind: u32, fallback: f32) -> f32 {
-    let c = decode_column(x, y);
+    return interval_field_at(0u, x, y, kind, fallback);
+}
+
+fn interval_field_at(level: u32, x: i32, y: i32, kind: u32, fallback: f32) -> f32 {
+    let c = decode_column_at(level, x, y);
     if (kind == SURFACE_FLOOR) {
         return c.low;
     }
@@ -59,8 +63,15 @@ fn interval_field(x: i32, y: i32, kind: u32, fallback: f32) -> f32 {
 // floors and slab tops, down for cave ceilings. Steep differences tilt it
 // towards horizontal, which is what a wall gets.
 fn surface_normal(x: i32, y: i32, kind: u32, here: f32) -> vec3<f32> {
-    let gx = 0.5 * (interval_field(x + 1, y, kind, here) - interval_field(x - 1, y, kind, here));
-    let gy = 0.5 * (interval_field(x, y + 1, kind, here) - interval_field(x, y - 1, kind, here));
+    return surface_normal_at(0u, x, y, kind, here);
+}
+
+// `surface_normal` at texel (x, y) of level of detail `level`, whose texels
+// are 2^level units apart.
+fn surface_normal_at(level: u32, x: i32, y: i32, kind: u32, here: f32) -> vec3<f32> {
+    let spacing = f32(1u << level);
+    let gx = 0.5 * (interval_field_at(level, x + 1, y, kind, here) - interval_field_at(level, x - 1, y, kind, here)) / spacing;
+    let gy = 0.5 * (interval_field_at(level, x, y + 1, kind, here) - interval_field_at(level, x, y - 1, kind, here)) / spacing;
     if (kind == SURFACE_CEILING) {
         return normalize(vec3<f32>(gx, gy, -1.0));
     }
@@ -134,9 +145,14 @@ fn shade(p: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
 // on a column's side lies on the texel line, where `floor(p)` may name the
 // neighbour the ray came from.
 fn shade_column(p: vec3<f32>, x: i32, y: i32, dir: vec3<f32>) -> vec3<f32> {
-    let c = decode_column(x, y);
+    return shade_column_at(p, 0u, x, y, dir);
+}
+
+// `shade_column` for a hit on texel (x, y) of level of detail `level`.
+fn shade_column_at(p: vec3<f32>, level: u32, x: i32, y: i32, dir: vec3<f32>) -> vec3<f32> {
+    let c = decode_column_at(level, x, y);
     let kind = surface_kind(c, p.z, dir.z);
     let here = select(c.high, c.mid, kind == SURFACE_CEILING);
-    let n = surface_normal(x, y, kind, here);
+    let n = surface_normal_at(level, x, y, kind, here);
     return shade_with_normal(p, c, kind, n);
 }

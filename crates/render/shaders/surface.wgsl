@@ -15,8 +15,17 @@ struct Column {
     upper_type: u32,
 }
 
+// The column at texel (x, y). Paged terrain's exact march may read it from
+// a coarser copy of the map (`fetch_level`): the column of the block of
+// 2^level texels holding (x, y).
 fn decode_column(x: i32, y: i32) -> Column {
-    let p = terrain_pair(x, y);
+    let level = fetch_level();
+    return decode_column_at(level, x >> level, y >> level);
+}
+
+// The column at texel (x, y) of level of detail `level` (0: the map).
+fn decode_column_at(level: u32, x: i32, y: i32) -> Column {
+    let p = terrain_pair_at(level, x, y);
     var c: Column;
     // The one pair rule: dual iff both texels carry the flag.
     if ((p.y & p.w & META_DOUBLE_LEVEL) != 0u) {

@@ -14,3 +14,14 @@ fn terrain_pair(x: i32, y: i32) -> vec4<u32> {
     let row = yy & ((1u << shift) - 1u);
     return textureLoad(terrain, vec2<u32>(px, row), layer, 0);
 }
+
+// The pair at texel (x, y) of level of detail `level`: the whole map has
+// level 0 only (paged terrain has coarser levels: `paged_fetch.wgsl`).
+fn terrain_pair_at(level: u32, x: i32, y: i32) -> vec4<u32> {
+    return terrain_pair(x, y);
+}
+
+// The level `decode_column` reads at: the whole map has its texels only.
+fn fetch_level() -> u32 {
+    return 0u;
+}

@@ -29,9 +29,7 @@ use zarrs::group::{Group, GroupBuilder};
 pub const LOD_GROUP: &str = "lod";
 /// The group attribute that says how many levels are complete.
 pub const LOD_ATTR: &str = "strata_lod";
-/// Most levels kept: level 8 stands one texel for a 256-texel tile, the
-/// coarsest tile the renderers' pyramids keep anyway.
-pub const MAX_LOD: u32 = 8;
+pub use strata_level::lod::MAX_LOD;
 /// gzip level of the coarse chunks (see the module docs).
 const LOD_GZIP: u32 = 1;
 
@@ -43,16 +41,10 @@ pub fn lod_name(k: u32, plane: &str) -> String {
 /// The two arrays of one level.
 pub(crate) type LodArrays = (StoreArray, StoreArray);
 
-/// Levels a world of `width` x `height` texels in `chunk` chunks can have:
-/// until a level is one chunk across or down, at most [`MAX_LOD`]; none
-/// when the chunk width is not a multiple of 4 (pairs are halved).
+/// Levels a world of `width` x `height` texels in `chunk` (rows, columns)
+/// chunks can have ([`strata_level::lod::possible_levels`]).
 pub fn possible_levels(width: u32, height: u32, chunk: (u32, u32)) -> u32 {
-    let (ch, cw) = chunk;
-    if cw % 4 != 0 || ch % 2 != 0 {
-        return 0;
-    }
-    let (gy, gx) = (height / ch, width / cw);
-    gy.min(gx).max(1).ilog2().min(MAX_LOD)
+    strata_level::lod::possible_levels(width, height, chunk.1, chunk.0)
 }
 
 fn level_shape(store: &WorldStore, k: u32) -> (Vec<u64>, Vec<u64>) {
@@ -264,6 +256,7 @@ impl WorldStore {
     /// The coarse chunks that change when the map's chunks `changed` are
     /// replaced: `(k, cy, cx, chunk)` for every level, the merge of the new
     /// chunks and the stored ones beside them.
+    #[cfg_attr(not(feature = "fs"), allow(dead_code))]
     pub(crate) fn lod_updates(
         &self,
         changed: &[(u64, u64, Chunk)],
@@ -289,6 +282,7 @@ impl WorldStore {
     }
 
     /// The arrays of level `k` (1-based).
+    #[cfg_attr(not(feature = "fs"), allow(dead_code))]
     pub(crate) fn lod_arrays(&self, k: u32) -> &LodArrays {
         &self.lods[k as usize - 1]
     }

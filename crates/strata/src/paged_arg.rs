@@ -26,6 +26,21 @@ pub struct PagedArgs {
     /// Most pages uploaded per frame.
     #[arg(long, default_value_t = 64)]
     pub upload_pages: u32,
+    /// Level of detail of paged terrain: far columns come from coarser
+    /// copies of the map where a texel of them spans at most this many
+    /// pixels; 0 reads every ray from the map's own texels.
+    #[arg(long, value_name = "PIXELS", default_value_t = 1.0, value_parser = parse_lod_pixels)]
+    pub lod_pixels: f32,
+}
+
+/// A pixel tolerance: 0 (off) or a positive, finite number.
+fn parse_lod_pixels(text: &str) -> Result<f32, String> {
+    match text.trim().parse::<f32>() {
+        Ok(p) if p.is_finite() && p >= 0.0 => Ok(p),
+        _ => Err(format!(
+            "`{text}` is not a pixel tolerance (0 turns the level of detail off; 1 is a texel per pixel)"
+        )),
+    }
 }
 
 /// `123`, `64KiB`, `256MiB`, `1GiB` (also `KB`/`MB`/`GB` as powers of 1000).
@@ -105,6 +120,7 @@ impl PagedWorld {
                 .gpu_budget
                 .unwrap_or(strata_render::paged::DEFAULT_GPU_BUDGET),
             upload_pages: args.upload_pages,
+            lod_pixels: args.lod_pixels,
             ..Default::default()
         }
     }

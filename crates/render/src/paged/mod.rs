@@ -29,14 +29,30 @@
 //!   read-back copy, the parameters). The frame's own targets and shadow map
 //!   are the renderer's, the same for every world, and reported apart.
 //!
+//! - **level of detail**: a source may also have coarser copies of the map
+//!   (`strata_level::lod`: level k holds the highest-topped texel pair of
+//!   each 2^k block; a store keeps them as `lod/{k}` arrays). Their pages
+//!   have ids after the chunks' ([`PageIds`]) and share the atlas. Where a
+//!   camera ray's footprint has grown to 2^k texels ([`PagedOptions::lod_pixels`]
+//!   pixels of it), the exact march reads level k: a tile of 2^k texels is
+//!   one column, tile maxima come from level k's page pyramids; shadow rays
+//!   take the level of a shadow-map texel. A horizon view then reads a few
+//!   pages per octave of distance instead of every chunk out to the far
+//!   plane. Its error against the CPU reference is measured
+//!   (`tests/paged.rs`, `strata fly`), not assumed.
+//!
 //! With the camera still, pending pixels fall to zero within a few frames and
-//! the image then equals the whole-world render bit for bit: the march and
-//! shading are the same WGSL over the same bytes (tested on lavapipe).
+//! the image then equals the whole-world render bit for bit where no ray's
+//! footprint reaches 2 texels (the paper's far plane of 600 never does: the
+//! focal length is 512 pixels): the march and shading are the same WGSL over
+//! the same bytes (tested on lavapipe).
 
+pub mod pages;
 pub mod residency;
 pub mod source;
 pub mod streamer;
 
+pub use pages::PageIds;
 pub use residency::{BudgetPlan, Residency};
 #[cfg(not(target_arch = "wasm32"))]
 pub use source::StorePages;
@@ -67,6 +83,13 @@ pub struct PagedOptions {
     /// Tries before a chunk that fails to read is given up (its pixels stay
     /// pending; the error is reported once).
     pub read_tries: u32,
+    /// Level of detail: a ray takes coarser copies of the map
+    /// (`strata_level::lod`) where its footprint is 2^k texels of at most
+    /// this many pixels (1: a coarse texel is never wider than a pixel);
+    /// 0 draws every ray from the map's texels. A far plane of 600 (the
+    /// paper's) never reaches a footprint of 2 texels at the fixed focal
+    /// length of 512 pixels, so the protocol's images are unchanged.
+    pub lod_pixels: f32,
 }
 
 impl Default for PagedOptions {
@@ -76,6 +99,7 @@ impl Default for PagedOptions {
             upload_pages: 64,
             threads: std::thread::available_parallelism().map_or(1, |n| n.get().clamp(1, 4)),
             read_tries: 3,
+            lod_pixels: 1.0,
         }
     }
 }
@@ -90,6 +114,8 @@ struct PagedParams {
     grid: [u32; 4],
     atlas: [u32; 4],
     offsets: [[u32; 4]; 2],
+    lod: [f32; 4],
+    lod_pages: [[u32; 4]; 3],
 }
 
 /// What the paging did, for reports and the viewer's overlay.
@@ -134,6 +160,8 @@ pub struct PagedTerrain {
     source: Arc<dyn PageSource>,
     /// Chunks across and down.
     grid: (u32, u32),
+    /// Ids of the pages of every level.
+    ids: PageIds,
     step: u32,
     options: PagedOptions,
     atlas: wgpu::Texture,
@@ -184,10 +212,12 @@ impl PagedTerrain {
     ) -> anyhow::Result<(TerrainTexture, BudgetPlan)> {
         let (w, h) = source.size();
         let chunks = (w / PAGE) * (h / PAGE);
+        let ids = page_ids(source, options);
         let limits = device.limits();
         let plan = BudgetPlan::new(
             options.gpu_budget,
             chunks,
+            ids.total(),
             page_pyramid_layout(step).bytes,
             std::mem::size_of::<PagedParams>() as u64,
             limits.max_texture_array_layers,
@@ -267,7 +297,15 @@ impl PagedTerrain {
         };
         let levels = buffer("page levels", plan.levels_bytes, U::STORAGE | U::COPY_DST);
         let table = buffer("page table", plan.table_bytes, U::STORAGE | U::COPY_DST);
-        let feedback_words = FEEDBACK_HEADER + MAX_REQUESTS + plan.slots + plan.chunks;
+        let ids = page_ids(source.as_ref(), &options);
+        if ids.total() != plan.pages {
+            anyhow::bail!(
+                "the plan counts {} pages; the source has {}",
+                plan.pages,
+                ids.total()
+            );
+        }
+        let feedback_words = FEEDBACK_HEADER + MAX_REQUESTS + plan.slots + plan.pages;
         let feedback = buffer(
             "page feedback",
             4 * u64::from(feedback_words),
@@ -286,7 +324,7 @@ impl PagedTerrain {
                 offsets[k / 4][k % 4] = info.offset;
             }
         }
-        let params = PagedParams {
+        let params_data = PagedParams {
             grid: [
                 grid.0.ilog2(),
                 plan.chunks.div_ceil(4) * 4,
@@ -300,13 +338,33 @@ impl PagedTerrain {
                 FEEDBACK_HEADER + MAX_REQUESTS + plan.slots,
             ],
             offsets,
+            lod: [
+                options.lod_pixels.recip().min(1e6) * f32::from(options.lod_pixels > 0.0),
+                options.lod_pixels.recip().min(1e6) * f32::from(options.lod_pixels > 0.0),
+                0.0,
+                0.0,
+            ],
+            lod_pages: {
+                let mut first = ids.first_ids();
+                first[2][3] = ids.levels();
+                first
+            },
         };
-        let params = shared.uniform_buffer("paged params", bytemuck::bytes_of(&params));
+        // Storage, not uniform: see `paged.wgsl`.
+        let params = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("paged params"),
+            size: std::mem::size_of::<PagedParams>() as u64,
+            usage: U::STORAGE | U::COPY_DST,
+            mapped_at_creation: false,
+        });
+        shared
+            .queue
+            .write_buffer(&params, 0, bytemuck::bytes_of(&params_data));
         let mut padded = tops.clone();
         padded.resize(tops.len().div_ceil(4) * 4, 0);
         shared.queue.write_buffer(&levels, 0, &padded);
         // Buffers start zeroed: nothing resident, nothing asked for.
-        let streamer = Streamer::new(source.clone(), step, options.threads);
+        let streamer = Streamer::new(source.clone(), ids, step, options.threads);
         let stats = PagingStats {
             gpu_budget: plan.budget,
             gpu_bytes: plan.total(),
@@ -317,6 +375,7 @@ impl PagedTerrain {
             plan,
             source,
             grid,
+            ids,
             step,
             options,
             atlas: shared.terrain.texture.clone(),
@@ -325,7 +384,7 @@ impl PagedTerrain {
             feedback,
             params,
             readback,
-            residency: Residency::new(plan.chunks, plan.slots),
+            residency: Residency::new(plan.pages, plan.slots),
             tops,
             streamer,
             stamp: 0,
@@ -407,7 +466,7 @@ impl PagedTerrain {
         self.requested = list
             .iter()
             .copied()
-            .filter(|&c| c < self.plan.chunks)
+            .filter(|&c| c < self.plan.pages)
             .collect();
         let first_stamp = (FEEDBACK_HEADER + MAX_REQUESTS) as usize;
         for (slot, &s) in words[first_stamp..].iter().enumerate() {
@@ -424,7 +483,7 @@ impl PagedTerrain {
     /// none given up, at most what the atlas can take.
     fn wanted(&self, camera: &Camera) -> Vec<u32> {
         let eye = camera.position.truncate();
-        let dist = |c: u32| chunk_distance(self.grid, eye, c);
+        let dist = |c: u32| self.ids.distance(eye, c);
         let usable = |c: &u32| {
             self.residency.slot_of(*c).is_none()
                 && self
@@ -498,9 +557,8 @@ impl PagedTerrain {
                     if *tries == self.options.read_tries {
                         self.stats.read_errors += 1;
                         if self.stats.first_error.is_none() {
-                            let (cx, cy) = (chunk % self.grid.0, chunk / self.grid.0);
                             self.stats.first_error =
-                                Some(format!("chunk ({cx}, {cy}) failed to read: {e}"));
+                                Some(format!("{} failed to read: {e}", self.describe(chunk)));
                         }
                     }
                 }
@@ -512,8 +570,8 @@ impl PagedTerrain {
     fn place(&mut self, shared: &Shared, chunk: u32, page: &PageData) {
         let keep_from = self.read_stamp;
         let eye = self.eye;
-        let grid = self.grid;
-        let distance = move |c: u32| chunk_distance(grid, eye, c);
+        let ids = self.ids;
+        let distance = move |c: u32| ids.distance(eye, c);
         let Some(placed) = self.residency.place(chunk, self.stamp, keep_from, distance) else {
             return;
         };
@@ -563,10 +621,11 @@ impl PagedTerrain {
             .write_buffer(&self.table, 4 * u64::from(chunk), bytemuck::bytes_of(&e));
     }
 
-    /// The source changed inside `chunks` (an edit, already written there):
-    /// refresh their coarse level and the resident pages now, so the next
-    /// frame shows the edit.
+    /// The source changed inside `chunks` (an edit, already written there,
+    /// coarse levels included): refresh their coarse level and the resident
+    /// pages over them, of every level, now, so the next frame shows the edit.
     pub fn refresh(&mut self, shared: &Shared, chunks: &[u32]) -> anyhow::Result<()> {
+        let mut coarse = Vec::new();
         for &chunk in chunks {
             if chunk >= self.plan.chunks {
                 anyhow::bail!(
@@ -574,11 +633,7 @@ impl PagedTerrain {
                     self.plan.chunks
                 );
             }
-            let (cx, cy) = (chunk % self.grid.0, chunk / self.grid.0);
-            let page = self
-                .source
-                .read_page(cx, cy, self.step)
-                .map_err(|e| anyhow::anyhow!("re-reading chunk ({cx}, {cy}) after an edit: {e}"))?;
+            let page = self.reread(shared, chunk)?;
             let top = page.top(self.step);
             if self.tops[chunk as usize] != top {
                 self.tops[chunk as usize] = top;
@@ -590,27 +645,62 @@ impl PagedTerrain {
                 }
                 shared.queue.write_buffer(&self.levels, w as u64, &word);
             }
-            if let Some(slot) = self.residency.slot_of(chunk) {
-                self.write_page(shared, slot, &page);
-            } else if self.streamer.is_in_flight(chunk) {
-                self.stale.insert(chunk);
+            coarse.extend(self.ids.above(chunk));
+        }
+        coarse.sort_unstable();
+        coarse.dedup();
+        for page in coarse {
+            // Only what the GPU holds or is reading: the rest reads fresh.
+            if self.residency.slot_of(page).is_some() || self.streamer.is_in_flight(page) {
+                self.reread(shared, page)?;
             }
-            self.failures.remove(&chunk);
         }
         Ok(())
     }
+
+    /// Read page `id` again after an edit: rewrite its slot if resident,
+    /// drop a read in flight (it may predate the edit).
+    fn reread(&mut self, shared: &Shared, id: u32) -> anyhow::Result<PageData> {
+        let (level, cx, cy) = self
+            .ids
+            .locate(id)
+            .ok_or_else(|| anyhow::anyhow!("page {id} is outside the world"))?;
+        let page = self
+            .source
+            .read_lod_page(level, cx, cy, self.step)
+            .map_err(|e| anyhow::anyhow!("re-reading {} after an edit: {e}", self.describe(id)))?;
+        if let Some(slot) = self.residency.slot_of(id) {
+            self.write_page(shared, slot, &page);
+        } else if self.streamer.is_in_flight(id) {
+            self.stale.insert(id);
+        }
+        self.failures.remove(&id);
+        Ok(page)
+    }
+
+    /// Page `id` in words: "chunk (x, y)", or "level-of-detail 2 page (x, y)".
+    fn describe(&self, id: u32) -> String {
+        match self.ids.locate(id) {
+            Some((0, cx, cy)) => format!("chunk ({cx}, {cy})"),
+            Some((k, cx, cy)) => format!("level-of-detail {k} page ({cx}, {cy})"),
+            None => format!("page {id}"),
+        }
+    }
+
+    /// The ids of the pages of every level.
+    pub fn ids(&self) -> &PageIds {
+        &self.ids
+    }
 }
 
-/// Squared distance from `eye` to the nearest wrapped copy of chunk `c`'s
-/// centre, on a grid of `grid` chunks.
-fn chunk_distance(grid: (u32, u32), eye: glam::Vec2, c: u32) -> f32 {
-    let (cx, cy) = (c % grid.0, c / grid.0);
-    let axis = |i: u32, n: u32, e: f32| {
-        let span = (n * PAGE) as f32;
-        let d = (i * PAGE + PAGE / 2) as f32 - e;
-        d - span * (d / span).round()
+/// The page ids of `source` drawn with `options`: coarse levels only with
+/// the level of detail on.
+fn page_ids(source: &dyn PageSource, options: &PagedOptions) -> PageIds {
+    let (w, h) = source.size();
+    let levels = if options.lod_pixels > 0.0 {
+        source.lod_levels()
+    } else {
+        0
     };
-    let dx = axis(cx, grid.0, eye.x);
-    let dy = axis(cy, grid.1, eye.y);
-    dx * dx + dy * dy
+    PageIds::new((w / PAGE, h / PAGE), levels)
 }

@@ -27,6 +27,10 @@ pub struct BudgetPlan {
     pub budget: u64,
     /// Chunks in the world.
     pub chunks: u32,
+    /// Pages of every level ([`super::PageIds::total`]; the chunks when
+    /// there is no level of detail): the page table's and the feedback
+    /// stamps' length.
+    pub pages: u32,
     /// Atlas slots (pages resident at most).
     pub slots: u32,
     /// log2 of pages across one atlas layer.
@@ -42,9 +46,9 @@ pub struct BudgetPlan {
     /// Bytes of the level buffer: the coarse level (chunk tops, padded to 4)
     /// then every slot's pyramid.
     pub levels_bytes: u64,
-    /// Bytes of the page table (a word per chunk).
+    /// Bytes of the page table (a word per page).
     pub table_bytes: u64,
-    /// Bytes of the feedback buffer (header, request list, slot and chunk
+    /// Bytes of the feedback buffer (header, request list, slot and page
     /// stamps) and of its read-back copy.
     pub feedback_bytes: u64,
     /// Bytes of the parameters uniform.
@@ -62,12 +66,12 @@ impl BudgetPlan {
     }
 
     /// Bytes that do not depend on the slots.
-    fn fixed(chunks: u32, params_bytes: u64) -> u64 {
+    fn fixed(chunks: u32, pages: u32, params_bytes: u64) -> u64 {
         let tops = u64::from(chunks.div_ceil(4) * 4);
-        let table = 4 * u64::from(chunks);
-        // Feedback: header, request list, chunk stamps; its read-back copy
+        let table = 4 * u64::from(pages);
+        // Feedback: header, request list, page stamps; its read-back copy
         // holds the header and the list.
-        let feedback = 4 * u64::from(FEEDBACK_HEADER + MAX_REQUESTS + chunks)
+        let feedback = 4 * u64::from(FEEDBACK_HEADER + MAX_REQUESTS + pages)
             + 4 * u64::from(FEEDBACK_HEADER + MAX_REQUESTS);
         tops + table + feedback + params_bytes
     }
@@ -78,40 +82,44 @@ impl BudgetPlan {
         PAGE_ATLAS_BYTES + u64::from(pyramid_stride) + 8
     }
 
-    /// The smallest budget that works for a world of `chunks` chunks: the
-    /// fixed part and two slots (an atlas has at least two layers; see
-    /// `terrain.rs` on GL).
-    pub fn smallest(chunks: u32, pyramid_stride: u32, params_bytes: u64) -> u64 {
-        Self::fixed(chunks, params_bytes) + 2 * Self::per_slot(pyramid_stride)
+    /// The smallest budget that works for a world of `chunks` chunks and
+    /// `pages` pages of every level: the fixed part and two slots (an atlas
+    /// has at least two layers; see `terrain.rs` on GL).
+    pub fn smallest(chunks: u32, pages: u32, pyramid_stride: u32, params_bytes: u64) -> u64 {
+        Self::fixed(chunks, pages, params_bytes) + 2 * Self::per_slot(pyramid_stride)
     }
 
-    /// Spend `budget` bytes on a world of `chunks` chunks whose pages have
+    /// Spend `budget` bytes on a world of `chunks` chunks and `pages` pages
+    /// of every level (at least `chunks`), whose pages have
     /// pyramids of `pyramid_stride` bytes, within `max_layers` texture
     /// layers and `max_binding` bytes of storage binding. A budget below
     /// [`BudgetPlan::smallest`] is refused, naming that size.
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
         budget: u64,
         chunks: u32,
+        pages: u32,
         pyramid_stride: u32,
         params_bytes: u64,
         max_layers: u32,
         max_binding: u64,
     ) -> Result<Self, String> {
-        let smallest = Self::smallest(chunks, pyramid_stride, params_bytes);
+        let pages = pages.max(chunks);
+        let smallest = Self::smallest(chunks, pages, pyramid_stride, params_bytes);
         if budget < smallest {
             return Err(format!(
                 "a GPU budget of {budget} bytes cannot hold the coarse level, page table and feedback of {chunks} chunks plus two pages; the smallest budget that works is {smallest} bytes ({:.2} MiB)",
                 smallest as f64 / 1048576.0
             ));
         }
-        let fixed = Self::fixed(chunks, params_bytes);
+        let fixed = Self::fixed(chunks, pages, params_bytes);
         let per_slot = Self::per_slot(pyramid_stride);
         let tops = u64::from(chunks.div_ceil(4) * 4);
         // No more slots than chunks, layers or the level buffer's binding allow.
         let by_binding =
             (max_binding.saturating_sub(tops) / u64::from(pyramid_stride.max(1))) as u32;
         let most = (((budget - fixed) / per_slot) as u32)
-            .min(chunks.max(2))
+            .min(pages.max(2))
             .min(by_binding)
             .min(max_layers.saturating_mul(MAX_PER_LAYER));
         if most < 2 {
@@ -128,6 +136,7 @@ impl BudgetPlan {
         let plan = BudgetPlan {
             budget,
             chunks,
+            pages,
             slots,
             across_log2: across.ilog2(),
             per_layer_log2: per_layer.ilog2(),
@@ -135,8 +144,8 @@ impl BudgetPlan {
             pyramid_stride,
             atlas_bytes: u64::from(slots) * PAGE_ATLAS_BYTES,
             levels_bytes: tops + u64::from(slots) * u64::from(pyramid_stride),
-            table_bytes: 4 * u64::from(chunks),
-            feedback_bytes: 4 * u64::from(FEEDBACK_HEADER + MAX_REQUESTS + chunks + slots)
+            table_bytes: 4 * u64::from(pages),
+            feedback_bytes: 4 * u64::from(FEEDBACK_HEADER + MAX_REQUESTS + pages + slots)
                 + 4 * u64::from(FEEDBACK_HEADER + MAX_REQUESTS + slots),
             params_bytes,
         };
@@ -308,21 +317,22 @@ mod tests {
     fn plans_stay_within_the_budget_and_refuse_below_the_smallest() {
         for budget in [1u64 << 20, 3 << 20, 16 << 20, 256 << 20, 1 << 30] {
             for chunks in [4u32, 64, 512, 65536] {
-                match BudgetPlan::new(budget, chunks, 21848, 64, 256, 128 << 20) {
+                match BudgetPlan::new(budget, chunks, chunks, 21848, 64, 256, 128 << 20) {
                     Ok(p) => {
                         assert!(p.total() <= budget, "{p:?}");
                         assert!(p.slots >= 2 && p.layers >= 2, "{p:?}");
                         assert!(p.slots <= chunks.max(2), "{p:?}");
                     }
                     Err(e) => {
-                        let smallest = BudgetPlan::smallest(chunks, 21848, 64);
+                        let smallest = BudgetPlan::smallest(chunks, chunks, 21848, 64);
                         assert!(budget < smallest || e.contains("limits"), "{e}");
                         assert!(
                             e.contains(&smallest.to_string()) || e.contains("limits"),
                             "{e}"
                         );
                         assert!(
-                            BudgetPlan::new(smallest, chunks, 21848, 64, 256, 128 << 20).is_ok()
+                            BudgetPlan::new(smallest, chunks, chunks, 21848, 64, 256, 128 << 20)
+                                .is_ok()
                         );
                     }
                 }
@@ -332,7 +342,7 @@ mod tests {
 
     #[test]
     fn slots_tile_the_atlas_without_overlap() {
-        let p = BudgetPlan::new(64 << 20, 1024, 21848, 64, 256, 128 << 20).unwrap();
+        let p = BudgetPlan::new(64 << 20, 1024, 1024, 21848, 64, 256, 128 << 20).unwrap();
         let (across, down) = p.layer_pages();
         let mut seen = std::collections::HashSet::new();
         for s in 0..p.slots {

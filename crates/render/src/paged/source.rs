@@ -126,18 +126,38 @@ pub trait PageSource: Send + Sync {
 
     /// Chunk (`cx`, `cy`) as a page, its pyramid built with `step`.
     fn read_page(&self, cx: u32, cy: u32, step: u32) -> Result<PageData, String>;
+
+    /// Coarse levels of detail the source has (`strata_level::lod`: level
+    /// k is the map halved k times, cut in pages like the map); 0: none.
+    fn lod_levels(&self) -> u32 {
+        0
+    }
+
+    /// Page (`cx`, `cy`) of level `level` (0: [`PageSource::read_page`]).
+    fn read_lod_page(&self, level: u32, cx: u32, cy: u32, step: u32) -> Result<PageData, String> {
+        if level == 0 {
+            self.read_page(cx, cy, step)
+        } else {
+            Err(format!("this source has no level of detail {level}"))
+        }
+    }
 }
 
 /// Pages cut from a world in memory.
 pub struct LevelPages {
     level: Arc<Level>,
+    /// The coarse levels' planes, 1.., made at the first ask.
+    lods: std::sync::OnceLock<Vec<(Vec<u8>, Vec<u8>)>>,
 }
 
 impl LevelPages {
     /// Pages of `level` (refused below one page a side).
     pub fn new(level: Arc<Level>) -> anyhow::Result<Self> {
         check_size(level.width(), level.height())?;
-        Ok(LevelPages { level })
+        Ok(LevelPages {
+            level,
+            lods: std::sync::OnceLock::new(),
+        })
     }
 
     /// The world.
@@ -146,16 +166,32 @@ impl LevelPages {
     }
 
     fn planes(&self, cx: u32, cy: u32) -> (Vec<u8>, Vec<u8>) {
-        let w = self.level.width() as usize;
-        let (x0, y0) = ((cx * PAGE) as usize, (cy * PAGE) as usize);
-        let mut heights = Vec::with_capacity((PAGE * PAGE) as usize);
-        let mut metas = Vec::with_capacity((PAGE * PAGE) as usize);
-        for y in y0..y0 + PAGE as usize {
-            let row = y * w + x0..y * w + x0 + PAGE as usize;
-            heights.extend_from_slice(&self.level.heights()[row.clone()]);
-            metas.extend_from_slice(&self.level.metas()[row]);
-        }
-        (heights, metas)
+        cut_page(
+            self.level.heights(),
+            self.level.metas(),
+            self.level.width() as usize,
+            cx,
+            cy,
+        )
+    }
+
+    /// Every coarse level's planes, halving the map level by level.
+    fn lod_planes(&self) -> &[(Vec<u8>, Vec<u8>)] {
+        self.lods.get_or_init(|| {
+            let (mut w, mut h) = (self.level.width() as usize, self.level.height() as usize);
+            let mut out: Vec<(Vec<u8>, Vec<u8>)> = Vec::new();
+            for _ in 0..self.lod_levels() {
+                let (hs, ms) = match out.last() {
+                    Some((hs, ms)) => strata_level::lod::halve(hs, ms, w, h),
+                    None => {
+                        strata_level::lod::halve(self.level.heights(), self.level.metas(), w, h)
+                    }
+                };
+                out.push((hs, ms));
+                (w, h) = (w / 2, h / 2);
+            }
+            out
+        })
     }
 }
 
@@ -189,6 +225,43 @@ impl PageSource for LevelPages {
         let (heights, metas) = self.planes(cx, cy);
         PageData::from_planes(&heights, &metas, self.level.mid_rule, step)
     }
+
+    fn lod_levels(&self) -> u32 {
+        strata_level::lod::possible_levels(self.level.width(), self.level.height(), PAGE, PAGE)
+    }
+
+    fn read_lod_page(&self, level: u32, cx: u32, cy: u32, step: u32) -> Result<PageData, String> {
+        if level == 0 {
+            return self.read_page(cx, cy, step);
+        }
+        let Some((hs, ms)) = self.lod_planes().get(level as usize - 1) else {
+            return Err(format!(
+                "level of detail {level} asked for; this world has {}",
+                self.lod_levels()
+            ));
+        };
+        let w = (self.level.width() >> level) as usize;
+        if (cx + 1) * PAGE > w as u32 || (cy + 1) as usize * PAGE as usize * w > hs.len() {
+            return Err(format!(
+                "page ({cx}, {cy}) is outside level of detail {level}"
+            ));
+        }
+        let (heights, metas) = cut_page(hs, ms, w, cx, cy);
+        PageData::from_planes(&heights, &metas, self.level.mid_rule, step)
+    }
+}
+
+/// Page (`cx`, `cy`) of planes `width` texels wide.
+fn cut_page(hs: &[u8], ms: &[u8], width: usize, cx: u32, cy: u32) -> (Vec<u8>, Vec<u8>) {
+    let (x0, y0) = ((cx * PAGE) as usize, (cy * PAGE) as usize);
+    let mut heights = Vec::with_capacity((PAGE * PAGE) as usize);
+    let mut metas = Vec::with_capacity((PAGE * PAGE) as usize);
+    for y in y0..y0 + PAGE as usize {
+        let row = y * width + x0..y * width + x0 + PAGE as usize;
+        heights.extend_from_slice(&hs[row.clone()]);
+        metas.extend_from_slice(&ms[row]);
+    }
+    (heights, metas)
 }
 
 /// Pages read through a store's chunk cache (the cache's byte budget bounds
@@ -247,6 +320,24 @@ impl PageSource for StorePages {
             .map_err(|e| e.to_string())?;
         PageData::from_planes(&chunk.heights, &chunk.metas, self.mid_rule(), step)
     }
+
+    fn lod_levels(&self) -> u32 {
+        self.cache.store().lod_levels()
+    }
+
+    fn read_lod_page(&self, level: u32, cx: u32, cy: u32, step: u32) -> Result<PageData, String> {
+        if level == 0 {
+            return self.read_page(cx, cy, step);
+        }
+        // Not through the cache: a coarse page is read once and then kept on
+        // the GPU; the cache's budget is for the map's chunks.
+        let chunk = self
+            .cache
+            .store()
+            .read_lod_chunk(level, u64::from(cy), u64::from(cx))
+            .map_err(|e| e.to_string())?;
+        PageData::from_planes(&chunk.heights, &chunk.metas, self.mid_rule(), step)
+    }
 }
 
 /// Paged worlds are whole pages, powers of two a side.
@@ -280,6 +371,40 @@ mod tests {
                 let twin = strata_maxmip::Pyramid::with_step(&level, step).data;
                 assert_eq!(page.pyramid, twin, "step {step} chunk ({cx}, {cy})");
             }
+        }
+    }
+}
+
+#[cfg(test)]
+mod lod_tests {
+    use super::*;
+
+    #[test]
+    fn coarse_pages_keep_the_highest_tops() {
+        let world = strata_level::generate::generate(&strata_level::generate::GenerateParams {
+            seed: 6,
+            width: 2048,
+            height: 2048,
+        })
+        .unwrap();
+        let pages = LevelPages::new(Arc::new(world.level.clone())).unwrap();
+        assert_eq!(pages.lod_levels(), 3);
+        for level in 1..=3u32 {
+            let page = pages.read_lod_page(level, 0, 0, 1).unwrap();
+            let max_pair = page.pairs.chunks_exact(2).map(|p| p[0]).max().unwrap();
+            // Page (0, 0) of level k covers 256 * 2^k texels a side.
+            let side = (256u32 << level) as i64;
+            let mut top = 0;
+            for y in 0..side {
+                for x in 0..side {
+                    top = top.max(world.level.column(x, y).top());
+                }
+            }
+            eprintln!(
+                "level {level}: page top {} pairs max {max_pair} map top {top}",
+                page.top(1)
+            );
+            assert_eq!(page.top(1), top, "level {level}");
         }
     }
 }

@@ -5,6 +5,7 @@
 //! threads (a browser page without workers), [`Streamer::poll`] reads on the
 //! calling thread within a time budget: the one platform seam.
 
+use super::pages::PageIds;
 use super::source::{PageData, PageSource};
 use std::collections::{HashSet, VecDeque};
 use std::sync::mpsc::{Receiver, Sender, channel};
@@ -31,6 +32,7 @@ struct Shared {
 /// The wanted-chunk queue and its readers.
 pub struct Streamer {
     source: Arc<dyn PageSource>,
+    ids: PageIds,
     step: u32,
     shared: Arc<Shared>,
     done_tx: Sender<PageResult>,
@@ -39,9 +41,9 @@ pub struct Streamer {
 }
 
 impl Streamer {
-    /// Read pages of `source` (pyramids built with `step`) on `threads`
-    /// worker threads; 0 reads in [`Streamer::poll`] instead.
-    pub fn new(source: Arc<dyn PageSource>, step: u32, threads: usize) -> Self {
+    /// Read pages of `source` (ids `ids`, pyramids built with `step`) on
+    /// `threads` worker threads; 0 reads in [`Streamer::poll`] instead.
+    pub fn new(source: Arc<dyn PageSource>, ids: PageIds, step: u32, threads: usize) -> Self {
         let shared = Arc::new(Shared {
             queue: Mutex::new(Queue {
                 wanted: VecDeque::new(),
@@ -57,12 +59,13 @@ impl Streamer {
                 let (shared, source, tx) = (shared.clone(), source.clone(), done_tx.clone());
                 std::thread::Builder::new()
                     .name(format!("strata-pages-{i}"))
-                    .spawn(move || worker(&shared, source.as_ref(), step, &tx))
+                    .spawn(move || worker(&shared, source.as_ref(), ids, step, &tx))
                     .ok()
             })
             .collect();
         Streamer {
             source,
+            ids,
             step,
             shared,
             done_tx,
@@ -112,9 +115,10 @@ impl Streamer {
                     next
                 };
                 let Some(chunk) = next else { break };
-                let _ = self
-                    .done_tx
-                    .send((chunk, read(self.source.as_ref(), chunk, self.step)));
+                let _ = self.done_tx.send((
+                    chunk,
+                    read(self.source.as_ref(), self.ids, chunk, self.step),
+                ));
             }
         }
         let taken: Vec<PageResult> = self.done.try_iter().take(most).collect();
@@ -136,13 +140,21 @@ impl Drop for Streamer {
     }
 }
 
-fn read(source: &dyn PageSource, chunk: u32, step: u32) -> Result<PageData, String> {
-    let (w, _) = source.size();
-    let across = w / super::source::PAGE;
-    source.read_page(chunk % across, chunk / across, step)
+/// Read page `id` (of any level).
+fn read(source: &dyn PageSource, ids: PageIds, id: u32, step: u32) -> Result<PageData, String> {
+    let (level, cx, cy) = ids
+        .locate(id)
+        .ok_or_else(|| format!("page {id} is outside the world"))?;
+    source.read_lod_page(level, cx, cy, step)
 }
 
-fn worker(shared: &Shared, source: &dyn PageSource, step: u32, done: &Sender<PageResult>) {
+fn worker(
+    shared: &Shared,
+    source: &dyn PageSource,
+    ids: PageIds,
+    step: u32,
+    done: &Sender<PageResult>,
+) {
     loop {
         let chunk = {
             let mut q = shared.queue.lock().expect("page queue");
@@ -157,7 +169,7 @@ fn worker(shared: &Shared, source: &dyn PageSource, step: u32, done: &Sender<Pag
                 q = shared.ready.wait(q).expect("page queue");
             }
         };
-        let page = read(source, chunk, step);
+        let page = read(source, ids, chunk, step);
         // Counted as finished before it is sent, so that `poll` (which
         // removes it from `finished`) never runs before the insert.
         {

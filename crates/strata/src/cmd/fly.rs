@@ -39,8 +39,16 @@ pub struct Args {
     #[arg(long, default_value = "1280x800", value_parser = super::render::parse_size)]
     pub size: (u32, u32),
     /// Far plane, world units (default: the camera's, 600, as the paper).
-    #[arg(long)]
+    #[arg(long, value_name = "TEXELS", value_parser = super::render::parse_far)]
     pub far: Option<f32>,
+    /// Fly at this altitude (texels above 0; terrain reaches 255) instead of
+    /// the views' eye heights, where higher: the horizon path.
+    #[arg(long, value_name = "Z")]
+    pub altitude: Option<f32>,
+    /// Pitch every pose by this many degrees (negative looks down) instead
+    /// of the views' own.
+    #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
+    pub pitch: Option<f32>,
     #[arg(long)]
     pub no_shadows: bool,
     #[command(flatten)]
@@ -285,8 +293,16 @@ fn path_cameras(args: &Args, world: &PagedWorld) -> anyhow::Result<Vec<Camera>> 
     // Each keyframe's eye altitude from the ground under it (one chunk read).
     let mut poses = Vec::with_capacity(keys.len());
     for (view, time) in &keys {
-        let c = world.camera(view, w, h)?;
-        poses.push((c.position, view.yaw, view.pitch, *time));
+        let mut c = world.camera(view, w, h)?;
+        if let Some(z) = args.altitude {
+            c.position.z = c.position.z.max(z);
+        }
+        poses.push((
+            c.position,
+            view.yaw,
+            args.pitch.unwrap_or(view.pitch),
+            *time,
+        ));
     }
     let mut cameras = Vec::with_capacity(args.frames as usize);
     for i in 0..args.frames {

@@ -204,9 +204,21 @@ fn chunked(
             metas,
         })
     };
-    let store = DirStore::create_with(&args.out, &world, (w, h), &layout, &make)
+    DirStore::create_with(&args.out, &world, (w, h), &layout, &make)
         .with_context(|| format!("writing the store {}", args.out.display()))?;
     let total_s = t0.elapsed().as_secs_f64();
+    // The coarse levels far terrain is drawn from (`strata_store::lod`).
+    let t1 = std::time::Instant::now();
+    let store = DirStore::build_lods(&args.out, &|k, n| {
+        if tell {
+            eprintln!(
+                "  level of detail {k}/{n}, {:.0} s",
+                t1.elapsed().as_secs_f64()
+            );
+        }
+    })
+    .with_context(|| format!("writing the levels of detail of {}", args.out.display()))?;
+    let lod_s = t1.elapsed().as_secs_f64();
     let sums = store.store().summaries()?;
     let dual: u64 = sums.iter().map(|s| u64::from(s.dual_texels)).sum();
     let low = sums.iter().map(|s| s.low_min).min().unwrap_or(0);
@@ -215,9 +227,10 @@ fn chunked(
     let mut out = String::new();
     outln!(
         out,
-        "wrote {} ({w}x{h}, seed {}, {total} chunks of {cw}x{ch}): generated and written in {total_s:.2} s",
+        "wrote {} ({w}x{h}, seed {}, {total} chunks of {cw}x{ch}): generated and written in {total_s:.2} s, {} levels of detail in {lod_s:.2} s",
         args.out.display(),
-        args.seed
+        args.seed,
+        store.store().lod_levels()
     );
     outln!(
         out,

@@ -63,6 +63,10 @@ pub struct Args {
     /// Cache directory. Default: $STRATA_CACHE_DIR/reference, else ~/.cache/strata/reference.
     #[arg(long, value_name = "DIR")]
     pub cache_dir: Option<PathBuf>,
+    /// Far plane, texels along the view axis (default 600, the paper's), as
+    /// `render --far` and `fly --far`: horizon views of large worlds.
+    #[arg(long, value_name = "TEXELS", value_parser = super::render::parse_far)]
+    pub far: Option<f32>,
 }
 
 /// One line of `--json` output.
@@ -138,7 +142,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     // Resolve every camera first, so a bad view fails before any work.
     let cameras = views
         .iter()
-        .map(|v| camera_for_view(source, v, w, h).context("resolving the camera"))
+        .map(|v| {
+            let mut c = camera_for_view(source, v, w, h).context("resolving the camera")?;
+            if let Some(far) = args.far {
+                c.far = far;
+            }
+            Ok(c)
+        })
         .collect::<anyhow::Result<Vec<_>>>()?;
     // The cache key: the map's content hash (a store's streamed, equal to
     // the same map's loaded whole), or none for a store too large to hash.

@@ -35,6 +35,11 @@ pub struct Args {
     /// Image size.
     #[arg(long, default_value = "1280x800", value_parser = parse_size)]
     pub size: (u32, u32),
+    /// Far plane, texels along the view axis (default 600, the paper's):
+    /// horizon views of large worlds (paged terrain draws far columns from
+    /// coarser levels of detail; see `--lod-pixels`).
+    #[arg(long, value_name = "TEXELS", value_parser = parse_far)]
+    pub far: Option<f32>,
     /// Timed frames per view.
     #[arg(long, default_value_t = 40)]
     pub frames: u32,
@@ -213,7 +218,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let cameras = views
         .iter()
         .map(|v| {
-            Camera::from_view(&world.level, v, w, h).with_context(|| format!("view `{}`", v.name))
+            Camera::from_view(&world.level, v, w, h)
+                .with_context(|| format!("view `{}`", v.name))
+                .map(|c| with_far(c, args.far))
         })
         .collect::<anyhow::Result<Vec<_>>>()?;
     let settings = args.method_args.settings();
@@ -287,7 +294,7 @@ fn run_paged(args: &Args, world: &PagedWorld) -> anyhow::Result<()> {
     let (w, h) = args.size;
     let cameras = views
         .iter()
-        .map(|v| world.camera(v, w, h))
+        .map(|v| world.camera(v, w, h).map(|c| with_far(c, args.far)))
         .collect::<anyhow::Result<Vec<_>>>()?;
     let gpu = args.adapter.open()?;
     let mut renderer = Renderer::new_paged(
@@ -359,6 +366,29 @@ fn run_paged(args: &Args, world: &PagedWorld) -> anyhow::Result<()> {
         }
     }
     Ok(())
+}
+
+/// `camera` with its far plane at `far`, if given.
+fn with_far(mut camera: Camera, far: Option<f32>) -> Camera {
+    if let Some(far) = far {
+        camera.far = far;
+    }
+    camera
+}
+
+/// A far plane: finite, beyond the near plane, at most 65536 texels.
+pub fn parse_far(text: &str) -> Result<f32, String> {
+    let far: f32 = text
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{text}` is not a distance in texels"))?;
+    if !far.is_finite() || far <= strata_camera::DEFAULT_NEAR || far > 65536.0 {
+        return Err(format!(
+            "a far plane must lie between the near plane ({}) and 65536 texels, got {text}",
+            strata_camera::DEFAULT_NEAR
+        ));
+    }
+    Ok(far)
 }
 
 #[cfg(test)]

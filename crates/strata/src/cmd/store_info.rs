@@ -16,6 +16,9 @@ struct StoreInfo {
     height: u32,
     chunk: [u32; 2],
     chunks: u64,
+    /// Levels of detail written (`strata_store::lod`), of those it can have.
+    lod_levels: u32,
+    lod_possible: u32,
     dual_percent: f64,
     height_min: u8,
     height_max: u8,
@@ -49,6 +52,8 @@ pub fn run(dir: &Path, json: bool) -> anyhow::Result<()> {
         height: a.height,
         chunk: a.chunk,
         chunks: summaries.len() as u64,
+        lod_levels: store.store().lod_levels(),
+        lod_possible: store.store().possible_lod_levels(),
         dual_percent: 100.0 * dual as f64 / texels,
         height_min: summaries.iter().map(|c| c.low_min).min().unwrap_or(0),
         height_max: summaries.iter().map(|c| c.top_max).max().unwrap_or(0),
@@ -71,6 +76,16 @@ pub fn run(dir: &Path, json: bool) -> anyhow::Result<()> {
         println!(
             "chunks       {} of {} x {} (rows x columns)",
             info.chunks, info.chunk[0], info.chunk[1]
+        );
+        println!(
+            "levels of detail {} of {}{}",
+            info.lod_levels,
+            info.lod_possible,
+            if info.lod_levels < info.lod_possible {
+                " (`strata convert --add-lod --level DIR` writes them)"
+            } else {
+                ""
+            }
         );
         println!("dual         {:.2} % of texels", info.dual_percent);
         println!("heights      {} .. {}", info.height_min, info.height_max);

@@ -89,7 +89,11 @@ pub(super) fn core_entries(
                 stages,
                 wgpu::BufferBindingType::Storage { read_only: false },
             ),
-            buffer_entry(11, stages, wgpu::BufferBindingType::Uniform),
+            buffer_entry(
+                11,
+                stages,
+                wgpu::BufferBindingType::Storage { read_only: true },
+            ),
         ]);
     }
     entries
