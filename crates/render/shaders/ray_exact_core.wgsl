@@ -92,6 +92,14 @@ fn exact_march(o: vec3<f32>, base: vec2<i32>, d: vec3<f32>, t0: f32, t1: f32) ->
         // new (and a grazing ray would step its plateau texel by texel).
         let leaf = exact_lod_at(t);
         let shift = lvl * ratio;
+        if (shift < leaf && lvl < top / ratio) {
+            // The level of detail grew past this tile: take its parent (the
+            // point at t is in it) rather than walk fine tiles of one coarse
+            // column.
+            cell = cell >> vec2<u32>(ratio);
+            lvl = lvl + 1u;
+            continue;
+        }
         let size = f32(1u << shift);
         let edge = vec2<f32>(cell + far_side) * size;
         let tb = select((edge - o.xy) * inv, vec2<f32>(EXACT_BIG), still);

@@ -509,6 +509,9 @@ impl PagedTerrain {
     /// direction (a turn of the camera then finds its pages resident), and
     /// under the frustum's far corners, wrapped.
     fn footprint(&self, camera: &Camera) -> Vec<u32> {
+        if self.ids.levels() > 0 && self.options.lod_pixels > 0.0 {
+            return self.lod_footprint(camera);
+        }
         let eye = camera.position;
         let (w, h) = (camera.width as f32, camera.height as f32);
         let scale = camera.far / camera.focal_px;
@@ -535,6 +538,45 @@ impl PagedTerrain {
         for cy in y0..=y1 {
             for cx in x0..=x1 {
                 out.push((cy.rem_euclid(gy) * gx + cx.rem_euclid(gx)) as u32);
+            }
+        }
+        out
+    }
+
+    /// With levels of detail: for each level the march reads (multiples of
+    /// its level ratio, `step`), that level's pages within the distance
+    /// where camera rays still take it (their footprint below the next
+    /// level's; the coarsest out to the far plane), in any direction. A
+    /// horizon view then prefetches a few rings of pages, not every chunk
+    /// out to the far plane.
+    fn lod_footprint(&self, camera: &Camera) -> Vec<u32> {
+        let eye = camera.position.truncate();
+        let levels = self.ids.levels();
+        let step = self.step.max(1);
+        let mut seen = std::collections::HashSet::new();
+        let mut out = Vec::new();
+        for k in (0..=levels).step_by(step as usize) {
+            let next = k + step;
+            let reach = if next > levels {
+                camera.far
+            } else {
+                ((1u64 << next) as f32 * camera.focal_px * self.options.lod_pixels).min(camera.far)
+            };
+            let side = (PAGE << k) as f32;
+            let (gx, gy) = self.ids.grid(k);
+            let (gx, gy) = (i64::from(gx), i64::from(gy));
+            let r = ((reach / side).ceil() as i64 + 1).min(gx.max(gy));
+            let (cx0, cy0) = ((eye.x / side).floor() as i64, (eye.y / side).floor() as i64);
+            // A page counts when its centre is within reach plus half its diagonal.
+            let limit = (reach + side * std::f32::consts::FRAC_1_SQRT_2).powi(2);
+            for dy in -r..=r {
+                for dx in -r..=r {
+                    let (cx, cy) = ((cx0 + dx).rem_euclid(gx), (cy0 + dy).rem_euclid(gy));
+                    let id = self.ids.id(k, cx as u32, cy as u32);
+                    if self.ids.distance(eye, id) <= limit && seen.insert(id) {
+                        out.push(id);
+                    }
+                }
             }
         }
         out
