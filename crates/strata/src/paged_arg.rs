@@ -72,6 +72,8 @@ pub struct PagedWorld {
     pub colors: TerrainColors,
     pub source: Arc<dyn PageSource>,
     columns: Columns,
+    /// The store's directory, when the world is a store.
+    pub dir: Option<std::path::PathBuf>,
 }
 
 impl PagedWorld {
@@ -96,6 +98,14 @@ impl PagedWorld {
                 .with_context(|| format!("reading the ground under view `{}`", view.name));
         }
         Ok(camera)
+    }
+
+    /// The store's chunk cache, when the world is a store.
+    pub fn cache(&self) -> Option<&Arc<ChunkCache>> {
+        match &self.columns {
+            Columns::Store(cache) => Some(cache),
+            Columns::Memory(_) => None,
+        }
     }
 
     /// The paging options from the flags.
@@ -138,6 +148,7 @@ pub fn open_paged(world: &WorldArgs, paged: &PagedArgs) -> anyhow::Result<Option
         colors: TerrainColors::from_world(&w),
         source: Arc::new(LevelPages::new(level.clone())?),
         columns: Columns::Memory(level),
+        dir: None,
     }))
 }
 
@@ -172,6 +183,7 @@ fn open_store(
         },
         source,
         columns: Columns::Store(cache),
+        dir: Some(dir.to_path_buf()),
     })
 }
 

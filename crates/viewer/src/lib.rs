@@ -30,6 +30,7 @@ pub mod minimap;
 pub mod overlay;
 #[cfg(target_arch = "wasm32")]
 mod page;
+pub mod paged;
 pub mod physics;
 pub mod platform;
 pub mod present;
@@ -78,6 +79,9 @@ pub struct Options {
     pub save: save::SaveOptions,
     /// Start with the physics toy on (key O toggles it).
     pub physics: bool,
+    /// Draw through paged terrain (issue 33): `world`'s level is then a
+    /// stand-in and the map is read from these pages as the view needs them.
+    pub paged: Option<paged::PagedWorld>,
 }
 
 /// Open the window and run until it is closed or the script ends.
