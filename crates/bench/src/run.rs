@@ -14,11 +14,17 @@ pub use crate::warm::{INCREMENTAL_BUDGET_TEXELS, WarmUp, build_frames, ms, warm_
 use anyhow::Context;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
+use std::sync::Arc;
 use std::time::Instant;
 use strata_camera::Camera;
 use strata_level::{EditSite, ViewSpec, World};
 use strata_reference::{ColorImage, Reference, ReferenceCache, Tracer};
+use strata_render::paged::{LevelPages, PAGED_METHODS, PageSource, PagedOptions};
 use strata_render::{Gpu, MethodSettings, Renderer, TerrainColors};
+
+/// Most frames a paged cell draws at its view waiting for every page it
+/// reads, before its warm-up and timed frames.
+const CONVERGE_FRAMES: u32 = 600;
 
 /// `--temporal`: the default path played in this many seconds ...
 pub const TEMPORAL_SECONDS: f32 = 2.0;
@@ -73,6 +79,9 @@ pub struct Plan {
     edit: Option<(EditSite, Camera)>,
     edit_skipped: Option<String>,
     warmup_first: u32,
+    /// `--gpu-budget`: the paged methods draw through pages of the world
+    /// ([`Plan::with_paging`]).
+    paging: Option<(PagedOptions, Arc<dyn PageSource>)>,
 }
 
 impl Plan {
@@ -131,7 +140,24 @@ impl Plan {
             edit,
             edit_skipped,
             warmup_first,
+            paging: None,
         })
+    }
+
+    /// Draw the paged methods (`strata_render::paged::PAGED_METHODS`)
+    /// through pages of the world within `options.gpu_budget`: each view
+    /// converges (nothing pending) before it is timed and compared, and its
+    /// row carries the paging numbers. The other methods keep the
+    /// whole-world path. `None`: every method draws the world whole.
+    pub fn with_paging(mut self, options: Option<PagedOptions>) -> anyhow::Result<Self> {
+        self.paging = match options {
+            Some(o) => {
+                let level = Arc::new(self.world.level.clone());
+                Some((o, Arc::new(LevelPages::new(level)?) as Arc<dyn PageSource>))
+            }
+            None => None,
+        };
+        Ok(self)
     }
 
     pub fn world(&self) -> &World {
@@ -391,6 +417,7 @@ impl Plan {
             shadows: self.opts.shadows,
             temporal: true,
             overlap: None,
+            paging: None,
         };
         let (pos, len) = (bar.position(), bar.length());
         let recording = video::record(gpu, &self.world, &path, &opts, None, bar);
@@ -551,15 +578,55 @@ impl Plan {
         }
         bar.set_message(format!("{label}: setup"));
         let start = Instant::now();
-        let mut renderer = Renderer::new(
-            gpu,
-            &self.world.level,
-            &self.colors,
-            choice.method,
-            &self.settings[m],
-            self.opts.width,
-            self.opts.height,
-        )?;
+        let paged = self
+            .paging
+            .as_ref()
+            .filter(|_| PAGED_METHODS.contains(&choice.method.name));
+        let built = match paged {
+            Some((options, source)) => Renderer::new_paged(
+                gpu,
+                source.clone(),
+                &self.colors,
+                choice.method,
+                &self.settings[m],
+                self.opts.width,
+                self.opts.height,
+                options.clone(),
+            ),
+            None => Renderer::new(
+                gpu,
+                &self.world.level,
+                &self.colors,
+                choice.method,
+                &self.settings[m],
+                self.opts.width,
+                self.opts.height,
+            ),
+        };
+        let mut renderer = match built {
+            Ok(r) => r,
+            // With paging on, a whole-world method that cannot hold this
+            // world is a refusal in the results, not the end of the run.
+            Err(e) if self.paging.is_some() => {
+                let error = format!(
+                    "{e:#} (with --gpu-budget, {} draw through pages)",
+                    PAGED_METHODS.join(", ")
+                );
+                bar.println(format!("{label}: {error}"));
+                for &v in &todo {
+                    session.results.failures.push(Failure {
+                        view: self.opts.views[v].name.clone(),
+                        method: label.clone(),
+                        error: error.clone(),
+                    });
+                    bar.inc(1);
+                    count.measured += 1;
+                }
+                session.save_json()?;
+                return Ok(());
+            }
+            Err(e) => return Err(e),
+        };
         let setup_ms = ms(start);
         for (i, &v) in todo.iter().enumerate() {
             if count.stop_after.is_some_and(|n| count.measured >= n) {
@@ -615,6 +682,10 @@ impl Plan {
     ) -> anyhow::Result<Row> {
         let view = &self.opts.views[v];
         let label = self.opts.methods[m].label();
+        // Paged terrain: every page the view reads resident before timing.
+        let converge_frames = renderer
+            .converge(camera, CONVERGE_FRAMES)
+            .context("paged terrain")?;
         if self.opts.hold_busy_ms > 0 {
             // A renderer's first view follows its setup, seconds of CPU work
             // in which the GPU idles down to its lowest clock (345 MHz on the
@@ -637,6 +708,19 @@ impl Plan {
         let frames = (0..self.opts.frames)
             .map(|_| renderer.render_frame(camera))
             .collect::<anyhow::Result<Vec<_>>>()?;
+        let paging = renderer.paged_terrain().map(|t| {
+            let s = t.stats();
+            CellPaging {
+                gpu_budget: s.gpu_budget,
+                gpu_bytes: s.gpu_bytes,
+                slots: s.slots,
+                resident_pages: s.resident_pages,
+                resident_bytes: s.resident_bytes,
+                converge_frames,
+                pending_pixels: s.pending_pixels,
+                read_errors: s.read_errors,
+            }
+        });
         let depth = renderer.read_depth()?;
         let distance = strata_reference::distance_from_depth(camera, &depth);
         let metrics = strata_reference::metrics::try_compare(reference, &distance)?;
@@ -669,6 +753,7 @@ impl Plan {
         };
         let mut row = self.row(v, m, measured, image)?;
         row.flip = flip;
+        row.paging = paging;
         Ok(row)
     }
 
@@ -734,6 +819,7 @@ impl Plan {
             passes,
             image,
             flip: None,
+            paging: None,
         })
     }
 }

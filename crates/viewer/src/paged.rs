@@ -259,13 +259,22 @@ impl EditedPages {
         Ok(dug)
     }
 
-    /// Put chunks back as they were (undo); returns their indices.
+    /// Put chunks back as they were (undo); returns their indices. A chunk
+    /// back to the world's own bytes leaves the edit layer.
     pub fn restore(&self, before: Vec<(u32, Arc<Planes>)>) -> Vec<u32> {
-        let mut edited = self.edited.lock().expect("edit lock");
+        let gx = self.grid().0;
         before
             .into_iter()
             .map(|(index, planes)| {
-                edited.insert(index, planes);
+                let unedited = self
+                    .base_planes(index % gx, index / gx)
+                    .is_ok_and(|b| b == *planes);
+                let mut edited = self.edited.lock().expect("edit lock");
+                if unedited {
+                    edited.remove(&index);
+                } else {
+                    edited.insert(index, planes);
+                }
                 index
             })
             .collect()
@@ -447,7 +456,9 @@ mod tests {
             LevelPagesTwin::page(&level, 2, 1),
             "the edit shows in the page"
         );
+        assert_eq!(pages.edited_chunks(), 4);
         pages.restore(dug.before);
+        assert_eq!(pages.edited_chunks(), 0, "undone chunks leave the layer");
         assert_eq!(pages.read_page(2, 1, 1).unwrap(), LevelPagesTwin::page(&level, 2, 1));
         assert_eq!(pages.edited_level().unwrap(), level);
         assert!(pages.column(512, 256).unwrap() == level.column(512, 256));

@@ -8,6 +8,7 @@
 //! `portability.md` + `portability.json` into `<out>`.
 
 use crate::adapter_arg::AdapterArgs;
+use crate::paged_arg::{PagedArgs, PagedWorld};
 use crate::world_arg::WorldArgs;
 use anyhow::Context;
 use std::path::PathBuf;
@@ -78,6 +79,11 @@ pub struct Args {
     pub hold_busy: Option<u32>,
     #[command(flatten)]
     pub adapter: AdapterArgs,
+    /// `--gpu-budget`: ray-exact and ray-exact-fragment draw through pages
+    /// (converged at each view before timing; `paging` in each row); the
+    /// other methods keep the whole-world path. Without it nothing changes.
+    #[command(flatten)]
+    pub paged: PagedArgs,
     /// Run the protocol on every adapter of --backend (default: every backend), each into
     /// `<out>/<adapter>-<backend>/`, then write the merged `portability.md` and
     /// `portability.json` into `<out>`. A CPU rasteriser runs the --quick form unless
@@ -118,11 +124,18 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let gpu = args.adapter.open()?;
     announce(&gpu.report);
     let options = options_for(&args, &prepared, &gpu.report, args.out_dir());
-    let plan = Plan::new(prepared.world, options)?;
+    let plan = Plan::new(prepared.world, options)?.with_paging(paging(&args))?;
     let (json, report) = plan.run(&gpu)?;
     println!("wrote {}", json.display());
     println!("wrote {}", report.display());
     Ok(())
+}
+
+/// The paging of `--gpu-budget` (`None` without it: the paper's protocol).
+fn paging(args: &Args) -> Option<strata_render::paged::PagedOptions> {
+    args.paged
+        .gpu_budget
+        .map(|_| PagedWorld::options(&args.paged))
 }
 
 /// Cheap checks first, then the level; the GPU comes later.
@@ -320,7 +333,9 @@ fn run_all_adapters(args: &Args, prepared: Prepared) -> anyhow::Result<()> {
         };
         announce(&gpu.report);
         let options = options_for(args, &prepared, &gpu.report, out.clone());
-        let result = Plan::new(prepared.world.clone(), options).and_then(|plan| plan.run(&gpu));
+        let result = Plan::new(prepared.world.clone(), options)
+            .and_then(|plan| plan.with_paging(paging(args)))
+            .and_then(|plan| plan.run(&gpu));
         drop(gpu);
         match result {
             Ok((json, report)) => {
