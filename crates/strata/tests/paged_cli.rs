@@ -69,7 +69,14 @@ fn store() -> &'static Path {
         let d = dir("store");
         let store = d.join("world");
         let out = strata(&[
-            "generate", "--size", "1024x1024", "--seed", "11", "--to", "store", "--out",
+            "generate",
+            "--size",
+            "1024x1024",
+            "--seed",
+            "11",
+            "--to",
+            "store",
+            "--out",
             p(&store),
         ]);
         assert!(out.status.success(), "{}", stderr(&out));
@@ -88,8 +95,7 @@ fn assert_clean_error(out: &Output, wanted: &[&str]) {
 }
 
 fn read_json(path: &Path) -> serde_json::Value {
-    let text =
-        std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     serde_json::from_str(&text).unwrap()
 }
 
@@ -331,6 +337,9 @@ fn a_whole_world_method_on_a_paged_world_names_the_paged_methods() {
     ]);
     assert_clean_error(
         &out,
-        &["`mesh` draws whole worlds only", "ray-exact, ray-exact-fragment"],
+        &[
+            "`mesh` draws whole worlds only",
+            "ray-exact, ray-exact-fragment",
+        ],
     );
 }

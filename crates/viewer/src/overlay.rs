@@ -505,7 +505,12 @@ fn methods_section(
             methods::check_support(name, status.caps)
                 .err()
                 .map(|why| format!("{why:#}"))
-                .or_else(|| status.paging.as_ref().and_then(|_| crate::paged::refusal(name)))
+                .or_else(|| {
+                    status
+                        .paging
+                        .as_ref()
+                        .and_then(|_| crate::paged::refusal(name))
+                })
         })
         .collect();
     if !unavailable.is_empty() {

@@ -300,13 +300,7 @@ impl EditedPages {
                 metas[at..at + PAGE as usize].copy_from_slice(&p.metas[src]);
             }
         }
-        let out = Level::from_planes(
-            level.width(),
-            level.height(),
-            heights,
-            metas,
-            self.mid_rule,
-        )?;
+        let out = Level::from_planes(level.width(), level.height(), heights, metas, self.mid_rule)?;
         *base = Base::Level(Arc::new(out.clone()));
         edited.clear();
         Ok(out)
@@ -435,11 +429,15 @@ mod tests {
             };
             let mut whole = level.clone();
             crater(&mut whole, &site);
-            let fresh = EditedPages::new(Base::Level(Arc::new(level.clone())), level.mid_rule)
-                .unwrap();
+            let fresh =
+                EditedPages::new(Base::Level(Arc::new(level.clone())), level.mid_rule).unwrap();
             let dug = fresh.dig(&site).unwrap();
             assert!(!dug.chunks.is_empty());
-            assert_eq!(fresh.edited_level().unwrap(), whole, "crater at {x},{y} r {r}");
+            assert_eq!(
+                fresh.edited_level().unwrap(),
+                whole,
+                "crater at {x},{y} r {r}"
+            );
         }
         // Undo puts the chunks back.
         let site = EditSite {
@@ -459,7 +457,10 @@ mod tests {
         assert_eq!(pages.edited_chunks(), 4);
         pages.restore(dug.before);
         assert_eq!(pages.edited_chunks(), 0, "undone chunks leave the layer");
-        assert_eq!(pages.read_page(2, 1, 1).unwrap(), LevelPagesTwin::page(&level, 2, 1));
+        assert_eq!(
+            pages.read_page(2, 1, 1).unwrap(),
+            LevelPagesTwin::page(&level, 2, 1)
+        );
         assert_eq!(pages.edited_level().unwrap(), level);
         assert!(pages.column(512, 256).unwrap() == level.column(512, 256));
         // A crater wider than the world is refused, not a panic.

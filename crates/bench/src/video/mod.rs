@@ -76,7 +76,12 @@ impl strata_render::paged::PageSource for SwappedPages {
         self.pages()?.chunk_tops()
     }
 
-    fn read_page(&self, cx: u32, cy: u32, step: u32) -> Result<strata_render::paged::PageData, String> {
+    fn read_page(
+        &self,
+        cx: u32,
+        cy: u32,
+        step: u32,
+    ) -> Result<strata_render::paged::PageData, String> {
         self.pages()?.read_page(cx, cy, step)
     }
 }

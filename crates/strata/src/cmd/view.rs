@@ -7,8 +7,8 @@ use crate::cmd::render::{MethodArgs, parse_size};
 use crate::paged_arg::{PagedArgs, PagedWorld, open_paged};
 use crate::world_arg::WorldArgs;
 use anyhow::Context;
-use std::sync::Arc;
 use std::path::PathBuf;
+use std::sync::Arc;
 use strata_level::save::SavePolicy;
 use strata_viewer::save::SaveOptions;
 use strata_viewer::{Options, Script};
@@ -84,7 +84,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                 start.elapsed().as_secs_f64(),
                 options.gpu_budget
             );
-            (world, Some(strata_viewer::paged::PagedWorld { pages, options }))
+            (
+                world,
+                Some(strata_viewer::paged::PagedWorld { pages, options }),
+            )
         }
         None => {
             let world = args.world.load()?;
@@ -126,12 +129,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 fn viewer_pages(
     world: &WorldArgs,
     paged: &PagedArgs,
-) -> anyhow::Result<
-    Option<(
-        strata_level::World,
-        Arc<strata_viewer::paged::EditedPages>,
-    )>,
-> {
+) -> anyhow::Result<Option<(strata_level::World, Arc<strata_viewer::paged::EditedPages>)>> {
     use strata_viewer::paged::{Base, EditedPages};
     let mid_rule = world.mid_rule();
     let is_store = world.level.as_deref().is_some_and(|d| {

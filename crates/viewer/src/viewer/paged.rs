@@ -41,9 +41,9 @@ impl PagedState {
 
     fn pending_pct(&self, render_size: (u32, u32)) -> f64 {
         let pixels = f64::from(render_size.0) * f64::from(render_size.1);
-        self.stats
-            .as_ref()
-            .map_or(0.0, |s| 100.0 * f64::from(s.pending_pixels) / pixels.max(1.0))
+        self.stats.as_ref().map_or(0.0, |s| {
+            100.0 * f64::from(s.pending_pixels) / pixels.max(1.0)
+        })
     }
 
     /// The overlay's lines: resident bytes of the budget, this frame's
