@@ -284,6 +284,8 @@ impl EditedPages {
     /// the layer is then folded into it).
     pub fn edited_level(&self) -> anyhow::Result<Level> {
         let mut base = self.base.lock().expect("base lock");
+        // Irrefutable in a browser, where a store is not a base.
+        #[allow(irrefutable_let_patterns)]
         let Base::Level(level) = &*base else {
             anyhow::bail!("a store is saved chunk by chunk, not as a level");
         };
