@@ -343,3 +343,45 @@ fn a_whole_world_method_on_a_paged_world_names_the_paged_methods() {
         ],
     );
 }
+
+#[test]
+fn video_with_a_gpu_budget_streams_the_paged_method_through_the_dig() {
+    if !has_gpu() {
+        return;
+    }
+    let d = dir("video");
+    let frames = d.join("frames");
+    let out = strata(&[
+        "video",
+        "--level",
+        p(store()),
+        "--gpu-budget",
+        "4MiB",
+        "--methods",
+        "ray-exact,ray",
+        "--size",
+        "320x100",
+        "--duration",
+        "2",
+        "--fps",
+        "4",
+        "--no-temporal",
+        "--frames-dir",
+        p(&frames),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let sidecar = read_json(&frames.join("video.json"));
+    assert!(
+        sidecar["dig_frame"].as_u64().is_some(),
+        "the default path digs"
+    );
+    let methods = sidecar["methods"].as_array().unwrap();
+    for m in ["ray-exact", "ray"] {
+        let track = methods
+            .iter()
+            .find(|t| t["method"].as_str().unwrap().split(':').next() == Some(m))
+            .unwrap_or_else(|| panic!("no {m} track: {sidecar}"));
+        assert!(track["error"].is_null(), "{track}");
+        assert!(track["first_post_edit_ms"].as_f64().unwrap() > 0.0);
+    }
+}
