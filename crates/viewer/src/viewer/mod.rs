@@ -464,6 +464,9 @@ impl Viewer {
                 t.wait_ms / f64::from(t.frames)
             ));
         }
+        if let Some(p) = &self.paged {
+            out.push_str(&format!("\n  {}", p.summary()));
+        }
         out
     }
 

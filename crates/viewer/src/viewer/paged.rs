@@ -26,6 +26,12 @@ pub(super) struct PagedState {
     /// Frames drawn and bytes uploaded over the session.
     frames: u64,
     uploaded_total: u64,
+    /// Over the session: frames with pending pixels, the sum and largest of
+    /// their percent of the frame, the most bytes resident.
+    pending_frames: u64,
+    pending_pct_sum: f64,
+    pending_pct_max: f64,
+    resident_max: u64,
 }
 
 impl PagedState {
@@ -36,7 +42,28 @@ impl PagedState {
             stats: None,
             frames: 0,
             uploaded_total: 0,
+            pending_frames: 0,
+            pending_pct_sum: 0.0,
+            pending_pct_max: 0.0,
+            resident_max: 0,
         }
+    }
+
+    /// One line over the session: pending pixels, uploads, residency.
+    pub fn summary(&self) -> String {
+        let s = self.stats.clone().unwrap_or_default();
+        format!(
+            "paged: {} frames, {} with pending pixels (mean {:.3} %, max {:.2} % of the frame); {:.1} MiB uploaded; resident at most {:.1} MiB, {:.1} of {:.1} MiB budget on the GPU; {} read error(s)",
+            self.frames,
+            self.pending_frames,
+            self.pending_pct_sum / (self.frames.max(1) as f64),
+            self.pending_pct_max,
+            self.uploaded_total as f64 / 1048576.0,
+            self.resident_max as f64 / 1048576.0,
+            s.gpu_bytes as f64 / 1048576.0,
+            s.gpu_budget as f64 / 1048576.0,
+            s.read_errors
+        )
     }
 
     fn pending_pct(&self, render_size: (u32, u32)) -> f64 {
@@ -101,7 +128,7 @@ impl PagedState {
         format!(
             " paged_gpu_bytes={} paged_budget={} resident_pages={} resident_bytes={} \
              uploaded_bytes={} uploaded_total={} pending_pixels={} pending_pct={:.3} \
-             read_errors={} edited_chunks={}",
+             pending_frames={} pending_pct_max={:.3} read_errors={} edited_chunks={}",
             s.gpu_bytes,
             s.gpu_budget,
             s.resident_pages,
@@ -110,6 +137,8 @@ impl PagedState {
             self.uploaded_total,
             s.pending_pixels,
             self.pending_pct(render_size),
+            self.pending_frames,
+            self.pending_pct_max,
             s.read_errors,
             self.world.pages.edited_chunks()
         )
@@ -211,6 +240,7 @@ impl Viewer {
             return;
         }
         let stats = self.renderer.paged_terrain().map(|t| t.stats());
+        let render_size = self.render_size();
         if let Some(p) = &mut self.paged {
             if let Some(s) = &stats {
                 p.uploaded_total += s.uploaded_bytes;
@@ -223,6 +253,15 @@ impl Viewer {
             }
             p.frames += 1;
             p.stats = stats;
+            let pending = p.pending_pct(render_size);
+            if pending > 0.0 {
+                p.pending_frames += 1;
+                p.pending_pct_sum += pending;
+                p.pending_pct_max = p.pending_pct_max.max(pending);
+            }
+            p.resident_max = p
+                .resident_max
+                .max(p.stats.as_ref().map_or(0, |s| s.resident_bytes));
         }
     }
 
