@@ -79,25 +79,11 @@ pub struct PagedWorld {
 impl PagedWorld {
     /// The camera of `view` at `width` x `height` (reads the one column under it).
     pub fn camera(&self, view: &ViewSpec, width: u32, height: u32) -> anyhow::Result<Camera> {
-        let mut error = None;
-        let column = |x: f32, y: f32| match &self.columns {
-            Columns::Memory(level) => level.column_at(x, y),
-            Columns::Store(cache) => cache
-                .column(x.floor() as i64, y.floor() as i64)
-                .unwrap_or_else(|e| {
-                    error = Some(e);
-                    strata_level::Level::flat(2, 1, 0, 0)
-                        .expect("a 2x1 level")
-                        .column(0, 0)
-                }),
+        let column = |x: i64, y: i64| match &self.columns {
+            Columns::Memory(level) => Ok(level.column(x, y)),
+            Columns::Store(cache) => cache.column(x, y),
         };
-        let camera = Camera::from_view_over(self.size, column, view, width, height)
-            .with_context(|| format!("view `{}`", view.name))?;
-        if let Some(e) = error {
-            return Err(e)
-                .with_context(|| format!("reading the ground under view `{}`", view.name));
-        }
-        Ok(camera)
+        strata_viewer::paged::camera_over(self.size, column, view, width, height)
     }
 
     /// The store's chunk cache, when the world is a store.

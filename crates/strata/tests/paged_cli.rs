@@ -84,6 +84,25 @@ fn store() -> &'static Path {
     })
 }
 
+/// `strata render` over the store at the middle view, 160x100, into `out`.
+fn render(out: &Path, extra: &[&str]) -> Output {
+    let mut args = vec![
+        "render",
+        "--level",
+        p(store()),
+        "--view",
+        VIEW,
+        "--pitch",
+        "-20",
+        "--size",
+        "160x100",
+        "--out",
+        p(out),
+    ];
+    args.extend_from_slice(extra);
+    strata(&args)
+}
+
 /// A failure that is an error message, not a panic.
 fn assert_clean_error(out: &Output, wanted: &[&str]) {
     let e = stderr(out);
@@ -161,27 +180,19 @@ fn render_with_a_gpu_budget_converges_and_reports_its_paging() {
         return;
     }
     let out_dir = dir("render");
-    let out = strata(&[
-        "render",
-        "--level",
-        p(store()),
-        "--method",
-        "ray-exact",
-        "--gpu-budget",
-        "4MiB",
-        "--view",
-        VIEW,
-        "--pitch",
-        "-20",
-        "--size",
-        "160x100",
-        "--frames",
-        "2",
-        "--warmup",
-        "1",
-        "--out",
-        p(&out_dir),
-    ]);
+    let out = render(
+        &out_dir,
+        &[
+            "--method",
+            "ray-exact",
+            "--gpu-budget",
+            "4MiB",
+            "--frames",
+            "2",
+            "--warmup",
+            "1",
+        ],
+    );
     assert!(out.status.success(), "{}", stderr(&out));
     let report = read_json(&out_dir.join("render.json"));
     let paging = &report["paging"];
@@ -255,23 +266,10 @@ fn a_budget_too_small_is_refused_with_the_smallest_that_works() {
         return;
     }
     let out_dir = dir("small-budget");
-    let out = strata(&[
-        "render",
-        "--level",
-        p(store()),
-        "--method",
-        "ray-exact",
-        "--gpu-budget",
-        "16KiB",
-        "--view",
-        VIEW,
-        "--pitch",
-        "-20",
-        "--size",
-        "160x100",
-        "--out",
-        p(&out_dir),
-    ]);
+    let out = render(
+        &out_dir,
+        &["--method", "ray-exact", "--gpu-budget", "16KiB"],
+    );
     assert_clean_error(&out, &["16384 bytes", "the smallest budget that works is"]);
     // The budget it names works.
     let e = stderr(&out);
@@ -282,29 +280,21 @@ fn a_budget_too_small_is_refused_with_the_smallest_that_works() {
         .unwrap()
         .parse()
         .unwrap();
-    let out = strata(&[
-        "render",
-        "--level",
-        p(store()),
-        "--method",
-        "ray-exact",
-        "--gpu-budget",
-        &smallest.to_string(),
-        "--view",
-        VIEW,
-        "--pitch",
-        "-20",
-        "--size",
-        "160x100",
-        "--frames",
-        "1",
-        "--warmup",
-        "0",
-        "--converge-frames",
-        "2",
-        "--out",
-        p(&out_dir),
-    ]);
+    let out = render(
+        &out_dir,
+        &[
+            "--method",
+            "ray-exact",
+            "--gpu-budget",
+            &smallest.to_string(),
+            "--frames",
+            "1",
+            "--warmup",
+            "0",
+            "--converge-frames",
+            "2",
+        ],
+    );
     assert!(
         !stderr(&out).contains("the smallest budget that works"),
         "the named budget is accepted: {}",
@@ -318,23 +308,7 @@ fn a_whole_world_method_on_a_paged_world_names_the_paged_methods() {
         return;
     }
     let out_dir = dir("refused");
-    let out = strata(&[
-        "render",
-        "--level",
-        p(store()),
-        "--method",
-        "mesh",
-        "--gpu-budget",
-        "4MiB",
-        "--view",
-        VIEW,
-        "--pitch",
-        "-20",
-        "--size",
-        "160x100",
-        "--out",
-        p(&out_dir),
-    ]);
+    let out = render(&out_dir, &["--method", "mesh", "--gpu-budget", "4MiB"]);
     assert_clean_error(
         &out,
         &[

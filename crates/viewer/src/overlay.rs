@@ -445,6 +445,20 @@ fn timings(ui: &mut egui::Ui, status: &Status<'_>) {
     });
 }
 
+/// Why `name` cannot be drawn here: the adapter lacks what it needs, or
+/// the world is paged and it draws whole worlds only.
+fn refusal(status: &Status<'_>, name: &str) -> Option<String> {
+    methods::check_support(name, status.caps)
+        .err()
+        .map(|e| format!("{e:#}"))
+        .or_else(|| {
+            status
+                .paging
+                .as_ref()
+                .and_then(|_| crate::paged::refusal(name))
+        })
+}
+
 fn methods_section(
     ui: &mut egui::Ui,
     status: &Status<'_>,
@@ -454,15 +468,7 @@ fn methods_section(
     ui.label("method (keys 1 .. 9, 0)");
     ui.horizontal_wrapped(|ui| {
         for (i, name) in methods::names().into_iter().enumerate() {
-            let refused = methods::check_support(name, status.caps)
-                .err()
-                .map(|e| format!("{e:#}"))
-                .or_else(|| {
-                    status
-                        .paging
-                        .as_ref()
-                        .and_then(|_| crate::paged::refusal(name))
-                });
+            let refused = refusal(status, name);
             if let Some(why) = refused {
                 ui.add_enabled(
                     false,
@@ -501,17 +507,7 @@ fn methods_section(
     });
     let unavailable: Vec<String> = methods::names()
         .into_iter()
-        .filter_map(|name| {
-            methods::check_support(name, status.caps)
-                .err()
-                .map(|why| format!("{why:#}"))
-                .or_else(|| {
-                    status
-                        .paging
-                        .as_ref()
-                        .and_then(|_| crate::paged::refusal(name))
-                })
-        })
+        .filter_map(|name| refusal(status, name))
         .collect();
     if !unavailable.is_empty() {
         ui.collapsing(

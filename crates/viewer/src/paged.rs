@@ -27,6 +27,31 @@ pub fn refusal(method: &str) -> Option<String> {
     })
 }
 
+/// The camera of `view` over a world of `size` texels whose columns
+/// `column` reads at texel (x, y) (the one under the eye); a failed read is
+/// an error naming the view.
+pub fn camera_over<E: std::fmt::Display>(
+    size: (u32, u32),
+    mut column: impl FnMut(i64, i64) -> Result<Column, E>,
+    view: &strata_level::ViewSpec,
+    width: u32,
+    height: u32,
+) -> anyhow::Result<strata_camera::Camera> {
+    let mut error = None;
+    let read = |x: f32, y: f32| {
+        column(x.floor() as i64, y.floor() as i64).unwrap_or_else(|e| {
+            error = Some(e.to_string());
+            Level::flat(2, 1, 0, 0).expect("a 2x1 level").column(0, 0)
+        })
+    };
+    let camera = strata_camera::Camera::from_view_over(size, read, view, width, height)
+        .map_err(|e| anyhow::anyhow!("view `{}`: {e:#}", view.name))?;
+    match error {
+        Some(e) => anyhow::bail!("reading the ground under view `{}`: {e}", view.name),
+        None => Ok(camera),
+    }
+}
+
 /// What `Options::paged` carries: the world's pages and how to page them.
 #[derive(Clone)]
 pub struct PagedWorld {

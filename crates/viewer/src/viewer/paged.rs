@@ -152,22 +152,7 @@ pub(super) fn camera_over(
     width: u32,
     height: u32,
 ) -> anyhow::Result<Camera> {
-    let mut error = None;
-    let column = |x: f32, y: f32| {
-        pages
-            .column(x.floor() as i64, y.floor() as i64)
-            .unwrap_or_else(|e| {
-                error = Some(e);
-                strata_level::Level::flat(2, 1, 0, 0)
-                    .expect("a 2x1 level")
-                    .column(0, 0)
-            })
-    };
-    let camera = Camera::from_view_over(pages.size(), column, view, width, height)?;
-    match error {
-        Some(e) => anyhow::bail!("reading the ground under view `{}`: {e}", view.name),
-        None => Ok(camera),
-    }
+    crate::paged::camera_over(pages.size(), |x, y| pages.column(x, y), view, width, height)
 }
 
 /// The paged method to open with: `method` when it draws paged terrain,
