@@ -24,7 +24,7 @@ use strata_render::{Gpu, MethodSettings, Renderer, TerrainColors};
 
 /// Most frames a paged cell draws at its view waiting for every page it
 /// reads, before its warm-up and timed frames.
-const CONVERGE_FRAMES: u32 = 600;
+pub(crate) const CONVERGE_FRAMES: u32 = 600;
 
 /// `--temporal`: the default path played in this many seconds ...
 pub const TEMPORAL_SECONDS: f32 = 2.0;
@@ -767,7 +767,24 @@ impl Plan {
         measured: Measured,
         image: String,
     ) -> anyhow::Result<Row> {
-        let view = &self.opts.views[v];
+        row_of(
+            &self.opts.views[v],
+            self.opts.methods[m].label(),
+            measured,
+            image,
+        )
+    }
+}
+
+/// The row of one cell from what was measured there ([`Plan::row`], and
+/// the runs over paged stores that have no [`Plan`]).
+pub fn row_of(
+    view: &ViewSpec,
+    method: String,
+    measured: Measured,
+    image: String,
+) -> anyhow::Result<Row> {
+    {
         let Measured {
             metrics,
             frames,
@@ -800,7 +817,7 @@ impl Plan {
         Ok(Row {
             view: view.name.clone(),
             pitch: view.pitch,
-            method: self.opts.methods[m].label(),
+            method,
             see_through: metrics.see_through,
             covers_sky: metrics.covers_sky,
             depth_p50: f64::from(metrics.depth_p50),

@@ -33,9 +33,14 @@ fn has_gpu() -> bool {
 }
 
 fn strata(args: &[&str]) -> Output {
+    strata_with(args, &[])
+}
+
+fn strata_with(args: &[&str], env: &[(&str, &str)]) -> Output {
     let out = Command::new(STRATA)
         .args(args)
         .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .envs(env.iter().copied())
         .output()
         .expect("the strata binary starts");
     eprintln!(
@@ -231,18 +236,7 @@ fn compare_with_a_gpu_budget_pages_the_paged_method_only() {
         p(&out_dir),
     ]);
     assert!(out.status.success(), "{}", stderr(&out));
-    let results: Vec<PathBuf> = std::fs::read_dir(&out_dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|f| {
-            f.file_name()
-                .unwrap()
-                .to_string_lossy()
-                .starts_with("results-")
-        })
-        .collect();
-    assert_eq!(results.len(), 1, "{results:?}");
-    let run = read_json(&results[0]);
+    let run = results_of(&out_dir);
     let failures = run["failures"].as_array().map_or(0, Vec::len);
     assert_eq!(failures, 0, "{}", run["failures"]);
     let rows = run["rows"].as_array().unwrap();
@@ -258,6 +252,75 @@ fn compare_with_a_gpu_budget_pages_the_paged_method_only() {
     // Converged, the paged picture is the exact one: nothing seen through.
     assert!(exact["see_through"].as_f64().unwrap() < 0.5, "{exact}");
     assert!(row("ray")["paging"].is_null(), "ray draws the world whole");
+}
+
+/// The one results file of a compare run in `out`.
+fn results_of(out: &Path) -> serde_json::Value {
+    let results: Vec<PathBuf> = std::fs::read_dir(out)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|f| {
+            f.file_name()
+                .unwrap()
+                .to_string_lossy()
+                .starts_with("results-")
+        })
+        .collect();
+    assert_eq!(results.len(), 1, "{results:?}");
+    read_json(&results[0])
+}
+
+#[test]
+fn compare_over_a_store_past_the_limit_measures_paged_methods_and_refuses_the_rest() {
+    if !has_gpu() {
+        return;
+    }
+    let d = dir("compare-big");
+    let views = d.join("views.txt");
+    std::fs::write(&views, format!("middle {VIEW} -20\n")).unwrap();
+    let out_dir = d.join("out");
+    // A 1 MiB limit puts the 1024² store (2 MiB of map) past it.
+    let out = strata_with(
+        &[
+            "compare",
+            "--level",
+            p(store()),
+            "--gpu-budget",
+            "4MiB",
+            "--methods",
+            "ray-exact,ray",
+            "--views",
+            p(&views),
+            "--quick",
+            "--out",
+            p(&out_dir),
+        ],
+        &[("STRATA_WHOLE_WORLD_LIMIT_MIB", "1")],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let run = results_of(&out_dir);
+    assert_eq!(run["complete"], serde_json::json!(true));
+    let rows = run["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 1, "{rows:?}");
+    assert!(rows[0]["method"].as_str().unwrap().starts_with("ray-exact"));
+    assert!(rows[0]["paging"]["gpu_bytes"].as_u64().unwrap() <= 4 << 20);
+    assert!(
+        rows[0]["see_through"].as_f64().unwrap() < 0.5,
+        "{}",
+        rows[0]
+    );
+    let failures = run["failures"].as_array().unwrap();
+    assert_eq!(failures.len(), 1, "{failures:?}");
+    let error = failures[0]["error"].as_str().unwrap();
+    for wanted in [
+        "`ray` draws whole worlds only",
+        "past the whole-world limit",
+        "STRATA_WHOLE_WORLD_LIMIT_MIB",
+        "ray-exact, ray-exact-fragment draw it through pages",
+    ] {
+        assert!(error.contains(wanted), "`{wanted}` missing from: {error}");
+    }
+    assert!(out_dir.join("report.md").is_file());
 }
 
 #[test]
