@@ -159,15 +159,18 @@ fn past_the_limit(args: &Args) -> anyhow::Result<Option<String>> {
         store.store().map_bytes(),
         crate::world_arg::whole_world_limit(),
     );
-    let gib = |b: u64| b as f64 / f64::from(1u32 << 30);
+    let size = |b: u64| match b {
+        b if b >= 1 << 30 => format!("{:.2} GiB", b as f64 / f64::from(1u32 << 30)),
+        b => format!("{:.1} MiB", b as f64 / f64::from(1u32 << 20)),
+    };
     Ok((bytes > limit).then(|| {
         format!(
-            "the store in {} is {}x{} texels ({:.2} GiB in memory), past the whole-world limit here ({:.2} GiB: half the available memory, at most 4; STRATA_WHOLE_WORLD_LIMIT_MIB sets it)",
+            "the store in {} is {}x{} texels ({} in memory), past the whole-world limit here ({}: half the available memory, at most 4 GiB; STRATA_WHOLE_WORLD_LIMIT_MIB sets it)",
             dir.display(),
             store.store().width(),
             store.store().height(),
-            gib(bytes),
-            gib(limit)
+            size(bytes),
+            size(limit)
         )
     }))
 }
