@@ -784,61 +784,59 @@ pub fn row_of(
     measured: Measured,
     image: String,
 ) -> anyhow::Result<Row> {
-    {
-        let Measured {
-            metrics,
-            frames,
-            warm,
-            setup_ms,
-            retained,
-        } = measured;
-        let n = frames.len() as f64;
-        let mut passes: Vec<PassTime> = Vec::new();
-        for t in &frames {
-            for (label, ms) in &t.passes {
-                match passes.iter_mut().find(|p| p.label == *label) {
-                    Some(p) => p.mean_ms += ms / n,
-                    None => passes.push(PassTime {
-                        label: label.clone(),
-                        mean_ms: ms / n,
-                    }),
-                }
+    let Measured {
+        metrics,
+        frames,
+        warm,
+        setup_ms,
+        retained,
+    } = measured;
+    let n = frames.len() as f64;
+    let mut passes: Vec<PassTime> = Vec::new();
+    for t in &frames {
+        for (label, ms) in &t.passes {
+            match passes.iter_mut().find(|p| p.label == *label) {
+                Some(p) => p.mean_ms += ms / n,
+                None => passes.push(PassTime {
+                    label: label.clone(),
+                    mean_ms: ms / n,
+                }),
             }
         }
-        let cpu: Vec<f64> = frames.iter().map(|t| t.cpu_ms).collect();
-        let gpu: Vec<f64> = frames.iter().filter_map(|t| t.gpu_ms).collect();
-        // Timestamps on some frames only would mix sources: keep GPU only when every frame has it.
-        let gpu_t = if gpu.len() == cpu.len() {
-            summarize(&gpu)
-        } else {
-            None
-        };
-        let cpu_t = summarize(&cpu).context("no timed frames")?;
-        Ok(Row {
-            view: view.name.clone(),
-            pitch: view.pitch,
-            method,
-            see_through: metrics.see_through,
-            covers_sky: metrics.covers_sky,
-            depth_p50: f64::from(metrics.depth_p50),
-            depth_p95: f64::from(metrics.depth_p95),
-            coherence: metrics.coherence,
-            gpu_ms_mean: gpu_t.as_ref().map(|t| t.mean),
-            cpu_ms_mean: cpu_t.mean,
-            timing_source: TimingSource::of(gpu_t.as_ref()),
-            gpu_ms: gpu_t,
-            cpu_ms: cpu_t,
-            prep_setup_ms: setup_ms,
-            prep_first_frame_ms: warm.first_ms,
-            prep_warmup_ms: warm.total_ms,
-            gpu_bytes: retained.gpu,
-            cpu_bytes: retained.cpu,
-            passes,
-            image,
-            flip: None,
-            paging: None,
-        })
     }
+    let cpu: Vec<f64> = frames.iter().map(|t| t.cpu_ms).collect();
+    let gpu: Vec<f64> = frames.iter().filter_map(|t| t.gpu_ms).collect();
+    // Timestamps on some frames only would mix sources: keep GPU only when every frame has it.
+    let gpu_t = if gpu.len() == cpu.len() {
+        summarize(&gpu)
+    } else {
+        None
+    };
+    let cpu_t = summarize(&cpu).context("no timed frames")?;
+    Ok(Row {
+        view: view.name.clone(),
+        pitch: view.pitch,
+        method,
+        see_through: metrics.see_through,
+        covers_sky: metrics.covers_sky,
+        depth_p50: f64::from(metrics.depth_p50),
+        depth_p95: f64::from(metrics.depth_p95),
+        coherence: metrics.coherence,
+        gpu_ms_mean: gpu_t.as_ref().map(|t| t.mean),
+        cpu_ms_mean: cpu_t.mean,
+        timing_source: TimingSource::of(gpu_t.as_ref()),
+        gpu_ms: gpu_t,
+        cpu_ms: cpu_t,
+        prep_setup_ms: setup_ms,
+        prep_first_frame_ms: warm.first_ms,
+        prep_warmup_ms: warm.total_ms,
+        gpu_bytes: retained.gpu,
+        cpu_bytes: retained.cpu,
+        passes,
+        image,
+        flip: None,
+        paging: None,
+    })
 }
 
 /// Cells measured so far in this call, and where [`Plan::run_until`] stops.
