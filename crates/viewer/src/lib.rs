@@ -10,7 +10,8 @@
 //! Modules: [`fly`] (camera), [`dig`] (pick, crater, undo), [`knobs`]
 //! (settings), [`minimap`], [`script`], [`physics`] (the rigid-body toy;
 //! `bodies` draws it),
-//! [`builds`] (background method builds), [`save`] (Ctrl+S), [`present`] (picture to window),
+//! [`builds`] (background method builds), [`save`] (Ctrl+S), [`paged`] (stores and
+//! `--gpu-budget`: paged terrain, digging through an edit layer), [`present`] (picture to window),
 //! [`overlay`] (egui), [`viewer`] (state and frame), and here the event loop.
 //!
 //! Stability: this crate is the `strata view` window and the web page, not a library API. Its public items
