@@ -484,3 +484,30 @@ fn failed_track(choice: &MethodChoice, e: &anyhow::Error) -> MethodTrack {
         error: Some(format!("{e:#}")),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_edit_touches_the_chunks_its_rectangles_cover() {
+        let rect = |x, y, width, height| DirtyRect {
+            x,
+            y,
+            width,
+            height,
+        };
+        // A 1024-wide map: 4 chunks across.
+        assert_eq!(touched_chunks(&[rect(10, 10, 20, 20)], 1024), [0]);
+        assert_eq!(touched_chunks(&[rect(250, 250, 10, 10)], 1024), [0, 1, 4, 5]);
+        // Two rectangles of one wrapped crater, and an empty one.
+        assert_eq!(
+            touched_chunks(
+                &[rect(1020, 0, 4, 8), rect(0, 0, 6, 8), rect(5, 5, 0, 3)],
+                1024
+            ),
+            [0, 3]
+        );
+        assert_eq!(touched_chunks(&[rect(0, 256, 256, 1)], 1024), [4]);
+    }
+}
