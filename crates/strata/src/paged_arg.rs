@@ -17,7 +17,8 @@ use strata_store::{ChunkCache, DirKind, DirStore};
 pub struct PagedArgs {
     /// Draw through paged terrain within this many GPU bytes (suffixes KiB,
     /// MiB, GiB): pages stream in as the view needs them. Default: paged only
-    /// for a store past the whole-world limit (2^28 texels), at 256 MiB.
+    /// for a store past a whole-world limit (2^28 texels, or the memory a
+    /// whole world may take here: STRATA_WHOLE_WORLD_LIMIT_MIB), at 256 MiB.
     #[arg(long, value_name = "BYTES", value_parser = parse_bytes)]
     pub gpu_budget: Option<u64>,
     /// CPU bytes of decoded chunks kept by a store's chunk cache.
@@ -107,7 +108,7 @@ impl PagedWorld {
 }
 
 /// The world to draw paged, when it must be: `--gpu-budget` given, or a
-/// store past the whole-world limit. `None`: draw it whole, as before.
+/// store past a whole-world limit (texels or memory). `None`: draw it whole, as before.
 pub fn open_paged(world: &WorldArgs, paged: &PagedArgs) -> anyhow::Result<Option<PagedWorld>> {
     let store_dir = match &world.level {
         Some(dir) if strata_store::dir_kind(dir)? == DirKind::Store => Some(dir.clone()),
@@ -117,7 +118,10 @@ pub fn open_paged(world: &WorldArgs, paged: &PagedArgs) -> anyhow::Result<Option
         let store = DirStore::open(&dir)
             .with_context(|| format!("opening the store in {}", dir.display()))?;
         let (w, h) = (store.store().width(), store.store().height());
-        if paged.gpu_budget.is_none() && u64::from(w) * u64::from(h) <= MAX_TEXELS {
+        // Past either whole-world limit (the texture's texels, or the memory
+        // a whole world may take here) a store is drawn paged by default.
+        let past_memory = store.store().map_bytes() > crate::world_arg::whole_world_limit();
+        if paged.gpu_budget.is_none() && u64::from(w) * u64::from(h) <= MAX_TEXELS && !past_memory {
             return Ok(None);
         }
         return open_store(&dir, store, world, paged).map(Some);

@@ -324,6 +324,41 @@ fn compare_over_a_store_past_the_limit_measures_paged_methods_and_refuses_the_re
 }
 
 #[test]
+fn a_store_past_the_memory_limit_renders_paged_without_the_flag() {
+    if !has_gpu() {
+        return;
+    }
+    let out_dir = dir("past-memory");
+    let mut args = vec![
+        "render",
+        "--level",
+        p(store()),
+        "--view",
+        VIEW,
+        "--pitch",
+        "-20",
+        "--size",
+        "160x100",
+        "--method",
+        "ray-exact",
+        "--frames",
+        "1",
+        "--warmup",
+        "0",
+        "--out",
+    ];
+    args.push(p(&out_dir));
+    let out = strata_with(&args, &[("STRATA_WHOLE_WORLD_LIMIT_MIB", "1")]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let report = read_json(&out_dir.join("render.json"));
+    assert_eq!(
+        report["paging"]["gpu_budget"].as_u64(),
+        Some(256 << 20),
+        "paged at the default budget: {report}"
+    );
+}
+
+#[test]
 fn a_budget_too_small_is_refused_with_the_smallest_that_works() {
     if !has_gpu() {
         return;

@@ -499,7 +499,10 @@ mod tests {
         };
         // A 1024-wide map: 4 chunks across.
         assert_eq!(touched_chunks(&[rect(10, 10, 20, 20)], 1024), [0]);
-        assert_eq!(touched_chunks(&[rect(250, 250, 10, 10)], 1024), [0, 1, 4, 5]);
+        assert_eq!(
+            touched_chunks(&[rect(250, 250, 10, 10)], 1024),
+            [0, 1, 4, 5]
+        );
         // Two rectangles of one wrapped crater, and an empty one.
         assert_eq!(
             touched_chunks(
