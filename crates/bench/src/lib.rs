@@ -16,6 +16,8 @@ pub mod font;
 pub mod grid;
 pub mod merge;
 pub mod methods;
+#[cfg(not(target_arch = "wasm32"))]
+pub mod paged_run;
 pub mod plan;
 pub mod portability;
 pub mod resume;

@@ -14,11 +14,17 @@ pub use crate::warm::{INCREMENTAL_BUDGET_TEXELS, WarmUp, build_frames, ms, warm_
 use anyhow::Context;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
+use std::sync::Arc;
 use std::time::Instant;
 use strata_camera::Camera;
 use strata_level::{EditSite, ViewSpec, World};
 use strata_reference::{ColorImage, Reference, ReferenceCache, Tracer};
+use strata_render::paged::{LevelPages, PAGED_METHODS, PageSource, PagedOptions};
 use strata_render::{Gpu, MethodSettings, Renderer, TerrainColors};
+
+/// Most frames a paged cell draws at its view waiting for every page it
+/// reads, before its warm-up and timed frames.
+pub(crate) const CONVERGE_FRAMES: u32 = 600;
 
 /// `--temporal`: the default path played in this many seconds ...
 pub const TEMPORAL_SECONDS: f32 = 2.0;
@@ -73,6 +79,9 @@ pub struct Plan {
     edit: Option<(EditSite, Camera)>,
     edit_skipped: Option<String>,
     warmup_first: u32,
+    /// `--gpu-budget`: the paged methods draw through pages of the world
+    /// ([`Plan::with_paging`]).
+    paging: Option<(PagedOptions, Arc<dyn PageSource>)>,
 }
 
 impl Plan {
@@ -131,7 +140,24 @@ impl Plan {
             edit,
             edit_skipped,
             warmup_first,
+            paging: None,
         })
+    }
+
+    /// Draw the paged methods (`strata_render::paged::PAGED_METHODS`)
+    /// through pages of the world within `options.gpu_budget`: each view
+    /// converges (nothing pending) before it is timed and compared, and its
+    /// row carries the paging numbers. The other methods keep the
+    /// whole-world path. `None`: every method draws the world whole.
+    pub fn with_paging(mut self, options: Option<PagedOptions>) -> anyhow::Result<Self> {
+        self.paging = match options {
+            Some(o) => {
+                let level = Arc::new(self.world.level.clone());
+                Some((o, Arc::new(LevelPages::new(level)?) as Arc<dyn PageSource>))
+            }
+            None => None,
+        };
+        Ok(self)
     }
 
     pub fn world(&self) -> &World {
@@ -391,6 +417,7 @@ impl Plan {
             shadows: self.opts.shadows,
             temporal: true,
             overlap: None,
+            paging: None,
         };
         let (pos, len) = (bar.position(), bar.length());
         let recording = video::record(gpu, &self.world, &path, &opts, None, bar);
@@ -551,15 +578,55 @@ impl Plan {
         }
         bar.set_message(format!("{label}: setup"));
         let start = Instant::now();
-        let mut renderer = Renderer::new(
-            gpu,
-            &self.world.level,
-            &self.colors,
-            choice.method,
-            &self.settings[m],
-            self.opts.width,
-            self.opts.height,
-        )?;
+        let paged = self
+            .paging
+            .as_ref()
+            .filter(|_| PAGED_METHODS.contains(&choice.method.name));
+        let built = match paged {
+            Some((options, source)) => Renderer::new_paged(
+                gpu,
+                source.clone(),
+                &self.colors,
+                choice.method,
+                &self.settings[m],
+                self.opts.width,
+                self.opts.height,
+                options.clone(),
+            ),
+            None => Renderer::new(
+                gpu,
+                &self.world.level,
+                &self.colors,
+                choice.method,
+                &self.settings[m],
+                self.opts.width,
+                self.opts.height,
+            ),
+        };
+        let mut renderer = match built {
+            Ok(r) => r,
+            // With paging on, a whole-world method that cannot hold this
+            // world is a refusal in the results, not the end of the run.
+            Err(e) if self.paging.is_some() => {
+                let error = format!(
+                    "{e:#} (with --gpu-budget, {} draw through pages)",
+                    PAGED_METHODS.join(", ")
+                );
+                bar.println(format!("{label}: {error}"));
+                for &v in &todo {
+                    session.results.failures.push(Failure {
+                        view: self.opts.views[v].name.clone(),
+                        method: label.clone(),
+                        error: error.clone(),
+                    });
+                    bar.inc(1);
+                    count.measured += 1;
+                }
+                session.save_json()?;
+                return Ok(());
+            }
+            Err(e) => return Err(e),
+        };
         let setup_ms = ms(start);
         for (i, &v) in todo.iter().enumerate() {
             if count.stop_after.is_some_and(|n| count.measured >= n) {
@@ -615,6 +682,10 @@ impl Plan {
     ) -> anyhow::Result<Row> {
         let view = &self.opts.views[v];
         let label = self.opts.methods[m].label();
+        // Paged terrain: every page the view reads resident before timing.
+        let converge_frames = renderer
+            .converge(camera, CONVERGE_FRAMES)
+            .context("paged terrain")?;
         if self.opts.hold_busy_ms > 0 {
             // A renderer's first view follows its setup, seconds of CPU work
             // in which the GPU idles down to its lowest clock (345 MHz on the
@@ -637,6 +708,19 @@ impl Plan {
         let frames = (0..self.opts.frames)
             .map(|_| renderer.render_frame(camera))
             .collect::<anyhow::Result<Vec<_>>>()?;
+        let paging = renderer.paged_terrain().map(|t| {
+            let s = t.stats();
+            CellPaging {
+                gpu_budget: s.gpu_budget,
+                gpu_bytes: s.gpu_bytes,
+                slots: s.slots,
+                resident_pages: s.resident_pages,
+                resident_bytes: s.resident_bytes,
+                converge_frames,
+                pending_pixels: s.pending_pixels,
+                read_errors: s.read_errors,
+            }
+        });
         let depth = renderer.read_depth()?;
         let distance = strata_reference::distance_from_depth(camera, &depth);
         let metrics = strata_reference::metrics::try_compare(reference, &distance)?;
@@ -669,6 +753,7 @@ impl Plan {
         };
         let mut row = self.row(v, m, measured, image)?;
         row.flip = flip;
+        row.paging = paging;
         Ok(row)
     }
 
@@ -682,60 +767,76 @@ impl Plan {
         measured: Measured,
         image: String,
     ) -> anyhow::Result<Row> {
-        let view = &self.opts.views[v];
-        let Measured {
-            metrics,
-            frames,
-            warm,
-            setup_ms,
-            retained,
-        } = measured;
-        let n = frames.len() as f64;
-        let mut passes: Vec<PassTime> = Vec::new();
-        for t in &frames {
-            for (label, ms) in &t.passes {
-                match passes.iter_mut().find(|p| p.label == *label) {
-                    Some(p) => p.mean_ms += ms / n,
-                    None => passes.push(PassTime {
-                        label: label.clone(),
-                        mean_ms: ms / n,
-                    }),
-                }
+        row_of(
+            &self.opts.views[v],
+            self.opts.methods[m].label(),
+            measured,
+            image,
+        )
+    }
+}
+
+/// The row of one cell from what was measured there ([`Plan::row`], and
+/// the runs over paged stores that have no [`Plan`]).
+pub fn row_of(
+    view: &ViewSpec,
+    method: String,
+    measured: Measured,
+    image: String,
+) -> anyhow::Result<Row> {
+    let Measured {
+        metrics,
+        frames,
+        warm,
+        setup_ms,
+        retained,
+    } = measured;
+    let n = frames.len() as f64;
+    let mut passes: Vec<PassTime> = Vec::new();
+    for t in &frames {
+        for (label, ms) in &t.passes {
+            match passes.iter_mut().find(|p| p.label == *label) {
+                Some(p) => p.mean_ms += ms / n,
+                None => passes.push(PassTime {
+                    label: label.clone(),
+                    mean_ms: ms / n,
+                }),
             }
         }
-        let cpu: Vec<f64> = frames.iter().map(|t| t.cpu_ms).collect();
-        let gpu: Vec<f64> = frames.iter().filter_map(|t| t.gpu_ms).collect();
-        // Timestamps on some frames only would mix sources: keep GPU only when every frame has it.
-        let gpu_t = if gpu.len() == cpu.len() {
-            summarize(&gpu)
-        } else {
-            None
-        };
-        let cpu_t = summarize(&cpu).context("no timed frames")?;
-        Ok(Row {
-            view: view.name.clone(),
-            pitch: view.pitch,
-            method: self.opts.methods[m].label(),
-            see_through: metrics.see_through,
-            covers_sky: metrics.covers_sky,
-            depth_p50: f64::from(metrics.depth_p50),
-            depth_p95: f64::from(metrics.depth_p95),
-            coherence: metrics.coherence,
-            gpu_ms_mean: gpu_t.as_ref().map(|t| t.mean),
-            cpu_ms_mean: cpu_t.mean,
-            timing_source: TimingSource::of(gpu_t.as_ref()),
-            gpu_ms: gpu_t,
-            cpu_ms: cpu_t,
-            prep_setup_ms: setup_ms,
-            prep_first_frame_ms: warm.first_ms,
-            prep_warmup_ms: warm.total_ms,
-            gpu_bytes: retained.gpu,
-            cpu_bytes: retained.cpu,
-            passes,
-            image,
-            flip: None,
-        })
     }
+    let cpu: Vec<f64> = frames.iter().map(|t| t.cpu_ms).collect();
+    let gpu: Vec<f64> = frames.iter().filter_map(|t| t.gpu_ms).collect();
+    // Timestamps on some frames only would mix sources: keep GPU only when every frame has it.
+    let gpu_t = if gpu.len() == cpu.len() {
+        summarize(&gpu)
+    } else {
+        None
+    };
+    let cpu_t = summarize(&cpu).context("no timed frames")?;
+    Ok(Row {
+        view: view.name.clone(),
+        pitch: view.pitch,
+        method,
+        see_through: metrics.see_through,
+        covers_sky: metrics.covers_sky,
+        depth_p50: f64::from(metrics.depth_p50),
+        depth_p95: f64::from(metrics.depth_p95),
+        coherence: metrics.coherence,
+        gpu_ms_mean: gpu_t.as_ref().map(|t| t.mean),
+        cpu_ms_mean: cpu_t.mean,
+        timing_source: TimingSource::of(gpu_t.as_ref()),
+        gpu_ms: gpu_t,
+        cpu_ms: cpu_t,
+        prep_setup_ms: setup_ms,
+        prep_first_frame_ms: warm.first_ms,
+        prep_warmup_ms: warm.total_ms,
+        gpu_bytes: retained.gpu,
+        cpu_bytes: retained.cpu,
+        passes,
+        image,
+        flip: None,
+        paging: None,
+    })
 }
 
 /// Cells measured so far in this call, and where [`Plan::run_until`] stops.

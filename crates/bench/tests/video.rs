@@ -26,6 +26,7 @@ fn flicker(
         shadows: true,
         temporal: true,
         overlap: Some(overlap),
+        paging: None,
     };
     let r = record(gpu, w, &path, &opts, None, &ProgressBar::hidden()).unwrap();
     assert_eq!(r.frames, 9);

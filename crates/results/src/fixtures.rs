@@ -48,6 +48,7 @@ pub fn row(view: &str, pitch: f32, method: &str, see: f64, coh: f64, gpu: &[f64]
         passes: Vec::new(),
         image: format!("cells/{view}-{method}.png"),
         flip: None,
+        paging: None,
     }
 }
 

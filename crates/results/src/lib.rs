@@ -205,6 +205,30 @@ pub struct Row {
     /// and in the browser's runs).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub flip: Option<FlipScore>,
+    /// Paged terrain's numbers where the method drew through pages
+    /// (`compare --gpu-budget`); absent for the whole-world path.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub paging: Option<CellPaging>,
+}
+
+/// What a paged cell kept on the GPU and how it converged (issue 33).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CellPaging {
+    /// The budget, bytes.
+    pub gpu_budget: u64,
+    /// Bytes the paged terrain keeps on the GPU (at most the budget).
+    pub gpu_bytes: u64,
+    /// Slots of the atlas, and pages resident when the cell was timed.
+    pub slots: u32,
+    pub resident_pages: u32,
+    pub resident_bytes: u64,
+    /// Frames drawn at the view until nothing was pending, before timing.
+    pub converge_frames: u32,
+    /// Pixels drawn from a missing page in the last timed frame (0 once
+    /// converged).
+    pub pending_pixels: u32,
+    /// Chunks that failed to read.
+    pub read_errors: u32,
 }
 
 /// A cell's perceptual colour error: ꟻLIP between its picture and the CPU

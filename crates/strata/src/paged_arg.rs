@@ -17,7 +17,8 @@ use strata_store::{ChunkCache, DirKind, DirStore};
 pub struct PagedArgs {
     /// Draw through paged terrain within this many GPU bytes (suffixes KiB,
     /// MiB, GiB): pages stream in as the view needs them. Default: paged only
-    /// for a store past the whole-world limit (2^28 texels), at 256 MiB.
+    /// for a store past a whole-world limit (2^28 texels, or the memory a
+    /// whole world may take here: STRATA_WHOLE_WORLD_LIMIT_MIB), at 256 MiB.
     #[arg(long, value_name = "BYTES", value_parser = parse_bytes)]
     pub gpu_budget: Option<u64>,
     /// CPU bytes of decoded chunks kept by a store's chunk cache.
@@ -87,30 +88,26 @@ pub struct PagedWorld {
     pub colors: TerrainColors,
     pub source: Arc<dyn PageSource>,
     columns: Columns,
+    /// The store's directory, when the world is a store.
+    pub dir: Option<std::path::PathBuf>,
 }
 
 impl PagedWorld {
     /// The camera of `view` at `width` x `height` (reads the one column under it).
     pub fn camera(&self, view: &ViewSpec, width: u32, height: u32) -> anyhow::Result<Camera> {
-        let mut error = None;
-        let column = |x: f32, y: f32| match &self.columns {
-            Columns::Memory(level) => level.column_at(x, y),
-            Columns::Store(cache) => cache
-                .column(x.floor() as i64, y.floor() as i64)
-                .unwrap_or_else(|e| {
-                    error = Some(e);
-                    strata_level::Level::flat(2, 1, 0, 0)
-                        .expect("a 2x1 level")
-                        .column(0, 0)
-                }),
+        let column = |x: i64, y: i64| match &self.columns {
+            Columns::Memory(level) => Ok(level.column(x, y)),
+            Columns::Store(cache) => cache.column(x, y),
         };
-        let camera = Camera::from_view_over(self.size, column, view, width, height)
-            .with_context(|| format!("view `{}`", view.name))?;
-        if let Some(e) = error {
-            return Err(e)
-                .with_context(|| format!("reading the ground under view `{}`", view.name));
+        strata_viewer::paged::camera_over(self.size, column, view, width, height)
+    }
+
+    /// The store's chunk cache, when the world is a store.
+    pub fn cache(&self) -> Option<&Arc<ChunkCache>> {
+        match &self.columns {
+            Columns::Store(cache) => Some(cache),
+            Columns::Memory(_) => None,
         }
-        Ok(camera)
     }
 
     /// The paging options from the flags.
@@ -127,7 +124,7 @@ impl PagedWorld {
 }
 
 /// The world to draw paged, when it must be: `--gpu-budget` given, or a
-/// store past the whole-world limit. `None`: draw it whole, as before.
+/// store past a whole-world limit (texels or memory). `None`: draw it whole, as before.
 pub fn open_paged(world: &WorldArgs, paged: &PagedArgs) -> anyhow::Result<Option<PagedWorld>> {
     let store_dir = match &world.level {
         Some(dir) if strata_store::dir_kind(dir)? == DirKind::Store => Some(dir.clone()),
@@ -137,7 +134,10 @@ pub fn open_paged(world: &WorldArgs, paged: &PagedArgs) -> anyhow::Result<Option
         let store = DirStore::open(&dir)
             .with_context(|| format!("opening the store in {}", dir.display()))?;
         let (w, h) = (store.store().width(), store.store().height());
-        if paged.gpu_budget.is_none() && u64::from(w) * u64::from(h) <= MAX_TEXELS {
+        // Past either whole-world limit (the texture's texels, or the memory
+        // a whole world may take here) a store is drawn paged by default.
+        let past_memory = store.store().map_bytes() > crate::world_arg::whole_world_limit();
+        if paged.gpu_budget.is_none() && u64::from(w) * u64::from(h) <= MAX_TEXELS && !past_memory {
             return Ok(None);
         }
         return open_store(&dir, store, world, paged).map(Some);
@@ -154,6 +154,7 @@ pub fn open_paged(world: &WorldArgs, paged: &PagedArgs) -> anyhow::Result<Option
         colors: TerrainColors::from_world(&w),
         source: Arc::new(LevelPages::new(level.clone())?),
         columns: Columns::Memory(level),
+        dir: None,
     }))
 }
 
@@ -188,6 +189,7 @@ fn open_store(
         },
         source,
         columns: Columns::Store(cache),
+        dir: Some(dir.to_path_buf()),
     })
 }
 

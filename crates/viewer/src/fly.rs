@@ -4,7 +4,7 @@
 
 use glam::Vec3;
 use strata_camera::Camera;
-use strata_level::{Level, ViewSpec};
+use strata_level::{Column, ViewSpec};
 
 /// Base flying speed, world units (texels) per second; Shift multiplies it.
 pub const DEFAULT_SPEED: f32 = 80.0;
@@ -66,21 +66,22 @@ impl FlyCamera {
 
     /// Move for `dt` seconds, then wrap onto the map (a torus in x and y)
     /// and keep the eye within the altitude range the renderers march.
-    pub fn fly(&mut self, motion: &Motion, dt: f32, level: &Level) {
+    /// `world` is the map's width and height, texels.
+    pub fn fly(&mut self, motion: &Motion, dt: f32, world: (u32, u32)) {
         let basis = self.basis();
         let speed = self.speed * if motion.fast { FAST } else { 1.0 };
         // The image's x axis runs along -right (the camera's mirrored screen).
         let dir = basis.forward * motion.forward - basis.right * motion.right + Vec3::Z * motion.up;
         self.position += dir * speed * dt;
-        self.wrap(level);
+        self.wrap(world);
     }
 
     /// Move by `offset` in camera terms: along the view, the screen's right,
     /// world up (the script's `fly`).
-    pub fn translate(&mut self, offset: Vec3, level: &Level) {
+    pub fn translate(&mut self, offset: Vec3, world: (u32, u32)) {
         let b = self.basis();
         self.position += b.forward * offset.x - b.right * offset.y + Vec3::Z * offset.z;
-        self.wrap(level);
+        self.wrap(world);
     }
 
     /// Turn by a mouse motion in pixels: right turns right, down looks down.
@@ -111,9 +112,9 @@ impl FlyCamera {
         .basis()
     }
 
-    fn wrap(&mut self, level: &Level) {
-        self.position.x = self.position.x.rem_euclid(level.width() as f32);
-        self.position.y = self.position.y.rem_euclid(level.height() as f32);
+    fn wrap(&mut self, (width, height): (u32, u32)) {
+        self.position.x = self.position.x.rem_euclid(width as f32);
+        self.position.y = self.position.y.rem_euclid(height as f32);
         // Heights are 0..255; a little room above for looking down on it all.
         self.position.z = self.position.z.clamp(0.5, 400.0);
     }
@@ -121,9 +122,8 @@ impl FlyCamera {
     /// The current eye as a `views.txt` entry: the eye height is measured
     /// above the column's top surface, or above its floor (`under`) when the
     /// eye is below the top (inside a cave), so [`Camera::from_view`] gives
-    /// this camera back.
-    pub fn view_spec(&self, level: &Level, name: &str) -> ViewSpec {
-        let column = level.column_at(self.position.x, self.position.y);
+    /// this camera back. `column` is the one under the eye.
+    pub fn view_spec(&self, column: Column, name: &str) -> ViewSpec {
         let z = self.position.z;
         let top = f32::from(column.top());
         let (eye, under) = if z >= top {
@@ -148,6 +148,8 @@ impl FlyCamera {
 mod tests {
     use super::*;
 
+    use strata_level::Level;
+
     fn level() -> Level {
         Level::flat(256, 512, 100, 1).unwrap()
     }
@@ -168,7 +170,7 @@ mod tests {
 
     #[test]
     fn strafing_right_moves_the_eye_to_the_screen_right() {
-        let level = level();
+        let size = (256, 512);
         for yaw in [0.0, 37.0, 90.0, 200.0] {
             let mut cam = fly_cam(yaw, -20.0);
             let ahead = cam.position + cam.basis().forward * 50.0;
@@ -177,7 +179,7 @@ mod tests {
                 right: 1.0,
                 ..Default::default()
             };
-            cam.fly(&motion, 0.1, &level);
+            cam.fly(&motion, 0.1, size);
             // The eye went right, so a fixed point ahead appears further left.
             assert!(screen_x(&cam, ahead) < before - 1.0, "yaw {yaw}");
         }
@@ -204,14 +206,14 @@ mod tests {
 
     #[test]
     fn flying_wraps_around_the_map_and_shift_is_faster() {
-        let level = level();
+        let size = (256, 512);
         let mut slow = fly_cam(0.0, 0.0);
         slow.position.y = 510.0;
         let forward = Motion {
             forward: 1.0,
             ..Default::default()
         };
-        slow.fly(&forward, 0.1, &level);
+        slow.fly(&forward, 0.1, size);
         assert!((slow.position.y - (510.0 + 8.0 - 512.0)).abs() < 1e-3);
         let mut fast = fly_cam(0.0, 0.0);
         fast.fly(
@@ -220,7 +222,7 @@ mod tests {
                 ..forward
             },
             0.1,
-            &level,
+            size,
         );
         assert!((fast.position.y - (100.0 + 8.0 * FAST)).abs() < 1e-3);
     }
@@ -252,7 +254,7 @@ mod tests {
                 pitch_deg: -12.5,
                 speed: DEFAULT_SPEED,
             };
-            let spec = cam.view_spec(&level, "copied");
+            let spec = cam.view_spec(level.column_at(50.0, 60.0), "copied");
             assert_eq!(spec.under, under);
             let line = spec.to_string();
             let parsed = strata_level::views::parse_views(&line).unwrap();

@@ -10,7 +10,8 @@
 //! Modules: [`fly`] (camera), [`dig`] (pick, crater, undo), [`knobs`]
 //! (settings), [`minimap`], [`script`], [`physics`] (the rigid-body toy;
 //! `bodies` draws it),
-//! [`builds`] (background method builds), [`save`] (Ctrl+S), [`present`] (picture to window),
+//! [`builds`] (background method builds), [`save`] (Ctrl+S), [`paged`] (stores and
+//! `--gpu-budget`: paged terrain, digging through an edit layer), [`present`] (picture to window),
 //! [`overlay`] (egui), [`viewer`] (state and frame), and here the event loop.
 //!
 //! Stability: this crate is the `strata view` window and the web page, not a library API. Its public items
@@ -30,6 +31,7 @@ pub mod minimap;
 pub mod overlay;
 #[cfg(target_arch = "wasm32")]
 mod page;
+pub mod paged;
 pub mod physics;
 pub mod platform;
 pub mod present;
@@ -78,6 +80,9 @@ pub struct Options {
     pub save: save::SaveOptions,
     /// Start with the physics toy on (key O toggles it).
     pub physics: bool,
+    /// Draw through paged terrain (issue 33): `world`'s level is then a
+    /// stand-in and the map is read from these pages as the view needs them.
+    pub paged: Option<paged::PagedWorld>,
 }
 
 /// Open the window and run until it is closed or the script ends.

@@ -86,6 +86,9 @@ pub struct Status<'a> {
     /// The last scores against the reference.
     pub scores: &'a [(String, strata_reference::Metrics)],
     pub log: &'a [String],
+    /// Paged terrain's numbers (resident bytes of the budget, uploads this
+    /// frame, pending pixels, read errors); `None` for a world in memory.
+    pub paging: Option<Vec<String>>,
 }
 
 /// What the overlay may change directly.
@@ -357,6 +360,13 @@ fn panel_contents(
         status.frame_ms
     ));
     section(ui, "GPU time per pass", true, |ui| timings(ui, status));
+    if let Some(lines) = &status.paging {
+        section(ui, "paged terrain", true, |ui| {
+            for line in lines {
+                ui.label(line);
+            }
+        });
+    }
     methods_section(ui, status, editable, actions);
     section(ui, "settings", true, |ui| {
         knobs(ui, status, editable, actions)
@@ -435,6 +445,20 @@ fn timings(ui: &mut egui::Ui, status: &Status<'_>) {
     });
 }
 
+/// Why `name` cannot be drawn here: the adapter lacks what it needs, or
+/// the world is paged and it draws whole worlds only.
+fn refusal(status: &Status<'_>, name: &str) -> Option<String> {
+    methods::check_support(name, status.caps)
+        .err()
+        .map(|e| format!("{e:#}"))
+        .or_else(|| {
+            status
+                .paging
+                .as_ref()
+                .and_then(|_| crate::paged::refusal(name))
+        })
+}
+
 fn methods_section(
     ui: &mut egui::Ui,
     status: &Status<'_>,
@@ -444,13 +468,13 @@ fn methods_section(
     ui.label("method (keys 1 .. 9, 0)");
     ui.horizontal_wrapped(|ui| {
         for (i, name) in methods::names().into_iter().enumerate() {
-            let refused = methods::check_support(name, status.caps).err();
+            let refused = refusal(status, name);
             if let Some(why) = refused {
                 ui.add_enabled(
                     false,
                     egui::Button::selectable(false, format!("{} {name} (unavailable)", i + 1)),
                 )
-                .on_disabled_hover_text(format!("{why:#}"));
+                .on_disabled_hover_text(why);
                 continue;
             }
             let building = status.building.iter().any(|b| b.method == name);
@@ -483,8 +507,7 @@ fn methods_section(
     });
     let unavailable: Vec<String> = methods::names()
         .into_iter()
-        .filter_map(|name| methods::check_support(name, status.caps).err())
-        .map(|why| format!("{why:#}"))
+        .filter_map(|name| refusal(status, name))
         .collect();
     if !unavailable.is_empty() {
         ui.collapsing(

@@ -110,6 +110,11 @@ impl Saver {
         &self.world
     }
 
+    /// Whether saving over the loaded world is allowed (`--overwrite`).
+    pub fn overwrite(&self) -> bool {
+        self.options.policy.overwrite
+    }
+
     /// Note an edit: the stores this session saves into will need those
     /// rectangles' chunks written.
     pub fn record_edit(&mut self, dirty: &[DirtyRect]) {

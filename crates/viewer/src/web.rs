@@ -131,6 +131,7 @@ impl App {
                 out: parts.out,
                 save: Default::default(),
                 physics: false,
+                paged: None,
             };
             let opened = Viewer::new(parts.window, parts.surface, parts.gpu, options);
             self.opened(event_loop, opened);

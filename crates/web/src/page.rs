@@ -131,6 +131,7 @@ pub async fn run() -> anyhow::Result<()> {
             out: "screenshots".into(),
             save: Default::default(),
             physics: false,
+            paged: None,
         },
         params.backend,
     )

@@ -43,6 +43,64 @@ pub struct VideoOptions {
     /// Trace the reference while the methods render (`None`: when the
     /// adapter is not a CPU rasteriser, whose frame times it would inflate).
     pub overlap: Option<bool>,
+    /// `--gpu-budget`: the paged methods (`strata_render::paged::PAGED_METHODS`)
+    /// draw through pages streamed as the camera flies (converged at the
+    /// first pose); the others keep the whole-world path.
+    pub paging: Option<strata_render::paged::PagedOptions>,
+}
+
+/// Pages of a world in memory whose level an edit replaces (the dig frame
+/// swaps in the edited level, then refreshes the touched pages).
+struct SwappedPages {
+    level: std::sync::RwLock<std::sync::Arc<Level>>,
+}
+
+impl SwappedPages {
+    fn pages(&self) -> Result<strata_render::paged::LevelPages, String> {
+        let level = self.level.read().expect("pages lock").clone();
+        strata_render::paged::LevelPages::new(level).map_err(|e| format!("{e:#}"))
+    }
+}
+
+impl strata_render::paged::PageSource for SwappedPages {
+    fn size(&self) -> (u32, u32) {
+        let level = self.level.read().expect("pages lock");
+        (level.width(), level.height())
+    }
+
+    fn mid_rule(&self) -> strata_level::MidRule {
+        self.level.read().expect("pages lock").mid_rule
+    }
+
+    fn chunk_tops(&self) -> Result<Vec<u8>, String> {
+        self.pages()?.chunk_tops()
+    }
+
+    fn read_page(
+        &self,
+        cx: u32,
+        cy: u32,
+        step: u32,
+    ) -> Result<strata_render::paged::PageData, String> {
+        self.pages()?.read_page(cx, cy, step)
+    }
+}
+
+/// The chunks (grid row-major) that `rects` touch on a map `width` wide.
+fn touched_chunks(rects: &[DirtyRect], width: u32) -> Vec<u32> {
+    let page = strata_render::paged::PAGE;
+    let mut chunks: Vec<u32> = rects
+        .iter()
+        .filter(|r| r.width > 0 && r.height > 0)
+        .flat_map(|r| {
+            (r.y / page..=(r.y + r.height - 1) / page).flat_map(move |cy| {
+                (r.x / page..=(r.x + r.width - 1) / page).map(move |cx| cy * (width / page) + cx)
+            })
+        })
+        .collect();
+    chunks.sort_unstable();
+    chunks.dedup();
+    chunks
 }
 
 /// The video's JSON sidecar (`<out>.json`).
@@ -103,6 +161,8 @@ struct Lane {
     previous: Option<Vec<f32>>,
     setup_ms: f64,
     settings: String,
+    /// The pages a paged lane draws (an edit swaps their level).
+    pages: Option<std::sync::Arc<SwappedPages>>,
 }
 
 /// Render `path` with every method, feeding composed frames to `sink` when
@@ -240,7 +300,14 @@ fn render_lanes(
     for lane in lanes {
         let start = Instant::now();
         if let Some((level, rects)) = edit {
-            lane.renderer.apply_edit(level, rects)?;
+            match &lane.pages {
+                Some(pages) => {
+                    *pages.level.write().expect("pages lock") = std::sync::Arc::new(level.clone());
+                    lane.renderer
+                        .refresh_pages(&touched_chunks(rects, level.width()))?;
+                }
+                None => lane.renderer.apply_edit(level, rects)?,
+            }
         }
         let timing = lane.renderer.render_frame(camera)?;
         if edit.is_some() {
@@ -310,15 +377,42 @@ fn build_lane(
 ) -> anyhow::Result<Lane> {
     let settings = settings_for(choice, opts.shadows)?;
     let start = Instant::now();
-    let mut renderer = Renderer::new(
-        gpu,
-        level,
-        colors,
-        choice.method,
-        &settings,
-        opts.tile.0,
-        opts.tile.1,
-    )?;
+    let paged = opts
+        .paging
+        .as_ref()
+        .filter(|_| strata_render::paged::PAGED_METHODS.contains(&choice.method.name));
+    let (mut renderer, pages) = match paged {
+        Some(options) => {
+            let pages = std::sync::Arc::new(SwappedPages {
+                level: std::sync::RwLock::new(std::sync::Arc::new(level.clone())),
+            });
+            let mut renderer = Renderer::new_paged(
+                gpu,
+                pages.clone(),
+                colors,
+                choice.method,
+                &settings,
+                opts.tile.0,
+                opts.tile.1,
+                options.clone(),
+            )?;
+            // The first pose with every page it reads (a loading screen).
+            renderer.converge(first, 600)?;
+            (renderer, Some(pages))
+        }
+        None => (
+            Renderer::new(
+                gpu,
+                level,
+                colors,
+                choice.method,
+                &settings,
+                opts.tile.0,
+                opts.tile.1,
+            )?,
+            None,
+        ),
+    };
     let setup_ms = ms(start);
     // Settle incremental builds before the first frame (as compare's first
     // view does), so the video shows the edit's catch-up, not the initial build.
@@ -334,6 +428,7 @@ fn build_lane(
         previous: None,
         setup_ms,
         settings: describe(choice.method, &settings),
+        pages,
     })
 }
 
@@ -387,5 +482,35 @@ fn failed_track(choice: &MethodChoice, e: &anyhow::Error) -> MethodTrack {
         first_post_edit_ms: None,
         flicker: None,
         error: Some(format!("{e:#}")),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_edit_touches_the_chunks_its_rectangles_cover() {
+        let rect = |x, y, width, height| DirtyRect {
+            x,
+            y,
+            width,
+            height,
+        };
+        // A 1024-wide map: 4 chunks across.
+        assert_eq!(touched_chunks(&[rect(10, 10, 20, 20)], 1024), [0]);
+        assert_eq!(
+            touched_chunks(&[rect(250, 250, 10, 10)], 1024),
+            [0, 1, 4, 5]
+        );
+        // Two rectangles of one wrapped crater, and an empty one.
+        assert_eq!(
+            touched_chunks(
+                &[rect(1020, 0, 4, 8), rect(0, 0, 6, 8), rect(5, 5, 0, 3)],
+                1024
+            ),
+            [0, 3]
+        );
+        assert_eq!(touched_chunks(&[rect(0, 256, 256, 1)], 1024), [4]);
     }
 }

@@ -8,6 +8,7 @@
 //! `portability.md` + `portability.json` into `<out>`.
 
 use crate::adapter_arg::AdapterArgs;
+use crate::paged_arg::{PagedArgs, PagedWorld};
 use crate::world_arg::WorldArgs;
 use anyhow::Context;
 use std::path::PathBuf;
@@ -78,6 +79,11 @@ pub struct Args {
     pub hold_busy: Option<u32>,
     #[command(flatten)]
     pub adapter: AdapterArgs,
+    /// `--gpu-budget`: ray-exact and ray-exact-fragment draw through pages
+    /// (converged at each view before timing; `paging` in each row); the
+    /// other methods keep the whole-world path. Without it nothing changes.
+    #[command(flatten)]
+    pub paged: PagedArgs,
     /// Run the protocol on every adapter of --backend (default: every backend), each into
     /// `<out>/<adapter>-<backend>/`, then write the merged `portability.md` and
     /// `portability.json` into `<out>`. A CPU rasteriser runs the --quick form unless
@@ -111,6 +117,9 @@ struct Prepared {
 }
 
 pub fn run(args: Args) -> anyhow::Result<()> {
+    if let Some(refusal) = past_the_limit(&args)? {
+        return run_paged_store(&args, refusal);
+    }
     let prepared = prepare(&args)?;
     if args.all_adapters {
         return run_all_adapters(&args, prepared);
@@ -118,15 +127,119 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let gpu = args.adapter.open()?;
     announce(&gpu.report);
     let options = options_for(&args, &prepared, &gpu.report, args.out_dir());
-    let plan = Plan::new(prepared.world, options)?;
+    let plan = Plan::new(prepared.world, options)?.with_paging(paging(&args))?;
     let (json, report) = plan.run(&gpu)?;
     println!("wrote {}", json.display());
     println!("wrote {}", report.display());
     Ok(())
 }
 
-/// Cheap checks first, then the level; the GPU comes later.
-fn prepare(args: &Args) -> anyhow::Result<Prepared> {
+/// The paging of `--gpu-budget` (`None` without it: the paper's protocol).
+fn paging(args: &Args) -> Option<strata_render::paged::PagedOptions> {
+    args.paged
+        .gpu_budget
+        .map(|_| PagedWorld::options(&args.paged))
+}
+
+/// `Some(why)` when `--level` is a store past the whole-world limit (it
+/// cannot be loaded whole here): why, naming the limit.
+fn past_the_limit(args: &Args) -> anyhow::Result<Option<String>> {
+    let Some(dir) = &args.world.level else {
+        return Ok(None);
+    };
+    if !matches!(
+        strata_store::fs::dir_kind(dir),
+        Ok(strata_store::fs::DirKind::Store)
+    ) {
+        return Ok(None);
+    }
+    let store = strata_store::DirStore::open(dir)
+        .with_context(|| format!("opening the store in {}", dir.display()))?;
+    let (bytes, limit) = (
+        store.store().map_bytes(),
+        crate::world_arg::whole_world_limit(),
+    );
+    let size = |b: u64| match b {
+        b if b >= 1 << 30 => format!("{:.2} GiB", b as f64 / f64::from(1u32 << 30)),
+        b => format!("{:.1} MiB", b as f64 / f64::from(1u32 << 20)),
+    };
+    Ok((bytes > limit).then(|| {
+        format!(
+            "the store in {} is {}x{} texels ({} in memory), past the whole-world limit here ({}: half the available memory, at most 4 GiB; STRATA_WHOLE_WORLD_LIMIT_MIB sets it)",
+            dir.display(),
+            store.store().width(),
+            store.store().height(),
+            size(bytes),
+            size(limit)
+        )
+    }))
+}
+
+/// A store that cannot be loaded whole: the paged methods are measured
+/// through pages (at `--gpu-budget`, default 256 MiB), every other method
+/// is a refusal in the results naming the limit and the paged methods.
+fn run_paged_store(args: &Args, refusal: String) -> anyhow::Result<()> {
+    if args.all_adapters || args.resume.is_some() {
+        anyhow::bail!(
+            "{refusal}: --all-adapters and --resume need a world loaded whole; compare it on one adapter (the paged methods draw it)"
+        );
+    }
+    let methods = choose_methods(args)?;
+    let explicit_size = args.size.as_deref().map(parse_size).transpose()?;
+    let mut paged_args = args.paged.clone();
+    paged_args.gpu_budget = Some(
+        paged_args
+            .gpu_budget
+            .unwrap_or(strata_render::paged::DEFAULT_GPU_BUDGET),
+    );
+    let pages = crate::paged_arg::open_paged(&args.world, &paged_args)?
+        .context("a store past the whole-world limit is drawn paged")?;
+    let opened = args.world.open()?;
+    let mut views = match &args.views {
+        Some(path) => {
+            let text = std::fs::read_to_string(path)
+                .with_context(|| format!("reading views file {}", path.display()))?;
+            strata_level::views::parse_views(&text)
+                .with_context(|| format!("views file {}", path.display()))?
+        }
+        None => pages.views.clone(),
+    };
+    if let Some(names) = &args.view_names {
+        views = keep_views(views, names)?;
+    }
+    prepare_out_dir(&args.out)?;
+    eprintln!(
+        "{refusal}: only {} are measured",
+        strata_render::paged::PAGED_METHODS.join(", ")
+    );
+    let prepared = Prepared {
+        methods,
+        explicit_size,
+        views,
+        world: opened.world().clone(),
+        edits: EditMode::Off,
+    };
+    let gpu = args.adapter.open()?;
+    announce(&gpu.report);
+    let options = options_for(args, &prepared, &gpu.report, args.out.clone());
+    let input = strata_bench::paged_run::PagedInput {
+        name: pages.name.clone(),
+        size: pages.size,
+        mid_rule: args.world.mid_rule(),
+        colors: pages.colors.clone(),
+        source: pages.source.clone(),
+        columns: opened.source(),
+        paging: PagedWorld::options(&paged_args),
+        refusal,
+    };
+    let (json, report) = strata_bench::paged_run::run(&gpu, &input, &options)?;
+    println!("wrote {}", json.display());
+    println!("wrote {}", report.display());
+    Ok(())
+}
+
+/// `--methods` (default: all), each without a setting taking `--settings`'.
+fn choose_methods(args: &Args) -> anyhow::Result<Vec<MethodChoice>> {
     let mut methods = match &args.methods {
         Some(list) => parse_methods(list, METHODS)?,
         None => every_method(),
@@ -139,6 +252,12 @@ fn prepare(args: &Args) -> anyhow::Result<Prepared> {
                 .with_context(|| format!("settings file {}", path.display()))?;
         }
     }
+    Ok(methods)
+}
+
+/// Cheap checks first, then the level; the GPU comes later.
+fn prepare(args: &Args) -> anyhow::Result<Prepared> {
+    let methods = choose_methods(args)?;
     // Parse an explicit size now, so a bad one fails before any GPU work.
     let explicit_size = args.size.as_deref().map(parse_size).transpose()?;
     let file_views = match &args.views {
@@ -320,7 +439,9 @@ fn run_all_adapters(args: &Args, prepared: Prepared) -> anyhow::Result<()> {
         };
         announce(&gpu.report);
         let options = options_for(args, &prepared, &gpu.report, out.clone());
-        let result = Plan::new(prepared.world.clone(), options).and_then(|plan| plan.run(&gpu));
+        let result = Plan::new(prepared.world.clone(), options)
+            .and_then(|plan| plan.with_paging(paging(args)))
+            .and_then(|plan| plan.run(&gpu));
         drop(gpu);
         match result {
             Ok((json, report)) => {

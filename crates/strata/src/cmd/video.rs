@@ -4,6 +4,7 @@
 //! times and temporal flicker.
 
 use crate::adapter_arg::AdapterArgs;
+use crate::paged_arg::{PagedArgs, PagedWorld};
 use crate::world_arg::WorldArgs;
 use anyhow::Context;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -51,6 +52,17 @@ pub struct Args {
     pub print_path: bool,
     #[command(flatten)]
     pub adapter: AdapterArgs,
+    /// `--gpu-budget`: ray-exact and ray-exact-fragment draw through pages
+    /// streamed as the camera flies; the other methods draw the world whole.
+    #[command(flatten)]
+    pub paged: PagedArgs,
+}
+
+/// The paging of `--gpu-budget` (`None` without it).
+fn paging(args: &Args) -> Option<strata_render::paged::PagedOptions> {
+    args.paged
+        .gpu_budget
+        .map(|_| PagedWorld::options(&args.paged))
 }
 
 pub fn run(args: Args) -> anyhow::Result<()> {
@@ -98,6 +110,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         shadows: !args.no_shadows,
         temporal: !args.no_temporal,
         overlap: None,
+        paging: paging(&args),
     };
     let gpu = args.adapter.open()?;
     eprintln!(

@@ -4,8 +4,11 @@
 
 use crate::adapter_arg::AdapterArgs;
 use crate::cmd::render::{MethodArgs, parse_size};
+use crate::paged_arg::{PagedArgs, PagedWorld, open_paged};
 use crate::world_arg::WorldArgs;
+use anyhow::Context;
 use std::path::PathBuf;
+use std::sync::Arc;
 use strata_level::save::SavePolicy;
 use strata_viewer::save::SaveOptions;
 use strata_viewer::{Options, Script};
@@ -42,6 +45,8 @@ pub struct Args {
     pub method_args: MethodArgs,
     #[command(flatten)]
     pub adapter: AdapterArgs,
+    #[command(flatten)]
+    pub paged: PagedArgs,
     /// Where screenshots (key P) go.
     #[arg(long, default_value = "out/view")]
     pub out: PathBuf,
@@ -67,12 +72,33 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     strata_render::methods::entry(&args.method)?;
     let settings = args.method_args.settings();
     let start = std::time::Instant::now();
-    let world = args.world.load()?;
-    eprintln!(
-        "strata view: {} loaded in {:.2} s",
-        world.name,
-        start.elapsed().as_secs_f64()
-    );
+    // A store past the whole-world limit, or any world with --gpu-budget:
+    // paged terrain, the map read as the view needs it.
+    let (world, paged) = match viewer_pages(&args.world, &args.paged)? {
+        Some((world, pages)) => {
+            let options = PagedWorld::options(&args.paged);
+            let (w, h) = pages.size();
+            eprintln!(
+                "strata view: {} ({w}x{h}) opened paged in {:.2} s (GPU budget {} B)",
+                world.name,
+                start.elapsed().as_secs_f64(),
+                options.gpu_budget
+            );
+            (
+                world,
+                Some(strata_viewer::paged::PagedWorld { pages, options }),
+            )
+        }
+        None => {
+            let world = args.world.load()?;
+            eprintln!(
+                "strata view: {} loaded in {:.2} s",
+                world.name,
+                start.elapsed().as_secs_f64()
+            );
+            (world, None)
+        }
+    };
     strata_viewer::run(Options {
         world,
         method: args.method,
@@ -93,5 +119,48 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             dir: args.save_to,
         },
         physics: args.physics,
+        paged,
     })
+}
+
+/// The world's files besides its map (the map a stand-in) and its pages
+/// with the viewer's edit layer over them; `None`: draw the world whole.
+#[allow(clippy::type_complexity)]
+fn viewer_pages(
+    world: &WorldArgs,
+    paged: &PagedArgs,
+) -> anyhow::Result<Option<(strata_level::World, Arc<strata_viewer::paged::EditedPages>)>> {
+    use strata_viewer::paged::{Base, EditedPages};
+    let mid_rule = world.mid_rule();
+    let is_store = world.level.as_deref().is_some_and(|d| {
+        matches!(
+            strata_store::fs::dir_kind(d),
+            Ok(strata_store::fs::DirKind::Store)
+        )
+    });
+    if !is_store {
+        if paged.gpu_budget.is_none() {
+            return Ok(None);
+        }
+        // A world in memory with --gpu-budget: loaded once, paged.
+        let mut shell = world.load()?;
+        let level = std::mem::replace(&mut shell.level, strata_level::Level::flat(2, 1, 0, 0)?);
+        let base = Base::Level(Arc::new(level));
+        return Ok(Some((shell, Arc::new(EditedPages::new(base, mid_rule)?))));
+    }
+    let Some(p) = open_paged(world, paged)? else {
+        return Ok(None);
+    };
+    let (Some(cache), Some(dir)) = (p.cache(), &p.dir) else {
+        anyhow::bail!("a store opened paged has a chunk cache");
+    };
+    let shell = cache
+        .store()
+        .world_shell()
+        .with_context(|| format!("reading the world in {}", dir.display()))?;
+    let base = Base::Store {
+        cache: cache.clone(),
+        dir: dir.clone(),
+    };
+    Ok(Some((shell, Arc::new(EditedPages::new(base, mid_rule)?))))
 }

@@ -14,6 +14,9 @@ use web_time::Instant;
 impl Viewer {
     /// Dig where picture point `at` (render pixels) shows terrain.
     pub(super) fn dig_at(&mut self, at: (f32, f32)) -> anyhow::Result<()> {
+        if self.paged.is_some() {
+            return self.dig_paged(at);
+        }
         let camera = self.camera()?;
         let start = Instant::now();
         let Some(hit) = pick(&self.level, &camera, at.0, at.1) else {
@@ -47,6 +50,10 @@ impl Viewer {
 
     /// The physics toy on or off.
     pub(super) fn toggle_physics(&mut self) {
+        if self.paged.is_some() && !self.physics.on {
+            self.say("the physics toy fits a collider to the whole world in memory; a paged world is not".into());
+            return;
+        }
         let line = self
             .physics
             .toggle(&self.level, f64::from(self.settings.mesh_quality));
@@ -57,7 +64,10 @@ impl Viewer {
     /// A refused or failed save is said and the session goes on.
     pub(super) fn save(&mut self, dir: Option<PathBuf>) -> anyhow::Result<()> {
         let dir = dir.unwrap_or_else(|| self.saver.default_dir.clone());
-        let said = self.saver.save(&dir, &self.level);
+        let said = match &self.paged {
+            Some(_) => self.save_paged(&dir),
+            None => self.saver.save(&dir, &self.level),
+        };
         match said {
             Ok(line) => {
                 self.say(line);
@@ -84,6 +94,14 @@ impl Viewer {
             self.say("stopping on an error; no unsaved edits".into());
             return;
         }
+        if let Some(p) = &self.paged {
+            let line = format!(
+                "stopping on an error; {} edited chunk(s) of the paged world are not saved (Ctrl+S saves them in place)",
+                p.world.pages.edited_chunks()
+            );
+            self.say(line);
+            return;
+        }
         let dir = self
             .out
             .join(format!("{}-recovered", self.saver.world().name));
@@ -108,9 +126,14 @@ impl Viewer {
             .platform
             .rss_bytes()
             .map_or("-".into(), |b| b.to_string());
+        let paging = self
+            .paged
+            .as_ref()
+            .map(|p| p.memory_fields(self.render_size()))
+            .unwrap_or_default();
         format!(
             "memory frames={} rss_bytes={rss} gpu_bytes={gpu} method_cpu_bytes={cpu} \
-             undo_bytes={} undo_depth={} kept={}",
+             undo_bytes={} undo_depth={} kept={}{paging}",
             self.frames,
             self.digger.undo_bytes(),
             self.digger.can_undo(),
@@ -119,6 +142,9 @@ impl Viewer {
     }
 
     pub(super) fn undo(&mut self) -> anyhow::Result<()> {
+        if self.paged.is_some() {
+            return self.undo_paged();
+        }
         match self.digger.undo(Arc::make_mut(&mut self.level)) {
             Some(dirty) => {
                 self.edited(&dirty)?;

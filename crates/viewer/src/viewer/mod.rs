@@ -7,6 +7,7 @@
 
 mod editing;
 mod input;
+mod paged;
 mod readback;
 mod scripted;
 
@@ -128,6 +129,9 @@ pub struct Viewer {
     quit: bool,
     /// Native window or browser page.
     platform: Platform,
+    /// Paged terrain (issue 33): the world's pages and the undo of digs
+    /// over them; `level` is then a stand-in.
+    paged: Option<paged::PagedState>,
 }
 
 /// What a viewer leaves to the viewer of the next world ([`Viewer::hand_over`]).
@@ -224,6 +228,7 @@ impl Viewer {
             out,
             save,
             physics,
+            paged: paged_world,
         } = options;
         gpu.options = render;
         let opened = Instant::now();
@@ -246,6 +251,9 @@ impl Viewer {
         let render_size = scaled(window_size, scale);
         let (saver, level) = Saver::new(world, save, &out);
         let world = saver.world();
+        let world_size = paged_world
+            .as_ref()
+            .map_or((level.width(), level.height()), |p| p.pages.size());
         let name = world.name.clone();
         let mut views = world.views.clone();
         // The edit fixture's camera is a view too: it looks at the crater site.
@@ -265,30 +273,45 @@ impl Viewer {
                 .clone(),
             None => views.first().cloned().unwrap_or_else(|| ViewSpec {
                 name: "centre".into(),
-                x: level.width() as f32 * 0.5,
-                y: level.height() as f32 * 0.5,
+                x: world_size.0 as f32 * 0.5,
+                y: world_size.1 as f32 * 0.5,
                 yaw: 0.0,
                 eye: 60.0,
                 under: false,
                 pitch: -20.0,
             }),
         };
-        let camera = Camera::from_view(&level, &start, render_size.0, render_size.1)?;
+        let camera = match &paged_world {
+            Some(p) => paged::camera_over(&p.pages, &start, render_size.0, render_size.1)?,
+            None => Camera::from_view(&level, &start, render_size.0, render_size.1)?,
+        };
         let colors = TerrainColors {
             palette: world.palette.colors,
             begin: world.config.begin_colors,
             end: world.config.end_colors,
         };
         let map = Minimap::new(&level, &colors);
-        let mut renderer = Renderer::new(
-            &gpu,
-            &level,
-            &colors,
-            FIRST_METHOD,
-            &settings,
-            render_size.0,
-            render_size.1,
-        )?;
+        let mut renderer = match &paged_world {
+            Some(p) => Renderer::new_paged(
+                &gpu,
+                p.pages.clone(),
+                &colors,
+                paged::first_method(&method),
+                &settings,
+                render_size.0,
+                render_size.1,
+                p.options.clone(),
+            )?,
+            None => Renderer::new(
+                &gpu,
+                &level,
+                &colors,
+                FIRST_METHOD,
+                &settings,
+                render_size.0,
+                render_size.1,
+            )?,
+        };
         // A still camera (or the second side of an A/B pair) keeps its shadow map.
         renderer.set_shadow_reuse(true);
         // The physics bodies draw over Strata's depth target with the depth test.
@@ -296,7 +319,10 @@ impl Viewer {
         let compositor = Compositor::new(renderer.shared(), window_size, config.format)?;
         let passes = PassTimer::new(&gpu.device, &gpu.queue, gpu.report.timestamps);
         let mut overlay = Overlay::new(&window, &gpu.device, WINDOW_FORMAT);
-        overlay.set_map(&map);
+        // A paged world has no picture of itself in memory: no map.
+        if paged_world.is_none() {
+            overlay.set_map(&map);
+        }
         let digger = Digger::new(world.edit.as_ref().unwrap_or(&EditSite::fostral()));
         let physics_toy = PhysicsToy::new(&level);
         let mut viewer = Viewer {
@@ -349,17 +375,25 @@ impl Viewer {
             unsaved: false,
             quit: false,
             platform: Platform,
+            paged: paged_world.map(paged::PagedState::new),
         };
         viewer.say(format!(
-            "{} on {} ({}), render {}x{}; window, device and {FIRST_METHOD} ready in {:.2} s",
+            "{} ({}x{}) on {} ({}), render {}x{}; window, device and {} ready in {:.2} s",
             name,
+            world_size.0,
+            world_size.1,
             viewer.gpu.report.name,
             viewer.gpu.report.backend,
             render_size.0,
             render_size.1,
+            viewer.renderer.method_name(),
             opened.elapsed().as_secs_f64()
         ));
-        viewer.request_method(&method)?;
+        if viewer.paged.is_some() {
+            viewer.say_paged_start(&method);
+        } else {
+            viewer.request_method(&method)?;
+        }
         if physics {
             viewer.toggle_physics();
         }
@@ -430,6 +464,9 @@ impl Viewer {
                 t.wait_ms / f64::from(t.frames)
             ));
         }
+        if let Some(p) = &self.paged {
+            out.push_str(&format!("\n  {}", p.summary()));
+        }
         out
     }
 
@@ -455,6 +492,9 @@ impl Viewer {
                 "unknown method `{name}`; known: {}",
                 methods::names().join(", ")
             );
+        }
+        if self.paged.is_some() {
+            return self.request_paged_method(name);
         }
         let current = self.renderer.method_name();
         if self.make_current(name)? {
@@ -489,6 +529,12 @@ impl Viewer {
     }
 
     fn set_split(&mut self, split: Option<String>) -> anyhow::Result<()> {
+        if split.is_some() && self.paged.is_some() {
+            return self.refuse(
+                "A/B needs two methods over one world in memory; a paged world draws one at a time"
+                    .into(),
+            );
+        }
         if let Some(name) = &split {
             if !methods::names().contains(&name.as_str()) {
                 bail!("unknown method `{name}`");
@@ -508,7 +554,11 @@ impl Viewer {
             return;
         };
         let (w, h) = self.render_size();
-        match Camera::from_view(&self.level, &view, w, h) {
+        let camera = match &self.paged {
+            Some(p) => paged::camera_over(&p.world.pages, &view, w, h),
+            None => Camera::from_view(&self.level, &view, w, h).map_err(anyhow::Error::from),
+        };
+        match camera {
             Ok(camera) => {
                 let speed = self.fly.speed;
                 self.fly = FlyCamera::from_camera(&camera);
@@ -520,7 +570,11 @@ impl Viewer {
     }
 
     fn copy_view(&mut self, name: &str) {
-        let line = self.fly.view_spec(&self.level, name).to_string();
+        let column = match self.column_at(self.fly.position.x, self.fly.position.y) {
+            Ok(c) => c,
+            Err(e) => return self.say(format!("copy view: {e:#}")),
+        };
+        let line = self.fly.view_spec(column, name).to_string();
         println!("{line}");
         self.overlay.copy_text(line.clone());
         self.say(format!("copied: {line}"));
@@ -528,13 +582,18 @@ impl Viewer {
 
     /// Fly to `to` (x, y), keeping the eye's height above the ground.
     fn teleport(&mut self, to: glam::Vec2) {
-        let here = self
-            .level
-            .column_at(self.fly.position.x, self.fly.position.y);
+        let columns = self
+            .column_at(self.fly.position.x, self.fly.position.y)
+            .and_then(|here| {
+                let (w, h) = self.world_size();
+                let (x, y) = (to.x.rem_euclid(w as f32), to.y.rem_euclid(h as f32));
+                Ok((here, x, y, self.column_at(x, y)?))
+            });
+        let (here, x, y, there) = match columns {
+            Ok(c) => c,
+            Err(e) => return self.say(format!("cannot fly there: {e:#}")),
+        };
         let clearance = (self.fly.position.z - f32::from(here.top())).max(20.0);
-        let (w, h) = (self.level.width() as f32, self.level.height() as f32);
-        let (x, y) = (to.x.rem_euclid(w), to.y.rem_euclid(h));
-        let there = self.level.column_at(x, y);
         let z = (f32::from(there.top()) + clearance).min(400.0);
         self.fly.position = glam::Vec3::new(x, y, z);
         self.say(format!("flew to {x:.0}, {y:.0}"));
@@ -548,6 +607,13 @@ impl Viewer {
     fn on_knob(&mut self, knob: Knob) -> anyhow::Result<()> {
         if knob == Knob::Shadows {
             self.renderer.set_shadows(self.settings.shadows);
+            return Ok(());
+        }
+        if self.paged.is_some() {
+            let name = self.renderer.method_name();
+            if knob.read_by(name) && !self.make_current(name)? {
+                self.rebuild_paged(name)?;
+            }
             return Ok(());
         }
         // What is on screen and reads the knob takes it in place or is
@@ -616,7 +682,7 @@ impl Viewer {
         // Held keys fly the camera; a long stall (a build) is not a jump.
         let motion = self.motion();
         if !motion.is_still() {
-            self.fly.fly(&motion, dt.min(0.1) as f32, &self.level);
+            self.fly.fly(&motion, dt.min(0.1) as f32, self.world_size());
         }
         if let Some(line) = self.physics.poll(&self.level) {
             self.say(line);
@@ -639,6 +705,7 @@ impl Viewer {
         let camera = self.camera()?;
         let active = self.renderer.method_name();
         let mut timings = vec![(active.to_string(), self.renderer.render_frame(&camera)?)];
+        self.after_paged_frame();
         self.physics.draw(self.renderer.shared(), &camera);
         let split = self
             .split
@@ -757,10 +824,11 @@ impl Viewer {
             "timings": self.timings.iter().map(|(m, t)| serde_json::json!({
                 "method": m, "cpu_ms": t.cpu_ms, "gpu_ms": t.gpu_ms, "record_ms": t.record_ms,
             })).collect::<Vec<_>>(),
-            "level_size": [self.level.width(), self.level.height()],
+            "level_size": self.world_size(),
+            "paging": self.paging_json(),
             "render_size": self.render_size(),
             "window_size": self.compositor.window_size(),
-            "undo_depth": self.digger.can_undo(),
+            "undo_depth": self.undo_depth(),
             "eye": [self.fly.position.x, self.fly.position.y, self.fly.position.z],
             "cursor": self.cursor,
             "scored": self.scored,
@@ -811,9 +879,13 @@ impl Viewer {
             camera: &self.fly,
             render_size: self.render_size(),
             window_size: self.compositor.window_size(),
-            undo_depth: self.digger.can_undo(),
+            undo_depth: self.undo_depth(),
             scores: &self.scores,
             log: &self.log,
+            paging: self
+                .paged
+                .as_ref()
+                .map(|p| p.overlay_lines(self.render_size())),
         };
         let mut editable = Editable {
             settings: &mut self.settings,

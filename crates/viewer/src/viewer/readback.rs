@@ -22,6 +22,11 @@ impl Viewer {
     /// reference for the same camera (DESIGN §3 metrics): draw each and start
     /// its depth read-back; [`Viewer::poll_score`] finishes it.
     pub(super) fn score(&mut self) -> anyhow::Result<()> {
+        if self.paged.is_some() {
+            return self.refuse(
+                "scoring traces the CPU reference over the whole world in memory; a paged world is not (`strata reference --level STORE` reads it in bounded memory)".into(),
+            );
+        }
         let camera = self.camera()?;
         let start = Instant::now();
         let reference = strata_reference::render_reference(&self.level, &camera);

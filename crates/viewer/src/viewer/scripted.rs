@@ -95,7 +95,7 @@ impl Viewer {
         if let Some((line, running)) = player.running.take() {
             let next = match running {
                 Running::Fly { per_frame, left } => {
-                    self.fly.translate(per_frame, &self.level);
+                    self.fly.translate(per_frame, self.world_size());
                     (left > 1).then_some(Running::Fly {
                         per_frame,
                         left: left - 1,
