@@ -319,4 +319,19 @@ impl TerrainCollider {
             sy,
         ))
     }
+
+    /// Where chunk `index`'s surfaces ([`TerrainCollider::chunk_surfaces`])
+    /// sit, in the frame whose origin is the world point `origin`.
+    pub fn chunk_pose(&self, index: usize, origin: [f64; 3]) -> Pose {
+        let (cx, cy) = self.layout.coords(index);
+        let (sx, sy) = (f64::from(self.layout.size_x), f64::from(self.layout.size_y));
+        crate::surface::Surfaces::pose_of(
+            [
+                f64::from(cx) * sx + 0.5 + sx * 0.5,
+                f64::from(cy) * sy + 0.5 + sy * 0.5,
+                0.0,
+            ],
+            origin,
+        )
+    }
 }

@@ -14,7 +14,7 @@
 
 use crate::columns::{Columns, Packed};
 use parry3d::math::{Pose, Rotation, Vector};
-use parry3d::shape::{HeightField, HeightFieldCellStatus};
+use parry3d::shape::{HeightField, HeightFieldCellStatus, HeightFieldFlags};
 use parry3d::utils::Array2;
 
 /// The height fields over samples `x0..=x0 + nx`, `y0..=y0 + ny` (texel
@@ -40,11 +40,16 @@ impl Surfaces {
 
     /// The fields' pose in a frame whose origin is the world point `origin`.
     pub fn pose(&self, origin: [f64; 3]) -> Pose {
+        Self::pose_of(self.centre, origin)
+    }
+
+    /// The pose of fields centred at `centre`, in the frame at `origin`.
+    pub(crate) fn pose_of(centre: [f64; 3], origin: [f64; 3]) -> Pose {
         Pose::from_parts(
             Vector::new(
-                (self.centre[0] - origin[0]) as f32,
-                (self.centre[1] - origin[1]) as f32,
-                (self.centre[2] - origin[2]) as f32,
+                (centre[0] - origin[0]) as f32,
+                (centre[1] - origin[1]) as f32,
+                (centre[2] - origin[2]) as f32,
             ),
             Self::rotation(),
         )
@@ -92,7 +97,15 @@ impl Columns {
             y0 as f64 + 0.5 + f64::from(ny) * 0.5,
             0.0,
         ];
-        let field = |h: Vec<f32>| HeightField::new(Array2::new(rows, cols, h), scale);
+        // Contacts on a shared edge of two coplanar triangles take the faces'
+        // normal (without it, balls on flat ground roll off the texel grid).
+        let field = |h: Vec<f32>| {
+            HeightField::with_flags(
+                Array2::new(rows, cols, h),
+                scale,
+                HeightFieldFlags::FIX_INTERNAL_EDGES,
+            )
+        };
         let any_dual = dual.iter().any(|&d| d);
         let slab = |h: Vec<f32>| {
             let mut f = field(h);

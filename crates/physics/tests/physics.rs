@@ -222,3 +222,27 @@ fn a_click_drops_the_body_above_the_ground_it_sees_or_under_the_ceiling() {
     assert_eq!(physics.body_count(), 0);
     assert_eq!(physics.bodies().count(), 0);
 }
+
+/// Only the chunks around bodies are in the world: a few cells per body,
+/// none once the bodies are gone (the whole map's surfaces never are).
+#[test]
+fn only_chunks_near_bodies_are_in_the_world() {
+    let level = Level::flat(1024, 1024, 30, 1).unwrap();
+    let mut physics = world(&level);
+    for k in 0..8 {
+        let at = [100.5 + 120.0 * k as f32, 60.5 + 117.0 * k as f32, 50.0];
+        physics.drop_body(ball(), at).unwrap();
+    }
+    for _ in 0..60 {
+        physics.step();
+    }
+    let (cells, bytes) = physics.terrain_cells();
+    println!("{cells} cells, {bytes} bytes of height fields for 8 bodies");
+    assert!((8..=8 * 4).contains(&cells), "{cells}");
+    // A flat map has no slabs: one 129 x 129 field per chunk.
+    assert!(bytes <= cells * (129 * 129 * 4 + 128 * 128), "{bytes}");
+    assert!(physics.bodies().all(|b| (b.position[2] - 35.0).abs() < TOLERANCE));
+    physics.clear_bodies();
+    physics.step();
+    assert_eq!(physics.terrain_cells(), (0, 0));
+}
