@@ -21,7 +21,8 @@ const MAX_LEVEL: u32 = 4;
 /// Pack a decoded column.
 #[inline]
 pub(crate) fn pack(c: &Column) -> u32 {
-    let flags = u32::from(c.dual) | u32::from(c.lower_type & 7) << 1 | u32::from(c.upper_type & 7) << 4;
+    let flags =
+        u32::from(c.dual) | u32::from(c.lower_type & 7) << 1 | u32::from(c.upper_type & 7) << 4;
     u32::from(c.low) | u32::from(c.mid) << 8 | u32::from(c.high) << 16 | flags << 24
 }
 
@@ -293,8 +294,22 @@ mod tests {
                 let col = level.column(x, y);
                 let p = c.get(x, y);
                 assert_eq!(
-                    (p.low(), p.mid(), p.high(), p.dual(), p.lower_type(), p.upper_type()),
-                    (col.low, col.mid, col.high, col.dual, col.lower_type, col.upper_type)
+                    (
+                        p.low(),
+                        p.mid(),
+                        p.high(),
+                        p.dual(),
+                        p.lower_type(),
+                        p.upper_type()
+                    ),
+                    (
+                        col.low,
+                        col.mid,
+                        col.high,
+                        col.dual,
+                        col.lower_type,
+                        col.upper_type
+                    )
                 );
             }
         }

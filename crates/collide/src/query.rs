@@ -221,7 +221,7 @@ impl TerrainCollider {
     /// assert!((c.distance + 0.25).abs() < 1e-3 && c.normal[2] > 0.99);
     /// ```
     pub fn contact_box(&self, b: &BoxShape, margin: f32) -> Option<BoxContact> {
-        if !b.is_valid() || !(margin.is_finite() && margin >= 0.0) {
+        if !(b.is_valid() && margin.is_finite() && margin >= 0.0) {
             return None;
         }
         let r = b.radius() + f64::from(margin);
@@ -229,7 +229,12 @@ impl TerrainCollider {
         let frame = Self::frame_near(b.centre);
         let pose = Self::box_pose(b, frame);
         let mut best: Option<BoxContact> = None;
-        let area = [b.centre[0] - r, b.centre[0] + r, b.centre[1] - r, b.centre[1] + r];
+        let area = [
+            b.centre[0] - r,
+            b.centre[0] + r,
+            b.centre[1] - r,
+            b.centre[1] + r,
+        ];
         self.for_each_piece(area, frame, |s, hf_pose| {
             for field in s.fields() {
                 let Ok(Some(c)) = query::contact(&hf_pose, field, &pose, &cuboid, margin) else {
@@ -260,8 +265,11 @@ impl TerrainCollider {
     /// ```
     pub fn cast_box(&self, b: &BoxShape, dir: [f64; 3], max_distance: f64) -> Option<BoxCastHit> {
         let len = (dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]).sqrt();
-        if !(len > 0.0 && len.is_finite() && max_distance.is_finite() && max_distance >= 0.0)
-            || !b.is_valid()
+        if !(len > 0.0
+            && len.is_finite()
+            && max_distance.is_finite()
+            && max_distance >= 0.0
+            && b.is_valid())
         {
             return None;
         }
@@ -312,12 +320,10 @@ impl TerrainCollider {
         }
         let (cx, cy) = self.layout.coords(index);
         let (sx, sy) = (self.layout.size_x, self.layout.size_y);
-        Some(self.columns.surfaces(
-            i64::from(cx * sx),
-            i64::from(cy * sy),
-            sx,
-            sy,
-        ))
+        Some(
+            self.columns
+                .surfaces(i64::from(cx * sx), i64::from(cy * sy), sx, sy),
+        )
     }
 
     /// Where chunk `index`'s surfaces ([`TerrainCollider::chunk_surfaces`])

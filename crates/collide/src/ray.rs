@@ -79,7 +79,14 @@ fn interval_entry(a: f64, b: f64, oz: f64, dz: f64, t0: f64, t1: f64) -> Option<
 /// The first solid point of the segment `[t0, t1]` in column `c`; `entry`
 /// says `t0` is where the ray entered the column (solid there: a wall).
 #[inline]
-fn column_hit(c: Packed, oz: f64, dz: f64, t0: f64, t1: f64, entry: bool) -> Option<(f64, Face, u8)> {
+fn column_hit(
+    c: Packed,
+    oz: f64,
+    dz: f64,
+    t0: f64,
+    t1: f64,
+    entry: bool,
+) -> Option<(f64, Face, u8)> {
     let floor = interval_entry(f64::NEG_INFINITY, f64::from(c.low()), oz, dz, t0, t1);
     let slab = if c.dual() {
         interval_entry(f64::from(c.mid()), f64::from(c.high()), oz, dz, t0, t1)
@@ -102,7 +109,11 @@ fn column_hit(c: Packed, oz: f64, dz: f64, t0: f64, t1: f64, entry: bool) -> Opt
     } else {
         Face::Ceiling
     };
-    let terrain = if is_slab { c.upper_type() } else { c.lower_type() };
+    let terrain = if is_slab {
+        c.upper_type()
+    } else {
+        c.lower_type()
+    };
     Some((t, face, terrain))
 }
 

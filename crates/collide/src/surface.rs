@@ -113,7 +113,11 @@ impl Columns {
             for j in 0..cols - 1 {
                 for i in 0..rows - 1 {
                     let corner = |i: usize, j: usize| dual[i + j * rows];
-                    if !(corner(i, j) || corner(i + 1, j) || corner(i, j + 1) || corner(i + 1, j + 1)) {
+                    if !(corner(i, j)
+                        || corner(i + 1, j)
+                        || corner(i, j + 1)
+                        || corner(i + 1, j + 1))
+                    {
                         status[(i, j)] = HeightFieldCellStatus::CELL_REMOVED;
                     }
                 }

@@ -67,7 +67,7 @@ fn rays(level: &Level, n: usize, seed: u64) -> Vec<(&'static str, DVec3, DVec3)>
                     1 => top + 0.5,
                     _ => top + 1.0,
                 };
-                let (x, y) = if rng.next_u32() % 2 == 0 {
+                let (x, y) = if rng.next_u32().is_multiple_of(2) {
                     (x.floor(), y)
                 } else {
                     (x, y)
@@ -111,7 +111,10 @@ fn random_and_grazing_rays_agree_with_the_reference() {
     let collider = TerrainCollider::new(&level);
     let (ok, n) = agreement(&collider, &level, 8000, 11);
     let share = ok as f64 / n as f64;
-    println!("{ok}/{n} rays agree with the CPU reference ({:.2} %)", share * 100.0);
+    println!(
+        "{ok}/{n} rays agree with the CPU reference ({:.2} %)",
+        share * 100.0
+    );
     assert!(share >= 0.99, "{share}");
     assert_eq!(ok, n, "the traversal is the reference's: every ray agrees");
 }
@@ -165,10 +168,16 @@ fn after_edits_rays_agree_and_the_dirty_chunks_are_reported() {
     (site.centre_x, site.centre_y, site.radius, site.depth) = (127, 60, 24, 40.0);
     let dirty = crater(&mut level, &site);
     let chunks = collider.apply_edit(&level, &dirty);
-    assert_eq!(chunks, dirty_chunks(&ChunkLayout::of(&level), 256, 256, &dirty));
+    assert_eq!(
+        chunks,
+        dirty_chunks(&ChunkLayout::of(&level), 256, 256, &dirty)
+    );
     let mut rng = Lcg(5);
     for k in 0..64 {
-        let (cx, cy) = (rng.next_u32() as i64 % 300 - 20, rng.next_u32() as i64 % 300 - 20);
+        let (cx, cy) = (
+            rng.next_u32() as i64 % 300 - 20,
+            rng.next_u32() as i64 % 300 - 20,
+        );
         (site.centre_x, site.centre_y) = (cx, cy);
         site.radius = 2 + k % 5;
         site.depth = 6.0;
@@ -205,7 +214,7 @@ fn memory_is_four_bytes_a_texel_and_a_pyramid() {
     let stats = TerrainCollider::new(&level).stats();
     let per_texel = stats.memory_bytes as f64 / (512.0 * 1024.0);
     println!("{per_texel:.3} bytes a texel");
-    assert!(per_texel < 4.1 && per_texel >= 4.0, "{per_texel}");
+    assert!((4.0..4.1).contains(&per_texel), "{per_texel}");
     assert_eq!(stats.columns, 512 * 1024);
 }
 
@@ -225,18 +234,25 @@ fn box_contact_and_cast_match_the_ground() {
     let ground = 100.0;
     let half = [0.5f32, 0.5, 0.5];
     let b = BoxShape::axis_aligned([x, y, ground + 50.0], half);
-    let hit = collider.cast_box(&b, [0.0, 0.0, -1.0], 200.0).expect("lands");
+    let hit = collider
+        .cast_box(&b, [0.0, 0.0, -1.0], 200.0)
+        .expect("lands");
     let rest = ground + 50.0 - hit.distance;
     assert!((rest - (ground + 0.5)).abs() < 1e-2, "{rest}");
     let sunk = BoxShape::axis_aligned([x, y, rest - 0.3], half);
     let c = collider.contact_box(&sunk, 0.0).expect("penetrates");
     assert!(c.distance < -0.2 && c.distance > -0.4, "{}", c.distance);
-    assert!(collider
-        .contact_box(&BoxShape::axis_aligned([x, y, rest + 5.0], half), 1.0)
-        .is_none());
+    assert!(
+        collider
+            .contact_box(&BoxShape::axis_aligned([x, y, rest + 5.0], half), 1.0)
+            .is_none()
+    );
     let near = BoxShape::axis_aligned([x, y, rest + 0.5], half);
     let c = collider.contact_box(&near, 1.0).expect("within the margin");
-    assert!((c.distance - 0.5).abs() < 1e-3 && c.normal[2] > 0.99, "{c:?}");
+    assert!(
+        (c.distance - 0.5).abs() < 1e-3 && c.normal[2] > 0.99,
+        "{c:?}"
+    );
     // Far from the origin (another copy of the map), the same answer.
     let far = BoxShape::axis_aligned([x + 256.0 * 40.0, y - 256.0 * 7.0, rest - 0.3], half);
     let c2 = collider.contact_box(&far, 0.0).unwrap();
@@ -265,13 +281,22 @@ fn boxes_see_floor_slab_top_and_ceiling() {
     let down = [0.0, 0.0, -1.0];
     let above = BoxShape::axis_aligned([120.5, 120.5, 100.0], half);
     let hit = collider.cast_box(&above, down, 200.0).unwrap();
-    assert!((hit.distance - 19.0).abs() < 1e-3, "onto the slab top: {hit:?}");
+    assert!(
+        (hit.distance - 19.0).abs() < 1e-3,
+        "onto the slab top: {hit:?}"
+    );
     let cave = BoxShape::axis_aligned([120.5, 120.5, 55.0], half);
     let hit = collider.cast_box(&cave, down, 200.0).unwrap();
-    assert!((hit.distance - 14.0).abs() < 1e-3, "onto the cave floor: {hit:?}");
+    assert!(
+        (hit.distance - 14.0).abs() < 1e-3,
+        "onto the cave floor: {hit:?}"
+    );
     let hit = collider.cast_box(&cave, [0.0, 0.0, 1.0], 200.0).unwrap();
     let ceiling = f64::from(level.column(120, 120).mid);
-    assert!((hit.distance - (ceiling - 56.0)).abs() < 1e-3, "up to the ceiling: {hit:?}");
+    assert!(
+        (hit.distance - (ceiling - 56.0)).abs() < 1e-3,
+        "up to the ceiling: {hit:?}"
+    );
     assert!(collider.contact_box(&cave, 0.5).is_none());
 }
 
@@ -295,15 +320,26 @@ fn bad_input_gives_defined_results() {
     let mut pillar = Level::flat(64, 64, 10, 1).unwrap();
     pillar.planes_mut().0[5 * 64 + 5] = 50;
     let pillar = TerrainCollider::new(&pillar);
-    assert_eq!(pillar.cast_ray([0.5, 0.5, 20.0], [1.0, 0.0, 0.0], f64::INFINITY), None);
+    assert_eq!(
+        pillar.cast_ray([0.5, 0.5, 20.0], [1.0, 0.0, 0.0], f64::INFINITY),
+        None
+    );
     // Far from the origin: the same hit as in the map.
-    let a = collider.cast_ray([30.5, 40.5, 300.0], [0.0, 0.0, -1.0], 400.0).unwrap();
+    let a = collider
+        .cast_ray([30.5, 40.5, 300.0], [0.0, 0.0, -1.0], 400.0)
+        .unwrap();
     let b = collider
-        .cast_ray([30.5 + 256.0 * 1e6, 40.5 - 256.0 * 3e5, 300.0], [0.0, 0.0, -1.0], 400.0)
+        .cast_ray(
+            [30.5 + 256.0 * 1e6, 40.5 - 256.0 * 3e5, 300.0],
+            [0.0, 0.0, -1.0],
+            400.0,
+        )
         .unwrap();
     assert_eq!(a.distance, b.distance);
     // Inside solid terrain: a hit at distance 0.
-    let inside = collider.cast_ray([30.5, 40.5, 0.5], [1.0, 0.0, 0.0], 10.0).unwrap();
+    let inside = collider
+        .cast_ray([30.5, 40.5, 0.5], [1.0, 0.0, 0.0], 10.0)
+        .unwrap();
     assert_eq!(inside.distance, 0.0);
     // Boxes with bad sizes or positions: no contact.
     let bad = BoxShape::axis_aligned([nan, 1.0, 1.0], [1.0; 3]);
@@ -313,17 +349,42 @@ fn bad_input_gives_defined_results() {
     assert!(collider.contact_box(&flat_box, 0.0).is_none());
     // Edits outside the map (wrapped), of radius 0, larger than the map.
     let mut site = EditSite::fostral();
-    for (cx, cy, r) in [(-1000, 5000, 6), (7, 9, 0), (100, 100, 1000), (i64::MAX, i64::MIN, 3)] {
+    for (cx, cy, r) in [
+        (-1000, 5000, 6),
+        (7, 9, 0),
+        (100, 100, 1000),
+        (i64::MAX, i64::MIN, 3),
+    ] {
         (site.centre_x, site.centre_y, site.radius, site.depth) = (cx, cy, r, 10.0);
         let dirty = crater(&mut level, &site);
         collider.apply_edit(&level, &dirty);
     }
     // Rectangles reaching past the map, or empty, from a careless caller.
     let odd = [
-        DirtyRect { x: 250, y: 250, width: 300, height: 20 },
-        DirtyRect { x: 5000, y: 3, width: 4, height: 4 },
-        DirtyRect { x: 3, y: 3, width: 0, height: 4 },
-        DirtyRect { x: u32::MAX, y: u32::MAX, width: u32::MAX, height: u32::MAX },
+        DirtyRect {
+            x: 250,
+            y: 250,
+            width: 300,
+            height: 20,
+        },
+        DirtyRect {
+            x: 5000,
+            y: 3,
+            width: 4,
+            height: 4,
+        },
+        DirtyRect {
+            x: 3,
+            y: 3,
+            width: 0,
+            height: 4,
+        },
+        DirtyRect {
+            x: u32::MAX,
+            y: u32::MAX,
+            width: u32::MAX,
+            height: u32::MAX,
+        },
     ];
     collider.apply_edit(&level, &odd);
     let (ok, n) = agreement(&collider, &level, 1000, 3);
@@ -332,6 +393,8 @@ fn bad_input_gives_defined_results() {
     let small = Level::flat(128, 64, 20, 2).unwrap();
     let chunks = collider.apply_edit(&small, &[]);
     assert_eq!(chunks.len(), 1);
-    let hit = collider.cast_ray([5.5, 5.5, 50.0], [0.0, 0.0, -1.0], 100.0).unwrap();
+    let hit = collider
+        .cast_ray([5.5, 5.5, 50.0], [0.0, 0.0, -1.0], 100.0)
+        .unwrap();
     assert_eq!(hit.distance, 30.0);
 }

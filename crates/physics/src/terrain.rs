@@ -141,11 +141,14 @@ impl ChunkColliders {
             self.shapes.insert(chunk, shapes);
         }
         // The chunk's pose in its own cell, moved to cell (gx, gy).
-        let s = terrain.chunk_pose(chunk, [
-            ((cx - gx) * i64::from(layout.size_x)) as f64,
-            ((cy - gy) * i64::from(layout.size_y)) as f64,
-            0.0,
-        ]);
+        let s = terrain.chunk_pose(
+            chunk,
+            [
+                ((cx - gx) * i64::from(layout.size_x)) as f64,
+                ((cy - gy) * i64::from(layout.size_y)) as f64,
+                0.0,
+            ],
+        );
         let handles = self.shapes[&chunk]
             .iter()
             .map(|shape| {

@@ -241,7 +241,11 @@ fn only_chunks_near_bodies_are_in_the_world() {
     assert!((8..=8 * 4).contains(&cells), "{cells}");
     // A flat map has no slabs: one 129 x 129 field per chunk.
     assert!(bytes <= cells * (129 * 129 * 4 + 128 * 128), "{bytes}");
-    assert!(physics.bodies().all(|b| (b.position[2] - 35.0).abs() < TOLERANCE));
+    assert!(
+        physics
+            .bodies()
+            .all(|b| (b.position[2] - 35.0).abs() < TOLERANCE)
+    );
     physics.clear_bodies();
     physics.step();
     assert_eq!(physics.terrain_cells(), (0, 0));
