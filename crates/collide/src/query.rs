@@ -172,7 +172,7 @@ impl TerrainCollider {
             let mut x = sx0;
             while x < sx1 {
                 let nx = (sx1 - x).min(PIECE);
-                let s = self.columns.surfaces(x, y, nx as u32, ny as u32);
+                let s = self.columns.surfaces(x, y, nx as u32, ny as u32, 1);
                 let pose = s.pose(frame);
                 f(&s, pose);
                 x += nx;
@@ -315,14 +315,31 @@ impl TerrainCollider {
     /// chunk's first), centred in the chunk's own cell; `None` for an index
     /// past the last chunk.
     pub fn chunk_surfaces(&self, index: usize) -> Option<crate::surface::Surfaces> {
+        self.chunk_surfaces_every(index, 1)
+    }
+
+    /// [`TerrainCollider::chunk_surfaces`] through every `step`-th sample
+    /// only: 1/step² the triangles (cheaper contacts for a physics world)
+    /// for a surface that is exact at those samples only. `step` is rounded
+    /// down to a power of two and clamped to 1..=the chunk's side.
+    pub fn chunk_surfaces_every(
+        &self,
+        index: usize,
+        step: u32,
+    ) -> Option<crate::surface::Surfaces> {
         if index >= self.layout.count() {
             return None;
         }
         let (cx, cy) = self.layout.coords(index);
         let (sx, sy) = (self.layout.size_x, self.layout.size_y);
+        let step = if step <= 1 {
+            1
+        } else {
+            (1u32 << step.ilog2()).min(sx).min(sy)
+        };
         Some(
             self.columns
-                .surfaces(i64::from(cx * sx), i64::from(cy * sy), sx, sy),
+                .surfaces(i64::from(cx * sx), i64::from(cy * sy), sx, sy, step),
         )
     }
 

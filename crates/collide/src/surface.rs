@@ -72,12 +72,15 @@ impl Surfaces {
 
 impl Columns {
     /// The surfaces over samples `x0..=x0 + nx`, `y0..=y0 + ny` (`nx`, `ny`
-    /// at least 1).
-    pub(crate) fn surfaces(&self, x0: i64, y0: i64, nx: u32, ny: u32) -> Surfaces {
-        let (rows, cols) = (ny as usize + 1, nx as usize + 1);
-        // Row i is texel row y0 + ny - i (local z runs to world -y); column
-        // j is texel column x0 + j. Column-major, as parry's Array2.
-        let sample = |i: usize, j: usize| self.get(x0 + j as i64, y0 + i64::from(ny) - i as i64);
+    /// at least 1), every `step`-th sample (`step` divides both; 1: every
+    /// sample, exact).
+    pub(crate) fn surfaces(&self, x0: i64, y0: i64, nx: u32, ny: u32, step: u32) -> Surfaces {
+        let (rows, cols) = ((ny / step) as usize + 1, (nx / step) as usize + 1);
+        let st = i64::from(step);
+        // Row i is texel row y0 + ny - i step (local z runs to world -y);
+        // column j is texel column x0 + j step. Column-major, as parry's Array2.
+        let sample =
+            |i: usize, j: usize| self.get(x0 + j as i64 * st, y0 + i64::from(ny) - i as i64 * st);
         let mut floor = Vec::with_capacity(rows * cols);
         let mut top = Vec::with_capacity(rows * cols);
         let mut under = Vec::with_capacity(rows * cols);

@@ -28,7 +28,6 @@ const PAD: f32 = 4.0;
 const KEEP: f32 = 32.0;
 
 /// The cells in the world and the shapes of their chunks.
-#[derive(Default)]
 pub(crate) struct ChunkColliders {
     /// Per chunk in use: its surfaces (floor, slab top, slab underside).
     shapes: BTreeMap<usize, Vec<SharedShape>>,
@@ -36,6 +35,8 @@ pub(crate) struct ChunkColliders {
     cells: BTreeMap<(i64, i64), (usize, Vec<ColliderHandle>)>,
     /// Bytes of the shapes held.
     bytes: usize,
+    /// Sample spacing of the surfaces (1: every texel centre, exact).
+    pub(crate) surface_step: u32,
 }
 
 /// Cells a body at `p` with `reach` touches: chunk squares of `size`
@@ -46,6 +47,16 @@ fn cell_range(p: f32, reach: f32, size: u32) -> std::ops::RangeInclusive<i64> {
 }
 
 impl ChunkColliders {
+    /// No cells yet; surfaces through every `surface_step`-th sample.
+    pub(crate) fn new(surface_step: u32) -> Self {
+        ChunkColliders {
+            shapes: BTreeMap::new(),
+            cells: BTreeMap::new(),
+            bytes: 0,
+            surface_step,
+        }
+    }
+
     /// Make the world hold the cells within reach of `bodies` (and drop the
     /// ones out of the wider reach).
     pub(crate) fn sync(
@@ -129,7 +140,7 @@ impl ChunkColliders {
         let (cx, cy) = (gx.rem_euclid(nx), gy.rem_euclid(ny));
         let chunk = layout.index(cx as u32, cy as u32);
         if !self.shapes.contains_key(&chunk) {
-            let Some(s) = terrain.chunk_surfaces(chunk) else {
+            let Some(s) = terrain.chunk_surfaces_every(chunk, self.surface_step) else {
                 return (chunk, Vec::new());
             };
             let shapes: Vec<SharedShape> = [Some(s.floor), s.slab_top, s.ceiling]

@@ -250,3 +250,29 @@ fn only_chunks_near_bodies_are_in_the_world() {
     physics.step();
     assert_eq!(physics.terrain_cells(), (0, 0));
 }
+
+/// Surfaces through every 4th sample: fewer triangles, the same rest
+/// heights on flat ground and on a slab.
+#[test]
+fn sparser_surfaces_hold_bodies_at_the_same_heights() {
+    let level = level();
+    let settings = PhysicsSettings {
+        surface_step: 4,
+        ..Default::default()
+    };
+    let mut physics = TerrainPhysics::fit(&level, 0.5, settings);
+    let ground = physics.drop_body(ball(), [60.5, 180.5, 120.0]).unwrap();
+    let slab = physics.drop_body(ball(), [175.5, 60.5, 110.0]).unwrap();
+    let g = settle(&mut physics, ground, 600);
+    let s = settle(&mut physics, slab, 600);
+    assert!((g[2] - (GROUND + RADIUS)).abs() < TOLERANCE, "{g:?}");
+    assert!((s[2] - (SLAB_TOP + RADIUS)).abs() < TOLERANCE, "{s:?}");
+    let (_, sparse) = physics.terrain_cells();
+    let mut exact = world(&level);
+    exact.drop_body(ball(), [60.5, 180.5, 120.0]).unwrap();
+    exact.drop_body(ball(), [175.5, 60.5, 110.0]).unwrap();
+    exact.step();
+    let (_, full) = exact.terrain_cells();
+    println!("height fields: {sparse} bytes every 4th sample, {full} bytes every sample");
+    assert!(sparse * 8 < full, "{sparse} vs {full}");
+}

@@ -39,6 +39,16 @@ pub struct Args {
         requires = "physics_bench"
     )]
     bodies: Vec<usize>,
+    /// With --physics-bench: spacing of the terrain surface's samples in
+    /// the physics world (1: every texel centre, exact; 2, 4: cheaper).
+    #[arg(
+        long,
+        value_name = "N",
+        default_value_t = 1,
+        requires = "physics_bench",
+        value_parser = clap::value_parser!(u32).range(1..=128)
+    )]
+    surface_step: u32,
 }
 
 #[derive(Serialize)]
@@ -126,7 +136,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             bail!("--bodies {:?}: each count must be at least 1", args.bodies);
         }
         let site = world.edit.clone().unwrap_or_else(EditSite::fostral);
-        let report = crate::cmd::physics_bench::run(&mut level, collider, &site, &args.bodies)?;
+        let report = crate::cmd::physics_bench::run(
+            &mut level,
+            collider,
+            &site,
+            &args.bodies,
+            args.surface_step,
+        )?;
         if args.json {
             println!(
                 "{}",

@@ -31,6 +31,8 @@ pub struct Run {
 
 #[derive(Serialize)]
 pub struct Report {
+    /// Spacing of the terrain surface's samples (1: exact).
+    surface_step: u32,
     world_build_ms: f64,
     runs: Vec<Run>,
     crater_chunks: usize,
@@ -69,9 +71,14 @@ pub fn run(
     collider: TerrainCollider,
     site: &EditSite,
     counts: &[usize],
+    surface_step: u32,
 ) -> anyhow::Result<Report> {
     let t = Instant::now();
-    let mut physics = TerrainPhysics::new(collider, PhysicsSettings::default());
+    let settings = PhysicsSettings {
+        surface_step,
+        ..Default::default()
+    };
+    let mut physics = TerrainPhysics::new(collider, settings);
     let world_build_ms = t.elapsed().as_secs_f64() * 1e3;
     let mut runs = Vec::new();
     for &n in counts {
@@ -116,6 +123,7 @@ pub fn run(
         })
         .count();
     Ok(Report {
+        surface_step,
         world_build_ms,
         runs,
         crater_chunks: edit.chunks.len(),
@@ -128,8 +136,8 @@ pub fn run(
 
 pub fn print(r: &Report) {
     println!(
-        "physics world (rapier3d) on the collider: {:.3} ms to create (chunk surfaces come with the bodies)",
-        r.world_build_ms
+        "physics world (rapier3d) on the collider: {:.3} ms to create (chunk surfaces, every {} texel(s), come with the bodies)",
+        r.world_build_ms, r.surface_step
     );
     for run in &r.runs {
         println!(
