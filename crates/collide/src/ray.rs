@@ -39,9 +39,13 @@ pub(crate) struct Hit {
 /// side the ray moves into.
 #[inline]
 fn texel_after(p: f64, d: f64) -> i64 {
-    let f = p.floor();
-    let c = f as i64;
-    if f == p && d < 0.0 { c - 1 } else { c }
+    // floor(p) without `f64::floor` (a libm call on baseline x86-64): exact
+    // for |p| < 2^63, and the callers keep |p| below 2^41.
+    let mut c = p as i64;
+    if c as f64 > p {
+        c -= 1;
+    }
+    if c as f64 == p && d < 0.0 { c - 1 } else { c }
 }
 
 /// Ray parameter where it leaves cell `c` (of side `size`) along one axis.
@@ -148,11 +152,21 @@ impl Columns {
         let mut cx = tx0 >> (LOG_RATIO as usize * lvl);
         let mut cy = ty0 >> (LOG_RATIO as usize * lvl);
         let mut across_x = false;
+        // The exit parameters of the current cell along x and y, kept while
+        // the cell's coordinate on that axis and the level stay the same
+        // (the same float the reference recomputes each step).
+        let (mut tx, mut ty) = (0.0, 0.0);
+        let (mut new_x, mut new_y) = (true, true);
         loop {
             let shift = LOG_RATIO as usize * lvl;
             let size = (1i64 << shift) as f64;
-            let tx = boundary_t(o[0], d[0], cx, size);
-            let ty = boundary_t(o[1], d[1], cy, size);
+            if new_x {
+                tx = boundary_t(o[0], d[0], cx, size);
+            }
+            if new_y {
+                ty = boundary_t(o[1], d[1], cy, size);
+            }
+            (new_x, new_y) = (false, false);
             let t_exit = tx.min(ty);
             let t_out = t_exit.min(t_end);
             if lvl > 0 {
@@ -169,6 +183,7 @@ impl Columns {
                     let last = |c: i64| (c << LOG_RATIO) + (1 << LOG_RATIO) - 1;
                     cx = (ax >> child_shift).clamp(first(cx), last(cx));
                     cy = (ay >> child_shift).clamp(first(cy), last(cy));
+                    (new_x, new_y) = (true, true);
                     continue;
                 }
             } else {
@@ -195,9 +210,11 @@ impl Columns {
             across_x = tx <= ty;
             if tx <= ty {
                 cx += step_x;
+                new_x = true;
             }
             if ty <= tx {
                 cy += step_y;
+                new_y = true;
             }
             if lvl < top
                 && (old_x >> LOG_RATIO != cx >> LOG_RATIO || old_y >> LOG_RATIO != cy >> LOG_RATIO)
@@ -205,6 +222,7 @@ impl Columns {
                 lvl += 1;
                 cx >>= LOG_RATIO;
                 cy >>= LOG_RATIO;
+                (new_x, new_y) = (true, true);
             }
         }
     }
