@@ -1,149 +1,100 @@
-//! The whole level's colliders: build, refit after edits, statistics.
+//! The whole level's collider: build, follow edits, statistics.
 
-use crate::chunk::ChunkCollider;
-use rayon::prelude::*;
+use crate::columns::Columns;
 use strata_level::{DirtyRect, Level};
-use strata_mesh::{ChunkFitter, ChunkLayout, ChunkMesh, LevelMesh, dirty_chunks};
+use strata_mesh::{ChunkLayout, dirty_chunks};
 
-/// One triangle-mesh collider per chunk of a level, following its edits.
+/// The terrain's exact collider: a packed copy of every texel's column and
+/// a max-height pyramid (see the crate docs), following the level's edits.
+#[derive(Clone, Debug)]
 pub struct TerrainCollider {
     pub(crate) layout: ChunkLayout,
-    /// Highest vertex over all chunks (rays rising above it stop).
-    pub(crate) top: f32,
-    tolerance: f64,
-    pub(crate) chunks: Vec<ChunkCollider>,
+    pub(crate) columns: Columns,
 }
 
 /// Size of a [`TerrainCollider`].
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ColliderStats {
-    /// Chunks (one collider each).
+    /// Chunks of the map (the units edits report and contact surfaces are
+    /// built in; 128 x 128 texels).
     pub chunks: usize,
-    /// Triangles over all chunks.
+    /// Triangles held: none (the collider holds columns; contact surfaces
+    /// are built on demand, see [`TerrainCollider::chunk_surfaces`]).
     pub triangles: usize,
-    /// Approximate memory of all chunk colliders (vertices, indices, BVH).
+    /// Texel columns held (the map's area).
+    pub columns: usize,
+    /// Memory of the columns and the pyramid, bytes.
     pub memory_bytes: usize,
 }
 
 impl TerrainCollider {
-    /// Fit the level's mesh at `tolerance` (see
-    /// [`strata_mesh::tolerance_for_quality`]) and build every chunk.
-    pub fn fit(level: &Level, tolerance: f64) -> Self {
-        let mesh = LevelMesh::fit(level, tolerance);
-        Self::from_mesh(level, &mesh)
-    }
-
-    /// Build every chunk from an existing fit of `level` (its index lists
-    /// must not have been released).
-    pub fn from_mesh(level: &Level, mesh: &LevelMesh) -> Self {
-        let layout = mesh.layout;
-        let chunks = mesh
-            .chunks
-            .par_iter()
-            .enumerate()
-            .map(|(i, m)| ChunkCollider::build(level, &layout, i, m))
-            .collect();
+    /// The collider of `level`: every column decoded and packed, the
+    /// pyramid built (all cores).
+    ///
+    /// ```
+    /// use strata_collide::TerrainCollider;
+    /// let level = strata_level::Level::flat(256, 128, 40, 1).unwrap();
+    /// let collider = TerrainCollider::new(&level);
+    /// let hit = collider.cast_ray([10.5, 10.5, 100.0], [0.0, 0.0, -1.0], 200.0).unwrap();
+    /// assert_eq!(hit.distance, 60.0);
+    /// assert_eq!(collider.stats().memory_bytes / (256 * 128), 4, "4 bytes a texel");
+    /// ```
+    pub fn new(level: &Level) -> Self {
         TerrainCollider {
-            layout,
-            top: 0.0,
-            tolerance: mesh.tolerance(),
-            chunks,
+            layout: ChunkLayout::of(level),
+            columns: Columns::new(level),
         }
-        .with_top()
     }
 
-    fn with_top(mut self) -> Self {
-        self.update_top();
-        self
+    /// [`TerrainCollider::new`]; `tolerance` is ignored (the collider is
+    /// exact to the texel model: there is no fit). Kept for callers of the
+    /// former triangle-mesh collider.
+    pub fn fit(level: &Level, tolerance: f64) -> Self {
+        let _ = tolerance;
+        Self::new(level)
     }
 
-    fn update_top(&mut self) {
-        self.top = self.chunks.iter().map(|c| c.z_range.1).fold(0.0, f32::max);
-    }
-
-    /// The fit tolerance (the mesh's max vertical error at LOD 0).
+    /// Vertical error of the collider against the texel model: 0.
     pub fn tolerance(&self) -> f64 {
-        self.tolerance
+        0.0
     }
 
-    /// The chunk grid.
+    /// The chunk grid (128 x 128 texels, fewer on a smaller map).
     pub fn layout(&self) -> &ChunkLayout {
         &self.layout
     }
 
-    /// Chunk `index`'s collider (row-major, see [`ChunkLayout`]).
-    pub fn chunk(&self, index: usize) -> &ChunkCollider {
-        &self.chunks[index]
-    }
-
-    /// After an edit of `level`: refit and rebuild exactly the chunks the
-    /// dirty rectangles touch (as the renderer's mesh refit does). Returns
-    /// their indices. A level of another size is rebuilt whole.
+    /// After an edit of `level`: re-decode the texels of the dirty
+    /// rectangles and refresh the pyramid over them. Returns the chunks
+    /// whose contact surfaces changed (see [`strata_mesh::dirty_chunks`]).
+    /// A level of another size is rebuilt whole; rectangles reaching past
+    /// the map wrap onto it.
     pub fn apply_edit(&mut self, level: &Level, dirty: &[DirtyRect]) -> Vec<usize> {
-        if ChunkLayout::of(level) != self.layout {
-            *self = Self::fit(level, self.tolerance);
-            return (0..self.chunks.len()).collect();
+        if (level.width(), level.height()) != (self.columns.width(), self.columns.height())
+            || level.mid_rule != self.columns.mid_rule
+        {
+            *self = Self::new(level);
+            return (0..self.layout.count()).collect();
         }
-        let ids = dirty_chunks(&self.layout, level.width(), level.height(), dirty);
-        let (layout, tol) = (self.layout, self.tolerance);
-        let fresh: Vec<ChunkCollider> = ids
-            .par_iter()
-            .map_init(ChunkFitter::default, |f, &i| {
-                let (cx, cy) = layout.coords(i);
-                let m = f.fit(level, &layout, cx, cy, tol);
-                ChunkCollider::build(level, &layout, i, &m)
-            })
-            .collect();
-        for (&i, c) in ids.iter().zip(fresh) {
-            self.chunks[i] = c;
+        for r in dirty {
+            self.columns.update(level, r);
         }
-        self.update_top();
-        ids
+        dirty_chunks(&self.layout, level.width(), level.height(), dirty)
     }
 
-    /// Replace chunks from meshes someone else already refit (the renderer's
-    /// mesh method, in the call that uploads them): `(chunk index, mesh)`.
-    ///
-    /// ```
-    /// use strata_collide::TerrainCollider;
-    /// use strata_mesh::{ChunkFitter, ChunkLayout};
-    /// let mut level = strata_level::Level::flat(256, 128, 40, 1).unwrap();
-    /// let mut collider = TerrainCollider::fit(&level, 1.0);
-    /// let mut site = strata_level::EditSite::fostral();
-    /// (site.centre_x, site.centre_y, site.radius, site.depth) = (60, 60, 20, 30.0);
-    /// strata_level::edit::crater(&mut level, &site);
-    /// // Chunk 0 refit elsewhere (as the renderer does), handed over.
-    /// let layout = ChunkLayout::of(&level);
-    /// let mesh = ChunkFitter::default().fit(&level, &layout, 0, 0, 1.0);
-    /// collider.replace_chunks(&level, &[(0, &mesh)]);
-    /// let hit = collider.cast_ray([60.5, 60.5, 100.0], [0.0, 0.0, -1.0], 200.0).unwrap();
-    /// assert!(hit.point[2] < 15.0, "the crater floor: {:?}", hit.point);
-    /// ```
-    pub fn replace_chunks(&mut self, level: &Level, refit: &[(usize, &ChunkMesh)]) {
-        let layout = self.layout;
-        let fresh: Vec<(usize, ChunkCollider)> = refit
-            .par_iter()
-            .map(|&(i, m)| (i, ChunkCollider::build(level, &layout, i, m)))
-            .collect();
-        for (i, c) in fresh {
-            self.chunks[i] = c;
-        }
-        self.update_top();
-    }
-
-    /// Chunk count, triangles and memory.
+    /// Chunk count, columns and memory.
     ///
     /// ```
     /// let level = strata_level::Level::flat(256, 256, 40, 1).unwrap();
-    /// let stats = strata_collide::TerrainCollider::fit(&level, 1.0).stats();
-    /// assert_eq!(stats.chunks, 4);
-    /// assert!(stats.triangles >= 8 && stats.memory_bytes > 0);
+    /// let stats = strata_collide::TerrainCollider::new(&level).stats();
+    /// assert_eq!((stats.chunks, stats.columns), (4, 256 * 256));
     /// ```
     pub fn stats(&self) -> ColliderStats {
         ColliderStats {
-            chunks: self.chunks.len(),
-            triangles: self.chunks.iter().map(ChunkCollider::triangles).sum(),
-            memory_bytes: self.chunks.iter().map(ChunkCollider::memory_bytes).sum(),
+            chunks: self.layout.count(),
+            triangles: 0,
+            columns: self.columns.width() as usize * self.columns.height() as usize,
+            memory_bytes: self.columns.memory_bytes(),
         }
     }
 }

@@ -1,13 +1,16 @@
-//! Rigid bodies on Strata's terrain (issue 18): a [rapier3d] world whose
-//! ground is the fitted mesh's [`TerrainCollider`](strata_collide::TerrainCollider), one fixed collider per
-//! 128x128 chunk, and whose ground follows edits: [`TerrainPhysics::apply_edit`]
-//! refits the dirty chunks and replaces exactly their colliders, so bodies
-//! resting on dug ground fall into the new crater. No GPU: the viewer draws
-//! the bodies; tests and `strata collide --physics-bench` run it headless.
+//! Rigid bodies on Strata's terrain (issues 18 and 35): a [rapier3d] world
+//! whose ground is the exact [`TerrainCollider`](strata_collide::TerrainCollider)'s
+//! contact surfaces (parry3d height fields of the floor, slab tops and slab
+//! undersides, per 128x128 chunk, built lazily for the chunks around the
+//! bodies so memory stays small), and whose ground follows edits:
+//! [`TerrainPhysics::apply_edit`] updates the collider and replaces exactly
+//! the dirty chunks' colliders, so bodies resting on dug ground fall into
+//! the new crater. No GPU: the viewer draws the bodies; tests and
+//! `strata collide --physics-bench` run it headless.
 //!
 //! rapier3d 0.36 is built on parry3d 0.31, the geometry library
-//! `strata-collide` builds its chunk meshes with, so each chunk's
-//! `Arc<TriMesh>` is the collider shape itself (shared, never converted).
+//! `strata-collide` builds its height fields with, so they go into the
+//! world as they are (shared between a chunk's copies, never converted).
 //!
 //! ```
 //! use strata_physics::{BodyShape, PhysicsSettings, TerrainPhysics};
@@ -19,7 +22,7 @@
 //! }
 //! let z = physics.body(ball).unwrap().position[2];
 //! assert!((z - 45.0).abs() < 0.5, "resting on the ground at 40: {z}");
-//! // Dig under it: the chunk's collider is replaced and the ball falls.
+//! // Dig under it: the chunk's colliders are replaced and the ball falls.
 //! let mut site = strata_level::EditSite::fostral();
 //! (site.centre_x, site.centre_y, site.radius, site.depth) = (100, 100, 20, 30.0);
 //! let dirty = strata_level::edit::crater(&mut level, &site);

@@ -8,7 +8,6 @@ use crate::terrain::ChunkColliders;
 use rapier3d::prelude::{PhysicsWorld, RigidBodyBuilder, RigidBodyHandle, Vector};
 use strata_collide::TerrainCollider;
 use strata_level::{DirtyRect, Level};
-use strata_mesh::ChunkMesh;
 use web_time::Instant;
 
 /// How the world moves.
@@ -22,8 +21,15 @@ pub struct PhysicsSettings {
     /// Most steps one [`TerrainPhysics::advance`] runs (see [`FixedStep`]).
     pub max_steps_per_advance: u32,
     /// Continuous collision detection on dropped bodies: fast bodies do
-    /// not tunnel through the terrain's thin triangles.
+    /// not tunnel through the terrain's thin surfaces.
     pub ccd: bool,
+    /// Spacing, in texels, of the terrain surface's samples in the world:
+    /// 1 (the default) puts every texel centre in, the surface exact to the
+    /// texel model's heights; 2 or 4 keep every 2nd or 4th (4 or 16 times
+    /// fewer triangles under each body, so cheaper steps, on a surface
+    /// exact at those samples only). Rounded down to a power of two,
+    /// clamped to a chunk's side.
+    pub surface_step: u32,
 }
 
 impl Default for PhysicsSettings {
@@ -33,6 +39,7 @@ impl Default for PhysicsSettings {
             step: 1.0 / 60.0,
             max_steps_per_advance: 15,
             ccd: true,
+            surface_step: 1,
         }
     }
 }
@@ -40,20 +47,22 @@ impl Default for PhysicsSettings {
 /// What an edit did to the physics world.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct EditReport {
-    /// The chunks refit (row-major indices).
+    /// The chunks whose surfaces changed (row-major indices).
     pub chunks: Vec<usize>,
-    /// Rapier colliders replaced: the chunks and their copies across the
-    /// map's edges.
+    /// Rapier colliders replaced: the changed chunks' surfaces in the world
+    /// (in place and across the map's edges).
     pub colliders_replaced: usize,
-    /// Refitting and rebuilding the chunks' meshes (all cores).
+    /// Updating the collider (columns and pyramid).
     pub refit_ms: f64,
-    /// Swapping them into the rapier world.
+    /// Rebuilding the changed surfaces in the world and swapping them in.
     pub replace_ms: f64,
 }
 
-/// Rigid bodies on the terrain. The terrain is a [`TerrainCollider`]; each
-/// of its chunk meshes is a fixed rapier collider (shared, not copied), and
-/// an edit replaces exactly the dirty chunks' colliders in the same call.
+/// Rigid bodies on the terrain. The terrain is a [`TerrainCollider`]; the
+/// chunks around the bodies are in the world as fixed height-field
+/// colliders (floor, slab top, slab underside; built when a body comes
+/// near, dropped when it leaves), and an edit replaces exactly the dirty
+/// chunks' colliders in the same call.
 pub struct TerrainPhysics {
     world: PhysicsWorld,
     terrain: TerrainCollider,
@@ -71,7 +80,7 @@ impl TerrainPhysics {
         let mut world = PhysicsWorld::new();
         world.gravity = Vector::new(0.0, 0.0, -settings.gravity);
         world.integration_parameters.dt = settings.step as f32;
-        let chunks = ChunkColliders::insert_all(&mut world, &terrain);
+        let chunks = ChunkColliders::new(settings.surface_step);
         let layout = terrain.layout();
         let size = [
             (layout.size_x * layout.chunks_x) as f32,
@@ -88,7 +97,8 @@ impl TerrainPhysics {
         }
     }
 
-    /// Fit `level`'s mesh at `tolerance` and build the world on it.
+    /// Build `level`'s collider and the world on it; `tolerance` is ignored
+    /// (the collider is exact, see [`TerrainCollider::fit`]).
     pub fn fit(level: &Level, tolerance: f64, settings: PhysicsSettings) -> Self {
         Self::new(TerrainCollider::fit(level, tolerance), settings)
     }
@@ -197,8 +207,15 @@ impl TerrainPhysics {
         })
     }
 
-    /// Run one fixed step.
+    /// Run one fixed step (first bringing the terrain cells around the
+    /// bodies into the world).
     pub fn step(&mut self) {
+        self.chunks.sync(
+            &mut self.world,
+            &self.terrain,
+            &self.bodies,
+            self.settings.step as f32,
+        );
         self.world.step();
         self.wrap_bodies();
     }
@@ -213,28 +230,13 @@ impl TerrainPhysics {
         steps
     }
 
-    /// After an edit of `level`: refit exactly the chunks the dirty
-    /// rectangles touch and replace their colliders in the world (bodies
-    /// resting on them wake and fall onto the new ground).
+    /// After an edit of `level`: the collider re-reads the dirty texels,
+    /// and the chunks they touch that are in the world get new surfaces
+    /// (bodies resting on them wake and fall onto the new ground).
     pub fn apply_edit(&mut self, level: &Level, dirty: &[DirtyRect]) -> EditReport {
         let t = Instant::now();
         let chunks = self.terrain.apply_edit(level, dirty);
-        self.replace_colliders(chunks, t)
-    }
-
-    /// Like [`TerrainPhysics::apply_edit`] for chunks someone else already
-    /// refit (a renderer's mesh method): `(chunk index, mesh)`.
-    pub fn replace_chunks(&mut self, level: &Level, refit: &[(usize, &ChunkMesh)]) -> EditReport {
-        let t = Instant::now();
-        self.terrain.replace_chunks(level, refit);
-        let chunks: Vec<usize> = refit.iter().map(|&(i, _)| i).collect();
-        self.replace_colliders(chunks, t)
-    }
-
-    /// The second half of an edit: the refit `chunks` (refit since
-    /// `refit_start`) get new colliders in the world.
-    fn replace_colliders(&mut self, chunks: Vec<usize>, refit_start: Instant) -> EditReport {
-        let refit_ms = refit_start.elapsed().as_secs_f64() * 1e3;
+        let refit_ms = t.elapsed().as_secs_f64() * 1e3;
         let t = Instant::now();
         let colliders_replaced = self.chunks.replace(&mut self.world, &self.terrain, &chunks);
         EditReport {
@@ -245,10 +247,15 @@ impl TerrainPhysics {
         }
     }
 
-    /// Chunk `index`'s rapier collider handles (in place and its copies
-    /// across the map's edges); empty for a chunk without triangles.
-    pub fn chunk_colliders(&self, index: usize) -> &[rapier3d::prelude::ColliderHandle] {
+    /// Chunk `index`'s rapier collider handles (its cells in the world, in
+    /// place and across the map's edges); empty while no body is near it.
+    pub fn chunk_colliders(&self, index: usize) -> Vec<rapier3d::prelude::ColliderHandle> {
         self.chunks.of(index)
+    }
+
+    /// Chunk cells in the world now, and the bytes of their height fields.
+    pub fn terrain_cells(&self) -> (usize, usize) {
+        (self.chunks.cell_count(), self.chunks.memory_bytes())
     }
 
     fn wrapped(&self, [x, y]: [f32; 2]) -> [f32; 2] {

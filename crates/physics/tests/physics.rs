@@ -222,3 +222,57 @@ fn a_click_drops_the_body_above_the_ground_it_sees_or_under_the_ceiling() {
     assert_eq!(physics.body_count(), 0);
     assert_eq!(physics.bodies().count(), 0);
 }
+
+/// Only the chunks around bodies are in the world: a few cells per body,
+/// none once the bodies are gone (the whole map's surfaces never are).
+#[test]
+fn only_chunks_near_bodies_are_in_the_world() {
+    let level = Level::flat(1024, 1024, 30, 1).unwrap();
+    let mut physics = world(&level);
+    for k in 0..8 {
+        let at = [100.5 + 120.0 * k as f32, 60.5 + 117.0 * k as f32, 50.0];
+        physics.drop_body(ball(), at).unwrap();
+    }
+    for _ in 0..60 {
+        physics.step();
+    }
+    let (cells, bytes) = physics.terrain_cells();
+    println!("{cells} cells, {bytes} bytes of height fields for 8 bodies");
+    assert!((8..=8 * 4).contains(&cells), "{cells}");
+    // A flat map has no slabs: one 129 x 129 field per chunk.
+    assert!(bytes <= cells * (129 * 129 * 4 + 128 * 128), "{bytes}");
+    assert!(
+        physics
+            .bodies()
+            .all(|b| (b.position[2] - 35.0).abs() < TOLERANCE)
+    );
+    physics.clear_bodies();
+    physics.step();
+    assert_eq!(physics.terrain_cells(), (0, 0));
+}
+
+/// Surfaces through every 4th sample: fewer triangles, the same rest
+/// heights on flat ground and on a slab.
+#[test]
+fn sparser_surfaces_hold_bodies_at_the_same_heights() {
+    let level = level();
+    let settings = PhysicsSettings {
+        surface_step: 4,
+        ..Default::default()
+    };
+    let mut physics = TerrainPhysics::fit(&level, 0.5, settings);
+    let ground = physics.drop_body(ball(), [60.5, 180.5, 120.0]).unwrap();
+    let slab = physics.drop_body(ball(), [175.5, 60.5, 110.0]).unwrap();
+    let g = settle(&mut physics, ground, 600);
+    let s = settle(&mut physics, slab, 600);
+    assert!((g[2] - (GROUND + RADIUS)).abs() < TOLERANCE, "{g:?}");
+    assert!((s[2] - (SLAB_TOP + RADIUS)).abs() < TOLERANCE, "{s:?}");
+    let (_, sparse) = physics.terrain_cells();
+    let mut exact = world(&level);
+    exact.drop_body(ball(), [60.5, 180.5, 120.0]).unwrap();
+    exact.drop_body(ball(), [175.5, 60.5, 110.0]).unwrap();
+    exact.step();
+    let (_, full) = exact.terrain_cells();
+    println!("height fields: {sparse} bytes every 4th sample, {full} bytes every sample");
+    assert!(sparse * 8 < full, "{sparse} vs {full}");
+}

@@ -66,11 +66,9 @@ impl Drive {
         let colors = TerrainColors::test_ramps();
         let mut renderer = Renderer::new(gpu, &level, &colors, method, &settings, size.0, size.1)?;
 
-        // The collider follows every edit the renderer applies, in the same call.
-        let quality = f64::from(settings.mesh_quality);
-        let tolerance = strata_mesh::tolerance_for_quality(quality)
-            .ok_or_else(|| anyhow::anyhow!("mesh quality {quality} is outside 0..=1"))?;
-        let collider = Arc::new(Mutex::new(TerrainCollider::fit(&level, tolerance)));
+        // The collider (exact to the texel model, 4 bytes a texel) follows
+        // every edit the renderer applies, in the same call.
+        let collider = Arc::new(Mutex::new(TerrainCollider::new(&level)));
         let follower = Arc::clone(&collider);
         renderer.set_edit_listener(Some(Box::new(move |level, rects| {
             if let Ok(mut c) = follower.lock() {

@@ -1,8 +1,9 @@
 //! `strata collide --physics-bench`: rigid bodies (strata-physics, rapier3d)
 //! on the whole world's terrain collider. Step time with N bodies falling
-//! onto and resting around the world's crater site, then the crater dug
-//! under them: refit of its chunks and the swap of their colliders inside
-//! the physics world.
+//! onto and resting around the world's crater site (the chunk surfaces
+//! around them built as they come), then the crater dug under them: the
+//! collider's update and the swap of the dirty chunks' surfaces inside the
+//! physics world.
 
 use serde::Serialize;
 use strata_collide::TerrainCollider;
@@ -23,10 +24,15 @@ pub struct Run {
     first_second_step_ms: f64,
     last_second_step_ms: f64,
     asleep_at_end: usize,
+    /// Chunk cells in the world at the end, and their height fields' bytes.
+    terrain_cells: usize,
+    terrain_cell_bytes: usize,
 }
 
 #[derive(Serialize)]
 pub struct Report {
+    /// Spacing of the terrain surface's samples (1: exact).
+    surface_step: u32,
     world_build_ms: f64,
     runs: Vec<Run>,
     crater_chunks: usize,
@@ -65,9 +71,14 @@ pub fn run(
     collider: TerrainCollider,
     site: &EditSite,
     counts: &[usize],
+    surface_step: u32,
 ) -> anyhow::Result<Report> {
     let t = Instant::now();
-    let mut physics = TerrainPhysics::new(collider, PhysicsSettings::default());
+    let settings = PhysicsSettings {
+        surface_step,
+        ..Default::default()
+    };
+    let mut physics = TerrainPhysics::new(collider, settings);
     let world_build_ms = t.elapsed().as_secs_f64() * 1e3;
     let mut runs = Vec::new();
     for &n in counts {
@@ -87,6 +98,8 @@ pub fn run(
             first_second_step_ms: mean(&times[..60]),
             last_second_step_ms: mean(&times[times.len() - 60..]),
             asleep_at_end: physics.bodies().filter(|b| b.sleeping).count(),
+            terrain_cells: physics.terrain_cells().0,
+            terrain_cell_bytes: physics.terrain_cells().1,
         });
     }
 
@@ -110,6 +123,7 @@ pub fn run(
         })
         .count();
     Ok(Report {
+        surface_step,
         world_build_ms,
         runs,
         crater_chunks: edit.chunks.len(),
@@ -122,23 +136,25 @@ pub fn run(
 
 pub fn print(r: &Report) {
     println!(
-        "physics world (rapier3d) on the collider: {:.1} ms to insert every chunk",
-        r.world_build_ms
+        "physics world (rapier3d) on the collider: {:.3} ms to create (chunk surfaces, every {} texel(s), come with the bodies)",
+        r.world_build_ms, r.surface_step
     );
     for run in &r.runs {
         println!(
-            "  {:>5} bodies: {:.3} ms per {:.4} s step over {} steps (first second {:.3} ms, last {:.3} ms; {} asleep at the end)",
+            "  {:>5} bodies: {:.3} ms per {:.4} s step over {} steps (first second {:.3} ms, last {:.3} ms; {} asleep at the end; {} chunk cells, {:.1} MiB of height fields)",
             run.bodies,
             run.mean_step_ms,
             PhysicsSettings::default().step,
             run.steps,
             run.first_second_step_ms,
             run.last_second_step_ms,
-            run.asleep_at_end
+            run.asleep_at_end,
+            run.terrain_cells,
+            run.terrain_cell_bytes as f64 / f64::from(1 << 20)
         );
     }
     println!(
-        "crater under them: {} chunks refit in {:.1} ms, {} rapier colliders replaced in {:.3} ms; {} bodies over it fell in",
+        "crater under them: collider updated in {1:.3} ms ({0} chunks), {2} rapier colliders replaced in {3:.3} ms; {4} bodies over it fell in",
         r.crater_chunks,
         r.crater_refit_ms,
         r.crater_colliders_replaced,
