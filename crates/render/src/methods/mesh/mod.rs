@@ -23,7 +23,10 @@
 //! edited level) and rewrite only their slots.
 
 use super::common::{begin_pass, forward_pipeline};
+mod fitter;
 mod knobs;
+pub mod paged;
+mod paged_pool;
 mod pool;
 use super::contract::{Frame, Method, MethodSettings, RetainedBytes};
 use crate::frame::{Shared, uniform_layout_entry};
@@ -59,6 +62,10 @@ pub fn lod_for(tolerance: f64, distance: f32, focal_px: f32, pixels: f32) -> u8 
 
 /// Per-draw record: the chunk copy's sample (0, 0) in unwrapped texels.
 const DRAW_BYTES: u64 = 16;
+
+/// The draw records' binding in group 1 (`draws` in `mesh.wgsl`; binding 1
+/// is the paged terrain's levels in `paged.wgsl`).
+const DRAWS_BINDING: u32 = 2;
 
 /// One visible chunk copy.
 #[derive(Clone, Copy, Debug)]
@@ -125,12 +132,22 @@ fn draws_binding(
         usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
         mapped_at_creation: false,
     });
-    let group = crate::frame::bind_group(
-        &shared.device,
-        "mesh",
-        layout,
-        &[params.as_entire_binding(), buffer.as_entire_binding()],
-    );
+    let group = shared
+        .device
+        .create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("mesh"),
+            layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: params.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: DRAWS_BINDING,
+                    resource: buffer.as_entire_binding(),
+                },
+            ],
+        });
     (buffer, group)
 }
 
@@ -281,7 +298,7 @@ fn from_fit(
         entries: &[
             uniform_layout_entry(0),
             wgpu::BindGroupLayoutEntry {
-                binding: 1,
+                binding: DRAWS_BINDING,
                 visibility: wgpu::ShaderStages::VERTEX,
                 ty: wgpu::BindingType::Buffer {
                     ty: wgpu::BufferBindingType::Storage { read_only: true },
