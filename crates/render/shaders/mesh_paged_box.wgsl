@@ -15,7 +15,9 @@ struct BoxOut {
     @location(0) @interpolate(flat) face: u32,
 }
 
-// Five faces (the top, then the four sides), two triangles each.
+// Six faces (the top, the four sides, the bottom at z = 0 for an eye inside
+// the box: it is above the terrain but may be below the box's top), two
+// triangles each.
 @vertex
 fn vs_mesh_box(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) -> BoxOut {
     let face = v / 6u;
@@ -29,6 +31,7 @@ fn vs_mesh_box(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) -
         case 2u: { q = vec3<f32>(u, 1.0, w); }
         case 3u: { q = vec3<f32>(0.0, u, w); }
         case 4u: { q = vec3<f32>(1.0, u, w); }
+        case 5u: { q = vec3<f32>(u, w, 0.0); }
         default: {}
     }
     let d = draws[i];

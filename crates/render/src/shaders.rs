@@ -30,8 +30,14 @@ pub const SOURCES: &[(&str, &str)] = &[
         "paged_fetch_read.wgsl",
         include_str!("../shaders/paged_fetch_read.wgsl"),
     ),
-    ("paged_stamp.wgsl", include_str!("../shaders/paged_stamp.wgsl")),
-    ("mesh_paged.wgsl", include_str!("../shaders/mesh_paged.wgsl")),
+    (
+        "paged_stamp.wgsl",
+        include_str!("../shaders/paged_stamp.wgsl"),
+    ),
+    (
+        "mesh_paged.wgsl",
+        include_str!("../shaders/mesh_paged.wgsl"),
+    ),
     (
         "mesh_paged_box.wgsl",
         include_str!("../shaders/mesh_paged_box.wgsl"),

@@ -257,7 +257,7 @@ fn a_budget_too_small_is_refused_with_the_smallest_that_works() {
             .expect("refused");
         let text = format!("{err:#}");
         assert!(text.contains("smallest budget that works"), "{text}");
-        let err = paged(&gpu, source.clone(), &colors, "mesh", BUDGET)
+        let err = paged(&gpu, source.clone(), &colors, "voxel", BUDGET)
             .err()
             .expect("refused");
         assert!(format!("{err:#}").contains("ray-exact"), "{err:#}");

@@ -132,6 +132,8 @@ pub struct PagingStats {
     /// The method's own work queued or running (the mesh's chunk fits;
     /// counted in `in_flight`).
     pub method_in_flight: u32,
+    /// The method's own evictions since creation (the mesh's pooled chunks).
+    pub method_evictions: u64,
 }
 
 /// The paged terrain's GPU data, its residency and its streamer.
@@ -640,6 +642,8 @@ pub struct MethodShare {
     pub gpu_bytes: u64,
     /// The method's work queued or running.
     pub in_flight: u32,
+    /// The method's own evictions since creation.
+    pub evictions: u64,
 }
 
 impl MethodShare {
@@ -652,6 +656,7 @@ impl MethodShare {
         s.method_gpu_bytes = self.gpu_bytes;
         s.in_flight += self.in_flight;
         s.method_in_flight = self.in_flight;
+        s.method_evictions = self.evictions;
     }
 }
 
@@ -682,6 +687,11 @@ impl PagedTerrain {
     /// The highest top of `chunk` (the always-resident coarse level).
     pub fn chunk_top(&self, chunk: u32) -> u8 {
         self.tops.get(chunk as usize).copied().unwrap_or(u8::MAX)
+    }
+
+    /// The options it was made with.
+    pub fn options(&self) -> &PagedOptions {
+        &self.options
     }
 
     /// Chunks (pages) across and down.

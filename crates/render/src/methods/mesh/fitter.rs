@@ -317,7 +317,11 @@ mod tests {
             for (&i, want) in ids.iter().zip(&whole) {
                 let (mesh, z) = fit_chunk(&spec, i as u32, &mut cache).unwrap();
                 assert_eq!(&mesh, want, "chunk {i} outline {outline}");
-                assert_eq!(z, super::super::z_range(&level, &layout, i, want), "chunk {i}");
+                assert_eq!(
+                    z,
+                    super::super::z_range(&level, &layout, i, want),
+                    "chunk {i}"
+                );
             }
         }
     }

@@ -132,22 +132,20 @@ fn draws_binding(
         usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
         mapped_at_creation: false,
     });
-    let group = shared
-        .device
-        .create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("mesh"),
-            layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: params.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: DRAWS_BINDING,
-                    resource: buffer.as_entire_binding(),
-                },
-            ],
-        });
+    let group = shared.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("mesh"),
+        layout,
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: params.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: DRAWS_BINDING,
+                resource: buffer.as_entire_binding(),
+            },
+        ],
+    });
     (buffer, group)
 }
 

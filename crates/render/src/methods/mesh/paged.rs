@@ -59,6 +59,9 @@ const DRAWS_RESERVED: u32 = 4096;
 /// neighbours) stays inside it.
 pub const COLOUR_MARGIN: u32 = 16;
 
+/// Vertices of a stand-in box: six faces of two triangles.
+const BOX_VERTICES: u32 = 36;
+
 /// Fitted chunks placed in the pool per frame, at most.
 const FITS_PER_FRAME: usize = 32;
 
@@ -132,9 +135,10 @@ pub struct PagedMesh {
     draws: Vec<ChunkCopy>,
     /// This frame's stand-ins: copy and box top.
     boxes: Vec<(ChunkCopy, u8)>,
-    /// Fits that failed (after which the chunk stays a box), and the first error.
-    fit_errors: u32,
-    first_fit_error: Option<String>,
+    /// Failed fits per chunk: after [`PagedOptions::read_tries`] the chunk
+    /// stays a box (pending; its page's read error is the paging's to report).
+    fit_failures: std::collections::HashMap<u32, u32>,
+    fit_tries: u32,
 }
 
 /// The paged shadow-map pass.
@@ -242,6 +246,7 @@ pub fn build(
         None
     };
     let source = paged.source().clone();
+    let fit_tries = paged.options().read_tries.max(1);
     let draws_capacity = DRAWS_RESERVED;
     let draws_buffer = draws_buffer(shared, draws_capacity);
     let paged = Box::new(paged);
@@ -276,8 +281,8 @@ pub fn build(
         stamp: 0,
         draws: Vec::new(),
         boxes: Vec::new(),
-        fit_errors: 0,
-        first_fit_error: None,
+        fit_failures: Default::default(),
+        fit_tries,
     };
     mesh.report_share();
     Ok(Box::new(mesh))
@@ -360,10 +365,7 @@ fn paged_shadow(
         bind_group_layouts: &[Some(&frame_layout), Some(&layout)],
         immediate_size: 0,
     });
-    let module = shared.shader(&format!(
-        "{}mesh_paged_shadow.wgsl",
-        crate::shaders::PAGED
-    ))?;
+    let module = shared.shader(&format!("{}mesh_paged_shadow.wgsl", crate::shaders::PAGED))?;
     let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
         label: Some("paged mesh shadow"),
         layout: Some(&pipeline_layout),
@@ -449,7 +451,11 @@ impl PagedMesh {
                     None => (0, self.box_top(chunk, &mut scratch)),
                 };
                 let origin = [(gx * sx) as i32, (gy * sy) as i32];
-                let lo = Vec3::new(origin[0] as f32 + 0.5, origin[1] as f32 + 0.5, f32::from(z.0));
+                let lo = Vec3::new(
+                    origin[0] as f32 + 0.5,
+                    origin[1] as f32 + 0.5,
+                    f32::from(z.0),
+                );
                 let hi = lo + Vec3::new(sx as f32, sy as f32, f32::from(z.1 - z.0));
                 if outside_frustum(&m, lo, hi) {
                     continue;
@@ -475,10 +481,7 @@ impl PagedMesh {
                 Ok((mesh, z)) => {
                     self.pool.insert(queue, chunk, &mesh, z, self.stamp);
                 }
-                Err(e) => {
-                    self.fit_errors += 1;
-                    self.first_fit_error.get_or_insert(e);
-                }
+                Err(_) => *self.fit_failures.entry(chunk).or_insert(0) += 1,
             }
         }
     }
@@ -489,18 +492,13 @@ impl PagedMesh {
             budget: self.budget,
             gpu_bytes: self.method_gpu_bytes(),
             in_flight: self.fitter.in_flight() as u32,
+            evictions: self.pool.evictions,
         };
         self.paged.set_method_share(share);
     }
 
     fn method_gpu_bytes(&self) -> u64 {
         self.pool.gpu_bytes() + self.draws_buffer.size() + UNIFORM_BYTES
-    }
-
-    /// Chunks placed and evicted in the pool since creation, and the chunks
-    /// it holds now (tests, reports).
-    pub fn pool_counts(&self) -> (u64, u64, usize) {
-        (self.pool.placed, self.pool.evictions, self.pool.len())
     }
 }
 
@@ -555,9 +553,11 @@ impl Method for PagedMesh {
         }
         self.paged.request(&pages, stamp);
         self.paged.begin_frame(shared, camera, stamp)?;
-        shared
-            .queue
-            .write_buffer(&self.stamp_buffer, 0, bytemuck::cast_slice(&[0, 0, stamp, 0]));
+        shared.queue.write_buffer(
+            &self.stamp_buffer,
+            0,
+            bytemuck::cast_slice(&[0, 0, stamp, 0]),
+        );
         // Drawable: fitted, and every page it reads resident.
         self.draws.clear();
         self.boxes.clear();
@@ -574,7 +574,11 @@ impl Method for PagedMesh {
             if fitted && scratch.iter().all(|&p| self.paged.is_resident(p)) {
                 self.draws.push(c);
             } else {
-                if !fitted && !wanted.contains(&c.chunk) {
+                let given_up = self
+                    .fit_failures
+                    .get(&c.chunk)
+                    .is_some_and(|&n| n >= self.fit_tries);
+                if !fitted && !given_up && !wanted.contains(&c.chunk) {
                     wanted.push(c.chunk);
                 }
                 let top = self.box_top(c.chunk, &mut scratch);
@@ -664,7 +668,7 @@ impl Method for PagedMesh {
                 let first = self.draws.len() as u32;
                 pass.set_pipeline(&self.box_pipeline);
                 pass.set_bind_group(1, &self.box_group, &[]);
-                pass.draw(0..30, first..first + self.boxes.len() as u32);
+                pass.draw(0..BOX_VERTICES, first..first + self.boxes.len() as u32);
             }
         }
         self.paged.record_feedback(encoder);
@@ -684,6 +688,7 @@ impl Method for PagedMesh {
         self.paged.refresh(shared, chunks)?;
         // Fits in flight may have read the old samples.
         self.fitter.invalidate();
+        self.fit_failures.clear();
         // The pooled mesh chunks whose samples lie in a refreshed page.
         let mut touched = Vec::new();
         let (gx, gy) = (self.layout.chunks_x as i64, self.layout.chunks_y as i64);
@@ -721,8 +726,8 @@ impl Method for PagedMesh {
         let plan = self.paged.plan();
         RetainedBytes {
             gpu: plan.total() - plan.atlas_bytes + self.method_gpu_bytes(),
-            cpu: ((self.draws.capacity() + self.boxes.capacity()) * std::mem::size_of::<ChunkCopy>())
-                as u64,
+            cpu: ((self.draws.capacity() + self.boxes.capacity())
+                * std::mem::size_of::<ChunkCopy>()) as u64,
         }
     }
 }

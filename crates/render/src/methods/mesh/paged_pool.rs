@@ -29,8 +29,6 @@ pub struct PagedPool {
     entries: std::collections::HashMap<u32, Entry>,
     /// Chunks evicted since creation.
     pub evictions: u64,
-    /// Chunks placed since creation.
-    pub placed: u64,
 }
 
 const INDEX_BYTES: u64 = 2;
@@ -51,18 +49,12 @@ impl PagedPool {
             free: vec![(0, capacity)],
             entries: Default::default(),
             evictions: 0,
-            placed: 0,
         }
     }
 
     /// GPU bytes of the pool.
     pub fn gpu_bytes(&self) -> u64 {
         self.buffer.size()
-    }
-
-    /// Chunks held.
-    pub fn len(&self) -> usize {
-        self.entries.len()
     }
 
     /// Chunk `chunk`, if held.
@@ -136,7 +128,6 @@ impl PagedPool {
                 used: stamp,
             },
         );
-        self.placed += 1;
         true
     }
 
