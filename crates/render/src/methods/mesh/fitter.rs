@@ -200,11 +200,14 @@ fn worker(shared: &Shared, spec: &FitSpec, done: &Sender<FitResult>) {
     }
 }
 
-/// A few pages' planes (heights, metas), most recent last: neighbouring
-/// chunks, fitted nearest first, share pages.
+/// A page's two planes: heights and metas, row-major.
+type Planes = Arc<(Vec<u8>, Vec<u8>)>;
+
+/// A few pages' planes, most recent last: neighbouring chunks, fitted
+/// nearest first, share pages.
 #[derive(Default)]
 struct PlaneCache {
-    pages: Vec<((u32, u32), Arc<(Vec<u8>, Vec<u8>)>)>,
+    pages: Vec<((u32, u32), Planes)>,
 }
 
 const PLANE_CACHE_PAGES: usize = 8;
@@ -214,7 +217,7 @@ impl PlaneCache {
         &mut self,
         source: &dyn PageSource,
         page: (u32, u32),
-    ) -> Result<Arc<(Vec<u8>, Vec<u8>)>, String> {
+    ) -> Result<Planes, String> {
         if let Some(k) = self.pages.iter().position(|(p, _)| *p == page) {
             let hit = self.pages.remove(k);
             let planes = hit.1.clone();
