@@ -213,11 +213,7 @@ struct PlaneCache {
 const PLANE_CACHE_PAGES: usize = 8;
 
 impl PlaneCache {
-    fn planes(
-        &mut self,
-        source: &dyn PageSource,
-        page: (u32, u32),
-    ) -> Result<Planes, String> {
+    fn planes(&mut self, source: &dyn PageSource, page: (u32, u32)) -> Result<Planes, String> {
         if let Some(k) = self.pages.iter().position(|(p, _)| *p == page) {
             let hit = self.pages.remove(k);
             let planes = hit.1.clone();
