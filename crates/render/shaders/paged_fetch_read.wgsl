@@ -6,9 +6,18 @@
 #include "frame.wgsl"
 #include "paged.wgsl"
 
+// The last chunk looked up and its table entry (a fragment's colour window
+// reads one chunk many times in a row).
+var<private> page_read_chunk: u32 = 0xffffffffu;
+var<private> page_read_entry: u32 = 0u;
+
 fn terrain_pair(x: i32, y: i32) -> vec4<u32> {
     let chunk = paged_chunk(x, y);
-    let e = page_table[chunk];
+    if (chunk != page_read_chunk) {
+        page_read_chunk = chunk;
+        page_read_entry = page_table[chunk];
+    }
+    let e = page_read_entry;
     if (e == 0u) {
         let h = paged_chunk_top(chunk);
         return vec4<u32>(h, 0u, h, 0u);
