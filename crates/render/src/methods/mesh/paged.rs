@@ -33,12 +33,11 @@
 
 use super::fitter::{Fitter, mesh_grid};
 use super::paged_pool::PagedPool;
-use super::{DRAW_BYTES, DRAWS_BINDING, lod_for, mesh_params, outside_frustum};
+use super::{DRAW_BYTES, DRAWS_BINDING, Draw, mesh_params, visible_copies};
 use crate::frame::Shared;
 use crate::methods::common::{begin_pass, forward_pipeline};
 use crate::methods::contract::{Frame, Method, MethodSettings, RetainedBytes};
 use crate::paged::{MethodShare, PAGE, PagedOptions, PagedTerrain};
-use glam::Vec3;
 use strata_camera::Camera;
 use strata_level::{DirtyRect, Level};
 use strata_mesh::{CHUNK, ChunkLayout, FitOptions};
@@ -99,15 +98,6 @@ pub fn split_budget(
     Ok((options, pool))
 }
 
-/// One visible chunk copy.
-#[derive(Clone, Copy, Debug)]
-struct ChunkCopy {
-    chunk: u32,
-    lod: u8,
-    distance: f32,
-    origin: [i32; 2],
-}
-
 /// The mesh over paged terrain.
 pub struct PagedMesh {
     paged: Box<PagedTerrain>,
@@ -132,9 +122,9 @@ pub struct PagedMesh {
     gradient_normal: bool,
     stamp: u32,
     /// This frame's chunk copies drawn as meshes, front to back.
-    draws: Vec<ChunkCopy>,
+    draws: Vec<Draw>,
     /// This frame's stand-ins: copy and box top.
-    boxes: Vec<(ChunkCopy, u8)>,
+    boxes: Vec<(Draw, u8)>,
     /// Failed fits per chunk: after [`PagedOptions::read_tries`] the chunk
     /// stays a box (pending; its page's read error is the paging's to report).
     fit_failures: std::collections::HashMap<u32, u32>,
@@ -420,57 +410,21 @@ impl PagedMesh {
             .unwrap_or(u8::MAX)
     }
 
-    /// Visible chunk copies for `camera`, front to back (as `Mesh::cull`,
-    /// with a chunk not in the pool boxed from 0 to its pages' top).
-    fn cull(&self, camera: &Camera) -> Vec<ChunkCopy> {
+    /// Visible chunk copies for `camera`, front to back (as the whole
+    /// mesh's, with a chunk not in the pool boxed from 0 to its pages' top).
+    fn cull(&self, camera: &Camera) -> Vec<Draw> {
         let mut copies = Vec::new();
-        let m = camera.view_proj();
-        let e = camera.position;
-        let (hw, hh) = (camera.width as f32 * 0.5, camera.height as f32 * 0.5);
-        let reach =
-            camera.far * (1.0 + (hw * hw + hh * hh) / (camera.focal_px * camera.focal_px)).sqrt();
-        let (sx, sy) = (self.layout.size_x as i64, self.layout.size_y as i64);
-        let (nx, ny) = (
-            i64::from(self.layout.chunks_x),
-            i64::from(self.layout.chunks_y),
-        );
-        let range = |c: f32, size: i64| {
-            let lo = ((c - reach - 1.0) as i64).div_euclid(size);
-            let hi = ((c + reach) as i64).div_euclid(size);
-            lo..=hi
-        };
         let mut scratch = Vec::new();
-        for gy in range(e.y, sy) {
-            for gx in range(e.x, sx) {
-                let chunk = self
-                    .layout
-                    .index(gx.rem_euclid(nx) as u32, gy.rem_euclid(ny) as u32)
-                    as u32;
-                let z = match self.pool.get(chunk) {
-                    Some(entry) => entry.z,
-                    None => (0, self.box_top(chunk, &mut scratch)),
-                };
-                let origin = [(gx * sx) as i32, (gy * sy) as i32];
-                let lo = Vec3::new(
-                    origin[0] as f32 + 0.5,
-                    origin[1] as f32 + 0.5,
-                    f32::from(z.0),
-                );
-                let hi = lo + Vec3::new(sx as f32, sy as f32, f32::from(z.1 - z.0));
-                if outside_frustum(&m, lo, hi) {
-                    continue;
-                }
-                let distance = (e.clamp(lo, hi) - e).length();
-                let lod = lod_for(self.tolerance, distance, camera.focal_px, self.lod_pixels);
-                copies.push(ChunkCopy {
-                    chunk,
-                    lod,
-                    distance,
-                    origin,
-                });
-            }
-        }
-        copies.sort_by(|a, b| a.distance.total_cmp(&b.distance));
+        visible_copies(
+            &self.layout,
+            camera,
+            (self.tolerance, self.lod_pixels),
+            |chunk| match self.pool.get(chunk) {
+                Some(entry) => entry.z,
+                None => (0, self.box_top(chunk, &mut scratch)),
+            },
+            &mut copies,
+        );
         copies
     }
 
@@ -518,20 +472,13 @@ impl Method for PagedMesh {
         shared: &Shared,
         settings: &MethodSettings,
     ) -> anyhow::Result<bool> {
-        let q = f64::from(settings.mesh_quality);
-        let same_fit = strata_mesh::tolerance_for_quality(q) == Some(self.tolerance)
-            && super::options_of(settings) == self.options;
-        if same_fit {
-            self.lod_pixels = super::lod_pixels_of(settings)?;
-            if settings.mesh_gradient_normal != self.gradient_normal {
-                self.gradient_normal = settings.mesh_gradient_normal;
-                let grid = mesh_params(&self.layout, self.gradient_normal);
-                shared
-                    .queue
-                    .write_buffer(&self.params, 0, bytemuck::cast_slice(&grid));
-            }
-        }
-        Ok(same_fit)
+        super::settings_in_place(
+            shared,
+            settings,
+            (self.tolerance, self.options),
+            (&mut self.lod_pixels, &mut self.gradient_normal),
+            (&self.layout, &self.params),
+        )
     }
 
     fn prepare(&mut self, shared: &Shared, camera: &Camera) -> anyhow::Result<()> {
@@ -726,8 +673,8 @@ impl Method for PagedMesh {
         let plan = self.paged.plan();
         RetainedBytes {
             gpu: plan.total() - plan.atlas_bytes + self.method_gpu_bytes(),
-            cpu: ((self.draws.capacity() + self.boxes.capacity())
-                * std::mem::size_of::<ChunkCopy>()) as u64,
+            cpu: ((self.draws.capacity() + self.boxes.capacity()) * std::mem::size_of::<Draw>())
+                as u64,
         }
     }
 }
