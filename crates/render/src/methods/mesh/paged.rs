@@ -371,8 +371,8 @@ fn paged_shadow(
     })
 }
 
-/// The pages (row-major chunk ids of the page grid `grid`, world of `size`
-/// texels) covering texels `[x0, x1] x [y0, y1]` (unwrapped, inclusive).
+/// Append the pages (row-major chunk ids of the page grid `grid`) covering
+/// texels `[x0, x1] x [y0, y1]` (unwrapped, inclusive), each once.
 fn pages_over(grid: (u32, u32), (x0, y0, x1, y1): (i64, i64, i64, i64), out: &mut Vec<u32>) {
     let page = i64::from(PAGE);
     let (gx, gy) = (i64::from(grid.0), i64::from(grid.1));
@@ -380,10 +380,7 @@ fn pages_over(grid: (u32, u32), (x0, y0, x1, y1): (i64, i64, i64, i64), out: &mu
     let (py0, py1) = (y0.div_euclid(page), y1.div_euclid(page));
     for py in py0..=py1.min(py0 + gy - 1) {
         for px in px0..=px1.min(px0 + gx - 1) {
-            let c = (py.rem_euclid(gy) * gx + px.rem_euclid(gx)) as u32;
-            if !out.contains(&c) {
-                out.push(c);
-            }
+            out.push((py.rem_euclid(gy) * gx + px.rem_euclid(gx)) as u32);
         }
     }
 }
@@ -490,13 +487,16 @@ impl Method for PagedMesh {
         }
         self.take_fits(&shared.queue);
         // The pages the copies read, nearest copy first.
-        let mut pages = Vec::new();
+        let (mut pages, mut scratch) = (Vec::new(), Vec::new());
+        let mut seen = std::collections::HashSet::new();
         for c in &copies {
+            scratch.clear();
             pages_over(
                 self.paged.grid(),
                 self.rect(c.chunk, COLOUR_MARGIN),
-                &mut pages,
+                &mut scratch,
             );
+            pages.extend(scratch.iter().filter(|p| seen.insert(**p)));
         }
         self.paged.request(&pages, stamp);
         self.paged.begin_frame(shared, camera, stamp)?;
@@ -509,7 +509,7 @@ impl Method for PagedMesh {
         self.draws.clear();
         self.boxes.clear();
         let mut wanted = Vec::new();
-        let mut scratch = Vec::new();
+        seen.clear();
         for c in copies {
             let fitted = self.pool.get(c.chunk).is_some();
             scratch.clear();
@@ -525,7 +525,7 @@ impl Method for PagedMesh {
                     .fit_failures
                     .get(&c.chunk)
                     .is_some_and(|&n| n >= self.fit_tries);
-                if !fitted && !given_up && !wanted.contains(&c.chunk) {
+                if !fitted && !given_up && seen.insert(c.chunk) {
                     wanted.push(c.chunk);
                 }
                 let top = self.box_top(c.chunk, &mut scratch);
