@@ -109,7 +109,8 @@ pub struct PagingStats {
     pub uploaded_pages: u32,
     /// Bytes uploaded before the last frame (texels, pyramids, table entries).
     pub uploaded_bytes: u64,
-    /// Pixels of the last read-back frame drawn from a missing page.
+    /// Pixels of the last read-back frame drawn from a missing page (the
+    /// paged mesh: fragments of its stand-in boxes, an upper bound).
     pub pending_pixels: u32,
     /// Shadow-map texels of that frame cast through a missing page (the
     /// pixels that sample them are not counted above).

@@ -168,7 +168,8 @@ const UNIFORM: wgpu::BufferBindingType = wgpu::BufferBindingType::Uniform;
 
 /// Build the paged mesh over `paged` (whose atlas is `shared`'s terrain
 /// texture, planned with [`PYRAMID_STEP`] from [`split_budget`]'s options),
-/// with an index pool of `pool_bytes` within `budget`.
+/// with an index pool of `pool_bytes` within `budget`; `threads` is the
+/// paging's reader threads (fits get [`fit_threads`]).
 pub fn build(
     shared: &Shared,
     paged: PagedTerrain,
@@ -249,7 +250,7 @@ pub fn build(
     );
     let mut mesh = PagedMesh {
         pool: PagedPool::new(device, pool_bytes),
-        fitter: Fitter::new(source, tolerance, options, threads),
+        fitter: Fitter::new(source, tolerance, options, fit_threads(threads)),
         paged,
         budget,
         pipeline,
@@ -277,6 +278,20 @@ pub fn build(
     mesh.report_share();
     Ok(Box::new(mesh))
 }
+
+/// Fit threads beside `readers` page readers: none where there are none
+/// (fits run between frames), else half the cores, at least `readers`, at
+/// most [`MAX_FIT_THREADS`] (a fit is far more work than a page read).
+fn fit_threads(readers: usize) -> usize {
+    if readers == 0 {
+        return 0;
+    }
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    (cores / 2).max(readers).min(MAX_FIT_THREADS)
+}
+
+/// Most fit threads.
+const MAX_FIT_THREADS: usize = 8;
 
 fn draws_buffer(shared: &Shared, capacity: u32) -> wgpu::Buffer {
     shared.device.create_buffer(&wgpu::BufferDescriptor {
