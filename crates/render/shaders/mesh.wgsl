@@ -17,7 +17,7 @@ struct MeshParams {
 
 @group(1) @binding(0) var<uniform> mesh: MeshParams;
 // Per draw: xy the chunk's sample (0, 0) in unwrapped texels.
-@group(1) @binding(1) var<storage, read> draws: array<vec4<i32>>;
+@group(1) @binding(2) var<storage, read> draws: array<vec4<i32>>;
 
 const KIND_FLOOR: u32 = 0u;
 const KIND_TOP: u32 = 1u;

@@ -85,6 +85,17 @@ fn paged_page(level: u32, bx: u32, by: u32) -> u32 {
     return first + (bx >> 8u) + ((by >> 8u) << (paged.grid.x - level));
 }
 
+// The pair texel of slot `slot` holding texel (bx, by) of its page: slot s
+// of the atlas is page (s mod across, s / across) of layer s / per-layer,
+// 128 pair texels x 256 rows.
+fn paged_atlas_texel(slot: u32, bx: u32, by: u32) -> vec4<u32> {
+    let layer = slot >> paged.atlas.y;
+    let in_layer = slot & ((1u << paged.atlas.y) - 1u);
+    let page = vec2<u32>(in_layer & ((1u << paged.atlas.x) - 1u), in_layer >> paged.atlas.x);
+    let local = vec2<u32>((bx & 255u) >> 1u, by & 255u);
+    return textureLoad(terrain, page * vec2<u32>(128u, 256u) + local, layer, 0);
+}
+
 // The chunk (level-0 page) holding texel (bx, by) of level `level` (<= 8).
 fn paged_chunk_of(level: u32, bx: u32, by: u32) -> u32 {
     let s = 8u - level;

@@ -1,6 +1,6 @@
 // `terrain_pair` through the page table (swapped in for `terrain_fetch.wgsl`
-// by `shaders::compose("paged:…")`): slot s of the atlas is page
-// (s mod across, s / across) of layer s / per-layer, 128 pair texels x 256 rows.
+// by `shaders::compose("paged:…")`), asking for missing pages; the atlas is
+// addressed by `paged_atlas_texel` (`paged.wgsl`).
 #include "frame.wgsl"
 #include "paged.wgsl"
 
@@ -22,12 +22,7 @@ fn terrain_pair_at(level: u32, x: i32, y: i32) -> vec4<u32> {
         let h = paged_chunk_top(paged_chunk_of(level, bx, by));
         return vec4<u32>(h, PAGED_BOX_META, h, PAGED_BOX_META);
     }
-    let slot = e - 1u;
-    let layer = slot >> paged.atlas.y;
-    let in_layer = slot & ((1u << paged.atlas.y) - 1u);
-    let page = vec2<u32>(in_layer & ((1u << paged.atlas.x) - 1u), in_layer >> paged.atlas.x);
-    let local = vec2<u32>((bx & 255u) >> 1u, by & 255u);
-    return textureLoad(terrain, page * vec2<u32>(128u, 256u) + local, layer, 0);
+    return paged_atlas_texel(e - 1u, bx, by);
 }
 
 // The level of detail `decode_column` reads at: the exact march's (see

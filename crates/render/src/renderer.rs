@@ -182,7 +182,7 @@ impl Renderer {
         let entry = method.entry()?;
         let compute = match entry.name {
             "ray-exact" => true,
-            "ray-exact-fragment" => false,
+            "ray-exact-fragment" | "mesh" => false,
             other => anyhow::bail!(
                 "`{other}` draws whole worlds only; paged worlds (past the whole-world limits, or with a GPU budget) are drawn by {}",
                 crate::paged::PAGED_METHODS.join(", ")
@@ -192,7 +192,19 @@ impl Renderer {
             compute,
             ..gpu.options.exact
         };
-        let step = options.pyramid_step();
+        let is_mesh = entry.name == "mesh";
+        let budget = paging.gpu_budget;
+        // The mesh's index pool shares the budget with the atlas.
+        let (paging, pool_bytes) = if is_mesh {
+            methods::mesh::paged::split_budget(&paging, source.as_ref())?
+        } else {
+            (paging, 0)
+        };
+        let step = if is_mesh {
+            methods::mesh::paged::PYRAMID_STEP
+        } else {
+            options.pyramid_step()
+        };
         let (atlas, plan) =
             crate::paged::PagedTerrain::atlas(&gpu.device, source.as_ref(), &paging, step)?;
         let (w, h) = source.size();
@@ -212,9 +224,13 @@ impl Renderer {
             height: h,
             mid_rule: source.mid_rule(),
         };
+        let threads = paging.threads;
         let paged = crate::paged::PagedTerrain::new(&shared, source, plan, paging, step)?;
-        let method: Box<dyn Method> =
-            Box::new(methods::ray_exact::build_paged(&shared, paged, options)?);
+        let method: Box<dyn Method> = if is_mesh {
+            methods::mesh::paged::build(&shared, paged, settings, budget, pool_bytes, threads)?
+        } else {
+            Box::new(methods::ray_exact::build_paged(&shared, paged, options)?)
+        };
         Self::assemble(gpu, shared, method, settings, level_shape, start)
     }
 
@@ -234,11 +250,9 @@ impl Renderer {
     /// resident pages, so the next frame shows the edit.
     pub fn refresh_pages(&mut self, chunks: &[u32]) -> anyhow::Result<()> {
         let shared = Arc::clone(&self.shared);
-        let paged = self.methods[self.active]
+        self.methods[self.active]
             .method
-            .paged_terrain()
-            .ok_or_else(|| anyhow::anyhow!("this renderer draws a whole world: use apply_edit"))?;
-        paged.refresh(&shared, chunks)?;
+            .refresh_pages(&shared, chunks)?;
         self.shadow_drawn = None;
         Ok(())
     }

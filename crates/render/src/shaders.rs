@@ -26,6 +26,26 @@ pub const SOURCES: &[(&str, &str)] = &[
         "paged_levels.wgsl",
         include_str!("../shaders/paged_levels.wgsl"),
     ),
+    (
+        "paged_fetch_read.wgsl",
+        include_str!("../shaders/paged_fetch_read.wgsl"),
+    ),
+    (
+        "paged_stamp.wgsl",
+        include_str!("../shaders/paged_stamp.wgsl"),
+    ),
+    (
+        "mesh_paged.wgsl",
+        include_str!("../shaders/mesh_paged.wgsl"),
+    ),
+    (
+        "mesh_paged_box.wgsl",
+        include_str!("../shaders/mesh_paged_box.wgsl"),
+    ),
+    (
+        "mesh_paged_shadow.wgsl",
+        include_str!("../shaders/mesh_paged_shadow.wgsl"),
+    ),
     ("shading.wgsl", include_str!("../shaders/shading.wgsl")),
     (
         "column_segment.wgsl",
@@ -150,6 +170,9 @@ pub const ENTRY_SHADERS: &[&str] = &[
     "paged:ray_exact_fragment.wgsl",
     "paged:ray_exact_shadow.wgsl",
     "paged:ray_exact_deferred.wgsl",
+    "paged-read:mesh_paged.wgsl",
+    "mesh_paged_box.wgsl",
+    "paged:mesh_paged_shadow.wgsl",
 ];
 
 /// The name prefix that composes a shader over paged terrain (`paged/`).
@@ -159,6 +182,19 @@ pub const PAGED: &str = "paged:";
 /// pyramid levels from the whole map, and their page-table twins.
 const PAGED_SWAPS: &[(&str, &str)] = &[
     ("terrain_fetch.wgsl", "paged_fetch.wgsl"),
+    ("exact_levels.wgsl", "paged_levels.wgsl"),
+];
+
+/// The name prefix that composes a shader over paged terrain read without
+/// feedback (the paged mesh's vertex and fragment stages: a vertex stage
+/// cannot write storage; the CPU places those draws only over resident
+/// pages and asks for pages itself).
+pub const PAGED_READ: &str = "paged-read:";
+
+/// [`PAGED_SWAPS`] for [`PAGED_READ`]: texel pairs through the page table,
+/// no feedback written.
+const PAGED_READ_SWAPS: &[(&str, &str)] = &[
+    ("terrain_fetch.wgsl", "paged_fetch_read.wgsl"),
     ("exact_levels.wgsl", "paged_levels.wgsl"),
 ];
 
@@ -185,9 +221,10 @@ fn source(name: &str) -> Result<&'static str, ShaderError> {
 pub fn compose(name: &str) -> Result<String, ShaderError> {
     let mut out = String::new();
     let mut seen = Vec::new();
-    let (name, swaps) = match name.strip_prefix(PAGED) {
-        Some(rest) => (rest, PAGED_SWAPS),
-        None => (name, &[][..]),
+    let (name, swaps) = match (name.strip_prefix(PAGED), name.strip_prefix(PAGED_READ)) {
+        (Some(rest), _) => (rest, PAGED_SWAPS),
+        (_, Some(rest)) => (rest, PAGED_READ_SWAPS),
+        _ => (name, &[][..]),
     };
     compose_into(name, swaps, &mut out, &mut seen)?;
     Ok(out)

@@ -12,7 +12,7 @@ use strata_store::{ChunkCache, DirStore};
 
 /// The commands that read a store through its chunk cache in bounded
 /// memory (named when a whole-world command refuses a large store).
-pub const BOUNDED_COMMANDS: &str = "reference, fit, export --region, info, metrics, and render, fly, view and compare with ray-exact or ray-exact-fragment (paged terrain)";
+pub const BOUNDED_COMMANDS: &str = "reference, fit, export --region, info, metrics, and render, fly, view and compare with ray-exact, ray-exact-fragment or mesh (paged terrain)";
 
 /// Default byte budget of a store's chunk cache, MiB.
 pub const DEFAULT_STORE_CACHE_MIB: u32 = 512;

@@ -166,6 +166,16 @@ pub trait Method: Send {
         None
     }
 
+    /// The paged terrain's source changed inside `chunks` (pages; an edit
+    /// written to its store): refresh what derives from them, so the next
+    /// frame shows the edit. The default refreshes the paged terrain alone.
+    fn refresh_pages(&mut self, shared: &Shared, chunks: &[u32]) -> anyhow::Result<()> {
+        match self.paged_terrain() {
+            Some(paged) => paged.refresh(shared, chunks),
+            None => anyhow::bail!("this renderer draws a whole world: use apply_edit"),
+        }
+    }
+
     /// Record this frame's passes.
     fn record(&self, shared: &Shared, frame: &Frame<'_>, encoder: &mut wgpu::CommandEncoder);
 

@@ -68,7 +68,7 @@ use std::sync::Arc;
 use strata_camera::Camera;
 
 /// The methods that draw paged terrain ([`crate::Renderer::new_paged`]).
-pub const PAGED_METHODS: &[&str] = &["ray-exact", "ray-exact-fragment"];
+pub const PAGED_METHODS: &[&str] = &["ray-exact", "ray-exact-fragment", "mesh"];
 
 /// How a paged renderer spends its GPU memory and upload bandwidth.
 #[derive(Clone, Debug)]
@@ -135,7 +135,8 @@ pub struct PagingStats {
     pub uploaded_pages: u32,
     /// Bytes uploaded before the last frame (texels, pyramids, table entries).
     pub uploaded_bytes: u64,
-    /// Pixels of the last read-back frame drawn from a missing page.
+    /// Pixels of the last read-back frame drawn from a missing page (the
+    /// paged mesh: fragments of its stand-in boxes, an upper bound).
     pub pending_pixels: u32,
     /// Shadow-map texels of that frame cast through a missing page (the
     /// pixels that sample them are not counted above).
@@ -152,6 +153,14 @@ pub struct PagingStats {
     pub read_errors: u32,
     /// The first read error, naming the chunk.
     pub first_error: Option<String>,
+    /// Bytes the method keeps in the budget beside the paged terrain (the
+    /// mesh's index pool and draw records; counted in `gpu_bytes`).
+    pub method_gpu_bytes: u64,
+    /// The method's own work queued or running (the mesh's chunk fits;
+    /// counted in `in_flight`).
+    pub method_in_flight: u32,
+    /// The method's own evictions since creation (the mesh's pooled chunks).
+    pub method_evictions: u64,
 }
 
 /// The paged terrain's GPU data, its residency and its streamer.
@@ -190,6 +199,10 @@ pub struct PagedTerrain {
     /// The last read-back frame's requests, most wanted first.
     requested: Vec<u32>,
     stats: PagingStats,
+    /// Pages a CPU reader asked for ([`PagedTerrain::request`]).
+    cpu_requests: Vec<u32>,
+    /// The method's share of the budget ([`PagedTerrain::set_method_share`]).
+    method_share: MethodShare,
 }
 
 impl PagingStats {
@@ -395,6 +408,8 @@ impl PagedTerrain {
             stale: Default::default(),
             requested: Vec::new(),
             stats,
+            cpu_requests: Vec::new(),
+            method_share: MethodShare::default(),
         })
     }
 
@@ -410,6 +425,7 @@ impl PagedTerrain {
         s.resident_bytes = u64::from(s.resident_pages)
             * (residency::PAGE_ATLAS_BYTES + u64::from(self.plan.pyramid_stride));
         s.in_flight = self.streamer.in_flight() as u32;
+        self.method_share.add_to(&mut s);
         s
     }
 
@@ -493,6 +509,8 @@ impl PagedTerrain {
         };
         let mut asked: Vec<u32> = self.requested.iter().copied().filter(usable).collect();
         asked.sort_by(|a, b| dist(*a).total_cmp(&dist(*b)));
+        // Then what a CPU reader asked for, in its order.
+        asked.extend(self.cpu_requests.iter().copied().filter(usable));
         let mut footprint: Vec<u32> = self.footprint(camera).into_iter().filter(usable).collect();
         footprint.sort_by(|a, b| dist(*a).total_cmp(&dist(*b)));
         let cap = (self.plan.slots as usize / 2).max(1);
@@ -745,4 +763,96 @@ fn page_ids(source: &dyn PageSource, options: &PagedOptions) -> PageIds {
         0
     };
     PageIds::new((w / PAGE, h / PAGE), levels)
+}
+
+/// A method's share of the GPU budget beside the paged terrain (the paged
+/// mesh's index pool): the atlas was planned for the rest.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct MethodShare {
+    /// The whole budget (the atlas's plan has the part left to it).
+    pub budget: u64,
+    /// Bytes the method keeps on the GPU within it.
+    pub gpu_bytes: u64,
+    /// The method's work queued or running.
+    pub in_flight: u32,
+    /// The method's own evictions since creation.
+    pub evictions: u64,
+}
+
+impl MethodShare {
+    fn add_to(&self, s: &mut PagingStats) {
+        if self.budget == 0 {
+            return;
+        }
+        s.gpu_budget = self.budget;
+        s.gpu_bytes += self.gpu_bytes;
+        s.method_gpu_bytes = self.gpu_bytes;
+        s.in_flight += self.in_flight;
+        s.method_in_flight = self.in_flight;
+        s.method_evictions = self.evictions;
+    }
+}
+
+/// Pages read by CPU-placed draws (the paged mesh, issue 33): its vertex
+/// stage reads texels through the page table without feedback, so it asks
+/// for pages here and marks the resident ones in use.
+impl PagedTerrain {
+    /// Ask for `chunks` (most wanted first) at the next
+    /// [`PagedTerrain::begin_frame`], after the frame feedback's requests
+    /// and before the view's footprint; the resident ones count as read by
+    /// frame `stamp` (not evicted for pages read less recently).
+    pub fn request(&mut self, chunks: &[u32], stamp: u32) {
+        self.cpu_requests.clear();
+        for &c in chunks {
+            match self.residency.slot_of(c) {
+                Some(slot) => self.residency.touch(slot, stamp),
+                None if c < self.plan.chunks => self.cpu_requests.push(c),
+                None => {}
+            }
+        }
+    }
+
+    /// Whether `chunk`'s page is in the atlas.
+    pub fn is_resident(&self, chunk: u32) -> bool {
+        self.residency.slot_of(chunk).is_some()
+    }
+
+    /// The highest top of `chunk` (the always-resident coarse level).
+    pub fn chunk_top(&self, chunk: u32) -> u8 {
+        self.tops.get(chunk as usize).copied().unwrap_or(u8::MAX)
+    }
+
+    /// The options it was made with.
+    pub fn options(&self) -> &PagedOptions {
+        &self.options
+    }
+
+    /// Chunks (pages) across and down.
+    pub fn grid(&self) -> (u32, u32) {
+        self.grid
+    }
+
+    /// Where pages come from.
+    pub fn source(&self) -> &Arc<dyn PageSource> {
+        &self.source
+    }
+
+    /// The method's share of the budget, reported with the paging's own
+    /// bytes in [`PagedTerrain::stats`].
+    pub fn set_method_share(&mut self, share: MethodShare) {
+        self.method_share = share;
+    }
+
+    /// The smallest budget whose plan holds a world of `source`'s size,
+    /// drawn with `options` (its levels of detail count in the page table),
+    /// with pyramids of `step` (what [`BudgetPlan::new`] refuses below).
+    pub fn smallest_budget(source: &dyn PageSource, options: &PagedOptions, step: u32) -> u64 {
+        let (w, h) = source.size();
+        BudgetPlan::smallest(
+            (w / PAGE) * (h / PAGE),
+            page_ids(source, options).total(),
+            page_pyramid_layout(step).bytes,
+            std::mem::size_of::<PagedParams>() as u64,
+        )
+    }
 }

@@ -310,3 +310,5 @@ pub fn crater_against_fresh(gpu: &Gpu, method: &str) -> (f64, f32, usize) {
     );
     (pct, p95, changed)
 }
+
+pub mod paged;

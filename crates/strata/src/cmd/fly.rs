@@ -19,7 +19,7 @@ use strata_render::{MethodSettings, Renderer};
 pub struct Args {
     #[command(flatten)]
     pub world: WorldArgs,
-    /// A paged method: ray-exact or ray-exact-fragment.
+    /// A paged method: ray-exact, ray-exact-fragment or mesh.
     #[arg(long, default_value = "ray-exact")]
     pub method: String,
     /// Camera path file (`X,Y:YAW:EYE[:under] PITCH TIME` per line, as `strata
@@ -85,6 +85,9 @@ pub struct FlyFrame {
     pub pending_pct: f64,
     pub uploaded_bytes: u64,
     pub resident_bytes: u64,
+    /// Everything the paged path keeps on the GPU within the budget (the
+    /// atlas's plan, and the mesh's index pool and draw records).
+    pub gpu_bytes: u64,
 }
 
 /// Mean, 99th percentile, largest.
@@ -123,7 +126,8 @@ pub struct FlyReport {
     pub far: f32,
     pub shadows: bool,
     pub gpu_budget: u64,
-    /// Bytes the paged terrain keeps on the GPU (≤ the budget).
+    /// Most bytes the paged path kept on the GPU in a frame (≤ the budget;
+    /// the mesh's index pool included).
     pub paged_gpu_bytes: u64,
     /// The renderer's own targets, uniforms and shadow map (every world
     /// alike; the atlas is in `paged_gpu_bytes`).
@@ -183,6 +187,7 @@ fn fly_one(args: &Args, world_args: &WorldArgs, out: &Path) -> anyhow::Result<Fl
         PagedWorld::options(&paged_args),
     )?;
     let plan = *renderer.paged_terrain().expect("paged").plan();
+    let budget = renderer.paged_terrain().expect("paged").stats().gpu_budget;
     // The start pose first, until nothing is pending (a loading screen):
     // the flight then measures streaming as the camera moves, not the
     // empty atlas of the first frame.
@@ -208,6 +213,7 @@ fn fly_one(args: &Args, world_args: &WorldArgs, out: &Path) -> anyhow::Result<Fl
             pending_pct: 100.0 * f64::from(stats.pending_pixels) / pixels,
             uploaded_bytes: stats.uploaded_bytes,
             resident_bytes: stats.resident_bytes,
+            gpu_bytes: stats.gpu_bytes,
         });
         if let (Some(e), true) = (&stats.first_error, reported_error.is_none()) {
             eprintln!("fly: frame {i}: {e}");
@@ -226,8 +232,9 @@ fn fly_one(args: &Args, world_args: &WorldArgs, out: &Path) -> anyhow::Result<Fl
         size: [w, h],
         far: cameras.first().map_or(0.0, |c| c.far),
         shadows: settings.shadows,
-        gpu_budget: plan.budget,
-        paged_gpu_bytes: plan.total(),
+        // With the mesh's index pool: the plan has the atlas's part.
+        gpu_budget: budget,
+        paged_gpu_bytes: frames.iter().map(|f| f.gpu_bytes).max().unwrap_or(0),
         // The shared frame counts the atlas as its terrain texture.
         frame_gpu_bytes: renderer.shared_gpu_bytes() - plan.atlas_bytes,
         setup_ms: renderer.setup_ms(),
@@ -247,16 +254,18 @@ fn fly_one(args: &Args, world_args: &WorldArgs, out: &Path) -> anyhow::Result<Fl
     let json = serde_json::to_string_pretty(&report)?;
     std::fs::write(out.join("fly.json"), json + "\n")
         .with_context(|| format!("writing {}", out.join("fly.json").display()))?;
-    let mut csv = String::from("frame,gpu_ms,cpu_ms,pending_pct,uploaded_bytes,resident_bytes\n");
+    let mut csv =
+        String::from("frame,gpu_ms,cpu_ms,pending_pct,uploaded_bytes,resident_bytes,gpu_bytes\n");
     for f in &report.per_frame {
         csv.push_str(&format!(
-            "{},{},{:.4},{:.4},{},{}\n",
+            "{},{},{:.4},{:.4},{},{},{}\n",
             f.frame,
             f.gpu_ms.map(|g| format!("{g:.4}")).unwrap_or_default(),
             f.cpu_ms,
             f.pending_pct,
             f.uploaded_bytes,
-            f.resident_bytes
+            f.resident_bytes,
+            f.gpu_bytes
         ));
     }
     std::fs::write(out.join("frames.csv"), csv)

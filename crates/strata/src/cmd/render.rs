@@ -308,6 +308,8 @@ fn run_paged(args: &Args, world: &PagedWorld) -> anyhow::Result<()> {
         PagedWorld::options(&args.paged),
     )?;
     let plan = *renderer.paged_terrain().expect("a paged renderer").plan();
+    // The budget and bytes with the mesh's index pool (the plan is the atlas's part).
+    let stats = renderer.paged_terrain().expect("a paged renderer").stats();
     if !args.json {
         let r = &gpu.report;
         println!(
@@ -316,12 +318,7 @@ fn run_paged(args: &Args, world: &PagedWorld) -> anyhow::Result<()> {
         );
         println!(
             "paged: {}x{} world, {} chunks; budget {} B: {} slots, {} B kept on the GPU",
-            world.size.0,
-            world.size.1,
-            plan.chunks,
-            plan.budget,
-            plan.slots,
-            plan.total()
+            world.size.0, world.size.1, plan.chunks, stats.gpu_budget, plan.slots, stats.gpu_bytes
         );
         println!(
             "{:<14} {:>10} {:>10} {:>9} {:>9} {:>12}",

@@ -23,7 +23,10 @@
 //! edited level) and rewrite only their slots.
 
 use super::common::{begin_pass, forward_pipeline};
+mod fitter;
 mod knobs;
+pub mod paged;
+mod paged_pool;
 mod pool;
 use super::contract::{Frame, Method, MethodSettings, RetainedBytes};
 use crate::frame::{Shared, uniform_layout_entry};
@@ -59,6 +62,10 @@ pub fn lod_for(tolerance: f64, distance: f32, focal_px: f32, pixels: f32) -> u8 
 
 /// Per-draw record: the chunk copy's sample (0, 0) in unwrapped texels.
 const DRAW_BYTES: u64 = 16;
+
+/// The draw records' binding in group 1 (`draws` in `mesh.wgsl`; binding 1
+/// is the paged terrain's levels in `paged.wgsl`).
+const DRAWS_BINDING: u32 = 2;
 
 /// One visible chunk copy.
 #[derive(Clone, Copy, Debug)]
@@ -125,12 +132,20 @@ fn draws_binding(
         usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
         mapped_at_creation: false,
     });
-    let group = crate::frame::bind_group(
-        &shared.device,
-        "mesh",
+    let group = shared.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("mesh"),
         layout,
-        &[params.as_entire_binding(), buffer.as_entire_binding()],
-    );
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: params.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: DRAWS_BINDING,
+                resource: buffer.as_entire_binding(),
+            },
+        ],
+    });
     (buffer, group)
 }
 
@@ -281,7 +296,7 @@ fn from_fit(
         entries: &[
             uniform_layout_entry(0),
             wgpu::BindGroupLayoutEntry {
-                binding: 1,
+                binding: DRAWS_BINDING,
                 visibility: wgpu::ShaderStages::VERTEX,
                 ty: wgpu::BindingType::Buffer {
                     ty: wgpu::BufferBindingType::Storage { read_only: true },
@@ -376,55 +391,81 @@ fn outside_frustum(m: &glam::Mat4, lo: Vec3, hi: Vec3) -> bool {
     mask.iter().any(|&o| o)
 }
 
-impl Mesh {
-    /// Visible chunk copies for `camera`, front to back.
-    fn cull(&mut self, camera: &Camera) {
-        self.draws.clear();
-        let m = camera.view_proj();
-        let e = camera.position;
-        // Farthest visible point: the far plane at the image corner.
-        let (hw, hh) = (camera.width as f32 * 0.5, camera.height as f32 * 0.5);
-        let reach =
-            camera.far * (1.0 + (hw * hw + hh * hh) / (camera.focal_px * camera.focal_px)).sqrt();
-        let (sx, sy) = (self.layout.size_x as i64, self.layout.size_y as i64);
-        let (nx, ny) = (
-            i64::from(self.layout.chunks_x),
-            i64::from(self.layout.chunks_y),
-        );
-        let range = |c: f32, size: i64| {
-            let lo = ((c - reach - 1.0) as i64).div_euclid(size);
-            let hi = ((c + reach) as i64).div_euclid(size);
-            lo..=hi
-        };
-        for gy in range(e.y, sy) {
-            for gx in range(e.x, sx) {
-                let chunk = self
-                    .layout
-                    .index(gx.rem_euclid(nx) as u32, gy.rem_euclid(ny) as u32);
-                let slot = &self.slots[chunk];
-                let origin = [(gx * sx) as i32, (gy * sy) as i32];
-                // Samples stand at texel centres: (0.5 .. size + 0.5).
-                let lo = Vec3::new(
-                    origin[0] as f32 + 0.5,
-                    origin[1] as f32 + 0.5,
-                    f32::from(slot.z.0),
-                );
-                let hi = lo + Vec3::new(sx as f32, sy as f32, f32::from(slot.z.1 - slot.z.0));
-                if outside_frustum(&m, lo, hi) {
-                    continue;
-                }
-                let distance = (e.clamp(lo, hi) - e).length();
-                let lod = lod_for(self.tolerance, distance, camera.focal_px, self.lod_pixels);
-                self.draws.push(Draw {
-                    chunk: chunk as u32,
-                    lod,
-                    distance,
-                    origin,
-                });
+/// The chunk copies around `camera`'s eye whose box its frustum may see,
+/// front to back, into `out`: the chunk grid walked in the unwrapped plane,
+/// each copy's box from `z_of(chunk)`, its LOD by projected error.
+fn visible_copies(
+    layout: &ChunkLayout,
+    camera: &Camera,
+    (tolerance, lod_pixels): (f64, f32),
+    mut z_of: impl FnMut(u32) -> (u8, u8),
+    out: &mut Vec<Draw>,
+) {
+    out.clear();
+    let m = camera.view_proj();
+    let e = camera.position;
+    // Farthest visible point: the far plane at the image corner.
+    let (hw, hh) = (camera.width as f32 * 0.5, camera.height as f32 * 0.5);
+    let reach =
+        camera.far * (1.0 + (hw * hw + hh * hh) / (camera.focal_px * camera.focal_px)).sqrt();
+    let (sx, sy) = (layout.size_x as i64, layout.size_y as i64);
+    let (nx, ny) = (i64::from(layout.chunks_x), i64::from(layout.chunks_y));
+    let range = |c: f32, size: i64| {
+        let lo = ((c - reach - 1.0) as i64).div_euclid(size);
+        let hi = ((c + reach) as i64).div_euclid(size);
+        lo..=hi
+    };
+    for gy in range(e.y, sy) {
+        for gx in range(e.x, sx) {
+            let chunk = layout.index(gx.rem_euclid(nx) as u32, gy.rem_euclid(ny) as u32) as u32;
+            let z = z_of(chunk);
+            let origin = [(gx * sx) as i32, (gy * sy) as i32];
+            // Samples stand at texel centres: (0.5 .. size + 0.5).
+            let lo = Vec3::new(
+                origin[0] as f32 + 0.5,
+                origin[1] as f32 + 0.5,
+                f32::from(z.0),
+            );
+            let hi = lo + Vec3::new(sx as f32, sy as f32, f32::from(z.1 - z.0));
+            if outside_frustum(&m, lo, hi) {
+                continue;
             }
+            let distance = (e.clamp(lo, hi) - e).length();
+            let lod = lod_for(tolerance, distance, camera.focal_px, lod_pixels);
+            out.push(Draw {
+                chunk,
+                lod,
+                distance,
+                origin,
+            });
         }
-        self.draws.sort_by(|a, b| a.distance.total_cmp(&b.distance));
     }
+    out.sort_by(|a, b| a.distance.total_cmp(&b.distance));
+}
+
+/// Take `settings` in place where they keep the fit (`fit`: its tolerance
+/// and options): the LOD tolerance and the normal diagnostic (rewriting
+/// `params`). `Ok(false)`: a new quality or outline needs a new fit.
+fn settings_in_place(
+    shared: &Shared,
+    settings: &MethodSettings,
+    fit: (f64, FitOptions),
+    (lod_pixels, gradient_normal): (&mut f32, &mut bool),
+    (layout, params): (&ChunkLayout, &wgpu::Buffer),
+) -> anyhow::Result<bool> {
+    let q = f64::from(settings.mesh_quality);
+    let same_fit = tolerance_for_quality(q) == Some(fit.0) && options_of(settings) == fit.1;
+    if same_fit {
+        *lod_pixels = lod_pixels_of(settings)?;
+        if settings.mesh_gradient_normal != *gradient_normal {
+            *gradient_normal = settings.mesh_gradient_normal;
+            let grid = mesh_params(layout, *gradient_normal);
+            shared
+                .queue
+                .write_buffer(params, 0, bytemuck::cast_slice(&grid));
+        }
+    }
+    Ok(same_fit)
 }
 
 impl Method for Mesh {
@@ -439,20 +480,13 @@ impl Method for Mesh {
     ) -> anyhow::Result<bool> {
         // A new quality or outline is a new fit; the LOD tolerance and the
         // normal diagnostic are per-frame choices, taken in place.
-        let q = f64::from(settings.mesh_quality);
-        let same_fit = tolerance_for_quality(q) == Some(self.tolerance)
-            && options_of(settings) == self.options;
-        if same_fit {
-            self.lod_pixels = lod_pixels_of(settings)?;
-            if settings.mesh_gradient_normal != self.gradient_normal {
-                self.gradient_normal = settings.mesh_gradient_normal;
-                let grid = mesh_params(&self.layout, self.gradient_normal);
-                shared
-                    .queue
-                    .write_buffer(&self.params, 0, bytemuck::cast_slice(&grid));
-            }
-        }
-        Ok(same_fit)
+        settings_in_place(
+            shared,
+            settings,
+            (self.tolerance, self.options),
+            (&mut self.lod_pixels, &mut self.gradient_normal),
+            (&self.layout, &self.params),
+        )
     }
 
     fn apply_edit(
@@ -485,7 +519,14 @@ impl Method for Mesh {
     }
 
     fn prepare(&mut self, shared: &Shared, camera: &Camera) -> anyhow::Result<()> {
-        self.cull(camera);
+        let slots = &self.slots;
+        visible_copies(
+            &self.layout,
+            camera,
+            (self.tolerance, self.lod_pixels),
+            |c| slots[c as usize].z,
+            &mut self.draws,
+        );
         let n = self.draws.len() as u32;
         if n > self.draws_capacity {
             let capacity = n.next_power_of_two();

@@ -1,0 +1,327 @@
+//! The paged mesh's chunk fits, off the render thread: a queue of wanted
+//! chunks (replaced each frame, nearest first), worker threads that read the
+//! pages a chunk's samples lie in from the [`PageSource`] (never the whole
+//! world) and fit it, and finished fits handed back to the render thread.
+//! Where there are no threads (a browser page), [`Fitter::poll`] fits on the
+//! calling thread within a time budget.
+//!
+//! A chunk is fitted from a 256x256 [`Level`] holding its samples at the
+//! origin ([`fit_chunk`]): a chunk's fit depends on its own
+//! `(CHUNK + 1)²` samples alone (`strata_mesh::samples`), so the fit equals
+//! that chunk of a whole-world fit (tested).
+
+use super::pool::Fitted;
+use crate::paged::{PAGE, PageSource};
+use std::collections::{HashSet, VecDeque};
+use std::sync::mpsc::{Receiver, Sender, channel};
+use std::sync::{Arc, Condvar, Mutex};
+use strata_level::Level;
+use strata_mesh::{CHUNK, ChunkLayout, FitOptions, fit_chunks};
+
+/// A finished fit: the chunk, the epoch it was queued in, and its mesh.
+pub type FitResult = (u32, u32, Result<Fitted, String>);
+
+/// What every fit is fitted with.
+struct FitSpec {
+    source: Arc<dyn PageSource>,
+    tolerance: f64,
+    options: FitOptions,
+}
+
+struct Queue {
+    wanted: VecDeque<(u32, u32)>,
+    /// Chunks being fitted or fitted and not yet polled.
+    busy: HashSet<u32>,
+    closed: bool,
+}
+
+struct Shared {
+    queue: Mutex<Queue>,
+    ready: Condvar,
+}
+
+/// The wanted-fit queue and its workers.
+pub struct Fitter {
+    spec: Arc<FitSpec>,
+    shared: Arc<Shared>,
+    done_tx: Sender<FitResult>,
+    done: Receiver<FitResult>,
+    workers: Vec<std::thread::JoinHandle<()>>,
+    /// Fits queued before the current epoch are dropped (an edit changed
+    /// their samples).
+    epoch: u32,
+    /// Pages decoded on the calling thread (no workers).
+    cache: PlaneCache,
+}
+
+impl Fitter {
+    /// Fit chunks of `source` at `tolerance` with `options` on `threads`
+    /// worker threads (0: in [`Fitter::poll`]).
+    pub fn new(
+        source: Arc<dyn PageSource>,
+        tolerance: f64,
+        options: FitOptions,
+        threads: usize,
+    ) -> Self {
+        let spec = Arc::new(FitSpec {
+            source,
+            tolerance,
+            options,
+        });
+        let shared = Arc::new(Shared {
+            queue: Mutex::new(Queue {
+                wanted: VecDeque::new(),
+                busy: HashSet::new(),
+                closed: false,
+            }),
+            ready: Condvar::new(),
+        });
+        let (done_tx, done) = channel();
+        let workers = (0..threads)
+            .filter_map(|i| {
+                let (shared, spec, tx) = (shared.clone(), spec.clone(), done_tx.clone());
+                std::thread::Builder::new()
+                    .name(format!("strata-fit-{i}"))
+                    .spawn(move || worker(&shared, &spec, &tx))
+                    .ok()
+            })
+            .collect();
+        Fitter {
+            spec,
+            shared,
+            done_tx,
+            done,
+            workers,
+            epoch: 0,
+            cache: PlaneCache::default(),
+        }
+    }
+
+    /// Make `chunks` (most wanted first) the queue; chunks being fitted stay.
+    pub fn want(&self, chunks: &[u32]) {
+        let mut q = self.shared.queue.lock().expect("fit queue");
+        let wanted = chunks
+            .iter()
+            .filter(|c| !q.busy.contains(c))
+            .map(|&c| (c, self.epoch))
+            .collect();
+        q.wanted = wanted;
+        drop(q);
+        self.shared.ready.notify_all();
+    }
+
+    /// Chunks queued, being fitted, or fitted and not yet polled.
+    pub fn in_flight(&self) -> usize {
+        let q = self.shared.queue.lock().expect("fit queue");
+        q.wanted.len() + q.busy.len()
+    }
+
+    /// Drop every fit queued or running (an edit changed samples they read).
+    pub fn invalidate(&mut self) {
+        self.epoch = self.epoch.wrapping_add(1);
+        self.cache = PlaneCache::default();
+        self.shared.queue.lock().expect("fit queue").wanted.clear();
+    }
+
+    /// Finished fits of the current epoch, at most `most`. Without worker
+    /// threads, first fits queued chunks here for up to `budget_ms`.
+    pub fn poll(&mut self, most: usize, budget_ms: f64) -> Vec<(u32, Result<Fitted, String>)> {
+        if self.workers.is_empty() {
+            let start = web_time::Instant::now();
+            while start.elapsed().as_secs_f64() * 1e3 < budget_ms {
+                let next = {
+                    let mut q = self.shared.queue.lock().expect("fit queue");
+                    let next = q.wanted.pop_front();
+                    if let Some((c, _)) = next {
+                        q.busy.insert(c);
+                    }
+                    next
+                };
+                let Some((chunk, epoch)) = next else { break };
+                let fit = fit_chunk(&self.spec, chunk, &mut self.cache);
+                let _ = self.done_tx.send((chunk, epoch, fit));
+            }
+        }
+        let taken: Vec<FitResult> = self.done.try_iter().take(most).collect();
+        let mut q = self.shared.queue.lock().expect("fit queue");
+        for (chunk, _, _) in &taken {
+            q.busy.remove(chunk);
+        }
+        drop(q);
+        taken
+            .into_iter()
+            .filter(|(_, epoch, _)| *epoch == self.epoch)
+            .map(|(chunk, _, fit)| (chunk, fit))
+            .collect()
+    }
+
+    /// Fit `chunk` now, on the calling thread (an edit's refit).
+    pub fn fit_now(&mut self, chunk: u32) -> Result<Fitted, String> {
+        self.cache = PlaneCache::default();
+        fit_chunk(&self.spec, chunk, &mut self.cache)
+    }
+}
+
+impl Drop for Fitter {
+    fn drop(&mut self) {
+        self.shared.queue.lock().expect("fit queue").closed = true;
+        self.shared.ready.notify_all();
+        for w in self.workers.drain(..) {
+            let _ = w.join();
+        }
+    }
+}
+
+fn worker(shared: &Shared, spec: &FitSpec, done: &Sender<FitResult>) {
+    let mut cache = PlaneCache::default();
+    let mut cache_epoch = 0;
+    loop {
+        let (chunk, epoch) = {
+            let mut q = shared.queue.lock().expect("fit queue");
+            loop {
+                if q.closed {
+                    return;
+                }
+                if let Some(job) = q.wanted.pop_front() {
+                    q.busy.insert(job.0);
+                    break job;
+                }
+                q = shared.ready.wait(q).expect("fit queue");
+            }
+        };
+        if epoch != cache_epoch {
+            // An edit since: the cached pages may be old.
+            (cache, cache_epoch) = (PlaneCache::default(), epoch);
+        }
+        let fit = fit_chunk(spec, chunk, &mut cache);
+        if done.send((chunk, epoch, fit)).is_err() {
+            return;
+        }
+    }
+}
+
+/// A page's two planes: heights and metas, row-major.
+type Planes = Arc<(Vec<u8>, Vec<u8>)>;
+
+/// A few pages' planes, most recent last: neighbouring chunks, fitted
+/// nearest first, share pages.
+#[derive(Default)]
+struct PlaneCache {
+    pages: Vec<((u32, u32), Planes)>,
+}
+
+const PLANE_CACHE_PAGES: usize = 8;
+
+impl PlaneCache {
+    fn planes(&mut self, source: &dyn PageSource, page: (u32, u32)) -> Result<Planes, String> {
+        if let Some(k) = self.pages.iter().position(|(p, _)| *p == page) {
+            let hit = self.pages.remove(k);
+            let planes = hit.1.clone();
+            self.pages.push(hit);
+            return Ok(planes);
+        }
+        let data = source.read_page(page.0, page.1, 2)?;
+        let n = (PAGE * PAGE) as usize;
+        let (mut heights, mut metas) = (Vec::with_capacity(n), Vec::with_capacity(n));
+        for p in data.pairs.chunks_exact(4) {
+            heights.extend_from_slice(&[p[0], p[2]]);
+            metas.extend_from_slice(&[p[1], p[3]]);
+        }
+        let planes = Arc::new((heights, metas));
+        if self.pages.len() == PLANE_CACHE_PAGES {
+            self.pages.remove(0);
+        }
+        self.pages.push((page, planes.clone()));
+        Ok(planes)
+    }
+}
+
+/// Side of the level a chunk is fitted from: its samples and the pair
+/// neighbour of its last column, at the origin.
+const FIT_SIDE: u32 = 256;
+
+/// Mesh chunks across and down a world of `size` texels.
+pub fn mesh_grid(size: (u32, u32)) -> (u32, u32) {
+    (size.0 / CHUNK, size.1 / CHUNK)
+}
+
+/// Fit mesh chunk `chunk` of `spec.source` from the pages its samples lie in.
+fn fit_chunk(spec: &FitSpec, chunk: u32, cache: &mut PlaneCache) -> Result<Fitted, String> {
+    let source = spec.source.as_ref();
+    let (w, h) = source.size();
+    let (across, down) = mesh_grid((w, h));
+    if chunk >= across * down {
+        return Err(format!("mesh chunk {chunk} is outside the world"));
+    }
+    let (x0, y0) = ((chunk % across) * CHUNK, (chunk / across) * CHUNK);
+    let side = FIT_SIDE as usize;
+    let (mut heights, mut metas) = (vec![0u8; side * side], vec![0u8; side * side]);
+    // Samples 0..=CHUNK down; across also the pair neighbour of the last
+    // column (a column is decoded with its pair).
+    for y in 0..=CHUNK {
+        let wy = (y0 + y) & (h - 1);
+        let mut x = 0;
+        while x < CHUNK + 2 {
+            let wx = (x0 + x) & (w - 1);
+            let page = (wx / PAGE, wy / PAGE);
+            let planes = cache
+                .planes(source, page)
+                .map_err(|e| format!("mesh chunk {chunk}: page {page:?}: {e}"))?;
+            // The rest of this page's row in one copy.
+            let local = ((wy % PAGE) * PAGE + wx % PAGE) as usize;
+            let run = (PAGE - wx % PAGE).min(CHUNK + 2 - x) as usize;
+            let at = y as usize * side + x as usize;
+            heights[at..at + run].copy_from_slice(&planes.0[local..local + run]);
+            metas[at..at + run].copy_from_slice(&planes.1[local..local + run]);
+            x += run as u32;
+        }
+    }
+    let level = Level::from_planes(FIT_SIDE, FIT_SIDE, heights, metas, source.mid_rule())
+        .map_err(|e| e.to_string())?;
+    let mesh = fit_chunks(&level, spec.tolerance, spec.options, &[0], 1)
+        .pop()
+        .ok_or_else(|| format!("mesh chunk {chunk}: the fit returned nothing"))?;
+    let z = super::z_range(&level, &ChunkLayout::of(&level), 0, &mesh);
+    Ok((mesh, z))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::paged::LevelPages;
+
+    #[test]
+    fn a_chunk_fitted_from_its_pages_equals_the_whole_world_fit() {
+        let world = strata_level::generate::generate(&strata_level::generate::GenerateParams {
+            seed: 5,
+            width: 512,
+            height: 512,
+        })
+        .unwrap();
+        let level = Arc::new(world.level.clone());
+        let source: Arc<dyn PageSource> = Arc::new(LevelPages::new(level.clone()).unwrap());
+        let tol = strata_mesh::tolerance_for_quality(0.5).unwrap();
+        let layout = ChunkLayout::of(&level);
+        // Chunks at the page's start and middle, and at the wrap edges.
+        let ids = [0usize, 1, 3, 5, 12, 15];
+        for outline in [false, true] {
+            let options = FitOptions { outline };
+            let whole = fit_chunks(&level, tol, options, &ids, 1);
+            let spec = FitSpec {
+                source: source.clone(),
+                tolerance: tol,
+                options,
+            };
+            let mut cache = PlaneCache::default();
+            for (&i, want) in ids.iter().zip(&whole) {
+                let (mesh, z) = fit_chunk(&spec, i as u32, &mut cache).unwrap();
+                assert_eq!(&mesh, want, "chunk {i} outline {outline}");
+                assert_eq!(
+                    z,
+                    super::super::z_range(&level, &layout, i, want),
+                    "chunk {i}"
+                );
+            }
+        }
+    }
+}
