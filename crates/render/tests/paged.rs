@@ -172,18 +172,16 @@ fn a_chunk_that_fails_to_read_stays_pending_and_is_reported_once() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// Converge `camera` and score it against the CPU reference; also the
-/// coarse pages resident and the pages uploaded.
-fn horizon_run(
+/// A paged renderer of `source` at a 16 MiB budget drawing far columns from
+/// coarse pages at `lod_pixels` (0: none).
+fn lod_renderer(
     gpu: &strata_render::Gpu,
     source: Arc<dyn PageSource>,
     colors: &TerrainColors,
     method: &str,
-    camera: &Camera,
-    reference: &strata_reference::Reference,
     lod_pixels: f32,
-) -> (strata_reference::Metrics, u32, u64) {
-    let mut r = Renderer::new_paged(
+) -> Renderer {
+    Renderer::new_paged(
         gpu,
         source,
         colors,
@@ -198,7 +196,31 @@ fn horizon_run(
             ..Default::default()
         },
     )
-    .unwrap();
+    .unwrap()
+}
+
+/// Coarse (level-of-detail) pages resident in `r`'s atlas.
+fn coarse_resident(r: &mut Renderer) -> u32 {
+    let paged = r.paged_terrain().unwrap();
+    let chunks = paged.ids().chunks() as usize;
+    paged.residency().table()[chunks..]
+        .iter()
+        .filter(|&&e| e != 0)
+        .count() as u32
+}
+
+/// Converge `camera` and score it against the CPU reference; also the
+/// coarse pages resident.
+fn horizon_run(
+    gpu: &strata_render::Gpu,
+    source: Arc<dyn PageSource>,
+    colors: &TerrainColors,
+    method: &str,
+    camera: &Camera,
+    reference: &strata_reference::Reference,
+    lod_pixels: f32,
+) -> (strata_reference::Metrics, u32) {
+    let mut r = lod_renderer(gpu, source, colors, method, lod_pixels);
     r.converge(camera, 200).unwrap();
     common::save_png(
         &r,
@@ -208,13 +230,7 @@ fn horizon_run(
     let depth = r.read_depth().unwrap();
     let distance = strata_reference::metrics::distance_from_depth(camera, &depth);
     let m = strata_reference::metrics::compare(reference, &distance);
-    let paged = r.paged_terrain().unwrap();
-    let chunks = paged.ids().chunks() as usize;
-    let coarse = paged.residency().table()[chunks..]
-        .iter()
-        .filter(|&&e| e != 0)
-        .count() as u32;
-    (m, coarse, paged.stats().total_uploads)
+    (m, coarse_resident(&mut r))
 }
 
 #[test]
@@ -246,7 +262,7 @@ fn horizon_views_take_coarse_pages_far_away_and_stay_close_to_the_reference() {
             for camera in &cameras {
                 let reference =
                     tracer.render(camera, &strata_reference::ReferenceSettings::default());
-                let (exact, coarse0, uploads0) = horizon_run(
+                let (exact, coarse0) = horizon_run(
                     &gpu,
                     source.clone(),
                     &colors,
@@ -255,7 +271,7 @@ fn horizon_views_take_coarse_pages_far_away_and_stay_close_to_the_reference() {
                     &reference,
                     0.0,
                 );
-                let (lod, coarse, uploads) = horizon_run(
+                let (lod, coarse) = horizon_run(
                     &gpu,
                     source.clone(),
                     &colors,
@@ -265,7 +281,7 @@ fn horizon_views_take_coarse_pages_far_away_and_stay_close_to_the_reference() {
                     1.0,
                 );
                 eprintln!(
-                    "{method}: exact {} ({uploads0} uploads) | lod {} ({uploads} uploads, {coarse} coarse pages resident)",
+                    "{method}: exact {} | lod {} ({coarse} coarse pages resident)",
                     common::metrics_line(&exact),
                     common::metrics_line(&lod)
                 );
@@ -298,7 +314,7 @@ fn coarse_pages_of_a_flat_world_draw_it_exactly() {
     let reference = tracer.render(&camera, &strata_reference::ReferenceSettings::default());
     for gpu in gpus {
         for method in ["ray-exact-fragment", "ray-exact"] {
-            let (m, coarse, _) = horizon_run(
+            let (m, coarse) = horizon_run(
                 &gpu,
                 source.clone(),
                 &colors,
@@ -349,26 +365,9 @@ fn an_edit_reaches_the_coarse_pages_of_a_far_view() {
     let pitch = -(150.0f32 / 1200.0).atan().to_degrees();
     let mut camera = Camera::new(eye, 0.0, pitch, W, H).unwrap();
     camera.far = 2000.0;
-    let options = || PagedOptions {
-        gpu_budget: 16 << 20,
-        upload_pages: 16,
-        lod_pixels: 0.5,
-        ..Default::default()
-    };
-    let settings = MethodSettings::default();
     for gpu in gpus {
         let (cache, source) = store_pages(&store);
-        let mut r = Renderer::new_paged(
-            &gpu,
-            source,
-            &colors,
-            "ray-exact",
-            &settings,
-            W,
-            H,
-            options(),
-        )
-        .unwrap();
+        let mut r = lod_renderer(&gpu, source, &colors, "ray-exact", 0.5);
         r.converge(&camera, 100).unwrap();
         let before = r.read_depth().unwrap();
         let cells = store.commit_rects(&level, &rects).unwrap();
@@ -383,26 +382,9 @@ fn an_edit_reaches_the_coarse_pages_of_a_far_view() {
         let after = r.read_depth().unwrap();
         let changed = after.iter().zip(&before).filter(|(a, b)| a != b).count();
         let (_, source) = store_pages(&store);
-        let mut fresh = Renderer::new_paged(
-            &gpu,
-            source,
-            &colors,
-            "ray-exact",
-            &settings,
-            W,
-            H,
-            options(),
-        )
-        .unwrap();
+        let mut fresh = lod_renderer(&gpu, source, &colors, "ray-exact", 0.5);
         fresh.converge(&camera, 100).unwrap();
-        let coarse = {
-            let p = fresh.paged_terrain().unwrap();
-            let chunks = p.ids().chunks() as usize;
-            p.residency().table()[chunks..]
-                .iter()
-                .filter(|&&e| e != 0)
-                .count()
-        };
+        let coarse = coarse_resident(&mut fresh);
         eprintln!("far edit: {changed} pixels changed, {coarse} coarse pages resident");
         assert!(changed > 0, "the edit changed nothing in the far view");
         assert!(coarse > 0, "the far view drew no coarse page");
