@@ -162,7 +162,7 @@ fn fly_over_a_store_writes_frames_and_a_summary_within_the_budget() {
     let mut lines = csv.lines();
     assert_eq!(
         lines.next(),
-        Some("frame,gpu_ms,cpu_ms,pending_pct,uploaded_bytes,resident_bytes")
+        Some("frame,gpu_ms,cpu_ms,pending_pct,uploaded_bytes,resident_bytes,gpu_bytes")
     );
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
     assert_eq!(rows.len(), 24);
@@ -316,7 +316,7 @@ fn compare_over_a_store_past_the_limit_measures_paged_methods_and_refuses_the_re
         "`ray` draws whole worlds only",
         "past the whole-world limit",
         "STRATA_WHOLE_WORLD_LIMIT_MIB",
-        "ray-exact, ray-exact-fragment draw it through pages",
+        "ray-exact, ray-exact-fragment, mesh draw it through pages",
     ] {
         assert!(error.contains(wanted), "`{wanted}` missing from: {error}");
     }
@@ -406,12 +406,12 @@ fn a_whole_world_method_on_a_paged_world_names_the_paged_methods() {
         return;
     }
     let out_dir = dir("refused");
-    let out = render(&out_dir, &["--method", "mesh", "--gpu-budget", "4MiB"]);
+    let out = render(&out_dir, &["--method", "voxel", "--gpu-budget", "4MiB"]);
     assert_clean_error(
         &out,
         &[
-            "`mesh` draws whole worlds only",
-            "ray-exact, ray-exact-fragment",
+            "`voxel` draws whole worlds only",
+            "ray-exact, ray-exact-fragment, mesh",
         ],
     );
 }

@@ -112,7 +112,7 @@ fn the_viewer_flies_digs_and_saves_a_paged_store() {
              undo\nscreenshot {s}/undone.png\n\
              dig 0.5 0.5\nframes 2\nmemory\nsave {store}\n\
              fly 300 0 0 20\nmemory\n\
-             method mesh\n",
+             method voxel\n",
             s = shots.display(),
             store = store.display()
         ),
@@ -124,10 +124,10 @@ fn the_viewer_flies_digs_and_saves_a_paged_store() {
         return;
     }
     // The script ends on a refused method: an error naming the paged ones.
-    assert!(!run.ok, "`method mesh` should stop the script");
+    assert!(!run.ok, "`method voxel` should stop the script");
     assert!(
         run.stderr
-            .contains("`mesh` draws whole worlds only; paged worlds are drawn by ray-exact"),
+            .contains("`voxel` draws whole worlds only; paged worlds are drawn by ray-exact"),
         "{}",
         run.stderr
     );
