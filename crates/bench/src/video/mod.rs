@@ -59,9 +59,11 @@ pub struct PagedTerrain {
     pub pages: std::sync::Arc<dyn strata_render::paged::PageSource>,
     pub columns: std::sync::Arc<dyn ColumnSource + Send + Sync>,
     /// Cut the crater into the pages; the chunks it touched (grid row-major).
-    #[allow(clippy::type_complexity)]
-    pub dig: Box<dyn Fn(&EditSite) -> anyhow::Result<Vec<u32>> + Send + Sync>,
+    pub dig: Box<Dig>,
 }
+
+/// Cuts a crater into pages; answers the chunks it touched.
+pub type Dig = dyn Fn(&EditSite) -> anyhow::Result<Vec<u32>> + Send + Sync;
 
 /// Where a recording's terrain is: a level in memory, or pages.
 enum Ground<'a> {
