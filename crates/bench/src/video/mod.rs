@@ -20,7 +20,8 @@ use path::CameraPath;
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
 use strata_camera::Camera;
-use strata_level::{DirtyRect, Level, World};
+use strata_level::source::ColumnSource;
+use strata_level::{DirtyRect, EditSite, Level, World};
 use strata_reference::{ReferenceSettings, Tracer};
 use strata_render::{Gpu, Renderer, TerrainColors};
 use temporal::{Flicker, FlickerTracker, flicker_percent};
@@ -47,6 +48,44 @@ pub struct VideoOptions {
     /// draw through pages streamed as the camera flies (converged at the
     /// first pose); the others keep the whole-world path.
     pub paging: Option<strata_render::paged::PagedOptions>,
+}
+
+/// A world drawn only through pages (a store past the whole-world limit):
+/// its map is never in memory whole. Every lane draws `pages`; eye heights
+/// and the CPU reference read `columns` (the ground as the pages show it,
+/// the dig included); the dig goes into the pages' edit layer, never into
+/// the store on disk.
+pub struct PagedTerrain {
+    pub pages: std::sync::Arc<dyn strata_render::paged::PageSource>,
+    pub columns: std::sync::Arc<dyn ColumnSource + Send + Sync>,
+    /// Cut the crater into the pages; the chunks it touched (grid row-major).
+    pub dig: Box<Dig>,
+}
+
+/// Cuts a crater into pages; answers the chunks it touched.
+pub type Dig = dyn Fn(&EditSite) -> anyhow::Result<Vec<u32>> + Send + Sync;
+
+/// Where a recording's terrain is: a level in memory, or pages.
+enum Ground<'a> {
+    Whole(&'a Level),
+    Paged(&'a PagedTerrain),
+}
+
+impl Ground<'_> {
+    fn columns(&self) -> &dyn ColumnSource {
+        match self {
+            Ground::Whole(level) => *level,
+            Ground::Paged(t) => &*t.columns,
+        }
+    }
+}
+
+/// What the dig frame applies before it draws.
+enum Edit<'a> {
+    /// The edited level and its dirty rectangles (a world in memory).
+    Level(&'a (Level, Vec<DirtyRect>)),
+    /// The chunks a dig into the pages touched.
+    Chunks(&'a [u32]),
 }
 
 /// Pages of a world in memory whose level an edit replaces (the dig frame
@@ -172,24 +211,71 @@ pub fn record(
     world: &World,
     path: &CameraPath,
     opts: &VideoOptions,
+    sink: Option<&mut dyn FrameSink>,
+    bar: &ProgressBar,
+) -> anyhow::Result<Recording> {
+    record_over(
+        gpu,
+        world,
+        Ground::Whole(&world.level),
+        path,
+        opts,
+        sink,
+        bar,
+    )
+}
+
+/// [`record`] over a world drawn only through pages: `world` holds
+/// everything but its map (a store's shell), `terrain` the map. Every
+/// method must be paged (`strata_render::paged::PAGED_METHODS`); another
+/// is left out, its track saying why.
+pub fn record_paged(
+    gpu: &Gpu,
+    world: &World,
+    terrain: &PagedTerrain,
+    path: &CameraPath,
+    opts: &VideoOptions,
+    sink: Option<&mut dyn FrameSink>,
+    bar: &ProgressBar,
+) -> anyhow::Result<Recording> {
+    record_over(gpu, world, Ground::Paged(terrain), path, opts, sink, bar)
+}
+
+fn record_over(
+    gpu: &Gpu,
+    world: &World,
+    ground: Ground<'_>,
+    path: &CameraPath,
+    opts: &VideoOptions,
     mut sink: Option<&mut dyn FrameSink>,
     bar: &ProgressBar,
 ) -> anyhow::Result<Recording> {
-    let level = &world.level;
-    let flight = path.resolve(level).context("the camera path")?;
+    let columns = ground.columns();
+    let flight = path.resolve(columns).context("the camera path")?;
     let frames = frame_count(flight.duration(), opts.fps);
     let (tw, th) = opts.tile;
     let colors = TerrainColors::from_world(world);
-    let first = flight.camera(level, flight.start(), tw, th)?;
+    let first = flight.camera(columns, flight.start(), tw, th)?;
 
     bar.set_length(u64::from(frames));
-    let (mut lanes, tracks_failed) = build_lanes(gpu, level, &colors, opts, &first, bar);
+    let (mut lanes, tracks_failed) = build_lanes(gpu, &ground, &colors, opts, &first, bar);
     if lanes.is_empty() {
         anyhow::bail!("no method could be built (see the messages above)");
     }
-    let edited = prepare_edit(world, path, bar);
-    let before = opts.temporal.then(|| Tracer::new(level));
-    let after = match (&edited, opts.temporal) {
+    let site = dig_site(world, path, bar);
+    let edited = match &ground {
+        Ground::Whole(level) => site.map(|site| {
+            let mut level = (*level).clone();
+            let rects = strata_level::edit::crater(&mut level, site);
+            (level, rects)
+        }),
+        Ground::Paged(_) => None,
+    };
+    let before = match opts.temporal {
+        true => Some(Tracer::over(columns).context("the CPU reference over the world")?),
+        false => None,
+    };
+    let mut after = match (&edited, opts.temporal) {
         (Some((l, _)), true) => Some(Tracer::new(l)),
         _ => None,
     };
@@ -200,18 +286,32 @@ pub fn record(
     let start = Instant::now();
     for f in 0..frames {
         let t = flight.start() + f as f32 / opts.fps as f32;
-        let dig_now =
-            dig_frame.is_none() && edited.is_some() && path.dig_at.is_some_and(|d| t >= d);
-        let current: &Level = match (&edited, dig_frame.is_some() || dig_now) {
+        let dig_now = dig_frame.is_none() && site.is_some() && path.dig_at.is_some_and(|d| t >= d);
+        // A dig into pages is cut now (and timed with the frame after it).
+        let (mut dug, mut dig_ms) = (Vec::new(), 0.0);
+        if let (true, Ground::Paged(terrain), Some(site)) = (dig_now, &ground, site) {
+            let start = Instant::now();
+            dug = (terrain.dig)(site).context("digging the crater into the pages")?;
+            dig_ms = ms(start);
+            if opts.temporal {
+                after =
+                    Some(Tracer::over(columns).context("the CPU reference over the dug world")?);
+            }
+        }
+        let current: &dyn ColumnSource = match (&edited, dig_frame.is_some() || dig_now) {
             (Some((l, _)), true) => l,
-            _ => level,
+            _ => columns,
         };
         let camera = flight.camera(current, t, tw, th)?;
         bar.set_message(format!(
             "path {t:.1} s{}",
             if dig_now { ", digging" } else { "" }
         ));
-        let edit = if dig_now { edited.as_ref() } else { None };
+        let edit = match (&edited, dig_now) {
+            (_, false) => None,
+            (Some(e), true) => Some(Edit::Level(e)),
+            (None, true) => Some(Edit::Chunks(&dug)),
+        };
         let tracer = if dig_frame.is_some() || dig_now {
             after.as_ref()
         } else {
@@ -228,14 +328,19 @@ pub fn record(
         // render. A CPU rasteriser would share its cores with the trace and
         // time its frames slower, so there the two take turns.
         let (reference, rendered) = if overlap {
-            rayon::join(trace, || render_lanes(&mut lanes, &camera, edit))
+            rayon::join(trace, || render_lanes(&mut lanes, &camera, edit.as_ref()))
         } else {
-            let rendered = render_lanes(&mut lanes, &camera, edit);
+            let rendered = render_lanes(&mut lanes, &camera, edit.as_ref());
             (trace(), rendered)
         };
         rendered?;
         if dig_now {
             dig_frame = Some(f);
+            for lane in &mut lanes {
+                if let Some(e) = &mut lane.first_post_edit_ms {
+                    *e += dig_ms;
+                }
+            }
         }
         let reference = reference.map(|(distance, ms)| {
             reference_ms.push(ms);
@@ -295,19 +400,21 @@ pub fn record(
 fn render_lanes(
     lanes: &mut [Lane],
     camera: &Camera,
-    edit: Option<&(Level, Vec<DirtyRect>)>,
+    edit: Option<&Edit<'_>>,
 ) -> anyhow::Result<()> {
     for lane in lanes {
         let start = Instant::now();
-        if let Some((level, rects)) = edit {
-            match &lane.pages {
+        match edit {
+            Some(Edit::Level((level, rects))) => match &lane.pages {
                 Some(pages) => {
                     *pages.level.write().expect("pages lock") = std::sync::Arc::new(level.clone());
                     lane.renderer
                         .refresh_pages(&touched_chunks(rects, level.width()))?;
                 }
                 None => lane.renderer.apply_edit(level, rects)?,
-            }
+            },
+            Some(Edit::Chunks(chunks)) => lane.renderer.refresh_pages(chunks)?,
+            None => {}
         }
         let timing = lane.renderer.render_frame(camera)?;
         if edit.is_some() {
@@ -322,7 +429,7 @@ fn render_lanes(
 /// Every method's lane; the tracks of those that could not be built.
 fn build_lanes(
     gpu: &Gpu,
-    level: &Level,
+    ground: &Ground<'_>,
     colors: &TerrainColors,
     opts: &VideoOptions,
     first: &Camera,
@@ -331,7 +438,7 @@ fn build_lanes(
     let (mut lanes, mut failed) = (Vec::new(), Vec::new());
     for choice in &opts.methods {
         bar.set_message(format!("{}: setup", choice.label()));
-        match build_lane(gpu, level, colors, choice, opts, first) {
+        match build_lane(gpu, ground, colors, choice, opts, first) {
             Ok(lane) => lanes.push(lane),
             Err(e) => {
                 bar.println(format!("{}: left out: {e:#}", choice.label()));
@@ -342,24 +449,17 @@ fn build_lanes(
     (lanes, failed)
 }
 
-/// The edited level and its dirty rectangles, made up front so the dig
-/// frame pays only the upload; `None` when the path does not dig.
-fn prepare_edit(
-    world: &World,
-    path: &CameraPath,
-    bar: &ProgressBar,
-) -> Option<(Level, Vec<DirtyRect>)> {
+/// Where the path digs its crater; `None` when it does not dig (or the
+/// level has no edit site: a note says so).
+fn dig_site<'w>(world: &'w World, path: &CameraPath, bar: &ProgressBar) -> Option<&'w EditSite> {
     path.dig_at?;
-    let Some(site) = &world.edit else {
+    if world.edit.is_none() {
         bar.println(format!(
             "note: the path digs, but level `{}` has no edit site: no dig",
             world.name
         ));
-        return None;
-    };
-    let mut level = world.level.clone();
-    let rects = strata_level::edit::crater(&mut level, site);
-    Some((level, rects))
+    }
+    world.edit.as_ref()
 }
 
 /// Frames in `seconds` at `fps`, the last keyframe included.
@@ -369,7 +469,7 @@ pub fn frame_count(seconds: f32, fps: u32) -> u32 {
 
 fn build_lane(
     gpu: &Gpu,
-    level: &Level,
+    ground: &Ground<'_>,
     colors: &TerrainColors,
     choice: &MethodChoice,
     opts: &VideoOptions,
@@ -377,30 +477,49 @@ fn build_lane(
 ) -> anyhow::Result<Lane> {
     let settings = settings_for(choice, opts.shadows)?;
     let start = Instant::now();
-    let paged = opts
-        .paging
-        .as_ref()
-        .filter(|_| strata_render::paged::PAGED_METHODS.contains(&choice.method.name));
-    let (mut renderer, pages) = match paged {
-        Some(options) => {
+    let pageable = strata_render::paged::PAGED_METHODS.contains(&choice.method.name);
+    // The pages a paged lane draws, the level an edit swaps in them (a
+    // world in memory), and how to page them.
+    type Paging = (
+        std::sync::Arc<dyn strata_render::paged::PageSource>,
+        Option<std::sync::Arc<SwappedPages>>,
+        strata_render::paged::PagedOptions,
+    );
+    let paging: Option<Paging> = match ground {
+        Ground::Paged(terrain) if pageable => Some((
+            terrain.pages.clone(),
+            None,
+            opts.paging.clone().unwrap_or_default(),
+        )),
+        Ground::Paged(_) => anyhow::bail!(
+            "`{}` draws whole worlds only; {} draw this one through pages",
+            choice.method.name,
+            strata_render::paged::PAGED_METHODS.join(", ")
+        ),
+        Ground::Whole(level) => opts.paging.clone().filter(|_| pageable).map(|options| {
             let pages = std::sync::Arc::new(SwappedPages {
-                level: std::sync::RwLock::new(std::sync::Arc::new(level.clone())),
+                level: std::sync::RwLock::new(std::sync::Arc::new((*level).clone())),
             });
+            (pages.clone() as _, Some(pages), options)
+        }),
+    };
+    let (mut renderer, pages) = match (paging, ground) {
+        (Some((source, pages, options)), _) => {
             let mut renderer = Renderer::new_paged(
                 gpu,
-                pages.clone(),
+                source,
                 colors,
                 choice.method,
                 &settings,
                 opts.tile.0,
                 opts.tile.1,
-                options.clone(),
+                options,
             )?;
             // The first pose with every page it reads (a loading screen).
             renderer.converge(first, 600)?;
-            (renderer, Some(pages))
+            (renderer, pages)
         }
-        None => (
+        (None, Ground::Whole(level)) => (
             Renderer::new(
                 gpu,
                 level,
@@ -412,11 +531,16 @@ fn build_lane(
             )?,
             None,
         ),
+        (None, Ground::Paged(_)) => anyhow::bail!("a paged world draws through pages only"),
     };
     let setup_ms = ms(start);
     // Settle incremental builds before the first frame (as compare's first
     // view does), so the video shows the edit's catch-up, not the initial build.
-    let cap = build_frames(level);
+    let cap = match ground {
+        Ground::Whole(level) => build_frames(level),
+        // Paged lanes build nothing incrementally over the whole map.
+        Ground::Paged(_) => 0,
+    };
     warm_up(&mut renderer, first, 1, cap + 1, gpu.report.timestamps)?;
     Ok(Lane {
         choice: choice.clone(),

@@ -9,7 +9,9 @@
 use glam::Vec3;
 use std::fmt;
 use strata_camera::Camera;
-use strata_level::{EditSite, Level, ViewSpec, World};
+use strata_level::model::Column;
+use strata_level::source::ColumnSource;
+use strata_level::{EditSite, ViewSpec, World};
 
 /// What a path file line can be wrong about; every message names the line.
 #[derive(Debug, PartialEq)]
@@ -178,15 +180,14 @@ impl CameraPath {
         out
     }
 
-    /// Resolve every keyframe against `level` (the eye's altitude), ready to sample.
-    pub fn resolve(&self, level: &Level) -> Result<Flight, PathError> {
+    /// Resolve every keyframe against the ground (the eye's altitude), ready
+    /// to sample: a level in memory, or a store read chunk by chunk.
+    pub fn resolve(&self, ground: &dyn ColumnSource) -> Result<Flight, PathError> {
         let mut poses = Vec::with_capacity(self.keys.len());
         let mut prev_yaw: Option<f32> = None;
         for k in &self.keys {
-            let cam = Camera::from_view(level, &k.view, 1, 1).map_err(|e| PathError::Keyframe {
-                line: k.line,
-                msg: e.to_string(),
-            })?;
+            let cam = view_camera(ground, &k.view)
+                .map_err(|msg| PathError::Keyframe { line: k.line, msg })?;
             // Unwrap yaw so each step turns the short way (350 -> 10 is +20).
             let yaw = match prev_yaw {
                 Some(p) => p + (k.view.yaw - p + 180.0).rem_euclid(360.0) - 180.0,
@@ -287,11 +288,18 @@ impl Flight {
 
     /// The camera at time `t` for a `width` x `height` image: wrapped onto
     /// the map, and lifted out of terrain where the curve cut through it.
-    pub fn camera(&self, level: &Level, t: f32, width: u32, height: u32) -> anyhow::Result<Camera> {
+    pub fn camera(
+        &self,
+        ground: &dyn ColumnSource,
+        t: f32,
+        width: u32,
+        height: u32,
+    ) -> anyhow::Result<Camera> {
         let pose = self.pose(t);
-        let x = pose.position.x.rem_euclid(level.width() as f32);
-        let y = pose.position.y.rem_euclid(level.height() as f32);
-        let z = free_altitude(level, x, y, pose.position.z);
+        let (w, h) = ground.size();
+        let x = pose.position.x.rem_euclid(w as f32);
+        let y = pose.position.y.rem_euclid(h as f32);
+        let z = free_altitude(ground, x, y, pose.position.z)?;
         Ok(Camera::new(
             Vec3::new(x, y, z),
             pose.yaw.rem_euclid(360.0),
@@ -302,19 +310,34 @@ impl Flight {
     }
 }
 
+/// The column under map point (`x`, `y`) (wrapping; one chunk read from a store).
+fn column_at(ground: &dyn ColumnSource, x: f32, y: f32) -> anyhow::Result<Column> {
+    ground
+        .column(x.floor() as i64, y.floor() as i64)
+        .map_err(|e| anyhow::anyhow!("reading the ground at ({x:.0}, {y:.0}): {e}"))
+}
+
+/// The camera of `view` over `ground` (one column read), or why not.
+fn view_camera(ground: &dyn ColumnSource, view: &ViewSpec) -> Result<Camera, String> {
+    let (w, h) = ground.size();
+    let (x, y) = (view.x.rem_euclid(w as f32), view.y.rem_euclid(h as f32));
+    let column = column_at(ground, x, y).map_err(|e| format!("{e:#}"))?;
+    Camera::from_view_over((w, h), |_, _| column, view, 1, 1).map_err(|e| e.to_string())
+}
+
 /// `z`, or the nearest altitude above it that is not solid: between two
 /// keyframes the curve may dip into the ground or a slab.
-fn free_altitude(level: &Level, x: f32, y: f32, z: f32) -> f32 {
+fn free_altitude(ground: &dyn ColumnSource, x: f32, y: f32, z: f32) -> anyhow::Result<f32> {
     const CLEARANCE: f32 = 2.0;
-    let c = level.column_at(x, y);
+    let c = column_at(ground, x, y)?;
     if !c.is_solid(z) {
-        return z;
+        return Ok(z);
     }
     let under_slab = f32::from(c.low) + CLEARANCE;
     if z <= f32::from(c.low) && !c.is_solid(under_slab) && under_slab < f32::from(c.mid) {
-        return under_slab;
+        return Ok(under_slab);
     }
-    f32::from(c.top()) + CLEARANCE
+    Ok(f32::from(c.top()) + CLEARANCE)
 }
 
 /// The default fly-through: from the level's nearest landmark view (the
@@ -323,14 +346,20 @@ fn free_altitude(level: &Level, x: f32, y: f32, z: f32) -> f32 {
 /// crater dug, then around and above it. Without an edit site: a flight
 /// between the level's first two views.
 pub fn default_path(world: &World) -> CameraPath {
-    match &world.edit {
+    default_path_over(world, &world.level).expect("a level in memory reads every column")
+}
+
+/// [`default_path`] over `ground` (the world's map, which `world` need not
+/// hold: a store's is read a chunk at a time); fails where a column cannot be read.
+pub fn default_path_over(world: &World, ground: &dyn ColumnSource) -> anyhow::Result<CameraPath> {
+    Ok(match &world.edit {
         Some(site) => {
             let path = around_edit_site(site);
-            let path = match nearest_landmark(world, site) {
+            let path = match nearest_landmark(ground.size(), world, site) {
                 Some(view) => lead_in(&view, path),
                 None => path,
             };
-            fit_under_slabs(path, &world.level)
+            fit_under_slabs(path, ground)?
         }
         None => {
             let keys = world
@@ -346,7 +375,7 @@ pub fn default_path(world: &World) -> CameraPath {
                 .collect();
             CameraPath { keys, dig_at: None }
         }
-    }
+    })
 }
 
 /// Landmark views this far from the crater (map units) make the lead-in.
@@ -356,8 +385,8 @@ const LEAD_IN_SECONDS: f32 = 5.0;
 
 /// The level's view nearest the crater within [`LEAD_IN_RANGE`], moved to
 /// the copy of the map (it wraps) nearest the crater, so the flight is short.
-fn nearest_landmark(world: &World, site: &EditSite) -> Option<ViewSpec> {
-    let (w, h) = (world.level.width() as f32, world.level.height() as f32);
+fn nearest_landmark((w, h): (u32, u32), world: &World, site: &EditSite) -> Option<ViewSpec> {
+    let (w, h) = (w as f32, h as f32);
     let (cx, cy) = (site.centre_x as f32, site.centre_y as f32);
     let near = |v: &ViewSpec| {
         let dx = (v.x - cx + w / 2.0).rem_euclid(w) - w / 2.0;
@@ -419,20 +448,26 @@ fn lead_in(landmark: &ViewSpec, mut path: CameraPath) -> CameraPath {
 
 /// Put each `under` keyframe's eye halfway between floor and slab (the
 /// headroom differs from level to level); drop one with no slab above it.
-fn fit_under_slabs(mut path: CameraPath, level: &Level) -> CameraPath {
-    path.keys.retain_mut(|k| {
-        if !k.view.under {
-            return true;
+fn fit_under_slabs(mut path: CameraPath, ground: &dyn ColumnSource) -> anyhow::Result<CameraPath> {
+    let (w, h) = ground.size();
+    let mut keys = Vec::with_capacity(path.keys.len());
+    for mut k in path.keys {
+        if k.view.under {
+            let c = column_at(
+                ground,
+                k.view.x.rem_euclid(w as f32),
+                k.view.y.rem_euclid(h as f32),
+            )?;
+            let headroom = f32::from(c.mid) - f32::from(c.low);
+            k.view.eye = headroom / 2.0;
+            if !(c.dual && headroom >= 4.0) {
+                continue;
+            }
         }
-        let c = level.column_at(
-            k.view.x.rem_euclid(level.width() as f32),
-            k.view.y.rem_euclid(level.height() as f32),
-        );
-        let headroom = f32::from(c.mid) - f32::from(c.low);
-        k.view.eye = headroom / 2.0;
-        c.dual && headroom >= 4.0
-    });
-    path
+        keys.push(k);
+    }
+    path.keys = keys;
+    Ok(path)
 }
 
 /// The keyframes of [`default_path`], relative to the crater centre. The
@@ -484,6 +519,7 @@ fn around_edit_site(site: &EditSite) -> CameraPath {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use strata_level::Level;
 
     fn flat() -> Level {
         Level::flat(256, 256, 20, 1).unwrap()
@@ -578,8 +614,8 @@ mod tests {
         let c = f.camera(&level, 0.5, 8, 8).unwrap();
         assert_eq!((c.position.x, c.position.y), (246.0, 44.0));
         // An altitude in the ground is lifted above it.
-        assert_eq!(free_altitude(&level, 5.0, 5.0, 3.0), 22.0);
-        assert_eq!(free_altitude(&level, 5.0, 5.0, 30.0), 30.0);
+        assert_eq!(free_altitude(&level, 5.0, 5.0, 3.0).unwrap(), 22.0);
+        assert_eq!(free_altitude(&level, 5.0, 5.0, 30.0).unwrap(), 30.0);
     }
 
     #[test]

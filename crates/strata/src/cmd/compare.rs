@@ -117,7 +117,7 @@ struct Prepared {
 }
 
 pub fn run(args: Args) -> anyhow::Result<()> {
-    if let Some(refusal) = past_the_limit(&args)? {
+    if let Some(refusal) = past_the_limit(&args.world)? {
         return run_paged_store(&args, refusal);
     }
     let prepared = prepare(&args)?;
@@ -143,8 +143,10 @@ fn paging(args: &Args) -> Option<strata_render::paged::PagedOptions> {
 
 /// `Some(why)` when `--level` is a store past the whole-world limit (it
 /// cannot be loaded whole here): why, naming the limit.
-fn past_the_limit(args: &Args) -> anyhow::Result<Option<String>> {
-    let Some(dir) = &args.world.level else {
+pub(crate) fn past_the_limit(
+    world: &crate::world_arg::WorldArgs,
+) -> anyhow::Result<Option<String>> {
+    let Some(dir) = &world.level else {
         return Ok(None);
     };
     if !matches!(

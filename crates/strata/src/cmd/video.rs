@@ -8,12 +8,19 @@ use crate::paged_arg::{PagedArgs, PagedWorld};
 use crate::world_arg::WorldArgs;
 use anyhow::Context;
 use indicatif::{ProgressBar, ProgressStyle};
+use std::collections::HashSet;
 use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
 use std::time::Instant;
 use strata_bench::plan::{MethodChoice, every_method, parse_methods, parse_size};
 use strata_bench::video::encode::{self, Ffmpeg, FrameSink, PngDir};
-use strata_bench::video::path::{CameraPath, default_path};
-use strata_bench::video::{self, VideoOptions, tiles};
+use strata_bench::video::path::{CameraPath, default_path, default_path_over};
+use strata_bench::video::{self, PagedTerrain, VideoOptions, tiles};
+use strata_level::EditSite;
+use strata_level::source::{ColumnSource, SourceError, SourceTile};
+use strata_render::paged::PageData;
+use strata_store::ChunkCache;
+use strata_viewer::paged::{Base, EditedPages, Planes};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -89,6 +96,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         }
         encode::check_ffmpeg()?;
     }
+    // A store past the whole-world limit is never loaded whole: its
+    // ground is read through the store's chunk cache and drawn through pages.
+    if let Some(refusal) = past_the_limit(&args.world)? {
+        let methods = paged_methods(args.methods.is_some(), methods, &refusal)?;
+        return run_paged_store(&args, methods, (width, height), file_path);
+    }
     let world = args.world.load()?;
     let mut path = file_path.unwrap_or_else(|| default_path(&world));
     if let Some(d) = args.duration {
@@ -101,17 +114,46 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     // Fail on a keyframe inside terrain now, not after the GPU is up.
     path.resolve(&world.level).context("the camera path")?;
 
-    let tile = tiles::tile_size(methods.len(), width, height);
-    let opts = VideoOptions {
+    let opts = options(&args, methods, (width, height), paging(&args));
+    let recorded = |gpu: &strata_render::Gpu, sink: &mut dyn FrameSink, bar: &ProgressBar| {
+        video::record(gpu, &world, &path, &opts, Some(sink), bar)
+    };
+    film(&args, &opts, &path, (width, height), recorded)
+}
+
+/// The video's options from the flags.
+fn options(
+    args: &Args,
+    methods: Vec<MethodChoice>,
+    (width, height): (u32, u32),
+    paging: Option<strata_render::paged::PagedOptions>,
+) -> VideoOptions {
+    VideoOptions {
+        tile: tiles::tile_size(methods.len(), width, height),
         methods,
-        tile,
         frame: Some((width, height)),
         fps: args.fps,
         shadows: !args.no_shadows,
         temporal: !args.no_temporal,
         overlap: None,
-        paging: paging(&args),
-    };
+        paging,
+    }
+}
+
+/// Open the GPU and the sink, record the frames (`record`), and write the
+/// sidecar and the summary.
+fn film(
+    args: &Args,
+    opts: &VideoOptions,
+    path: &CameraPath,
+    (width, height): (u32, u32),
+    record: impl FnOnce(
+        &strata_render::Gpu,
+        &mut dyn FrameSink,
+        &ProgressBar,
+    ) -> anyhow::Result<video::Recording>,
+) -> anyhow::Result<()> {
+    let tile = opts.tile;
     let gpu = args.adapter.open()?;
     eprintln!(
         "adapter: {} ({}); {} method(s) in {}x{} tiles, {} frames at {} fps",
@@ -140,7 +182,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let start = Instant::now();
-    let recorded = video::record(&gpu, &world, &path, &opts, Some(sink.as_mut()), &bar);
+    let recorded = record(&gpu, sink.as_mut(), &bar);
     bar.finish_and_clear();
     let mut recording = recorded?;
     let written = sink.finish()?;
@@ -154,6 +196,217 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     println!("wrote {}", sidecar.display());
     summarize(&recording);
     Ok(())
+}
+
+/// Why a whole world cannot be loaded from `--level`, when it is a store
+/// past the whole-world limit (the memory a whole world may take here, as
+/// `compare` says, or the texels one texture holds).
+fn past_the_limit(world: &WorldArgs) -> anyhow::Result<Option<String>> {
+    if let Some(refusal) = crate::cmd::compare::past_the_limit(world)? {
+        return Ok(Some(refusal));
+    }
+    let Some(dir) = world.level.as_ref().filter(|d| {
+        matches!(
+            strata_store::fs::dir_kind(d),
+            Ok(strata_store::fs::DirKind::Store)
+        )
+    }) else {
+        return Ok(None);
+    };
+    let store = strata_store::DirStore::open(dir)
+        .with_context(|| format!("opening the store in {}", dir.display()))?;
+    let (w, h) = (store.store().width(), store.store().height());
+    Ok((u64::from(w) * u64::from(h) > strata_level::generate::MAX_TEXELS).then(|| {
+        format!(
+            "the store in {} is {w}x{h} texels, past the whole-world limit of {} texels (one GPU texture)",
+            dir.display(),
+            strata_level::generate::MAX_TEXELS
+        )
+    }))
+}
+
+/// The methods that can draw a store past the limit: those asked for, each
+/// of them paged (another is refused, naming the limit and the paged
+/// methods), or every paged method when none was asked for.
+fn paged_methods(
+    asked: bool,
+    methods: Vec<MethodChoice>,
+    refusal: &str,
+) -> anyhow::Result<Vec<MethodChoice>> {
+    use strata_render::paged::PAGED_METHODS;
+    let paged = |m: &MethodChoice| PAGED_METHODS.contains(&m.method.name);
+    if asked {
+        if let Some(m) = methods.iter().find(|m| !paged(m)) {
+            anyhow::bail!(
+                "{refusal}: `{}` draws whole worlds only; the methods that draw it through pages are {}",
+                m.method.name,
+                PAGED_METHODS.join(", ")
+            );
+        }
+        return Ok(methods);
+    }
+    eprintln!(
+        "note: {refusal}; filming the methods that draw it through pages: {}",
+        PAGED_METHODS.join(", ")
+    );
+    Ok(methods.into_iter().filter(paged).collect())
+}
+
+/// Film a store past the whole-world limit: its ground (eye heights, the
+/// dig site) read through the store's chunk cache, every method drawing
+/// pages, and the crater dug into an edit layer over the pages (the
+/// viewer's), never into the store on disk.
+fn run_paged_store(
+    args: &Args,
+    methods: Vec<MethodChoice>,
+    size: (u32, u32),
+    file_path: Option<CameraPath>,
+) -> anyhow::Result<()> {
+    let Some(paged) = crate::paged_arg::open_paged(&args.world, &args.paged)? else {
+        anyhow::bail!("the store could not be opened for paged drawing");
+    };
+    let (Some(cache), Some(dir)) = (paged.cache().cloned(), paged.dir.clone()) else {
+        anyhow::bail!("the world past the limit is not a store");
+    };
+    let shell = strata_store::DirStore::open(&dir)
+        .with_context(|| format!("opening the store in {}", dir.display()))?
+        .store()
+        .world_shell()
+        .with_context(|| format!("reading the world in {}", dir.display()))?;
+    let terrain = store_terrain(cache, dir, args.world.mid_rule())?;
+    let mut path = match file_path {
+        Some(p) => p,
+        None => default_path_over(&shell, &*terrain.columns).context("the default path")?,
+    };
+    if let Some(d) = args.duration {
+        path = path.retimed(d);
+    }
+    if args.print_path {
+        print!("{}", path.to_text());
+        return Ok(());
+    }
+    // Fail on a keyframe inside terrain now, not after the GPU is up.
+    path.resolve(&*terrain.columns).context("the camera path")?;
+    let opts = options(args, methods, size, Some(PagedWorld::options(&args.paged)));
+    let recorded = |gpu: &strata_render::Gpu, sink: &mut dyn FrameSink, bar: &ProgressBar| {
+        video::record_paged(gpu, &shell, &terrain, &path, &opts, Some(sink), bar)
+    };
+    film(args, &opts, &path, size, recorded)
+}
+
+/// A store's pages with an edit layer over them (the viewer's), read by
+/// the renderers, the camera path and the CPU reference alike.
+fn store_terrain(
+    cache: Arc<ChunkCache>,
+    dir: PathBuf,
+    mid_rule: strata_level::MidRule,
+) -> anyhow::Result<PagedTerrain> {
+    let page = strata_render::paged::PAGE;
+    if cache.tile_shape() != (page, page) {
+        anyhow::bail!(
+            "the store's chunks are {:?} texels; paged drawing needs {page}x{page}",
+            cache.tile_shape()
+        );
+    }
+    let pages = Arc::new(EditedPages::new(
+        Base::Store {
+            cache: cache.clone(),
+            dir,
+        },
+        mid_rule,
+    )?);
+    let columns = Arc::new(DugColumns {
+        pages: pages.clone(),
+        cache,
+        dug: Mutex::new(HashSet::new()),
+    });
+    let dig = {
+        let (pages, columns) = (pages.clone(), columns.clone());
+        move |site: &EditSite| -> anyhow::Result<Vec<u32>> {
+            let dug = pages.dig(site)?;
+            columns
+                .dug
+                .lock()
+                .expect("dug lock")
+                .extend(dug.chunks.iter().copied());
+            Ok(dug.chunks)
+        }
+    };
+    Ok(PagedTerrain {
+        pages,
+        columns,
+        dig: Box::new(dig),
+    })
+}
+
+/// A store's columns with the chunks dug into its edit layer read from
+/// the layer (the others straight from the chunk cache, its summaries
+/// and per-chunk pyramids kept).
+struct DugColumns {
+    pages: Arc<EditedPages>,
+    cache: Arc<ChunkCache>,
+    /// Chunks dug (grid row-major).
+    dug: Mutex<HashSet<u32>>,
+}
+
+/// A dug chunk's planes as a tile.
+struct DugTile(Arc<Planes>);
+
+impl SourceTile for DugTile {
+    fn planes(&self) -> (&[u8], &[u8]) {
+        (&self.0.heights, &self.0.metas)
+    }
+}
+
+impl DugColumns {
+    fn is_dug(&self, ty: u64, tx: u64) -> Option<u32> {
+        let gx = u64::from(self.pages.grid().0);
+        let index = u32::try_from(ty * gx + tx).ok()?;
+        self.dug
+            .lock()
+            .expect("dug lock")
+            .contains(&index)
+            .then_some(index)
+    }
+}
+
+impl ColumnSource for DugColumns {
+    fn size(&self) -> (u32, u32) {
+        self.cache.size()
+    }
+    fn mid_rule(&self) -> strata_level::MidRule {
+        ColumnSource::mid_rule(&*self.cache)
+    }
+    fn tile_shape(&self) -> (u32, u32) {
+        self.cache.tile_shape()
+    }
+    fn tile(&self, ty: u64, tx: u64) -> Result<Arc<dyn SourceTile + '_>, SourceError> {
+        if self.is_dug(ty, tx).is_none() {
+            return self.cache.tile(ty, tx);
+        }
+        let planes = self
+            .pages
+            .planes(tx as u32, ty as u32)
+            .map_err(SourceError)?;
+        Ok(Arc::new(DugTile(planes)))
+    }
+    fn tile_tops(&self) -> Result<Option<Vec<u8>>, SourceError> {
+        let dug: Vec<u32> = self.dug.lock().expect("dug lock").iter().copied().collect();
+        let Some(mut tops) = self.cache.tile_tops()? else {
+            return Ok(None);
+        };
+        for index in dug {
+            let gx = self.pages.grid().0;
+            let p = self
+                .pages
+                .planes(index % gx, index / gx)
+                .map_err(SourceError)?;
+            tops[index as usize] = PageData::from_planes(&p.heights, &p.metas, self.mid_rule(), 1)
+                .map_err(SourceError)?
+                .top(1);
+        }
+        Ok(Some(tops))
+    }
 }
 
 fn choose_methods(list: Option<&str>) -> anyhow::Result<Vec<MethodChoice>> {
