@@ -6,9 +6,12 @@
 //!
 //! Every float is computed as the reference computes it (the segment ends
 //! from the crossed texel line's own coordinate, f64 throughout), so a hit
-//! here is the reference's hit: same column, same distance.
+//! here is the reference's hit: same column, same distance. The float
+//! steps themselves (`texel_after`, `boundary_t`, the column entry) are
+//! `strata_level::ray`, which both tracers call.
 
 use crate::columns::{Columns, LOG_RATIO, Packed};
+use strata_level::ray;
 
 /// How a ray met a column: what [`crate::RayHit::normal`] is made from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -35,51 +38,6 @@ pub(crate) struct Hit {
     pub terrain: u8,
 }
 
-/// The texel containing `p + eps d`: a point on a texel line belongs to the
-/// side the ray moves into.
-#[inline]
-fn texel_after(p: f64, d: f64) -> i64 {
-    // floor(p) without `f64::floor` (a libm call on baseline x86-64): exact
-    // for |p| < 2^63, and the callers keep |p| below 2^41.
-    let mut c = p as i64;
-    if c as f64 > p {
-        c -= 1;
-    }
-    if c as f64 == p && d < 0.0 { c - 1 } else { c }
-}
-
-/// Ray parameter where it leaves cell `c` (of side `size`) along one axis.
-#[inline]
-fn boundary_t(o: f64, d: f64, c: i64, size: f64) -> f64 {
-    if d > 0.0 {
-        ((c + 1) as f64 * size - o) / d
-    } else if d < 0.0 {
-        (c as f64 * size - o) / d
-    } else {
-        f64::INFINITY
-    }
-}
-
-/// First `t` in `[t0, t1]` with `a <= oz + t dz <= b`.
-#[inline]
-fn interval_entry(a: f64, b: f64, oz: f64, dz: f64, t0: f64, t1: f64) -> Option<f64> {
-    if t1 < t0 {
-        return None;
-    }
-    let (lo, hi) = if dz == 0.0 {
-        if a <= oz && oz <= b {
-            (f64::NEG_INFINITY, f64::INFINITY)
-        } else {
-            return None;
-        }
-    } else {
-        let (ta, tb) = ((a - oz) / dz, (b - oz) / dz);
-        (ta.min(tb), ta.max(tb))
-    };
-    let enter = lo.max(t0);
-    (enter <= hi.min(t1)).then_some(enter)
-}
-
 /// The first solid point of the segment `[t0, t1]` in column `c`; `entry`
 /// says `t0` is where the ray entered the column (solid there: a wall).
 #[inline]
@@ -91,19 +49,8 @@ fn column_hit(
     t1: f64,
     entry: bool,
 ) -> Option<(f64, Face, u8)> {
-    let floor = interval_entry(f64::NEG_INFINITY, f64::from(c.low()), oz, dz, t0, t1);
-    let slab = if c.dual() {
-        interval_entry(f64::from(c.mid()), f64::from(c.high()), oz, dz, t0, t1)
-    } else {
-        None
-    };
-    // The earlier entry wins; on a tie the floor.
-    let (t, is_slab) = match (floor, slab) {
-        (Some(f), Some(s)) if s < f => (s, true),
-        (Some(f), _) => (f, false),
-        (None, Some(s)) => (s, true),
-        (None, None) => return None,
-    };
+    let slab = c.dual().then(|| (c.mid(), c.high()));
+    let (t, is_slab) = ray::column_entry(c.low(), slab, oz, dz, t0, t1)?;
     let face = if entry && t <= t0 {
         Face::Wall { across_x: false }
     } else if !is_slab {
@@ -145,8 +92,8 @@ impl Columns {
         let step_x: i64 = if d[0] > 0.0 { 1 } else { -1 };
         let step_y: i64 = if d[1] > 0.0 { 1 } else { -1 };
         let (tx0, ty0) = (
-            texel_after(o[0] + d[0] * t, d[0]),
-            texel_after(o[1] + d[1] * t, d[1]),
+            ray::texel_after(o[0] + d[0] * t, d[0]),
+            ray::texel_after(o[1] + d[1] * t, d[1]),
         );
         let mut lvl = top;
         let mut cx = tx0 >> (LOG_RATIO as usize * lvl);
@@ -161,10 +108,10 @@ impl Columns {
             let shift = LOG_RATIO as usize * lvl;
             let size = (1i64 << shift) as f64;
             if new_x {
-                tx = boundary_t(o[0], d[0], cx, size);
+                tx = ray::boundary_t(o[0], d[0], cx, size);
             }
             if new_y {
-                ty = boundary_t(o[1], d[1], cy, size);
+                ty = ray::boundary_t(o[1], d[1], cy, size);
             }
             (new_x, new_y) = (false, false);
             let t_exit = tx.min(ty);
@@ -176,8 +123,8 @@ impl Columns {
                     lvl -= 1;
                     let child_shift = shift - LOG_RATIO as usize;
                     let (ax, ay) = (
-                        texel_after(o[0] + d[0] * t, d[0]),
-                        texel_after(o[1] + d[1] * t, d[1]),
+                        ray::texel_after(o[0] + d[0] * t, d[0]),
+                        ray::texel_after(o[1] + d[1] * t, d[1]),
                     );
                     let first = |c: i64| c << LOG_RATIO;
                     let last = |c: i64| (c << LOG_RATIO) + (1 << LOG_RATIO) - 1;

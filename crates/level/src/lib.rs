@@ -97,6 +97,7 @@ pub mod lcg;
 pub mod lod;
 pub mod model;
 pub mod palette;
+pub mod ray;
 pub mod save;
 pub mod source;
 pub mod stats;

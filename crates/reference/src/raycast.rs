@@ -14,6 +14,7 @@ use serde::{Deserialize, Serialize};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use strata_camera::Camera;
+use strata_level::ray;
 use strata_level::source::{ColumnSource, SourceError};
 use strata_level::{Column, Level};
 
@@ -380,8 +381,8 @@ fn march<G: Grid>(
     loop {
         let shift = LOG_RATIO as usize * lvl;
         let size = (1i64 << shift) as f64;
-        let tx = boundary_t(o.x, d.x, cx, size);
-        let ty = boundary_t(o.y, d.y, cy, size);
+        let tx = ray::boundary_t(o.x, d.x, cx, size);
+        let ty = ray::boundary_t(o.y, d.y, cy, size);
         let t_exit = tx.min(ty);
         let t_out = t_exit.min(t_end);
         if lvl > 0 {
@@ -445,26 +446,7 @@ fn march<G: Grid>(
 /// belongs to the side the ray is moving into.
 #[inline]
 fn texel_after(p: DVec3, d: DVec3) -> (i64, i64) {
-    let axis = |v: f64, dv: f64| {
-        let f = v.floor();
-        let c = f as i64;
-        if f == v && dv < 0.0 { c - 1 } else { c }
-    };
-    (axis(p.x, d.x), axis(p.y, d.y))
-}
-
-/// Ray parameter where it leaves cell `c` (of side `size`) along one axis.
-/// Computed from the boundary's own coordinate, never accumulated, so the
-/// same texel line gives the same float at every level and subdivision.
-#[inline]
-fn boundary_t(o: f64, d: f64, c: i64, size: f64) -> f64 {
-    if d > 0.0 {
-        ((c + 1) as f64 * size - o) / d
-    } else if d < 0.0 {
-        (c as f64 * size - o) / d
-    } else {
-        f64::INFINITY
-    }
+    (ray::texel_after(p.x, d.x), ray::texel_after(p.y, d.y))
 }
 
 /// First point of the segment `[t0, t1]` inside one of the column's solid
@@ -472,19 +454,8 @@ fn boundary_t(o: f64, d: f64, c: i64, size: f64) -> f64 {
 /// the ray entered the column (so being solid there means a wall).
 #[inline]
 fn column_hit(c: &Column, o: DVec3, d: DVec3, t0: f64, t1: f64, entry: bool) -> Option<RayHit> {
-    let floor = interval_entry(f64::NEG_INFINITY, f64::from(c.low), o.z, d.z, t0, t1);
-    let slab = if c.dual {
-        interval_entry(f64::from(c.mid), f64::from(c.high), o.z, d.z, t0, t1)
-    } else {
-        None
-    };
-    // The earlier entry wins; on a tie the floor (the lower interval).
-    let (t, is_slab) = match (floor, slab) {
-        (Some(f), Some(s)) if s < f => (s, true),
-        (Some(f), _) => (f, false),
-        (None, Some(s)) => (s, true),
-        (None, None) => return None,
-    };
+    let slab = c.dual.then_some((c.mid, c.high));
+    let (t, is_slab) = ray::column_entry(c.low, slab, o.z, d.z, t0, t1)?;
     let class = if entry && t <= t0 {
         HitClass::Wall
     } else if !is_slab {
@@ -501,26 +472,6 @@ fn column_hit(c: &Column, o: DVec3, d: DVec3, t0: f64, t1: f64, entry: bool) -> 
         // Filled in by the traversal, which knows the column's coordinates.
         column: [0, 0],
     })
-}
-
-/// First `t` in `[t0, t1]` with `a <= oz + t dz <= b`, if any.
-#[inline]
-fn interval_entry(a: f64, b: f64, oz: f64, dz: f64, t0: f64, t1: f64) -> Option<f64> {
-    if t1 < t0 {
-        return None;
-    }
-    let (lo, hi) = if dz == 0.0 {
-        if a <= oz && oz <= b {
-            (f64::NEG_INFINITY, f64::INFINITY)
-        } else {
-            return None;
-        }
-    } else {
-        let (ta, tb) = ((a - oz) / dz, (b - oz) / dz);
-        (ta.min(tb), ta.max(tb))
-    };
-    let enter = lo.max(t0);
-    (enter <= hi.min(t1)).then_some(enter)
 }
 
 /// [`column_hit`] over the segment cut at every `1/sub` texel line: the
@@ -552,8 +503,8 @@ fn subdivided_hit(
     let (mut sx, mut sy) = (inside(p.x, d.x, cx), inside(p.y, d.y, cy));
     let mut t = t0;
     loop {
-        let tx = boundary_t(o.x, d.x, sx, size);
-        let ty = boundary_t(o.y, d.y, sy, size);
+        let tx = ray::boundary_t(o.x, d.x, sx, size);
+        let ty = ray::boundary_t(o.y, d.y, sy, size);
         let t_exit = tx.min(ty);
         if let Some(hit) = column_hit(c, o, d, t, t_exit.min(t1), entry) {
             return Some(hit);

@@ -152,5 +152,8 @@ fn collide_reports_its_numbers() {
     assert!(v["hits_both"].as_u64().unwrap() > 400, "{v}");
     assert!(v["agree_percent"].as_f64().unwrap() >= 99.0, "{v}");
     assert!(v["grazing_agree_percent"].as_f64().unwrap() >= 99.0, "{v}");
-    assert!(v["edit_frame_refit_ms_median"].as_f64().unwrap() >= 0.0, "{v}");
+    assert!(
+        v["edit_frame_refit_ms_median"].as_f64().unwrap() >= 0.0,
+        "{v}"
+    );
 }
