@@ -2,7 +2,7 @@
 //!
 //! Coordinates are unwrapped world units (texels in x and y, altitude in z);
 //! the map is a torus, so a query anywhere sees the map repeated. Ray casts
-//! walk the columns in f64 ([`crate::ray`]); box queries run against the
+//! walk the columns in f64 (`ray.rs`); box queries run against the
 //! contact surfaces ([`crate::surface`]) built over the box's footprint, in
 //! a frame centred near the box so f32 stays exact however far the map
 //! extends.

@@ -8,9 +8,9 @@
 //!   read instead ([`PagedTerrain::request`]): those of the chunk's samples
 //!   and a margin of [`COLOUR_MARGIN`] texels around them for the colour
 //!   window, merged with what the shadow pass's feedback asks for.
-//! - **Fits** run on worker threads ([`Fitter`]), nearest chunk copy first,
+//! - **Fits** run on worker threads (`Fitter`), nearest chunk copy first,
 //!   each reading only the pages its samples lie in; no frame waits on one.
-//!   Fitted chunks go into an index pool of a fixed size ([`PagedPool`]),
+//!   Fitted chunks go into an index pool of a fixed size (`PagedPool`),
 //!   least recently drawn evicted first.
 //! - **Budget**: the pool takes [`POOL_SHARE`] of `--gpu-budget` (after the
 //!   draw records), the atlas's plan the rest; [`PagingStats`] reports the
@@ -174,7 +174,7 @@ const UNIFORM: wgpu::BufferBindingType = wgpu::BufferBindingType::Uniform;
 /// Build the paged mesh over `paged` (whose atlas is `shared`'s terrain
 /// texture, planned with [`PYRAMID_STEP`] from [`split_budget`]'s options),
 /// with an index pool of `pool_bytes` within `budget`; `threads` is the
-/// paging's reader threads (fits get [`fit_threads`]).
+/// paging's reader threads (fits get `fit_threads`).
 pub fn build(
     shared: &Shared,
     paged: PagedTerrain,
