@@ -11,7 +11,7 @@ use crate::methods::{describe, settings_for};
 use crate::plan::{MethodChoice, file_part, source_revision};
 use crate::results::*;
 use crate::run::{CONVERGE_FRAMES, Measured, Options, row_of};
-use crate::session::{GridMode, Session, color_image, reference_image};
+use crate::session::{GridMode, Session, color_image};
 use crate::warm::{ms, warm_up};
 use anyhow::Context;
 use std::path::PathBuf;
@@ -116,16 +116,7 @@ pub fn run(
         let r = tracer
             .try_render(camera, &ReferenceSettings::default())
             .with_context(|| format!("reference of view `{}`", view.name))?;
-        let image = session.save_picture(
-            GridMode::Pictures,
-            (v, 0),
-            &format!("{}-reference", view.name),
-            reference_image(&r, camera.far),
-        )?;
-        session.results.reference_images.push(ViewImage {
-            view: view.name.clone(),
-            image,
-        });
+        session.save_reference(v, &view.name, &r, camera.far)?;
         references.push(r);
     }
     for (m, choice) in opts.methods.iter().enumerate() {

@@ -7,7 +7,7 @@ use crate::edits;
 use crate::methods::{describe, settings_for};
 use crate::plan::{MethodChoice, check_view_names, file_part, prepare_out_dir, source_revision};
 use crate::results::*;
-use crate::session::{GridMode, Session, color_image, reference_image};
+use crate::session::{GridMode, Session, color_image};
 use crate::stats::summarize;
 use crate::video;
 pub use crate::warm::{INCREMENTAL_BUDGET_TEXELS, WarmUp, build_frames, ms, warm_up};
@@ -486,16 +486,7 @@ impl Plan {
                         .0
                 }
             };
-            let image = session.save_picture(
-                GridMode::Pictures,
-                (v, 0),
-                &format!("{}-reference", view.name),
-                reference_image(&r, camera.far),
-            )?;
-            session.results.reference_images.push(ViewImage {
-                view: view.name.clone(),
-                image,
-            });
+            session.save_reference(v, &view.name, &r, camera.far)?;
             out.push(r);
             bar.inc(1);
         }

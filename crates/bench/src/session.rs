@@ -101,6 +101,30 @@ impl Session {
         Ok(rel)
     }
 
+    /// Save view `v`'s CPU reference picture (its first grid column) and
+    /// list it in the results.
+    pub fn save_reference(
+        &mut self,
+        v: usize,
+        view: &str,
+        reference: &strata_reference::Reference,
+        far: f32,
+    ) -> anyhow::Result<()> {
+        let image = self.save_picture(
+            GridMode::Pictures,
+            (v, 0),
+            &format!("{view}-reference"),
+            reference_image(reference, far),
+        )?;
+        self.results
+            .reference_images
+            .push(crate::results::ViewImage {
+                view: view.to_string(),
+                image,
+            });
+        Ok(())
+    }
+
     /// Rewrite `grid.png` and `report.md`.
     pub fn save_report(&self) -> anyhow::Result<PathBuf> {
         let rows: Vec<String> = self

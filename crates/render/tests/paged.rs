@@ -39,7 +39,7 @@ fn paged(
     )
 }
 
-use common::paged::{converge_paged as converge, store_pages, temp_store, world};
+use common::paged::{converge_paged as converge, level_pages, store_pages, temp_store, world};
 
 #[test]
 fn a_world_four_times_the_budget_converges_to_the_whole_world_image() {
@@ -49,7 +49,7 @@ fn a_world_four_times_the_budget_converges_to_the_whole_world_image() {
     }
     let w = world();
     let colors = TerrainColors::from_world(&w);
-    let source: Arc<dyn PageSource> = Arc::new(LevelPages::new(Arc::new(w.level.clone())).unwrap());
+    let source = level_pages(&w);
     for gpu in gpus {
         for method in ["ray-exact", "ray-exact-fragment"] {
             let mut whole = Renderer::new(
@@ -124,7 +124,7 @@ fn a_budget_too_small_is_refused_with_the_smallest_that_works() {
     }
     let w = world();
     let colors = TerrainColors::from_world(&w);
-    let source: Arc<dyn PageSource> = Arc::new(LevelPages::new(Arc::new(w.level.clone())).unwrap());
+    let source = level_pages(&w);
     for gpu in gpus {
         let err = paged(&gpu, source.clone(), &colors, "ray-exact", 100_000)
             .err()

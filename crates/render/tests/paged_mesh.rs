@@ -9,7 +9,7 @@ mod common;
 
 use std::sync::Arc;
 use strata_camera::Camera;
-use strata_render::paged::{LevelPages, PageSource, PagedOptions};
+use strata_render::paged::{PageSource, PagedOptions};
 use strata_render::{MethodSettings, Renderer, TerrainColors};
 
 const W: u32 = 160;
@@ -41,7 +41,7 @@ fn paged(
     )
 }
 
-use common::paged::{converge_paged as converge, world};
+use common::paged::{converge_paged as converge, level_pages, world};
 
 fn differing(a: &[f32], b: &[f32]) -> usize {
     a.iter().zip(b).filter(|(x, y)| x != y).count()
@@ -55,7 +55,7 @@ fn a_world_four_times_the_budget_converges_to_the_whole_world_mesh() {
     }
     let w = world();
     let colors = TerrainColors::from_world(&w);
-    let source: Arc<dyn PageSource> = Arc::new(LevelPages::new(Arc::new(w.level.clone())).unwrap());
+    let source = level_pages(&w);
     for gpu in gpus {
         let settings = MethodSettings::default();
         let mut whole = Renderer::new(&gpu, &w.level, &colors, "mesh", &settings, W, H).unwrap();

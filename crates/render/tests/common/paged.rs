@@ -16,6 +16,14 @@ pub fn world() -> World {
     .expect("generated world")
 }
 
+/// Pages cut from `w`'s level in memory.
+pub fn level_pages(w: &World) -> std::sync::Arc<dyn strata_render::paged::PageSource> {
+    std::sync::Arc::new(
+        strata_render::paged::LevelPages::new(std::sync::Arc::new(w.level.clone()))
+            .expect("a paged world"),
+    )
+}
+
 /// `w` written as a store in a fresh temporary directory named for `what`.
 pub fn temp_store(w: &World, what: &str) -> (std::path::PathBuf, strata_store::DirStore) {
     let dir = std::env::temp_dir().join(format!("strata-paged-{what}-{}", std::process::id()));
