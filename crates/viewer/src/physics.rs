@@ -1,6 +1,6 @@
 //! The physics toy (`--physics`, key O): rigid bodies (strata-physics,
 //! rapier3d) dropped where the user clicks, on the terrain collider that
-//! follows the viewer's digs. The collider is fitted on a thread when the
+//! follows the viewer's digs. The collider is built on a thread when the
 //! toy is first switched on; digs made meanwhile are applied when it lands.
 //! Natively only: in a browser the toy says so and stays off.
 

@@ -22,7 +22,7 @@ enum Running {
     WaitMethod(String),
     /// Until no build runs (a changed knob's rebuild).
     WaitBuilds,
-    /// Until the physics toy's collider is fitted.
+    /// Until the physics toy's collider is built.
     WaitPhysics,
     /// Until this many scores have finished (their read-backs arrive later).
     WaitScore(u32),
