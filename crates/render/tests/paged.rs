@@ -23,6 +23,27 @@ fn paged(
     method: &str,
     budget: u64,
 ) -> anyhow::Result<Renderer> {
+    paged_with(
+        gpu,
+        source,
+        colors,
+        method,
+        PagedOptions {
+            gpu_budget: budget,
+            upload_pages: 4,
+            ..Default::default()
+        },
+    )
+}
+
+/// A paged renderer of `source` at the test size with `options`.
+fn paged_with(
+    gpu: &strata_render::Gpu,
+    source: Arc<dyn PageSource>,
+    colors: &TerrainColors,
+    method: &str,
+    options: PagedOptions,
+) -> anyhow::Result<Renderer> {
     Renderer::new_paged(
         gpu,
         source,
@@ -31,11 +52,7 @@ fn paged(
         &MethodSettings::default(),
         W,
         H,
-        PagedOptions {
-            gpu_budget: budget,
-            upload_pages: 4,
-            ..Default::default()
-        },
+        options,
     )
 }
 
@@ -181,14 +198,11 @@ fn lod_renderer(
     method: &str,
     lod_pixels: f32,
 ) -> Renderer {
-    Renderer::new_paged(
+    paged_with(
         gpu,
         source,
         colors,
         method,
-        &MethodSettings::default(),
-        W,
-        H,
         PagedOptions {
             gpu_budget: 16 << 20,
             upload_pages: 16,
