@@ -10,7 +10,7 @@
 use crate::methods::{describe, settings_for};
 use crate::plan::{MethodChoice, file_part, source_revision};
 use crate::results::*;
-use crate::run::{CONVERGE_FRAMES, Measured, Options, row_of};
+use crate::run::{CONVERGE_FRAMES, Measured, Options, adapter_info, row_of};
 use crate::session::{GridMode, Session, color_image};
 use crate::warm::{ms, warm_up};
 use anyhow::Context;
@@ -68,14 +68,7 @@ pub fn run(
             width: input.size.0,
             height: input.size.1,
         },
-        adapter: AdapterInfo {
-            name: gpu.report.name.clone(),
-            backend: gpu.report.backend.clone(),
-            driver: format!("{} {}", gpu.report.driver, gpu.report.driver_info)
-                .trim()
-                .to_string(),
-            timestamps: gpu.report.timestamps,
-        },
+        adapter: adapter_info(gpu),
         settings: Settings {
             width: w,
             height: h,

@@ -203,14 +203,7 @@ impl Plan {
                 width: level.width(),
                 height: level.height(),
             },
-            adapter: AdapterInfo {
-                name: gpu.report.name.clone(),
-                backend: gpu.report.backend.clone(),
-                driver: format!("{} {}", gpu.report.driver, gpu.report.driver_info)
-                    .trim()
-                    .to_string(),
-                timestamps: gpu.report.timestamps,
-            },
+            adapter: adapter_info(gpu),
             settings: Settings {
                 width: self.opts.width,
                 height: self.opts.height,
@@ -882,4 +875,16 @@ fn save_edit_pictures(
         after,
     });
     Ok(())
+}
+
+/// The results file's record of the adapter `gpu` runs on.
+pub(crate) fn adapter_info(gpu: &strata_render::Gpu) -> AdapterInfo {
+    AdapterInfo {
+        name: gpu.report.name.clone(),
+        backend: gpu.report.backend.clone(),
+        driver: format!("{} {}", gpu.report.driver, gpu.report.driver_info)
+            .trim()
+            .to_string(),
+        timestamps: gpu.report.timestamps,
+    }
 }
