@@ -4,6 +4,7 @@
 
 use crate::caps::Capabilities;
 use crate::gpu::{AdapterReport, ErrorSink, Gpu};
+use anyhow::Context;
 use serde::Serialize;
 use std::sync::Arc;
 
@@ -156,12 +157,30 @@ pub fn list_adapters(backend: BackendChoice) -> Vec<AdapterListing> {
         .into_iter()
         .enumerate()
         .map(|(index, adapter)| {
-            let info = adapter.get_info();
+            let mut refused = (adapter.get_info().backend == wgpu::Backend::Gl)
+                .then(|| check_gl_adapter(&adapter).err())
+                .flatten();
+            // As `Gpu::open` does: wgpu's GL context mis-binds, Strata's own may not.
+            let mut own_context = None;
+            let mut adapter = adapter;
+            if refused
+                .as_ref()
+                .is_some_and(|e| e.is::<crate::self_check::BindingsMisread>())
+                && let Some((own, context)) = own_gl_adapter(&instance)
+            {
+                (adapter, own_context, refused) = (own, Some(context), None);
+            }
+            let mut info = adapter.get_info();
+            if let Some(context) = &own_context {
+                info.driver_info = format!(
+                    "{} (Strata's own EGL context, {context}; wgpu's own misreads bindings: \
+                     bench/gl-repro)",
+                    info.driver_info
+                );
+            }
+            let refused = refused.map(|e| format!("{e:#}"));
             let (features, limits) = device_request(&adapter);
             let capabilities = Capabilities::of(&adapter, &limits, features);
-            let refused = (info.backend == wgpu::Backend::Gl)
-                .then(|| check_gl_adapter(&adapter).err().map(|e| format!("{e:#}")))
-                .flatten();
             let methods = crate::methods::METHODS
                 .iter()
                 .map(|entry| MethodSupport {
@@ -185,6 +204,22 @@ pub fn list_adapters(backend: BackendChoice) -> Vec<AdapterListing> {
             }
         })
         .collect()
+}
+
+/// A GL adapter on a context Strata makes, if it passes the self-check, and
+/// the context's description.
+#[cfg(all(unix, not(target_vendor = "apple"), not(target_arch = "wasm32")))]
+fn own_gl_adapter(instance: &wgpu::Instance) -> Option<(wgpu::Adapter, String)> {
+    let (adapter, context) = crate::gl_context::open(instance).ok()?;
+    check_gl_adapter(&adapter).ok()?;
+    // The listing makes no device on it later (only limits and features):
+    // the context may go.
+    Some((adapter, context.description.clone()))
+}
+
+#[cfg(not(all(unix, not(target_vendor = "apple"), not(target_arch = "wasm32"))))]
+fn own_gl_adapter(_instance: &wgpu::Instance) -> Option<(wgpu::Adapter, String)> {
+    None
 }
 
 /// Make a device on a GL adapter and run the self-check on it.
@@ -250,7 +285,48 @@ impl Gpu {
         surface: Option<&wgpu::Surface<'_>>,
         choice: &AdapterChoice,
     ) -> anyhow::Result<Self> {
-        pollster::block_on(Self::with_instance_async(instance, surface, choice))
+        // `STRATA_GL_OWN_CONTEXT=1`: headless GL on Strata's own context
+        // even where wgpu's works (tests it on Mesa, measures it).
+        if surface.is_none()
+            && choice.backend == BackendChoice::Gl
+            && std::env::var_os("STRATA_GL_OWN_CONTEXT").is_some_and(|v| v == "1")
+        {
+            return Self::on_own_gl_context(
+                instance,
+                anyhow::anyhow!("STRATA_GL_OWN_CONTEXT=1 asked for Strata's own GL context"),
+            );
+        }
+        match pollster::block_on(Self::with_instance_async(instance.clone(), surface, choice)) {
+            // Headless, wgpu's GL context mis-binds: try one of Strata's own.
+            Err(e) if surface.is_none() && e.is::<crate::self_check::BindingsMisread>() => {
+                Self::on_own_gl_context(instance, e)
+            }
+            other => other,
+        }
+    }
+
+    /// The device on a GL context Strata makes (`gl_context.rs`), after
+    /// wgpu's own failed the self-check with `why`.
+    #[cfg(all(unix, not(target_vendor = "apple"), not(target_arch = "wasm32")))]
+    fn on_own_gl_context(instance: wgpu::Instance, why: anyhow::Error) -> anyhow::Result<Self> {
+        let (adapter, context) = match crate::gl_context::open(&instance) {
+            Ok(pair) => pair,
+            Err(e) => return Err(why.context(format!("{e:#}"))),
+        };
+        let mut gpu = pollster::block_on(Self::on_adapter(instance, adapter))
+            .with_context(|| format!("on Strata's own {} context", context.description))?;
+        gpu.report.driver_info = format!(
+            "{} (Strata's own EGL context, {}: wgpu's desktop 3.3 context mis-binds uniform \
+             blocks here, bench/gl-repro)",
+            gpu.report.driver_info, context.description
+        );
+        gpu.own_gl_context = Some(Box::new(context));
+        Ok(gpu)
+    }
+
+    #[cfg(not(all(unix, not(target_vendor = "apple"), not(target_arch = "wasm32"))))]
+    fn on_own_gl_context(_instance: wgpu::Instance, why: anyhow::Error) -> anyhow::Result<Self> {
+        Err(why)
     }
 
     /// [`Gpu::with_instance`] as a future: a browser answers adapter and
@@ -261,6 +337,12 @@ impl Gpu {
         choice: &AdapterChoice,
     ) -> anyhow::Result<Self> {
         let adapter = pick_adapter(&instance, surface, choice).await?;
+        Self::on_adapter(instance, adapter).await
+    }
+
+    /// A device on `adapter` (of `instance`), with the features and limits
+    /// Strata requests.
+    async fn on_adapter(instance: wgpu::Instance, adapter: wgpu::Adapter) -> anyhow::Result<Self> {
         let info = adapter.get_info();
         let (features, limits) = device_request(&adapter);
         let caps = Capabilities::of(&adapter, &limits, features);
@@ -333,7 +415,7 @@ impl Gpu {
         // compares WebGL2's picture with WebGPU's instead.)
         if !cfg!(target_arch = "wasm32") && info.backend == wgpu::Backend::Gl {
             crate::self_check::uniforms_read_back(&device, &queue, &errors)
-                .map_err(|e| anyhow::anyhow!("adapter `{}` (gl): {e:#}", info.name))?;
+                .with_context(|| format!("adapter `{}` (gl)", info.name))?;
         }
 
         let report = AdapterReport {
@@ -353,6 +435,7 @@ impl Gpu {
             caps,
             errors,
             options: Default::default(),
+            own_gl_context: None,
         })
     }
 }

@@ -87,6 +87,9 @@ pub struct Gpu {
     /// The caller's measuring switches and test hooks for renderers built
     /// on this device (default: the product's).
     pub options: RenderOptions,
+    /// A GL context Strata made itself (`gl_context.rs`), kept until the
+    /// device above is gone (fields drop in order).
+    pub(crate) own_gl_context: Option<Box<dyn std::any::Any + Send + Sync>>,
 }
 
 impl Gpu {

@@ -80,6 +80,8 @@ pub mod embed;
 pub mod frame;
 #[doc(hidden)]
 pub mod fullscreen;
+#[cfg(all(unix, not(target_vendor = "apple"), not(target_arch = "wasm32")))]
+pub mod gl_context;
 pub mod gpu;
 pub mod methods;
 pub mod options;

@@ -4,7 +4,8 @@
 //! desktop GL 3.3 context (through EGL) uniform blocks read wrong values:
 //! every method drew sky, and `ray`'s step count came back in the billions
 //! (the GPU hung). Such an adapter is refused by name instead of drawing
-//! wrong pictures.
+//! wrong pictures; headless, Strata then tries a GL context of its own
+//! (`gl_context.rs`). `bench/gl-repro/` narrows the fault down with wgpu alone.
 
 use crate::gpu::{ErrorSink, read_texture};
 
@@ -46,7 +47,31 @@ fn uniform(device: &wgpu::Device, queue: &wgpu::Queue, x: u32) -> wgpu::Buffer {
     buffer
 }
 
-/// `Err` when a fragment shader does not compute what the bindings hold: two
+/// The self-check's failure: what the probe computed and what was due.
+#[derive(Debug)]
+pub struct BindingsMisread {
+    pub got: u32,
+    pub want: u32,
+}
+
+impl std::fmt::Display for BindingsMisread {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "a fragment shader computed {:#010x} from its bindings where {:#010x} was due: bind \
+             groups (uniforms in two groups and an array texture, as every method binds them) \
+             do not reach shaders on this adapter through wgpu (NVIDIA's desktop GL 3.3 context \
+             through EGL: every uniform block reads binding point 0, because wgpu-hal takes \
+             GL_ARB_compute_shader for explicit binding layouts that naga's GLSL 330 lacks; \
+             bench/gl-repro/ shows it with wgpu alone); use another backend (--backend vulkan)",
+            self.got, self.want
+        )
+    }
+}
+
+impl std::error::Error for BindingsMisread {}
+
+/// `Err` ([`BindingsMisread`] when the answer is wrong) when a fragment shader does not compute what the bindings hold: two
 /// uniforms and a `u32` array texture in group 0, a uniform in group 1, as
 /// every method binds the shared frame and its own parameters.
 pub fn uniforms_read_back(
@@ -160,12 +185,7 @@ pub fn uniforms_read_back(
         .map(|b| u32::from_le_bytes(*b))
         .ok_or_else(|| anyhow::anyhow!("the self-check read back no pixel"))?;
     if got != want {
-        anyhow::bail!(
-            "a fragment shader computed {got:#010x} from its bindings where {want:#010x} was \
-             due: bind groups (uniforms in two groups and an array texture, as every method \
-             binds them) do not reach shaders on this adapter through wgpu (seen on NVIDIA's \
-             desktop GL 3.3 context through EGL); use another backend (--backend vulkan)"
-        );
+        return Err(BindingsMisread { got, want }.into());
     }
     Ok(())
 }
