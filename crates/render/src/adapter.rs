@@ -217,7 +217,7 @@ fn own_gl_adapter(instance: &wgpu::Instance) -> Option<(wgpu::Adapter, String)> 
     Some((adapter, context.description.clone()))
 }
 
-#[cfg(not(all(unix, not(target_vendor = "apple"), not(target_arch = "wasm32"))))]
+#[cfg(all(not(target_arch = "wasm32"), any(not(unix), target_vendor = "apple")))]
 fn own_gl_adapter(_instance: &wgpu::Instance) -> Option<(wgpu::Adapter, String)> {
     None
 }
@@ -324,7 +324,7 @@ impl Gpu {
         Ok(gpu)
     }
 
-    #[cfg(not(all(unix, not(target_vendor = "apple"), not(target_arch = "wasm32"))))]
+    #[cfg(all(not(target_arch = "wasm32"), any(not(unix), target_vendor = "apple")))]
     fn on_own_gl_context(_instance: wgpu::Instance, why: anyhow::Error) -> anyhow::Result<Self> {
         Err(why)
     }
@@ -435,6 +435,7 @@ impl Gpu {
             caps,
             errors,
             options: Default::default(),
+            #[cfg(not(target_arch = "wasm32"))]
             own_gl_context: None,
         })
     }

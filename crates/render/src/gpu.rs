@@ -89,6 +89,7 @@ pub struct Gpu {
     pub options: RenderOptions,
     /// A GL context Strata made itself (`gl_context.rs`), kept until the
     /// device above is gone (fields drop in order).
+    #[cfg(not(target_arch = "wasm32"))]
     pub(crate) own_gl_context: Option<Box<dyn std::any::Any + Send + Sync>>,
 }
 

@@ -1,21 +1,23 @@
 //! The viewer's state and its frame: input to camera, script steps, finished
 //! builds, the method (or A/B pair) drawn through the harness's
 //! [`Renderer`], the overlay, and the swapchain. Input handling is in
-//! `input`, script running in `scripted`, the score and screenshot
+//! `input`, method switching and knobs in `switching`, views and flying to a
+//! point in `navigation`, script running in `scripted`, the score and screenshot
 //! read-backs (finished a frame or more later) in `readback`, digging,
 //! undo, saving and the memory report in `editing`.
 
 mod editing;
 mod input;
+mod navigation;
 mod paged;
 mod readback;
 mod scripted;
+mod switching;
 
 use crate::Options;
-use crate::builds::{Builds, Finished};
+use crate::builds::Builds;
 use crate::dig::Digger;
 use crate::fly::FlyCamera;
-use crate::knobs::{Knob, relevant};
 use crate::minimap::Minimap;
 use crate::overlay::{self, Action, Building, Drawn, Editable, Overlay, Status};
 use crate::physics::PhysicsToy;
@@ -482,184 +484,6 @@ impl Viewer {
         self.screenshots += 1;
         self.out
             .join(format!("screenshot-{:03}.png", self.screenshots))
-    }
-
-    /// Draw `name` from now on, building it first (in the background) when
-    /// it is not kept with the current settings.
-    fn request_method(&mut self, name: &str) -> anyhow::Result<()> {
-        if !methods::names().contains(&name) {
-            bail!(
-                "unknown method `{name}`; known: {}",
-                methods::names().join(", ")
-            );
-        }
-        if self.paged.is_some() {
-            return self.request_paged_method(name);
-        }
-        let current = self.renderer.method_name();
-        if self.make_current(name)? {
-            if current != name {
-                self.previous_method = current.to_string();
-                self.renderer.activate(name)?;
-                self.say(format!("drawing {name}"));
-            }
-            self.waiting_for = None;
-        } else {
-            self.builds
-                .start(&self.renderer, &self.level, name, &self.settings)?;
-            self.waiting_for = Some(name.to_string());
-        }
-        Ok(())
-    }
-
-    /// Whether `name` is kept with the current settings, giving them to it
-    /// in place where it can take them (otherwise it needs a rebuild).
-    fn make_current(&mut self, name: &str) -> anyhow::Result<bool> {
-        if self.is_current(name) {
-            return Ok(true);
-        }
-        self.renderer.update_settings(name, &self.settings)
-    }
-
-    /// Whether `name` is kept, built with the current settings.
-    fn is_current(&self, name: &str) -> bool {
-        self.renderer
-            .settings_of(name)
-            .is_some_and(|s| relevant(name, s) == relevant(name, &self.settings))
-    }
-
-    fn set_split(&mut self, split: Option<String>) -> anyhow::Result<()> {
-        if split.is_some() && self.paged.is_some() {
-            return self.refuse(
-                "A/B needs two methods over one world in memory; a paged world draws one at a time"
-                    .into(),
-            );
-        }
-        if let Some(name) = &split {
-            if !methods::names().contains(&name.as_str()) {
-                bail!("unknown method `{name}`");
-            }
-            if !self.make_current(name)? {
-                self.builds
-                    .start(&self.renderer, &self.level, name, &self.settings)?;
-            }
-        }
-        self.split = split;
-        Ok(())
-    }
-
-    fn go_to_view(&mut self, index: usize) {
-        let Some(view) = self.views.get(index).cloned() else {
-            self.say(format!("the level has no view {}", index + 1));
-            return;
-        };
-        let (w, h) = self.render_size();
-        let camera = match &self.paged {
-            Some(p) => paged::camera_over(&p.world.pages, &view, w, h),
-            None => Camera::from_view(&self.level, &view, w, h).map_err(anyhow::Error::from),
-        };
-        match camera {
-            Ok(camera) => {
-                let speed = self.fly.speed;
-                self.fly = FlyCamera::from_camera(&camera);
-                self.fly.speed = speed;
-                self.say(format!("view {}", view.name));
-            }
-            Err(e) => self.say(format!("view {}: {e}", view.name)),
-        }
-    }
-
-    fn copy_view(&mut self, name: &str) {
-        let column = match self.column_at(self.fly.position.x, self.fly.position.y) {
-            Ok(c) => c,
-            Err(e) => return self.say(format!("copy view: {e:#}")),
-        };
-        let line = self.fly.view_spec(column, name).to_string();
-        println!("{line}");
-        self.overlay.copy_text(line.clone());
-        self.say(format!("copied: {line}"));
-    }
-
-    /// Fly to `to` (x, y), keeping the eye's height above the ground.
-    fn teleport(&mut self, to: glam::Vec2) {
-        let columns = self
-            .column_at(self.fly.position.x, self.fly.position.y)
-            .and_then(|here| {
-                let (w, h) = self.world_size();
-                let (x, y) = (to.x.rem_euclid(w as f32), to.y.rem_euclid(h as f32));
-                Ok((here, x, y, self.column_at(x, y)?))
-            });
-        let (here, x, y, there) = match columns {
-            Ok(c) => c,
-            Err(e) => return self.say(format!("cannot fly there: {e:#}")),
-        };
-        let clearance = (self.fly.position.z - f32::from(here.top())).max(20.0);
-        let z = (f32::from(there.top()) + clearance).min(400.0);
-        self.fly.position = glam::Vec3::new(x, y, z);
-        self.say(format!("flew to {x:.0}, {y:.0}"));
-    }
-
-    fn camera(&self) -> anyhow::Result<Camera> {
-        let (w, h) = self.render_size();
-        self.fly.camera(w, h)
-    }
-
-    fn on_knob(&mut self, knob: Knob) -> anyhow::Result<()> {
-        if knob == Knob::Shadows {
-            self.renderer.set_shadows(self.settings.shadows);
-            return Ok(());
-        }
-        if self.paged.is_some() {
-            let name = self.renderer.method_name();
-            if knob.read_by(name) && !self.make_current(name)? {
-                self.rebuild_paged(name)?;
-            }
-            return Ok(());
-        }
-        // What is on screen and reads the knob takes it in place or is
-        // rebuilt; other kept methods catch up when next shown.
-        let shown: Vec<String> = std::iter::once(self.renderer.method_name().to_string())
-            .chain(self.split.clone())
-            .collect();
-        for name in shown {
-            if knob.read_by(&name) && !self.make_current(&name)? {
-                self.builds
-                    .start(&self.renderer, &self.level, &name, &self.settings)?;
-            }
-        }
-        Ok(())
-    }
-
-    fn set_knob(&mut self, knob: Knob, value: f32) -> anyhow::Result<()> {
-        knob.set(&mut self.settings, value)?;
-        self.on_knob(knob)
-    }
-
-    /// Keep finished builds; activate the one waited for.
-    fn collect_builds(&mut self) -> anyhow::Result<()> {
-        for finished in self.builds.collect(&mut self.renderer, &self.level) {
-            match finished {
-                Finished::Kept { name, seconds } => {
-                    self.say(format!("built {name} in {seconds:.2} s"));
-                    if self.waiting_for.as_deref() == Some(name.as_str()) {
-                        self.request_method(&name)?;
-                    }
-                }
-                Finished::Failed { name, error } => {
-                    if self.waiting_for.as_deref() == Some(name.as_str()) {
-                        self.waiting_for = None;
-                    }
-                    if self.split.as_deref() == Some(name.as_str()) {
-                        self.split = None;
-                    }
-                    if self.player.is_some() {
-                        return Err(error.context(format!("building {name}")));
-                    }
-                    self.say(format!("building {name} failed: {error:#}"));
-                }
-            }
-        }
-        Ok(())
     }
 
     /// One frame: script, builds, camera, the picture(s), overlay, present.
