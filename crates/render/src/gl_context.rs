@@ -53,7 +53,8 @@ const VERSIONS: [(khronos_egl::Enum, i32, i32); 4] = [
 ];
 
 /// An adapter of `instance` (which must have the GL backend) on a context of
-/// the first version in [`VERSIONS`] EGL gives, current on this thread.
+/// the first version EGL gives (desktop GL 4.6, 4.5, 4.3 core, then GLES
+/// 3.2), current on this thread.
 pub fn open(instance: &wgpu::Instance) -> anyhow::Result<(wgpu::Adapter, OwnGlContext)> {
     use anyhow::Context;
     use khronos_egl as egl;

@@ -49,6 +49,9 @@ fn own_gl_context_draws_what_wgpus_context_draws() {
             "{method}: the report names the own context"
         );
         assert!(!wgpus_json.contains("Strata's own EGL context"));
-        assert!(wgpus == own, "{method}: the two contexts drew different pictures");
+        assert!(
+            wgpus == own,
+            "{method}: the two contexts drew different pictures"
+        );
     }
 }
