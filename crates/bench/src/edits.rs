@@ -54,6 +54,25 @@ pub fn disagreement(a: &[f32], b: &[f32]) -> (f64, f64) {
     )
 }
 
+/// Percent of pixels where the images differ by more than the protocol
+/// allows anywhere: one has terrain and the other sky, or both hit and the
+/// distances differ by more than [`EDIT_MAX_DEPTH_P95`]. Stricter than
+/// [`disagreement`]'s p95 for edits that cover a small part of the image
+/// (a track stamp), which a p95 over all pixels does not see.
+pub fn differing_pixels(a: &[f32], b: &[f32]) -> f64 {
+    let n = a.len().min(b.len()).max(1);
+    let differ = a
+        .iter()
+        .zip(b)
+        .filter(|(x, y)| match (x.is_finite(), y.is_finite()) {
+            (true, true) => f64::from((*x - *y).abs()) > EDIT_MAX_DEPTH_P95,
+            (false, false) => false,
+            _ => true,
+        })
+        .count();
+    100.0 * differ as f64 / n as f64
+}
+
 /// The first checked frame count at which the images agree, if any.
 pub fn consistent_after(checks: &[EditCheck]) -> Option<u32> {
     checks.iter().find(|c| c.consistent).map(|c| c.frames)
@@ -131,6 +150,18 @@ pub fn checks_until_consistent(
     target: &[f32],
     drawn: u32,
 ) -> anyhow::Result<Vec<EditCheck>> {
+    checks_until(r, cam, target, drawn, |_| true)
+}
+
+/// [`checks_until_consistent`] where a check is consistent only if `also`
+/// accepts the edited renderer's distances too.
+pub fn checks_until(
+    r: &mut Renderer,
+    cam: &Camera,
+    target: &[f32],
+    drawn: u32,
+    mut also: impl FnMut(&[f32]) -> bool,
+) -> anyhow::Result<Vec<EditCheck>> {
     let mut checks = Vec::new();
     let mut done = drawn;
     for frames in EDIT_CHECK_FRAMES.into_iter().filter(|&f| f >= drawn) {
@@ -138,9 +169,11 @@ pub fn checks_until_consistent(
             r.render_frame(cam)?;
             done += 1;
         }
-        let (class_mismatch, depth_p95) = disagreement(&distance(r, cam)?, target);
-        let consistent =
-            class_mismatch <= EDIT_MAX_CLASS_MISMATCH && depth_p95 <= EDIT_MAX_DEPTH_P95;
+        let seen = distance(r, cam)?;
+        let (class_mismatch, depth_p95) = disagreement(&seen, target);
+        let consistent = class_mismatch <= EDIT_MAX_CLASS_MISMATCH
+            && depth_p95 <= EDIT_MAX_DEPTH_P95
+            && also(&seen);
         checks.push(EditCheck {
             frames,
             class_mismatch,

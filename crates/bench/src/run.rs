@@ -172,7 +172,7 @@ impl Plan {
         spec: Option<crate::gameplay::GameplaySpec>,
     ) -> anyhow::Result<Self> {
         if let Some(spec) = spec {
-            crate::gameplay::Workload::new(&self.world, spec)?;
+            crate::gameplay::Workload::new(&self.world, spec, self.opts.width, self.opts.height)?;
         }
         self.gameplay = spec;
         Ok(self)
@@ -301,7 +301,11 @@ impl Plan {
         let n_methods = refused.iter().filter(|r| r.is_none()).count();
         let total = self.cameras.len() * n_methods
             + if self.edit.is_some() { n_methods } else { 0 }
-            + if self.gameplay.is_some() { n_methods } else { 0 };
+            + if self.gameplay.is_some() {
+                n_methods
+            } else {
+                0
+            };
         let kept = session.results.rows.len() + session.results.edit_rows.len();
         let bar = ProgressBar::new(total.saturating_sub(kept) as u64);
         let mut count = CellCount {
@@ -419,11 +423,16 @@ impl Plan {
     ) -> anyhow::Result<()> {
         use crate::gameplay::{GameplayInput, Workload, follow_collider};
         use crate::results::gameplay::{ColliderFollow, GameplayResults, Spread};
-        let workload = Workload::new(&self.world, spec)?;
+        let workload = Workload::new(&self.world, spec, self.opts.width, self.opts.height)?;
         // A resumed run keeps the rows of the same workload only.
         let same = |g: &GameplayResults| {
             (g.edits_per_frame, g.frames, g.check_every, g.seed)
-                == (spec.edits_per_frame, spec.frames, spec.check_every, spec.seed)
+                == (
+                    spec.edits_per_frame,
+                    spec.frames,
+                    spec.check_every,
+                    spec.seed,
+                )
         };
         if !session.results.gameplay.as_ref().is_some_and(same) {
             bar.set_message("gameplay: level edits and collider");

@@ -81,6 +81,9 @@ pub struct GameplayCheck {
     pub class_mismatch: f64,
     /// 95th percentile of |distance difference| where both hit, world units.
     pub depth_p95: f64,
+    /// Percent of pixels that differ at all: terrain against sky, or
+    /// distances more than 0.1 apart (the p95 misses small edits).
+    pub differing_pixels: f64,
 }
 
 /// One method under the workload.
@@ -146,7 +149,12 @@ fn checks_label(r: &GameplayRow) -> String {
                 .checks
                 .iter()
                 .filter(|c| c.consistent_after_frames.is_none())
-                .map(|c| format!("frame {}: {:.4} % / {:.2}", c.frame, c.class_mismatch, c.depth_p95))
+                .map(|c| {
+                    format!(
+                        "frame {}: {:.4} % / {:.2} / {:.3} % differ",
+                        c.frame, c.class_mismatch, c.depth_p95, c.differing_pixels
+                    )
+                })
                 .next()
                 .unwrap_or_default();
             format!("**no** ({worst})")
@@ -254,6 +262,7 @@ mod tests {
                 consistent_after_frames: Some(0),
                 class_mismatch: 0.0,
                 depth_p95: 0.0,
+                differing_pixels: 0.0,
             }],
             consistent: true,
             edit_cpu_samples: vec![],

@@ -147,10 +147,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 /// `--gameplay [K]`'s workload: the 600 frames, or the quick form's
 /// 40 where the run is quick (`--quick`, or a CPU rasteriser without
 /// `--size`/`--frames`).
-fn gameplay(
-    args: &Args,
-    adapter: &AdapterReport,
-) -> Option<strata_bench::gameplay::GameplaySpec> {
+fn gameplay(args: &Args, adapter: &AdapterReport) -> Option<strata_bench::gameplay::GameplaySpec> {
     use strata_bench::gameplay::GameplaySpec;
     let k = args.gameplay?;
     Some(match is_quick(args, adapter) {
