@@ -624,15 +624,19 @@ mod tests {
         .unwrap()
     }
 
+    fn spec(edits_per_frame: u32, frames: u32, check_every: u32, seed: u64) -> GameplaySpec {
+        GameplaySpec {
+            edits_per_frame,
+            frames,
+            check_every,
+            seed,
+        }
+    }
+
     #[test]
     fn the_workload_is_deterministic_and_has_every_kind_of_edit() {
         let world = world();
-        let spec = GameplaySpec {
-            edits_per_frame: 6,
-            frames: 24,
-            check_every: 12,
-            seed: 3,
-        };
+        let spec = spec(6, 24, 12, 3);
         let a = Workload::new(&world, spec, 64, 40).unwrap();
         let b = Workload::new(&world, spec, 64, 40).unwrap();
         let all: Vec<GameEdit> = (0..spec.frames).flat_map(|f| a.edits(f)).collect();
@@ -661,12 +665,7 @@ mod tests {
     #[test]
     fn replays_agree_and_undo_restores_the_texels() {
         let world = world();
-        let spec = GameplaySpec {
-            edits_per_frame: 8,
-            frames: 30,
-            check_every: 10,
-            seed: 9,
-        };
+        let spec = spec(8, 30, 10, 9);
         let w = Workload::new(&world, spec, 64, 40).unwrap();
         let (mut a, mut b) = (
             Replay::new(world.level.clone()),
@@ -693,12 +692,7 @@ mod tests {
     #[test]
     fn the_collider_follows_the_workload() {
         let world = world();
-        let spec = GameplaySpec {
-            edits_per_frame: 16,
-            frames: 12,
-            check_every: 6,
-            seed: 1,
-        };
+        let spec = spec(16, 12, 6, 1);
         let w = Workload::new(&world, spec, 64, 40).unwrap();
         let follow = follow_collider(&world, &w);
         let (refit, same) = follow.collider.unwrap();

@@ -13,6 +13,23 @@ use strata_render::{MethodSettings, Renderer, TerrainColors};
 
 const SIZE: (u32, u32) = (64, 40);
 
+/// Fresh builds on `gpu` at `camera`, warmed up past any incremental build.
+fn fresh<'a>(
+    gpu: &'a strata_render::Gpu,
+    colors: &'a TerrainColors,
+    camera: &'a strata_camera::Camera,
+    level: &strata_level::Level,
+) -> FreshBuild<'a> {
+    FreshBuild {
+        gpu,
+        colors,
+        camera,
+        warmup_cap: strata_bench::warm::build_frames(level) + 1,
+        hold_busy_ms: 0,
+        timestamps: gpu.report.timestamps,
+    }
+}
+
 fn spec() -> GameplaySpec {
     GameplaySpec {
         edits_per_frame: 4,
@@ -31,14 +48,7 @@ fn every_method_follows_the_gameplay_workload_on_every_backend() {
         let camera = workload.camera(&world.level, 0, SIZE.0, SIZE.1).unwrap();
         let input = GameplayInput {
             world: &world,
-            fresh: FreshBuild {
-                gpu: &gpu,
-                colors: &colors,
-                camera: &camera,
-                warmup_cap: strata_bench::warm::build_frames(&world.level) + 1,
-                hold_busy_ms: 0,
-                timestamps: gpu.report.timestamps,
-            },
+            fresh: fresh(&gpu, &colors, &camera, &world.level),
             width: SIZE.0,
             height: SIZE.1,
         };
@@ -108,14 +118,7 @@ fn a_renderer_not_told_of_the_edits_fails_the_check() {
     let camera = workload
         .camera(replay.level(), spec().frames - 1, SIZE.0, SIZE.1)
         .unwrap();
-    let fresh = FreshBuild {
-        gpu: &gpu,
-        colors: &colors,
-        camera: &camera,
-        warmup_cap: strata_bench::warm::build_frames(&world.level) + 1,
-        hold_busy_ms: 0,
-        timestamps: gpu.report.timestamps,
-    };
+    let fresh = fresh(&gpu, &colors, &camera, &world.level);
     let settings = MethodSettings {
         shadows: false,
         ..Default::default()

@@ -348,7 +348,10 @@ fn bad_craters_wrap_do_nothing_or_are_refused() {
     for (x, y) in [(10 + 64 * 1000, 12 - 32 * 7), (10 - 64 * 3, 12 + 32 * 5)] {
         let (outside, dirty) = dig(&site(x, y));
         assert!(!dirty.is_empty());
-        assert!(outside == inside, "crater at {x},{y} is not the one at 10,12");
+        assert!(
+            outside == inside,
+            "crater at {x},{y} is not the one at 10,12"
+        );
     }
     // Radius 0: nothing.
     let (level, dirty) = dig(&EditSite {

@@ -141,9 +141,17 @@ mod tests {
             assert!(digger.dig(&mut level, bad).is_empty(), "{bad}");
         }
         digger.depth = f32::NAN;
-        assert!(digger.dig(&mut level, Vec3::new(10.0, 10.0, 100.0)).is_empty());
+        assert!(
+            digger
+                .dig(&mut level, Vec3::new(10.0, 10.0, 100.0))
+                .is_empty()
+        );
         (digger.depth, digger.radius) = (20.0, 0);
-        assert!(digger.dig(&mut level, Vec3::new(10.0, 10.0, 100.0)).is_empty());
+        assert!(
+            digger
+                .dig(&mut level, Vec3::new(10.0, 10.0, 100.0))
+                .is_empty()
+        );
         assert!(level == original && digger.can_undo() == 0);
         // Far outside the map (a pick past the seam): wraps onto it.
         digger.radius = 8;
