@@ -60,9 +60,9 @@ pub struct Args {
     pub temporal: bool,
     /// Also run the sustained edit workload (issue 35): K small edits a frame (default 64;
     /// tracks of radius 2-6 along the video's default path, a few craters, slabs carved and
-    /// built, old edits undone) for 600 frames (40 with --quick), through every method's own
+    /// built, old edits undone) for 600 frames (24 with --quick), through every method's own
     /// update path; per method the edits' and the frame's CPU/GPU ms (p50/p99/max), checked
-    /// against a fresh build every 100 frames (20 with --quick) and at the end; the terrain
+    /// against a fresh build every 100 frames (12 with --quick) and at the end; the terrain
     /// collider's refit per frame.
     #[arg(long, value_name = "K", num_args = 0..=1, default_missing_value = "64")]
     pub gameplay: Option<u32>,
@@ -145,7 +145,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 }
 
 /// `--gameplay [K]`'s workload: the issue's 600 frames, or the quick form's
-/// 40 where the run is quick (`--quick`, or a CPU rasteriser without
+/// 24 where the run is quick (`--quick`, or a CPU rasteriser without
 /// `--size`/`--frames`).
 fn gameplay(args: &Args, adapter: &AdapterReport) -> Option<strata_bench::gameplay::GameplaySpec> {
     use strata_bench::gameplay::GameplaySpec;
