@@ -138,3 +138,46 @@ fn a_renderer_not_told_of_the_edits_fails_the_check() {
     .unwrap();
     assert_eq!(edits::consistent_after(&checks), None, "{checks:?}");
 }
+
+/// `compare --gameplay` end to end: the plan runs the workload after the
+/// protocol; the results file holds a row per method and the collider's
+/// refit, the report its section.
+#[test]
+fn the_protocol_writes_the_gameplay_rows_and_section() {
+    let Some(gpu) = common::gpu_or_skip("gameplay protocol") else {
+        return;
+    };
+    let out = std::env::temp_dir().join(format!("strata-gameplay-plan-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out);
+    let world = common::world();
+    let views = world.views[..1].to_vec();
+    let mut opts = common::options(out.clone(), &["ray-exact", "mesh"], views);
+    opts.shadows = false;
+    let plan = strata_bench::run::Plan::new(world, opts)
+        .unwrap()
+        .with_gameplay(Some(GameplaySpec {
+            frames: 6,
+            check_every: 3,
+            ..spec()
+        }))
+        .unwrap();
+    let (json, report) = plan.run(&gpu).unwrap();
+    let run =
+        strata_bench::results::RunResults::from_json(&std::fs::read_to_string(&json).unwrap())
+            .unwrap();
+    let g = run.gameplay.expect("gameplay results");
+    assert_eq!((g.frames, g.edits_per_frame), (6, 4));
+    assert_eq!(
+        g.rows.iter().map(|r| r.method.as_str()).collect::<Vec<_>>(),
+        ["ray-exact", "mesh"]
+    );
+    assert!(g.rows.iter().all(|r| r.consistent && r.checks.len() == 2));
+    let collider = g.collider.expect("the collider's refit");
+    assert!(collider.consistent && collider.refit_ms.max >= collider.refit_ms.p50);
+    let md = std::fs::read_to_string(report).unwrap();
+    assert!(
+        md.contains("## Gameplay edits") && md.contains("| mesh |"),
+        "{md}"
+    );
+    let _ = std::fs::remove_dir_all(&out);
+}
