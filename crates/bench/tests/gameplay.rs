@@ -181,3 +181,42 @@ fn the_protocol_writes_the_gameplay_rows_and_section() {
     );
     let _ = std::fs::remove_dir_all(&out);
 }
+
+/// K = 64: a frame's rectangles outnumber the exact pyramid's update slots,
+/// which then merges them (not the whole map); the result still matches a
+/// fresh build at every check.
+#[test]
+fn the_exact_march_follows_sixty_four_edits_a_frame() {
+    let Some(gpu) = common::gpu_or_skip("gameplay K = 64") else {
+        return;
+    };
+    let world = common::world();
+    let colors = TerrainColors::from_world(&world);
+    let spec = GameplaySpec {
+        edits_per_frame: 64,
+        frames: 6,
+        check_every: 3,
+        ..spec()
+    };
+    let workload = Workload::new(&world, spec, SIZE.0, SIZE.1).unwrap();
+    let camera = workload.camera(&world.level, 0, SIZE.0, SIZE.1).unwrap();
+    let input = GameplayInput {
+        world: &world,
+        fresh: fresh(&gpu, &colors, &camera, &world.level),
+        width: SIZE.0,
+        height: SIZE.1,
+    };
+    let settings = MethodSettings {
+        shadows: false,
+        ..Default::default()
+    };
+    for name in ["ray-exact", "ray-exact-fragment"] {
+        let row = method_row(&input, &workload, name, name, &settings).unwrap();
+        eprintln!(
+            "{name}: edits {:?}, checks {:?}",
+            row.edit_cpu_ms, row.checks
+        );
+        assert!(row.consistent, "{name}: {:?}", row.checks);
+        assert_eq!(row.checks.len(), 2);
+    }
+}
