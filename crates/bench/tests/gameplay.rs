@@ -30,6 +30,24 @@ fn fresh<'a>(
     }
 }
 
+/// The workload's input at the tests' size.
+fn input<'a>(world: &'a strata_level::World, fresh: FreshBuild<'a>) -> GameplayInput<'a> {
+    GameplayInput {
+        world,
+        fresh,
+        width: SIZE.0,
+        height: SIZE.1,
+    }
+}
+
+/// No shared shadow map: 1024² cast on a CPU rasteriser per frame.
+fn no_shadows() -> MethodSettings {
+    MethodSettings {
+        shadows: false,
+        ..Default::default()
+    }
+}
+
 fn spec() -> GameplaySpec {
     GameplaySpec {
         edits_per_frame: 4,
@@ -46,17 +64,8 @@ fn every_method_follows_the_gameplay_workload_on_every_backend() {
     let workload = Workload::new(&world, spec(), SIZE.0, SIZE.1).unwrap();
     for gpu in common::every_backend("gameplay workload") {
         let camera = workload.camera(&world.level, 0, SIZE.0, SIZE.1).unwrap();
-        let input = GameplayInput {
-            world: &world,
-            fresh: fresh(&gpu, &colors, &camera, &world.level),
-            width: SIZE.0,
-            height: SIZE.1,
-        };
-        // No shared shadow map: 1024² cast on a CPU rasteriser per frame.
-        let settings = MethodSettings {
-            shadows: false,
-            ..Default::default()
-        };
+        let input = input(&world, fresh(&gpu, &colors, &camera, &world.level));
+        let settings = no_shadows();
         let mut ran = 0;
         for entry in strata_render::methods::METHODS {
             if strata_render::methods::check_support(entry, &gpu.caps).is_err() {
@@ -119,10 +128,7 @@ fn a_renderer_not_told_of_the_edits_fails_the_check() {
         .camera(replay.level(), spec().frames - 1, SIZE.0, SIZE.1)
         .unwrap();
     let fresh = fresh(&gpu, &colors, &camera, &world.level);
-    let settings = MethodSettings {
-        shadows: false,
-        ..Default::default()
-    };
+    let settings = no_shadows();
     let target = edits::distance(
         &edits::build(&fresh, replay.level(), "ray-exact", &settings).unwrap(),
         &camera,
@@ -200,16 +206,8 @@ fn the_exact_march_follows_sixty_four_edits_a_frame() {
     };
     let workload = Workload::new(&world, spec, SIZE.0, SIZE.1).unwrap();
     let camera = workload.camera(&world.level, 0, SIZE.0, SIZE.1).unwrap();
-    let input = GameplayInput {
-        world: &world,
-        fresh: fresh(&gpu, &colors, &camera, &world.level),
-        width: SIZE.0,
-        height: SIZE.1,
-    };
-    let settings = MethodSettings {
-        shadows: false,
-        ..Default::default()
-    };
+    let input = input(&world, fresh(&gpu, &colors, &camera, &world.level));
+    let settings = no_shadows();
     for name in ["ray-exact", "ray-exact-fragment"] {
         let row = method_row(&input, &workload, name, name, &settings).unwrap();
         eprintln!(
