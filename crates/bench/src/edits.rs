@@ -54,13 +54,60 @@ pub fn disagreement(a: &[f32], b: &[f32]) -> (f64, f64) {
     )
 }
 
+/// Percent of pixels where the images differ by more than the protocol
+/// allows anywhere: one has terrain and the other sky, or both hit and the
+/// distances differ by more than [`EDIT_MAX_DEPTH_P95`]. Stricter than
+/// [`disagreement`]'s p95 for edits that cover a small part of the image
+/// (a track stamp), which a p95 over all pixels does not see.
+pub fn differing_pixels(a: &[f32], b: &[f32]) -> f64 {
+    let n = a.len().min(b.len()).max(1);
+    let differ = a
+        .iter()
+        .zip(b)
+        .filter(|(x, y)| match (x.is_finite(), y.is_finite()) {
+            (true, true) => f64::from((*x - *y).abs()) > EDIT_MAX_DEPTH_P95,
+            (false, false) => false,
+            _ => true,
+        })
+        .count();
+    100.0 * differ as f64 / n as f64
+}
+
 /// The first checked frame count at which the images agree, if any.
 pub fn consistent_after(checks: &[EditCheck]) -> Option<u32> {
     checks.iter().find(|c| c.consistent).map(|c| c.frames)
 }
 
-fn build(
-    input: &EditInput<'_>,
+/// What a renderer built fresh for a check needs besides its level and method.
+#[derive(Clone, Copy)]
+pub struct FreshBuild<'a> {
+    pub gpu: &'a Gpu,
+    pub colors: &'a TerrainColors,
+    pub camera: &'a Camera,
+    /// See [`EditInput::warmup_cap`].
+    pub warmup_cap: u32,
+    /// See [`EditInput::hold_busy_ms`] (0: none).
+    pub hold_busy_ms: u32,
+    pub timestamps: bool,
+}
+
+impl EditInput<'_> {
+    fn fresh(&self) -> FreshBuild<'_> {
+        FreshBuild {
+            gpu: self.gpu,
+            colors: self.colors,
+            camera: self.camera,
+            warmup_cap: self.warmup_cap,
+            hold_busy_ms: self.hold_busy_ms,
+            timestamps: self.timestamps,
+        }
+    }
+}
+
+/// `name` built on `level` and warmed up at the camera: one frame, continued
+/// while an incremental build is in flight (then held busy, if asked).
+pub fn build(
+    input: &FreshBuild<'_>,
     level: &Level,
     name: &str,
     settings: &MethodSettings,
@@ -85,11 +132,60 @@ fn build(
     Ok(r)
 }
 
-fn distance(r: &Renderer, camera: &Camera) -> anyhow::Result<Vec<f32>> {
+/// Distance along each pixel's ray of the renderer's last frame.
+pub fn distance(r: &Renderer, camera: &Camera) -> anyhow::Result<Vec<f32>> {
     Ok(strata_reference::distance_from_depth(
         camera,
         &r.read_depth()?,
     ))
+}
+
+/// Compare an edited renderer that has drawn `drawn` frames since its edit
+/// with `target` (a fresh build's distances) after each of
+/// [`EDIT_CHECK_FRAMES`] post-edit frames, drawing the frames between, up
+/// to the first consistent check.
+pub fn checks_until_consistent(
+    r: &mut Renderer,
+    cam: &Camera,
+    target: &[f32],
+    drawn: u32,
+) -> anyhow::Result<Vec<EditCheck>> {
+    checks_until(r, cam, target, drawn, |_| true)
+}
+
+/// [`checks_until_consistent`] where a check is consistent only if `also`
+/// accepts the edited renderer's distances too.
+pub fn checks_until(
+    r: &mut Renderer,
+    cam: &Camera,
+    target: &[f32],
+    drawn: u32,
+    mut also: impl FnMut(&[f32]) -> bool,
+) -> anyhow::Result<Vec<EditCheck>> {
+    let mut checks = Vec::new();
+    let mut done = drawn;
+    for frames in EDIT_CHECK_FRAMES.into_iter().filter(|&f| f >= drawn) {
+        while done < frames {
+            r.render_frame(cam)?;
+            done += 1;
+        }
+        let seen = distance(r, cam)?;
+        let (class_mismatch, depth_p95) = disagreement(&seen, target);
+        let consistent = class_mismatch <= EDIT_MAX_CLASS_MISMATCH
+            && depth_p95 <= EDIT_MAX_DEPTH_P95
+            && also(&seen);
+        checks.push(EditCheck {
+            frames,
+            class_mismatch,
+            depth_p95,
+            consistent,
+        });
+        // The answer is the first consistent count; later frames cannot change it.
+        if consistent {
+            break;
+        }
+    }
+    Ok(checks)
 }
 
 /// The edit camera's colour (RGBA8) just before the edit and on the first
@@ -107,7 +203,7 @@ pub fn edit_row(
 ) -> anyhow::Result<(EditRow, EditPictures)> {
     let cam = input.camera;
     // The fresh build of the already-edited level: steady time and the target image.
-    let mut fresh = build(input, input.edited, name, settings)?;
+    let mut fresh = build(&input.fresh(), input.edited, name, settings)?;
     let (mut steady_cpu, mut steady_gpu) = (Vec::new(), Vec::new());
     for _ in 0..input.steady_frames.max(1) {
         let t = fresh.render_frame(cam)?;
@@ -124,7 +220,7 @@ pub fn edit_row(
         after: Vec::new(),
     };
     for sample in 0..FIRST_FRAME_SAMPLES {
-        let mut r = build(input, input.original, name, settings)?;
+        let mut r = build(&input.fresh(), input.original, name, settings)?;
         if sample == 0 {
             // Read before the clock starts: the picture costs the edit nothing.
             pictures.before = r.read_color()?;
@@ -137,26 +233,7 @@ pub fn edit_row(
         first_gpu.extend(t.gpu_ms);
         if sample == 0 {
             pictures.after = r.read_color()?;
-            let mut done = 1;
-            for frames in EDIT_CHECK_FRAMES {
-                while done < frames {
-                    r.render_frame(cam)?;
-                    done += 1;
-                }
-                let (class_mismatch, depth_p95) = disagreement(&distance(&r, cam)?, &target);
-                let consistent =
-                    class_mismatch <= EDIT_MAX_CLASS_MISMATCH && depth_p95 <= EDIT_MAX_DEPTH_P95;
-                checks.push(EditCheck {
-                    frames,
-                    class_mismatch,
-                    depth_p95,
-                    consistent,
-                });
-                // The answer is the first consistent count; later frames cannot change it.
-                if consistent {
-                    break;
-                }
-            }
+            checks = checks_until_consistent(&mut r, cam, &target, 1)?;
         }
     }
     let all_timed = |g: &Vec<f64>, c: &Vec<f64>| if g.len() == c.len() { median(g) } else { None };

@@ -13,6 +13,7 @@ pub mod figures;
 #[cfg(not(target_arch = "wasm32"))]
 pub mod flip;
 pub mod font;
+pub mod gameplay;
 pub mod grid;
 pub mod merge;
 pub mod methods;

@@ -100,6 +100,7 @@ pub fn run(
         reference_images: Vec::new(),
         temporal: Vec::new(),
         edit_images: Vec::new(),
+        gameplay: None,
     };
     let mut session = Session::new(&opts.out, results);
     // The references, traced through the store's chunk cache.

@@ -121,6 +121,7 @@ pub fn carry_over(there: RunResults, here: &mut RunResults) {
     here.edit_rows = there.edit_rows;
     here.edit_images = there.edit_images;
     here.temporal = there.temporal;
+    here.gameplay = there.gameplay;
 }
 
 /// Is cell (`view`, `method`) among the finished rows?

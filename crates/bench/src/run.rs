@@ -82,6 +82,8 @@ pub struct Plan {
     /// `--gpu-budget`: the paged methods draw through pages of the world
     /// ([`Plan::with_paging`]).
     paging: Option<(PagedOptions, Arc<dyn PageSource>)>,
+    /// `--gameplay`: the sustained edit workload ([`Plan::with_gameplay`]).
+    gameplay: Option<crate::gameplay::GameplaySpec>,
 }
 
 impl Plan {
@@ -141,6 +143,7 @@ impl Plan {
             edit_skipped,
             warmup_first,
             paging: None,
+            gameplay: None,
         })
     }
 
@@ -157,6 +160,21 @@ impl Plan {
             }
             None => None,
         };
+        Ok(self)
+    }
+
+    /// Also run the sustained edit workload ([`crate::gameplay`]) with
+    /// every method the adapter runs, after the edit protocol. Checked
+    /// here: a spec that makes no workload, or a world whose camera path
+    /// does not resolve, is an error before any GPU work.
+    pub fn with_gameplay(
+        mut self,
+        spec: Option<crate::gameplay::GameplaySpec>,
+    ) -> anyhow::Result<Self> {
+        if let Some(spec) = spec {
+            crate::gameplay::Workload::new(&self.world, spec, self.opts.width, self.opts.height)?;
+        }
+        self.gameplay = spec;
         Ok(self)
     }
 
@@ -237,6 +255,7 @@ impl Plan {
             reference_images: Vec::new(),
             temporal: Vec::new(),
             edit_images: Vec::new(),
+            gameplay: None,
         }
     }
 
@@ -280,8 +299,13 @@ impl Plan {
             })
             .collect();
         let n_methods = refused.iter().filter(|r| r.is_none()).count();
-        let total =
-            self.cameras.len() * n_methods + if self.edit.is_some() { n_methods } else { 0 };
+        let total = self.cameras.len() * n_methods
+            + if self.edit.is_some() { n_methods } else { 0 }
+            + if self.gameplay.is_some() {
+                n_methods
+            } else {
+                0
+            };
         let kept = session.results.rows.len() + session.results.edit_rows.len();
         let bar = ProgressBar::new(total.saturating_sub(kept) as u64);
         let mut count = CellCount {
@@ -373,6 +397,9 @@ impl Plan {
                 bar.inc(1);
             }
         }
+        if let Some(spec) = self.gameplay {
+            self.gameplay(gpu, &mut session, &refused, spec, &bar)?;
+        }
         // A resumed run keeps the temporal rows of one that got that far.
         if self.opts.temporal && session.results.temporal.is_empty() {
             self.temporal(gpu, &mut session, &refused, &bar)?;
@@ -382,6 +409,101 @@ impl Plan {
         session.save_json()?;
         let report = session.save_report()?;
         Ok((json, report))
+    }
+
+    /// `--gameplay`: every runnable method through the sustained edit
+    /// workload; a method that fails is a failure row and the rest go on.
+    fn gameplay(
+        &self,
+        gpu: &Gpu,
+        session: &mut Session,
+        refused: &[Option<String>],
+        spec: crate::gameplay::GameplaySpec,
+        bar: &ProgressBar,
+    ) -> anyhow::Result<()> {
+        use crate::gameplay::{GameplayInput, Workload, follow_collider};
+        use crate::results::gameplay::{ColliderFollow, GameplayResults, Spread};
+        let workload = Workload::new(&self.world, spec, self.opts.width, self.opts.height)?;
+        // A resumed run keeps the rows of the same workload only.
+        let same = |g: &GameplayResults| {
+            (g.edits_per_frame, g.frames, g.check_every, g.seed)
+                == (
+                    spec.edits_per_frame,
+                    spec.frames,
+                    spec.check_every,
+                    spec.seed,
+                )
+        };
+        if !session.results.gameplay.as_ref().is_some_and(same) {
+            bar.set_message("gameplay: level edits and collider");
+            let cpu = follow_collider(&self.world, &workload);
+            session.results.gameplay = Some(GameplayResults {
+                edits_per_frame: spec.edits_per_frame,
+                frames: spec.frames,
+                check_every: spec.check_every,
+                seed: spec.seed,
+                edits_total: cpu.edits,
+                dirty_texels_per_frame: cpu.dirty_texels as f64 / f64::from(spec.frames),
+                level_edit_ms: Spread::of(&cpu.level_edit_ms).context("no frames")?,
+                collider: cpu.collider.and_then(|(refit, consistent)| {
+                    Some(ColliderFollow {
+                        refit_ms: Spread::of(&refit)?,
+                        consistent,
+                    })
+                }),
+                rows: Vec::new(),
+            });
+            session.save_json()?;
+        }
+        let input = GameplayInput {
+            world: &self.world,
+            fresh: edits::FreshBuild {
+                gpu,
+                colors: &self.colors,
+                camera: &self.cameras[0],
+                warmup_cap: self.warmup_first,
+                hold_busy_ms: self.opts.hold_busy_ms,
+                timestamps: gpu.report.timestamps,
+            },
+            width: self.opts.width,
+            height: self.opts.height,
+        };
+        for (m, choice) in self.opts.methods.iter().enumerate() {
+            let label = choice.label();
+            let done = session
+                .results
+                .gameplay
+                .as_ref()
+                .is_some_and(|g| g.rows.iter().any(|r| r.method == label));
+            if refused[m].is_some() || done {
+                continue;
+            }
+            bar.set_message(format!("gameplay / {label}"));
+            match crate::gameplay::method_row(
+                &input,
+                &workload,
+                &label,
+                choice.name(),
+                &self.settings[m],
+            ) {
+                Ok(row) => {
+                    if let Some(g) = session.results.gameplay.as_mut() {
+                        g.rows.push(row);
+                    }
+                }
+                Err(e) => {
+                    bar.println(format!("gameplay / {label}: {e:#}"));
+                    session.results.failures.push(Failure {
+                        view: "gameplay".into(),
+                        method: label,
+                        error: format!("{e:#}"),
+                    });
+                }
+            }
+            session.save_json()?;
+            bar.inc(1);
+        }
+        Ok(())
     }
 
     /// `--temporal`: every runnable method along the video's default path,

@@ -6,7 +6,7 @@ use strata_mesh::{ChunkLayout, dirty_chunks};
 
 /// The terrain's exact collider: a packed copy of every texel's column and
 /// a max-height pyramid (see the crate docs), following the level's edits.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq, Eq)]
 pub struct TerrainCollider {
     pub(crate) layout: ChunkLayout,
     pub(crate) columns: Columns,

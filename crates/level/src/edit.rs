@@ -360,14 +360,49 @@ pub fn fill_single(level: &mut Level, rect: EditRect, height: u8, terrain: u8) -
     })
 }
 
+/// Why [`try_crater`] refused a crater.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum EditError {
+    /// The depth is NaN or infinite.
+    #[error("crater depth {0} is not a finite number")]
+    Depth(f32),
+}
+
+/// [`crater`], refusing what makes no crater: a depth that is not finite
+/// is an error. A radius of 0 digs nothing (no dirty rectangle); a centre
+/// anywhere (past the map, negative, near `i64::MAX`) wraps onto the map;
+/// a radius past half the map covers the whole map once, each texel at its
+/// distance from the nearest copy of the centre.
+pub fn try_crater(level: &mut Level, site: &EditSite) -> Result<Vec<DirtyRect>, EditError> {
+    if !site.depth.is_finite() {
+        return Err(EditError::Depth(site.depth));
+    }
+    Ok(crater(level, site))
+}
+
+/// Distance along one axis from `c` to `x` on a map of `size` that wraps:
+/// to the nearest copy of `c` (exact for any i64s).
+fn wrapped_offset(x: i64, c: i64, size: u32) -> f32 {
+    let size = i128::from(size);
+    let d = (i128::from(x) - i128::from(c)).rem_euclid(size);
+    (if 2 * d >= size { d - size } else { d }) as f32
+}
+
 /// The paper's crater: inside radius `r` of the centre the floor drops by
 /// `depth (1 - d²/r²)` (never below 0) and the upper layer is removed
-/// (dual pairs become single at the lowered floor).
+/// (dual pairs become single at the lowered floor). The map wraps: `d` is
+/// the distance to the nearest copy of the centre. A radius of 0, or a
+/// depth that is not finite, changes nothing ([`try_crater`] refuses the
+/// latter with an error).
 pub fn crater(level: &mut Level, site: &EditSite) -> Vec<DirtyRect> {
+    if site.radius == 0 || !site.depth.is_finite() {
+        return Vec::new();
+    }
     let r2 = (site.radius as f32).powi(2);
     let (cx, cy) = (site.centre_x, site.centre_y);
+    let (w, h) = (level.width(), level.height());
     edit_columns(level, crater_rect(site), |x, y, c| {
-        let (dx, dy) = (x.wrapping_sub(cx) as f32, y.wrapping_sub(cy) as f32);
+        let (dx, dy) = (wrapped_offset(x, cx, w), wrapped_offset(y, cy, h));
         let d2 = dx * dx + dy * dy;
         if d2 >= r2 {
             return c;

@@ -328,3 +328,83 @@ fn snapshot_undoes_a_crater_exactly_across_the_corner() {
         assert!(snapshot.bytes() <= 2 * 20 * 19);
     }
 }
+
+/// Issue 35, bad input: a crater outside the map wraps onto it (the same
+/// texels as its copy inside), a radius of 0 digs nothing, a radius larger
+/// than the map lowers every texel once (the nearest copy of the centre
+/// decides), a depth that is not finite is refused by `try_crater` and
+/// changes nothing through `crater`; centres at the ends of i64 do not panic.
+#[test]
+fn bad_craters_wrap_do_nothing_or_are_refused() {
+    use strata_level::edit::{EditError, try_crater};
+    let original = synthetic(64, 32, 5);
+    let dig = |s: &EditSite| {
+        let mut level = original.clone();
+        let dirty = crater(&mut level, s);
+        (level, dirty)
+    };
+    // Outside the map, many maps away: the same crater as its copy inside.
+    let (inside, _) = dig(&site(10, 12));
+    for (x, y) in [(10 + 64 * 1000, 12 - 32 * 7), (10 - 64 * 3, 12 + 32 * 5)] {
+        let (outside, dirty) = dig(&site(x, y));
+        assert!(!dirty.is_empty());
+        assert!(
+            outside == inside,
+            "crater at {x},{y} is not the one at 10,12"
+        );
+    }
+    // Radius 0: nothing.
+    let (level, dirty) = dig(&EditSite {
+        radius: 0,
+        ..site(10, 12)
+    });
+    assert!(dirty.is_empty() && level == original);
+    // Larger than the map: every texel lowered, once; symmetric about the centre.
+    let mut flat = Level::flat(64, 32, 200, 2).unwrap();
+    let dirty = crater(
+        &mut flat,
+        &EditSite {
+            radius: 1000,
+            depth: 50.0,
+            ..site(7, 3)
+        },
+    );
+    assert!(!dirty.is_empty());
+    for y in 0..32i64 {
+        for x in 0..64i64 {
+            let low = flat.column(x, y).low;
+            assert!((150..200).contains(&low), "{x},{y}: {low}");
+            assert_eq!(low, flat.column(14 - x, 6 - y).low, "{x},{y}");
+        }
+    }
+    assert_eq!(flat.column(7, 3).low, 150);
+    let mut huge = Level::flat(64, 32, 200, 2).unwrap();
+    crater(
+        &mut huge,
+        &EditSite {
+            radius: u32::MAX,
+            depth: 50.0,
+            ..site(7, 3)
+        },
+    );
+    assert!((0..64).all(|x| huge.column(x, 9).low == 150));
+    // NaN and infinite depths: an error from try_crater, nothing changed.
+    for depth in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+        let s = EditSite {
+            depth,
+            ..site(10, 12)
+        };
+        let mut level = original.clone();
+        let e = try_crater(&mut level, &s).unwrap_err();
+        assert!(matches!(e, EditError::Depth(_)));
+        assert!(e.to_string().contains("not a finite number"), "{e}");
+        assert!(level == original);
+        assert!(dig(&s).1.is_empty());
+    }
+    assert!(try_crater(&mut original.clone(), &site(10, 12)).is_ok());
+    // The ends of i64: wraps, no overflow.
+    for (x, y) in [(i64::MAX, i64::MIN), (i64::MIN, i64::MAX)] {
+        let (level, _) = dig(&site(x, y));
+        assert_pairs_valid(&level);
+    }
+}

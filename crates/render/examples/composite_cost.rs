@@ -1,7 +1,9 @@
-//! What `Renderer::render_into` adds to a frame: the GPU time of the one
-//! full-screen pass that copies Strata's colour and depth into the caller's
-//! views, per target format pair, by timestamp queries (wall clock of a
-//! submit-and-wait where the adapter has none).
+//! What `Renderer::render_into` adds to a frame: the GPU time of getting
+//! Strata's colour and depth into the caller's views — two texture copies
+//! where the targets allow (`Rgba8Unorm`/`Rgba8UnormSrgb` + `Depth32Float`
+//! made with `COPY_DST`, one sample), else the full-screen pass — per
+//! target format pair, by timestamp queries (wall clock of a submit-and-wait
+//! where the adapter has none). Each line says which path it took.
 //!
 //! ```text
 //! cargo run --release -p strata-render --example composite_cost -- [--size WxH] [--frames N] [--method NAME]
@@ -88,14 +90,16 @@ fn main() -> anyhow::Result<()> {
         (set, resolve, read)
     });
     let period_ms = f64::from(gpu.queue.get_timestamp_period()) * 1e-6;
-    for (color, depth, samples) in [
-        (F::Rgba8Unorm, F::Depth32Float, 1),
-        (F::Bgra8UnormSrgb, F::Depth24Plus, 1),
-        (F::Rgba16Float, F::Depth24PlusStencil8, 1),
-        (F::Bgra8Unorm, F::Depth24Plus, 1),
-        (F::Rgba8Unorm, F::Depth24Plus, 1),
-        (F::Bgra8UnormSrgb, F::Depth32Float, 1),
-        (F::Bgra8UnormSrgb, F::Depth24Plus, 4),
+    for (color, depth, samples, copy_dst) in [
+        (F::Rgba8Unorm, F::Depth32Float, 1, true),
+        (F::Rgba8UnormSrgb, F::Depth32Float, 1, true),
+        (F::Rgba8Unorm, F::Depth32Float, 1, false),
+        (F::Bgra8UnormSrgb, F::Depth24Plus, 1, false),
+        (F::Rgba16Float, F::Depth24PlusStencil8, 1, false),
+        (F::Bgra8Unorm, F::Depth24Plus, 1, false),
+        (F::Rgba8Unorm, F::Depth24Plus, 1, false),
+        (F::Bgra8UnormSrgb, F::Depth32Float, 1, false),
+        (F::Bgra8UnormSrgb, F::Depth24Plus, 4, false),
     ] {
         let target = |format| {
             gpu.device
@@ -110,7 +114,12 @@ fn main() -> anyhow::Result<()> {
                     sample_count: samples,
                     dimension: wgpu::TextureDimension::D2,
                     format,
-                    usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+                    usage: match copy_dst {
+                        true => {
+                            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_DST
+                        }
+                        false => wgpu::TextureUsages::RENDER_ATTACHMENT,
+                    },
                     view_formats: &[],
                 })
                 .create_view(&Default::default())
@@ -118,6 +127,7 @@ fn main() -> anyhow::Result<()> {
         let (cv, dv) = (target(color), target(depth));
         let targets = TargetViews::new(&cv, &dv);
         let mut times = Vec::new();
+        let mut copied = false;
         for _ in 0..frames {
             let mut encoder = gpu.device.create_command_encoder(&Default::default());
             let writes = queries
@@ -127,7 +137,7 @@ fn main() -> anyhow::Result<()> {
                     beginning_of_pass_write_index: Some(0),
                     end_of_pass_write_index: Some(1),
                 });
-            r.record_copy_into(&mut encoder, &targets, writes)?;
+            copied = r.record_copy_into(&mut encoder, &targets, writes)?;
             if let Some((set, resolve, read)) = &queries {
                 encoder.resolve_query_set(set, 0..2, resolve, 0);
                 encoder.copy_buffer_to_buffer(resolve, 0, read, 0, 16);
@@ -146,7 +156,8 @@ fn main() -> anyhow::Result<()> {
             });
         }
         println!(
-            "composite into {color:?} + {depth:?} x{samples}: median {:.3} ms, min {:.3} ms over {frames}",
+            "{} into {color:?} + {depth:?} x{samples}: median {:.3} ms, min {:.3} ms over {frames}",
+            if copied { "copies" } else { "pass" },
             median(times.clone()),
             times.iter().copied().fold(f64::INFINITY, f64::min)
         );

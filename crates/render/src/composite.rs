@@ -189,6 +189,52 @@ pub(crate) fn key_of(targets: &TargetViews<'_>, size: (u32, u32)) -> Result<Key,
     })
 }
 
+/// Whether the frame can reach the caller's targets by texture copies
+/// instead of the full-screen pass: single-sampled, colour of Strata's own
+/// format (or its sRGB twin: a copy stores the same bytes the pass makes
+/// it store, decoded then encoded), depth `Depth32Float` where the adapter
+/// copies depth (GL does not), both whole textures (one mip level, one
+/// layer) made with `COPY_DST`. The copy writes the same bytes as the pass
+/// at a fraction of its cost (`examples/composite_cost.rs`).
+pub(crate) fn copyable(
+    targets: &TargetViews<'_>,
+    key: Key,
+    caps: &crate::caps::Capabilities,
+) -> bool {
+    let (color, depth) = (targets.color.texture(), targets.depth.texture());
+    let whole = |t: &wgpu::Texture| {
+        t.mip_level_count() == 1
+            && t.depth_or_array_layers() == 1
+            && t.usage().contains(wgpu::TextureUsages::COPY_DST)
+    };
+    key.samples == 1
+        && caps.depth_copies
+        && color.format().remove_srgb_suffix() == crate::frame::COLOR_FORMAT
+        && depth.format() == crate::frame::DEPTH_FORMAT
+        && whole(color)
+        && whole(depth)
+}
+
+/// Record the copies of the shared frame (colour and depth) into the
+/// caller's targets ([`copyable`] said they take them).
+pub(crate) fn record_copies(
+    encoder: &mut wgpu::CommandEncoder,
+    shared: &crate::frame::Shared,
+    targets: &TargetViews<'_>,
+) {
+    let size = wgpu::Extent3d {
+        width: shared.width,
+        height: shared.height,
+        depth_or_array_layers: 1,
+    };
+    for (from, to) in [
+        (&shared.color, targets.color.texture()),
+        (&shared.depth, targets.depth.texture()),
+    ] {
+        encoder.copy_texture_to_texture(from.as_image_copy(), to.as_image_copy(), size);
+    }
+}
+
 /// The composite pipelines built so far (one per format pair and sample
 /// count a caller used) and the bind group over the current shared targets.
 #[derive(Default)]

@@ -3,13 +3,16 @@
 //! afterwards with the ordinary depth test, compose with it.
 //!
 //! How: the active method renders into Strata's own targets as in
-//! [`Renderer::render_frame`], then one full-screen pass in the same command
-//! buffer writes that frame's colour and depth (`frag_depth`) into the
-//! caller's views. One pass serves every format pair and sample count (a
-//! texture copy would serve only Strata's own formats at one sample, and GL
-//! has no depth copies), so there is a single path to test. A multisampled
-//! target receives each pixel's colour and depth in all its samples (the
-//! terrain is drawn at one sample per pixel; your objects get the MSAA).
+//! [`Renderer::render_frame`], then, in the same command buffer, the
+//! frame's colour and depth reach the caller's views: by two texture copies
+//! where the targets allow (colour `Rgba8Unorm` or `Rgba8UnormSrgb`, depth
+//! `Depth32Float`, one sample, both made with `COPY_DST`, and an adapter
+//! with depth copies; GL has none), else by one full-screen pass that
+//! writes colour and depth (`frag_depth`) and serves every format pair and
+//! sample count. Both store the same bytes (`tests/embed.rs`); the copies
+//! cost a fraction of the pass. A multisampled target receives each pixel's
+//! colour and depth in all its samples (the terrain is drawn at one sample
+//! per pixel; your objects get the MSAA).
 //!
 //! # Depth convention
 //! The depth written is Strata's depth-buffer value under
@@ -20,7 +23,9 @@
 //! **1.0**. Draw your objects with the same `view_proj`, depth compare
 //! [`wgpu::CompareFunction::Less`] and `LoadOp::Load` on both views.
 
-use crate::composite::{TargetError, TargetViews, key_of, record_composite};
+use crate::composite::{
+    TargetError, TargetViews, copyable, key_of, record_composite, record_copies,
+};
 use crate::gpu::catching;
 use crate::renderer::Renderer;
 use strata_camera::Camera;
@@ -67,10 +72,16 @@ impl Renderer {
         // a view wgpu refuses): caught here to name them, not left to the
         // device's error sink (in a browser they reach the sink).
         let mut composite = std::mem::take(&mut self.composite);
+        let copies = copyable(targets, key, &self.shared().caps);
         let (recorded, error) = catching(&device, wgpu::ErrorFilter::Validation, || {
+            // The copy or the composite reads the shared depth target: fill it.
+            if copies {
+                let mut encoder = self.record_frame_with(camera, true)?;
+                record_copies(&mut encoder, self.shared(), targets);
+                return anyhow::Ok(encoder.finish());
+            }
             let pipeline = composite.pipeline(&device, key)?;
             let group = composite.group(self.shared());
-            // The composite reads the shared depth target: fill it.
             let mut encoder = self.record_frame_with(camera, true)?;
             record_composite(&mut encoder, targets, key, &pipeline, &group, None);
             anyhow::Ok(encoder.finish())
@@ -99,14 +110,17 @@ impl Renderer {
     /// [`Renderer::render_frame`] or [`Renderer::render_into`]) into the
     /// caller's views, in the caller's encoder: to show one frame in more
     /// targets, or to time the copy (`timestamp_writes`; what
-    /// `examples/composite_cost.rs` measures). The same checks as
-    /// `render_into`; wgpu errors reach the device's error sink.
+    /// `examples/composite_cost.rs` measures). The same checks and the same
+    /// choice of texture copies or the pass as `render_into` (with copies,
+    /// the stamps are written by an empty compute pass before and one
+    /// after them); wgpu errors reach the device's error sink. Returns
+    /// whether it copied.
     pub fn record_copy_into(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
         targets: &TargetViews<'_>,
         timestamp_writes: Option<wgpu::RenderPassTimestampWrites<'_>>,
-    ) -> anyhow::Result<()> {
+    ) -> anyhow::Result<bool> {
         let key = key_of(targets, (self.shared().width, self.shared().height))?;
         if !self.depth_target_current {
             anyhow::bail!(
@@ -114,13 +128,34 @@ impl Renderer {
                 self.method_name()
             );
         }
+        if copyable(targets, key, &self.shared().caps) {
+            let stamp = |encoder: &mut wgpu::CommandEncoder, start: bool| {
+                let Some(w) = &timestamp_writes else { return };
+                let index = match start {
+                    true => w.beginning_of_pass_write_index,
+                    false => w.end_of_pass_write_index,
+                };
+                encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("composite copy stamp"),
+                    timestamp_writes: Some(wgpu::ComputePassTimestampWrites {
+                        query_set: w.query_set,
+                        beginning_of_pass_write_index: index.filter(|_| !start),
+                        end_of_pass_write_index: index.filter(|_| start),
+                    }),
+                });
+            };
+            stamp(encoder, true);
+            record_copies(encoder, self.shared(), targets);
+            stamp(encoder, false);
+            return Ok(true);
+        }
         let device = self.shared().device.clone();
         let mut composite = std::mem::take(&mut self.composite);
         let pipeline = composite.pipeline(&device, key);
         let group = composite.group(self.shared());
         self.composite = composite;
         record_composite(encoder, targets, key, &pipeline?, &group, timestamp_writes);
-        Ok(())
+        Ok(false)
     }
 }
 

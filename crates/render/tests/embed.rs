@@ -257,3 +257,101 @@ fn bad_targets_get_named_errors() {
         .unwrap();
     gpu.wait().unwrap();
 }
+
+/// Issue 35: targets of Strata's own formats made with `COPY_DST` take the
+/// frame by texture copies instead of the full-screen pass; both paths
+/// store the same bytes, for every method.
+#[test]
+fn the_copy_path_stores_what_the_pass_stores() {
+    use wgpu::TextureFormat as F;
+    let Some(gpu) = common::gpu() else { return };
+    let (level, camera) = scene();
+    let settings = MethodSettings {
+        shadows: false,
+        ..Default::default()
+    };
+    let colors = TerrainColors::test_ramps();
+    let reader = DepthReader::new(&gpu.device, &gpu.caps).unwrap();
+    let read = |texture: &wgpu::Texture| -> Vec<u8> {
+        let aspect = match texture.format().is_depth_stencil_format() {
+            true => wgpu::TextureAspect::DepthOnly,
+            false => wgpu::TextureAspect::All,
+        };
+        match (&reader, aspect) {
+            (Some(reader), wgpu::TextureAspect::DepthOnly) => bytemuck::cast_slice(
+                &reader
+                    .read(&gpu.device, &gpu.queue, &gpu.errors, texture)
+                    .unwrap(),
+            )
+            .to_vec(),
+            _ => strata_render::gpu::read_texture(
+                &gpu.device,
+                &gpu.queue,
+                &gpu.errors,
+                texture,
+                aspect,
+            )
+            .unwrap(),
+        }
+    };
+    let copy_usage = USAGE | wgpu::TextureUsages::COPY_DST;
+    let mut tested = 0;
+    for name in strata_render::methods::names() {
+        let mut r = match Renderer::new(&gpu, &level, &colors, name, &settings, W, H) {
+            Ok(r) => r,
+            Err(e) => {
+                eprintln!("{name}: not on this adapter ({e:#})");
+                continue;
+            }
+        };
+        for color_format in [F::Rgba8Unorm, F::Rgba8UnormSrgb] {
+            let mut images = Vec::new();
+            for usage in [USAGE, copy_usage] {
+                let (color_tex, color_view) = target(&gpu, color_format, (W, H), 1, usage);
+                let (depth_tex, depth_view) = target(&gpu, F::Depth32Float, (W, H), 1, usage);
+                let targets = TargetViews::new(&color_view, &depth_view);
+                r.render_into(&camera, &targets).unwrap();
+                gpu.wait().unwrap();
+                // The same choice as `render_into` made, said by the copy-only call.
+                let mut encoder = gpu.device.create_command_encoder(&Default::default());
+                let copied = r.record_copy_into(&mut encoder, &targets, None).unwrap();
+                gpu.queue.submit([encoder.finish()]);
+                gpu.wait().unwrap();
+                assert_eq!(
+                    copied,
+                    usage == copy_usage && gpu.caps.depth_copies,
+                    "{name}: {usage:?}"
+                );
+                images.push((read(&color_tex), read(&depth_tex)));
+            }
+            let ((pass_color, pass_depth), (copy_color, copy_depth)) = (&images[0], &images[1]);
+            let worst = pass_color
+                .iter()
+                .zip(copy_color)
+                .map(|(a, b)| a.abs_diff(*b))
+                .max()
+                .unwrap_or(0);
+            let depths_differ = pass_depth
+                .chunks_exact(4)
+                .zip(copy_depth.chunks_exact(4))
+                .filter(|(a, b)| a != b)
+                .count();
+            let terrain = bytemuck::cast_slice::<u8, f32>(copy_depth)
+                .iter()
+                .filter(|d| **d < 1.0)
+                .count();
+            println!(
+                "{name} into {color_format:?}: copy vs pass: worst channel difference {worst}, \
+                 {depths_differ} depths differ, {terrain} terrain pixels"
+            );
+            // Rgba8Unorm: the very bytes; the sRGB twin: the pass's decode +
+            // encode round trip may move a byte by one.
+            let allowed = u8::from(color_format == F::Rgba8UnormSrgb);
+            assert!(worst <= allowed, "{name} {color_format:?}: {worst}");
+            assert_eq!(depths_differ, 0, "{name} {color_format:?}");
+            assert!(terrain > (W * H / 4) as usize, "{name}: {terrain}");
+        }
+        tested += 1;
+    }
+    assert!(tested >= 2, "{tested} methods ran");
+}

@@ -58,6 +58,7 @@ pub fn run(adapter: &str) -> RunResults {
     RunResults {
         temporal: Vec::new(),
         edit_images: Vec::new(),
+        gameplay: None,
         protocol_version: PROTOCOL_VERSION,
         level: LevelInfo {
             name: "test".into(),

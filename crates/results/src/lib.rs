@@ -7,6 +7,7 @@
 //! re-exports this crate as `strata_bench::results`; `strata-fuzz` fuzzes
 //! the reader without building a GPU stack.
 
+pub mod gameplay;
 pub mod merge;
 pub mod report;
 pub mod stats;
@@ -74,6 +75,9 @@ pub struct RunResults {
     /// Before/after pictures of the edit camera for the edit figure.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub edit_images: Vec<EditImages>,
+    /// `compare --gameplay`: the sustained edit workload (issue 35).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gameplay: Option<gameplay::GameplayResults>,
 }
 
 /// One method's temporal flicker along `compare --temporal`'s short path.

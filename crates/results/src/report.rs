@@ -48,6 +48,7 @@ pub fn render(runs: &[RunResults], pictures: &Pictures, disagreements: &[Disagre
     preparation_table(&mut md, runs);
     memory_table(&mut md, base);
     edit_tables(&mut md, runs);
+    crate::gameplay::section(&mut md, runs);
     temporal_table(&mut md, runs);
     figures(&mut md, pictures);
     per_view_table(&mut md, base);

@@ -5,7 +5,7 @@
 
 use glam::{DVec3, Vec3};
 use strata_camera::Camera;
-use strata_level::edit::{Snapshot, crater, crater_rect};
+use strata_level::edit::{Snapshot, crater_rect, try_crater};
 use strata_level::{DirtyRect, EditSite, Level};
 use strata_reference::{ReferenceSettings, Tracer};
 
@@ -54,8 +54,13 @@ impl Digger {
     }
 
     /// Cut a crater centred under `point`; returns the dirty rectangles
-    /// (empty when nothing changed, and then there is nothing to undo).
+    /// (empty when nothing changed, and then there is nothing to undo). A
+    /// point anywhere wraps onto the map; a point that is not finite (NaN,
+    /// infinite), a radius of 0 or a depth that is not finite dig nothing.
     pub fn dig(&mut self, level: &mut Level, point: Vec3) -> Vec<DirtyRect> {
+        if !point.is_finite() {
+            return Vec::new();
+        }
         let site = EditSite {
             centre_x: point.x.floor() as i64,
             centre_y: point.y.floor() as i64,
@@ -64,7 +69,7 @@ impl Digger {
             ..EditSite::fostral()
         };
         let snapshot = Snapshot::take(level, crater_rect(&site));
-        let dirty = crater(level, &site);
+        let dirty = try_crater(level, &site).unwrap_or_default();
         if !dirty.is_empty() {
             if self.undo.len() == UNDO_DEPTH {
                 self.undo.remove(0);
@@ -121,5 +126,37 @@ mod tests {
         digger.undo(&mut level).unwrap();
         assert!(level == original);
         assert_eq!(digger.undo(&mut level), None);
+    }
+
+    #[test]
+    fn a_dig_at_no_point_or_of_no_size_digs_nothing() {
+        let original = Level::flat(256, 256, 100, 2).unwrap();
+        let mut level = original.clone();
+        let mut digger = Digger::new(&EditSite::fostral());
+        for bad in [
+            Vec3::new(f32::NAN, 10.0, 100.0),
+            Vec3::new(10.0, f32::INFINITY, 100.0),
+            Vec3::new(10.0, 10.0, f32::NAN),
+        ] {
+            assert!(digger.dig(&mut level, bad).is_empty(), "{bad}");
+        }
+        digger.depth = f32::NAN;
+        assert!(
+            digger
+                .dig(&mut level, Vec3::new(10.0, 10.0, 100.0))
+                .is_empty()
+        );
+        (digger.depth, digger.radius) = (20.0, 0);
+        assert!(
+            digger
+                .dig(&mut level, Vec3::new(10.0, 10.0, 100.0))
+                .is_empty()
+        );
+        assert!(level == original && digger.can_undo() == 0);
+        // Far outside the map (a pick past the seam): wraps onto it.
+        digger.radius = 8;
+        let far = digger.dig(&mut level, Vec3::new(10.5 + 256.0 * 40.0, -245.5, 100.0));
+        assert!(!far.is_empty() && level.column(10, 10).low < 100);
+        assert_eq!(digger.can_undo(), 1);
     }
 }

@@ -32,6 +32,28 @@ pub fn gpu_or_skip(test: &str) -> Option<Gpu> {
     }
 }
 
+/// One adapter per backend found (lavapipe's Vulkan and llvmpipe's GL on a
+/// CPU machine), every method held to the same check on each; none found:
+/// a loud skip (as [`gpu_or_skip`]).
+pub fn every_backend(test: &str) -> Vec<Gpu> {
+    use strata_render::{AdapterChoice, BackendChoice};
+    let mut found = Vec::new();
+    for backend in [BackendChoice::Vulkan, BackendChoice::Gl] {
+        let choice = AdapterChoice {
+            backend,
+            ..Default::default()
+        };
+        match Gpu::open(&choice) {
+            Ok(g) => found.push(g),
+            Err(e) => eprintln!("\n*** SKIPPED GPU backend {backend}: {test}: {e:#} ***\n"),
+        }
+    }
+    if found.is_empty() {
+        skip_loudly(&format!("{test}: no GPU adapter on Vulkan or GL"));
+    }
+    found
+}
+
 /// The methods of these names, default settings.
 pub fn choices(names: &[&str]) -> Vec<MethodChoice> {
     names

@@ -58,6 +58,14 @@ pub struct Args {
     /// every method and report each one's depth flicker beyond the CPU reference's.
     #[arg(long)]
     pub temporal: bool,
+    /// Also run the sustained edit workload (issue 35): K small edits a frame (default 64;
+    /// tracks of radius 2-6 along the video's default path, a few craters, slabs carved and
+    /// built, old edits undone) for 600 frames (24 with --quick), through every method's own
+    /// update path; per method the edits' and the frame's CPU/GPU ms (p50/p99/max), checked
+    /// against a fresh build every 100 frames (12 with --quick) and at the end; the terrain
+    /// collider's refit per frame.
+    #[arg(long, value_name = "K", num_args = 0..=1, default_missing_value = "64")]
+    pub gameplay: Option<u32>,
     /// What grid.png shows: `pictures` (each method's picture) or `flip` (each cell's ꟻLIP
     /// error map against the CPU colour reference, which fills the reference column).
     #[arg(long, value_name = "MODE", default_value = "pictures")]
@@ -127,11 +135,25 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let gpu = args.adapter.open()?;
     announce(&gpu.report);
     let options = options_for(&args, &prepared, &gpu.report, args.out_dir());
-    let plan = Plan::new(prepared.world, options)?.with_paging(paging(&args))?;
+    let plan = Plan::new(prepared.world, options)?
+        .with_paging(paging(&args))?
+        .with_gameplay(gameplay(&args, &gpu.report))?;
     let (json, report) = plan.run(&gpu)?;
     println!("wrote {}", json.display());
     println!("wrote {}", report.display());
     Ok(())
+}
+
+/// `--gameplay [K]`'s workload: the issue's 600 frames, or the quick form's
+/// 24 where the run is quick (`--quick`, or a CPU rasteriser without
+/// `--size`/`--frames`).
+fn gameplay(args: &Args, adapter: &AdapterReport) -> Option<strata_bench::gameplay::GameplaySpec> {
+    use strata_bench::gameplay::GameplaySpec;
+    let k = args.gameplay?;
+    Some(match is_quick(args, adapter) {
+        true => GameplaySpec::quick(k),
+        false => GameplaySpec::full(k),
+    })
 }
 
 /// The paging of `--gpu-budget` (`None` without it: the paper's protocol).
@@ -181,6 +203,11 @@ pub(crate) fn past_the_limit(
 /// through pages (at `--gpu-budget`, default 256 MiB), every other method
 /// is a refusal in the results naming the limit and the paged methods.
 fn run_paged_store(args: &Args, refusal: String) -> anyhow::Result<()> {
+    if args.gameplay.is_some() {
+        anyhow::bail!(
+            "{refusal}: --gameplay edits the world in memory; run it on a world loaded whole"
+        );
+    }
     if args.all_adapters || args.resume.is_some() {
         anyhow::bail!(
             "{refusal}: --all-adapters and --resume need a world loaded whole; compare it on one adapter (the paged methods draw it)"
@@ -343,12 +370,16 @@ fn announce(report: &AdapterReport) {
     );
 }
 
+/// `--quick`, or a CPU rasteriser without an explicit `--size`/`--frames`.
+fn is_quick(args: &Args, adapter: &AdapterReport) -> bool {
+    args.quick || (adapter.device_type == "Cpu" && args.size.is_none() && args.frames.is_none())
+}
+
 /// The run's options on one adapter: the publication configuration, or the
 /// quick smoke on a CPU rasteriser (lavapipe/llvmpipe), where the full one
 /// takes hours; an explicit --size or --frames still wins.
 fn options_for(args: &Args, p: &Prepared, adapter: &AdapterReport, out: PathBuf) -> Options {
-    let quick = args.quick
-        || (adapter.device_type == "Cpu" && args.size.is_none() && args.frames.is_none());
+    let quick = is_quick(args, adapter);
     if quick && !args.quick {
         eprintln!(
             "note: {} is a CPU rasteriser: running the --quick smoke (320x200, 4 frames); \
@@ -443,6 +474,7 @@ fn run_all_adapters(args: &Args, prepared: Prepared) -> anyhow::Result<()> {
         let options = options_for(args, &prepared, &gpu.report, out.clone());
         let result = Plan::new(prepared.world.clone(), options)
             .and_then(|plan| plan.with_paging(paging(args)))
+            .and_then(|plan| plan.with_gameplay(gameplay(args, &gpu.report)))
             .and_then(|plan| plan.run(&gpu));
         drop(gpu);
         match result {

@@ -144,6 +144,48 @@ fn gpu_pyramid_equals_its_twin_before_and_after_an_edit() {
     }
 }
 
+/// Issue 35: a game's frame of edits (here 200 small rectangles, more than
+/// the update's slots) is merged into fewer rectangles, and the GPU
+/// pyramid still equals a fresh one.
+#[test]
+fn many_small_edits_in_one_frame_update_the_pyramid_exactly() {
+    for gpu in common::gpus() {
+        let world = world(256, 1024, 6);
+        let mut level = world.level.clone();
+        let shared = shared_for(&gpu, &level);
+        let mut gp = GpuMaxMip::new(&shared, &level, 2).unwrap();
+        let mut rects = Vec::new();
+        for k in 0..200u32 {
+            // Tracks lower, ridges raise: a stale tile either way shows.
+            let (x, y) = ((k * 37) % 250, (k * 101) % 1020);
+            let rect = strata_level::edit::EditRect {
+                x: i64::from(x),
+                y: i64::from(y),
+                width: 3,
+                height: 3,
+            };
+            let height = if k % 2 == 0 { 0 } else { 250 };
+            rects.extend(strata_level::edit::fill_single(&mut level, rect, height, 1));
+        }
+        assert!(rects.len() >= 150, "{} rects", rects.len());
+        shared
+            .terrain
+            .upload(&shared.queue, &level, &rects)
+            .unwrap();
+        gp.enqueue(&rects);
+        run_pending(&mut gp, &shared);
+        let fresh = strata_maxmip::Pyramid::with_step(&level, 2);
+        let got = gp.read_back(&shared).unwrap();
+        assert!(
+            got == fresh.words(),
+            "after {} rects: {}",
+            rects.len(),
+            first_diff(&got, &fresh.words())
+        );
+        gpu.errors.check().unwrap();
+    }
+}
+
 /// One ray for both tracers: f32 as the GPU takes it.
 #[derive(Clone, Copy, Debug)]
 struct TestRay {
