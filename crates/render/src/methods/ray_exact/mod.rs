@@ -701,6 +701,7 @@ impl Drop for RayExact {
 
 mod bindings;
 mod deferred;
+pub mod replay;
 use crate::paged::PagedTerrain;
 pub use bindings::Levels;
 use bindings::{buffer_entry, core_bindings, core_entries, exact_pipeline, march_group};
