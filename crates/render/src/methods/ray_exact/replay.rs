@@ -344,6 +344,11 @@ pub struct PassCount {
     pub terrain_reads: Spread,
     /// Shadow-map texels read per ray (the shading pass).
     pub shadow_reads: u64,
+    /// Mean over 32-lane warps (8x4 pixels or texels of an 8x8 workgroup) of
+    /// the most iterations of a lane: a warp steps as long as its longest ray.
+    pub warp_iterations: f64,
+    /// Iterations over warp steps x 32: the share of lanes doing work.
+    pub simd_efficiency: f64,
     /// Bytes read, all requests (terrain, pyramid, shadow map, the pass's
     /// own images).
     pub bytes_read: u64,
@@ -401,13 +406,23 @@ impl PassAcc {
         self.terrain.push(m.terrain_reads);
     }
 
-    fn finish(self) -> PassCount {
+    /// `warps`: the lanes of each warp, as indices into the rays.
+    fn finish(self, warps: impl Iterator<Item = Vec<usize>>) -> PassCount {
         let rays = self.iterations.len() as u64;
+        let (mut count, mut steps) = (0u64, 0u64);
+        for lanes in warps {
+            let most = lanes.iter().map(|&i| self.iterations[i]).max().unwrap_or(0);
+            count += 1;
+            steps += u64::from(most);
+        }
+        let work: u64 = self.iterations.iter().map(|&x| u64::from(x)).sum();
         let pyramid = Spread::of(self.pyramid);
         let terrain = Spread::of(self.terrain);
         PassCount {
             rays,
             bytes_read: pyramid.total * PYRAMID_WORD_BYTES + terrain.total * TERRAIN_TEXEL_BYTES,
+            warp_iterations: steps as f64 / count.max(1) as f64,
+            simd_efficiency: work as f64 / (steps * 32).max(1) as f64,
             iterations: Spread::of(self.iterations),
             pyramid_reads: pyramid,
             terrain_reads: terrain,
@@ -489,7 +504,15 @@ pub fn replay_frame(replay: &mut Replay<'_>, g: &Globals) -> FrameCount {
         }
     }
     let pixels = u64::from(w) * u64::from(h);
-    let mut march = march.finish();
+    // Warps of 8x8 workgroups over the image: 8x4 pixels each.
+    let warps = (0..h.div_ceil(4)).flat_map(|wy| {
+        (0..w.div_ceil(8)).map(move |wx| {
+            (wy * 4..(wy * 4 + 4).min(h))
+                .flat_map(|y| (wx * 8..(wx * 8 + 8).min(w)).map(move |x| (y * w + x) as usize))
+                .collect()
+        })
+    });
+    let mut march = march.finish(warps);
     // hits (4 B each pixel), depth_io (4 B per hit), stamps and list.
     march.bytes_written =
         pixels * TEXEL_BYTES + hits.len() as u64 * TEXEL_BYTES + listed.len() as u64 * 8;
@@ -507,7 +530,9 @@ pub fn replay_frame(replay: &mut Replay<'_>, g: &Globals) -> FrameCount {
             }
         }
     }
-    let mut shadow = shadow.finish();
+    // Each listed block is a workgroup, its texels in rows: two warps.
+    let rays = shadow.iterations.len();
+    let mut shadow = shadow.finish((0..rays / 32).map(|k| (k * 32..k * 32 + 32).collect()));
     shadow.bytes_read += listed.len() as u64 * 4;
     shadow.bytes_written = listed.len() as u64 * SHADOW_BLOCK_TEXELS * TEXEL_BYTES;
     let shadow_most_iterations = shadow.iterations.max;
