@@ -5,8 +5,10 @@
 #include "surface.wgsl"
 #include "shading.wgsl"
 #include "forward.wgsl"
+#include "column_segment.wgsl"
 
-// count.y: slices N; count.z: the slice nearest the eye's altitude.
+// count.y: slices N; count.z: the slice nearest the eye's altitude; count.w:
+// the most columns a gap walk takes (at most a tile's side).
 @group(1) @binding(0) var<uniform> footprint: Footprint;
 
 // Twin of `methods::slice_tiles::SliceTileParams`.
@@ -24,6 +26,21 @@ struct SliceTiles {
 
 // Top of the sliced range (Rust: `forward::Z_MAX`).
 const SLICE_TOP: f32 = 256.0;
+// Where a pixel's ray crosses the slices more than GAP_MIN texels apart
+// (grazing rays: the gap is spacing / slope), a thin wall or a peak can sit
+// between two crossings, and the plain point test sees through it. There a
+// fragment whose point is air walks the ray from the previous slice's
+// crossing (the first slice: from the near plane) to its own point (the
+// last before the far plane: on to the far plane),
+// at most footprint.count.w columns (`column_segment.wgsl::first_entry`;
+// Rust: `sliced::GAP_TEXELS`), and keeps the first solid point it meets: the
+// slices then cover the ray without gaps down to slopes of about spacing /
+// count.w. Steeper rays never walk.
+const GAP_MIN: f32 = 1.0;
+// The walk from the near plane to the first slice a ray meets: one per
+// pixel, so it may be long (near the horizon the first crossing is hundreds
+// of texels out; the far plane 600 is under 900 columns away).
+const FIRST_GAP_TEXELS: u32 = 1024u;
 
 struct VertexOut {
     @builtin(position) clip: vec4<f32>,
@@ -31,6 +48,37 @@ struct VertexOut {
     @location(1) @interpolate(flat) altitude: f32,
     // j: the slice at altitude SLICE_TOP - (j + 1) * SLICE_TOP / N
     @location(2) @interpolate(flat) rank: u32,
+}
+
+// The highest top of the tile and its 8 neighbours (a walk from a fragment
+// of this tile reaches at most count.w <= one tile side into them).
+fn tile_max_around(tile: vec2<i32>) -> u32 {
+    var m = 0u;
+    for (var dy = -1; dy <= 1; dy = dy + 1) {
+        for (var dx = -1; dx <= 1; dx = dx + 1) {
+            let wrapped = vec2<u32>(tile + vec2<i32>(dx, dy)) & slice_tiles.tiles.yz;
+            m = max(m, textureLoad(tile_max, wrapped, 0).r);
+        }
+    }
+    return m;
+}
+
+// Whether slice altitude `z` is all air over `tile` for every fragment the
+// tile would make: its own maximum, or, where some of its fragments may walk
+// the gap to the next slice (`GAP_MIN`: the gap along a ray through a point
+// at horizontal distance r from the eye is spacing * r / |z - eye z|), the
+// neighbours' maxima against the lowest altitude a walk reaches.
+fn tile_culled(tile: vec2<i32>, z: f32, spacing: f32) -> bool {
+    let k = slice_tiles.tiles.x;
+    let own = f32(textureLoad(tile_max, vec2<u32>(tile) & slice_tiles.tiles.yz, 0).r);
+    let lo = vec2<f32>(tile << vec2<u32>(k));
+    let hi = vec2<f32>((tile + vec2<i32>(1)) << vec2<u32>(k));
+    let e = globals.eye.xyz;
+    let far_corner = max(abs(lo - e.xy), abs(hi - e.xy));
+    if (spacing * length(far_corner) <= GAP_MIN * abs(z - e.z)) {
+        return z > own;
+    }
+    return z - spacing > f32(tile_max_around(tile));
 }
 
 // Instance i: slice rank i / tiles, tile i % tiles of the footprint's grid;
@@ -57,8 +105,10 @@ fn vs_sliced(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) -> 
         let t = i % per_slice;
         let tile = g.xy + vec2<i32>(i32(t % u32(g.z)), i32(t / u32(g.z)));
         let k = slice_tiles.tiles.x;
-        let wrapped = vec2<u32>(tile) & slice_tiles.tiles.yz;
-        if (z > f32(textureLoad(tile_max, wrapped, 0).r)) {
+        // The slices within a spacing of the eye's altitude are the first
+        // that rays meet, whose walks start at the eye: never culled.
+        let spacing = SLICE_TOP / f32(n);
+        if (abs(z - globals.eye.z) > spacing && tile_culled(tile, z, spacing)) {
             // A degenerate triangle (all three vertices equal) rasterises nothing.
             out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
             out.world = vec3<f32>(0.0);
@@ -85,33 +135,74 @@ fn vs_sliced(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) -> 
 // world position interpolated across it is imprecise on some rasterisers
 // (SwiftShader's showed sky for a whole horizon view); the plane hit is exact.
 // Edge-on (the ray parallel to the slice) keeps the interpolated point.
-fn slice_point(in: VertexOut) -> vec3<f32> {
+struct SliceHit {
+    // whether the fragment is kept
+    keep: bool,
+    // the solid point it stands for (the slice point, or the first solid
+    // point of the gap walk)
+    p: vec3<f32>,
+    // the column `p` belongs to
+    cell: vec2<i32>,
+}
+
+fn slice_hit(in: VertexOut) -> SliceHit {
+    var h: SliceHit;
     let d = camera_ray(in.clip.x, in.clip.y);
     let e = globals.eye.xyz;
     if (abs(d.z) < 1e-6 * length(d)) {
-        return in.world;
+        h.p = in.world;
+        h.cell = vec2<i32>(floor(h.p.xy));
+        h.keep = is_solid(h.p);
+        return h;
     }
-    return e + d * ((in.altitude - e.z) / d.z);
+    let t = (in.altitude - e.z) / d.z;
+    h.p = e + d * t;
+    h.cell = vec2<i32>(floor(h.p.xy));
+    h.keep = is_solid(h.p);
+    // The ray met the previous slice `gap` before this one (or left the
+    // near plane after that): walk from there to this slice's point. The
+    // last slice before the far plane also walks on to the far plane.
+    let gap = SLICE_TOP / f32(footprint.count.y) / abs(d.z);
+    if (h.keep || gap * length(d.xy) <= GAP_MIN) {
+        return h;
+    }
+    let t_near = globals.forward.w / globals.eye.w;
+    let t_far = globals.right.w / globals.eye.w;
+    // The first slice the ray meets (the eye's neighbours, never culled)
+    // walks from the near plane as far as it takes.
+    let first = t - gap <= t_near;
+    let cap = select(footprint.count.w, FIRST_GAP_TEXELS, first);
+    var x = first_entry(e, d, max(t - gap, t_near), t, cap);
+    if (!x.hit && t + gap > t_far) {
+        x = first_entry(e, d, t, t_far, footprint.count.w);
+    }
+    if (x.hit) {
+        h.keep = true;
+        h.p = e + d * x.t;
+        h.cell = x.column;
+    }
+    return h;
 }
 
 @fragment
 fn fs_sliced(in: VertexOut) -> @location(0) vec4<f32> {
-    let p = slice_point(in);
-    if (!is_solid(p)) {
+    let h = slice_hit(in);
+    if (!h.keep) {
         discard;
     }
-    return vec4<f32>(shade(p, p - globals.eye.xyz), 1.0);
+    return vec4<f32>(shade_column(h.p, h.cell.x, h.cell.y, h.p - globals.eye.xyz), 1.0);
 }
 
 // `sliced:N/refine`, pass 1: the same slices and the same test, but a kept
 // fragment writes only its slice's rank + 1 (0 = none) into the marks image
 // and no colour: pass 2 (`sliced_refine.wgsl`) searches the exact crossing
-// once per pixel and shades it. The depth is the slice plane's, from the
-// rasteriser, so early depth testing still rejects the slices behind.
+// once per pixel (up to the marked slice's point, which the gap walk never
+// passes) and shades it. The depth is the slice
+// plane's, from the rasteriser, so early depth testing still rejects the
+// slices behind.
 @fragment
 fn fs_slice_mark(in: VertexOut) -> @location(0) vec4<u32> {
-    let p = slice_point(in);
-    if (!is_solid(p)) {
+    if (!slice_hit(in).keep) {
         discard;
     }
     return vec4<u32>(in.rank + 1u, 0u, 0u, 0u);

@@ -14,9 +14,22 @@
 #include "forward.wgsl"
 #include "fullscreen.wgsl"
 
-// count.y: slices N.
+// count.y: slices N; count.w: the most columns a slice fragment's gap walk
+// takes (`sliced.wgsl::slice_hit`).
 @group(1) @binding(0) var<uniform> footprint: Footprint;
 @group(1) @binding(1) var slice_marks: texture_2d<u32>;
+
+// Twin of `methods::slice_tiles::SliceTileParams` (the slice pass's): here
+// only `tiles` (x: log2 of the tile side; y, z: the map's tiles across and
+// down - 1) is read.
+struct SliceTiles {
+    grid: vec4<i32>,
+    tiles: vec4<u32>,
+}
+
+@group(1) @binding(2) var<uniform> slice_tiles: SliceTiles;
+// The highest solid top over each tile of the map and a one-texel margin.
+@group(1) @binding(3) var tile_max: texture_2d<u32>;
 
 // Top of the sliced range (Rust: `forward::Z_MAX`).
 const SLICE_TOP: f32 = 256.0;
@@ -91,17 +104,65 @@ fn first_crossing(e: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32) -> Crossing {
     return out;
 }
 
+// Most tiles one search crosses (far 600 crosses at most ~60 of 32 texels).
+const REFINE_TILES: u32 = 512u;
+
+// `first_crossing` over [t0, t1], tile by tile of the slice pass's culling
+// tiles: a tile whose highest top (margin included) is below the segment's
+// lowest point in it holds no crossing and is stepped over whole, so the
+// column walk runs only where the ray comes down to the ground.
+fn first_crossing_tiled(e: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32) -> Crossing {
+    var out: Crossing;
+    out.found = false;
+    out.t = t1;
+    let side = f32(1u << slice_tiles.tiles.x);
+    let step = vec2<i32>(select(-1, 1, d.x > 0.0), select(-1, 1, d.y > 0.0));
+    let moves = abs(d.xy) > vec2<f32>(1e-12);
+    let inv = select(vec2<f32>(0.0), vec2<f32>(1.0) / d.xy, moves);
+    var tile = vec2<i32>(floor((e + d * t0).xy / side));
+    var t = t0;
+    for (var i = 0u; i < REFINE_TILES; i = i + 1u) {
+        let next = vec2<f32>(tile + max(step, vec2<i32>(0))) * side;
+        let tb = select(vec2<f32>(NO_ENTRY), (next - e.xy) * inv, moves);
+        let t_out = max(min(min(tb.x, tb.y), t1), t);
+        let z_min = min(e.z + d.z * t, e.z + d.z * t_out);
+        let top = textureLoad(tile_max, vec2<u32>(tile) & slice_tiles.tiles.yz, 0).r;
+        if (z_min <= f32(top)) {
+            let x = first_crossing(e, d, t, t_out);
+            if (x.found) {
+                return x;
+            }
+        }
+        if (t_out >= t1) {
+            break;
+        }
+        t = t_out;
+        if (tb.x <= tb.y) {
+            tile.x = tile.x + step.x;
+        } else {
+            tile.y = tile.y + step.y;
+        }
+    }
+    return out;
+}
+
 struct RefinedOut {
     @location(0) color: vec4<f32>,
     @builtin(frag_depth) depth: f32,
 }
 
-// A ray whose altitude changes by less than this many slice spacings between
-// the near and the far plane meets at most a few slices, or none (the rows
-// at the horizon of a level view): no mark says it is empty, so the pass
-// searches it whole. Measured at 640x400 on the generated world's 0° views:
-// most of the plain slicer's see-through were such rays.
-const UNSAMPLED_SPACINGS: f32 = 4.0;
+// An unmarked ray is empty only where the slices sampled it without gaps:
+// each slice fragment in air walks the ray to its own point
+// from the previous slice's crossing (`sliced.wgsl::slice_hit`; the first
+// from the near plane), at most count.w columns. A ray whose gap
+// between crossings needs more (near the horizon of a level view) may have
+// slipped past a thin wall or peak, or crossed no slice at all, so the pass
+// searches it whole. A segment whose ends are `dx`, `dy` apart crosses at
+// most |dx| + |dy| + 2 columns.
+fn gaps_walked(d: vec3<f32>, spacing: f32) -> bool {
+    let gap = spacing / abs(d.z);
+    return gap * (abs(d.x) + abs(d.y)) + 2.0 <= f32(footprint.count.w);
+}
 
 @fragment
 fn fs_sliced_refine(@builtin(position) pos: vec4<f32>) -> RefinedOut {
@@ -113,21 +174,23 @@ fn fs_sliced_refine(@builtin(position) pos: vec4<f32>) -> RefinedOut {
     // View depth = t * focal.
     let t_near = globals.forward.w / globals.eye.w;
     let t_far = globals.right.w / globals.eye.w;
-    // Search up to the slice point (edge-on: as far as the view goes).
+    // Search up to the slice point (edge-on or unmarked: as far as the view
+    // goes).
     var t_k = t_far;
+    let edge_on = abs(d.z) <= 1e-6 * length(d);
     if (mark == 0u) {
-        if (abs(d.z) * (t_far - t_near) >= UNSAMPLED_SPACINGS * spacing) {
+        if (!edge_on && gaps_walked(d, spacing)) {
             // The slices sampled this ray and found it empty: sky, as the
             // plain slicer leaves it (colour cleared here, depth by pass 1).
             discard;
         }
-    } else if (abs(d.z) > 1e-6 * length(d)) {
+    } else if (!edge_on) {
         let altitude = SLICE_TOP - f32(mark) * spacing;
         t_k = clamp((altitude - e.z) / d.z, t_near, t_far);
     }
     var t = t_k;
     var cell = vec2<i32>(floor((e + d * t_k).xy));
-    let x = first_crossing(e, d, t_near, t_k);
+    let x = first_crossing_tiled(e, d, t_near, t_k);
     if (x.found) {
         t = x.t;
         cell = x.cell;

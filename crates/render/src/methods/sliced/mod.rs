@@ -24,6 +24,15 @@ use strata_camera::Camera;
 use strata_level::Level;
 use tiles::SliceTiles;
 
+/// Most texel columns a slice fragment whose point is air walks along its
+/// pixel's ray from the previous slice's crossing, where grazing rays cross
+/// the slices more than a texel apart (`sliced.wgsl::slice_hit`); capped at
+/// the culling tiles' side, so that a walk stays within a tile's neighbours.
+/// 32: the slices cover rays without gaps down to slopes of about 1/48 at
+/// 512 slices (the horizon rows of a level view are left to the refine pass's
+/// whole-ray search).
+pub const GAP_TEXELS: u32 = 32;
+
 /// More slices than this sample far below the 256 quantised altitudes and
 /// only multiply overdraw; refuse them rather than draw for seconds.
 pub const MAX_SLICES: u32 = 1 << 16;
@@ -111,7 +120,7 @@ pub fn create(
             ("vs_sliced", "fs_slice_mark"),
             MARK_FORMAT,
         )?;
-        (marks, Some(Refine::new(shared, &params)?))
+        (marks, Some(Refine::new(shared, &params, &tiles)?))
     } else {
         let plain = forward_pipeline(
             shared,
@@ -172,7 +181,7 @@ impl Method for Sliced {
 
     fn resize(&mut self, shared: &Shared) -> anyhow::Result<()> {
         if let Some(refine) = &mut self.refine {
-            refine.resize(shared, &self.params);
+            refine.resize(shared, &self.params, &self.tiles);
         }
         Ok(())
     }
@@ -183,6 +192,7 @@ impl Method for Sliced {
         self.empty = f.size[0] == 0 || f.size[1] == 0;
         f.count[1] = self.slices;
         f.count[2] = slice_near(camera.position.z, self.slices);
+        f.count[3] = GAP_TEXELS.min(self.tiles.side());
         self.tiles_per_slice = self
             .tiles
             .prepare(shared, [f.origin[0], f.origin[1]], f.extent());

@@ -13,6 +13,7 @@
 
 use super::super::common::{draw_fullscreen_with_depth, fullscreen_pipeline};
 use super::super::contract::{Frame, RetainedBytes};
+use super::tiles::SliceTiles;
 use crate::frame::{Shared, texture_entry, uniform_layout_entry};
 
 /// Format of the slice marks: rank + 1 of the kept slice, 0 = none. An
@@ -34,7 +35,12 @@ struct Marks {
 }
 
 impl Marks {
-    fn new(shared: &Shared, layout: &wgpu::BindGroupLayout, params: &wgpu::Buffer) -> Self {
+    fn new(
+        shared: &Shared,
+        layout: &wgpu::BindGroupLayout,
+        params: &wgpu::Buffer,
+        tiles: &SliceTiles,
+    ) -> Self {
         let (_, view) = shared.target_texture(
             "sliced marks",
             MARK_FORMAT,
@@ -47,6 +53,8 @@ impl Marks {
             &[
                 params.as_entire_binding(),
                 wgpu::BindingResource::TextureView(&view),
+                tiles.params.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&tiles.view),
             ],
         );
         Marks {
@@ -58,8 +66,9 @@ impl Marks {
 }
 
 impl Refine {
-    /// `params`: the slicer's footprint uniform (slice count, search budget).
-    pub fn new(shared: &Shared, params: &wgpu::Buffer) -> anyhow::Result<Self> {
+    /// `params`: the slicer's footprint uniform (slice count, gap walks);
+    /// `tiles`: its culling tiles, whose maxima let the search skip air.
+    pub fn new(shared: &Shared, params: &wgpu::Buffer, tiles: &SliceTiles) -> anyhow::Result<Self> {
         let layout = shared
             .device
             .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -68,6 +77,12 @@ impl Refine {
                     uniform_layout_entry(0),
                     texture_entry(
                         1,
+                        wgpu::TextureSampleType::Uint,
+                        wgpu::TextureViewDimension::D2,
+                    ),
+                    uniform_layout_entry(2),
+                    texture_entry(
+                        3,
                         wgpu::TextureSampleType::Uint,
                         wgpu::TextureViewDimension::D2,
                     ),
@@ -80,7 +95,7 @@ impl Refine {
             &shared.pipeline_layout("sliced refine", &[&layout]),
             "fs_sliced_refine",
         )?;
-        let marks = Marks::new(shared, &layout, params);
+        let marks = Marks::new(shared, &layout, params, tiles);
         Ok(Refine {
             layout,
             pipeline,
@@ -89,8 +104,8 @@ impl Refine {
     }
 
     /// A marks image at the shared targets' new size.
-    pub fn resize(&mut self, shared: &Shared, params: &wgpu::Buffer) {
-        self.marks = Marks::new(shared, &self.layout, params);
+    pub fn resize(&mut self, shared: &Shared, params: &wgpu::Buffer, tiles: &SliceTiles) {
+        self.marks = Marks::new(shared, &self.layout, params, tiles);
     }
 
     /// The slice pass's colour target: the marks, cleared to 0 (no slice).

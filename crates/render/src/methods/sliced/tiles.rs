@@ -287,6 +287,11 @@ impl SliceTiles {
         }
     }
 
+    /// The tiles' side, texels.
+    pub fn side(&self) -> u32 {
+        1 << self.cpu.log2
+    }
+
     /// GPU bytes: the texture and the uniform.
     pub fn gpu_bytes(&self) -> u64 {
         self.cpu.data.len() as u64 + std::mem::size_of::<SliceTileParams>() as u64
