@@ -14,7 +14,7 @@ use std::path::PathBuf;
 use strata_level::{ViewSpec, views::parse_views};
 use strata_render::frame::{Globals, LevelShape};
 use strata_render::methods::ray_exact::replay::{
-    FrameCount, PassCount, Replay, compute_pyramid, replay_frame,
+    FrameCount, PassCount, Replay, Traversal, compute_pyramid, replay_frame,
 };
 
 #[derive(clap::Args)]
@@ -34,6 +34,14 @@ pub struct Args {
     /// Print one JSON object instead of text.
     #[arg(long)]
     json: bool,
+    /// Try another traversal on paper: most levels climbed per step
+    /// (`EXACT_CLIMB`; the GPU's: 1).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=8))]
+    climb: u32,
+    /// Try another traversal on paper: the visited level rays start at (0
+    /// texels .. 4 the 256-texel tiles; the GPU's: 4).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=4))]
+    start_level: Option<u32>,
 }
 
 #[derive(Serialize)]
@@ -59,7 +67,7 @@ struct Report {
 
 fn pass_line(name: &str, p: &PassCount) -> String {
     format!(
-        "  {name:7} {:>9} rays  iter {:6.1} (p99 {:4}, max {:4}; warp {:6.1}, SIMD {:3.0} %)  pyramid {:6.1} (p99 {:4})  \
+        "  {name:7} {:>9} rays  iter {:6.1} (p99 {:4}, max {:4}; warp {:6.1}, SIMD {:3.0} %; down {:5.1}, up {:5.1})  pyramid {:6.1} (p99 {:4})  \
          terrain {:5.1} (p99 {:3})  shadow taps {:>8}  read {:8.2} MB  written {:6.2} MB",
         p.rays,
         p.iterations.mean,
@@ -67,6 +75,8 @@ fn pass_line(name: &str, p: &PassCount) -> String {
         p.iterations.max,
         p.warp_iterations,
         100.0 * p.simd_efficiency,
+        p.descents,
+        p.climbs,
         p.pyramid_reads.mean,
         p.pyramid_reads.p99,
         p.terrain_reads.mean,
@@ -100,6 +110,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .collect::<anyhow::Result<Vec<_>>>()?;
     let pyramid = compute_pyramid(&world.level);
     let mut replay = Replay::new(&world.level, &pyramid);
+    replay.traversal = Traversal {
+        climb: args.climb,
+        start: args.start_level,
+    };
     let shape = LevelShape::of(&world.level);
     let mut out = std::io::stdout().lock();
     let mut counts = Vec::new();

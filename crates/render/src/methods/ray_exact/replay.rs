@@ -50,6 +50,30 @@ pub struct MarchCount {
     pub pyramid_reads: u32,
     /// Terrain texels read.
     pub terrain_reads: u32,
+    /// Iterations that went down a level.
+    pub descents: u32,
+    /// Levels climbed after steps that left the parent tile.
+    pub climbs: u32,
+}
+
+/// Traversal knobs to try on paper; [`Traversal::GPU`] is what the compute
+/// pipelines run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Traversal {
+    /// Most levels climbed after a step leaves its parent tile
+    /// (`EXACT_CLIMB`).
+    pub climb: u32,
+    /// The visited level (0 = texels, top = 256-texel tiles) camera and
+    /// shadow rays start at (`None`: the top).
+    pub start: Option<u32>,
+}
+
+impl Traversal {
+    /// The compute pipelines' traversal.
+    pub const GPU: Traversal = Traversal {
+        climb: 1,
+        start: None,
+    };
 }
 
 /// Distinct elements read of one resource (a bit per element).
@@ -87,6 +111,8 @@ pub struct Replay<'a> {
     level: &'a Level,
     pyramid: &'a Pyramid,
     top: u32,
+    /// The traversal replayed ([`Traversal::GPU`] unless changed).
+    pub traversal: Traversal,
     terrain_touched: Touched,
     pyramid_touched: Touched,
 }
@@ -165,6 +191,7 @@ impl<'a> Replay<'a> {
             level,
             pyramid,
             top: pyramid.top(),
+            traversal: Traversal::GPU,
             terrain_touched: Touched::new(pairs),
             pyramid_touched: Touched::new(u64::from(pyramid.layout.bytes / 4)),
         }
@@ -207,7 +234,7 @@ impl<'a> Replay<'a> {
             if still[1] { 0.0 } else { 1.0 / d.y },
         );
         let top = self.top / ratio;
-        let mut lvl = top;
+        let mut lvl = self.traversal.start.map_or(top, |s| s.min(top));
         let mut t = t0;
         let mut cell = texel_after(oxy + dxy * t, dxy) >> (lvl * ratio) as i32;
         loop {
@@ -230,6 +257,7 @@ impl<'a> Replay<'a> {
                 let tile = (base >> shift as i32) + cell;
                 r.pyramid_reads += 1;
                 if z_min <= self.maxmip(shift, tile.x, tile.y) {
+                    r.descents += 1;
                     lvl -= 1;
                     let child = texel_after(oxy + dxy * t, dxy) >> (shift - ratio) as i32;
                     let first = cell << ratio as i32;
@@ -257,10 +285,16 @@ impl<'a> Replay<'a> {
             if tb.y <= tb.x {
                 cell.y += step.y;
             }
-            // EXACT_CLIMB 1.
-            if lvl < top && (old >> ratio as i32) != (cell >> ratio as i32) {
+            // EXACT_CLIMB.
+            let mut was = old;
+            for _ in 0..self.traversal.climb {
+                if lvl >= top || (was >> ratio as i32) == (cell >> ratio as i32) {
+                    break;
+                }
+                was = was >> ratio as i32;
                 cell = cell >> ratio as i32;
                 lvl += 1;
+                r.climbs += 1;
             }
         }
     }
@@ -342,6 +376,10 @@ pub struct PassCount {
     pub pyramid_reads: Spread,
     /// Terrain texels read per ray.
     pub terrain_reads: Spread,
+    /// Descents per ray (mean).
+    pub descents: f64,
+    /// Levels climbed per ray (mean).
+    pub climbs: f64,
     /// Shadow-map texels read per ray (the shading pass).
     pub shadow_reads: u64,
     /// Mean over 32-lane warps (8x4 pixels or texels of an 8x8 workgroup) of
@@ -394,6 +432,8 @@ impl FrameCount {
 /// Per-ray counts of a pass into a [`PassCount`].
 #[derive(Default)]
 struct PassAcc {
+    descents: u64,
+    climbs: u64,
     iterations: Vec<u32>,
     pyramid: Vec<u32>,
     terrain: Vec<u32>,
@@ -401,6 +441,8 @@ struct PassAcc {
 
 impl PassAcc {
     fn add(&mut self, m: &MarchCount) {
+        self.descents += u64::from(m.descents);
+        self.climbs += u64::from(m.climbs);
         self.iterations.push(m.iterations);
         self.pyramid.push(m.pyramid_reads);
         self.terrain.push(m.terrain_reads);
@@ -421,6 +463,8 @@ impl PassAcc {
         PassCount {
             rays,
             bytes_read: pyramid.total * PYRAMID_WORD_BYTES + terrain.total * TERRAIN_TEXEL_BYTES,
+            descents: self.descents as f64 / rays.max(1) as f64,
+            climbs: self.climbs as f64 / rays.max(1) as f64,
             warp_iterations: steps as f64 / count.max(1) as f64,
             simd_efficiency: work as f64 / (steps * 32).max(1) as f64,
             iterations: Spread::of(self.iterations),
