@@ -291,8 +291,8 @@ impl<'a> Replay<'a> {
                 if lvl >= top || (was >> ratio as i32) == (cell >> ratio as i32) {
                     break;
                 }
-                was = was >> ratio as i32;
-                cell = cell >> ratio as i32;
+                was >>= ratio as i32;
+                cell >>= ratio as i32;
                 lvl += 1;
                 r.climbs += 1;
             }
