@@ -37,6 +37,8 @@ const SLICE_TOP: f32 = 256.0;
 // the slice point is kept.
 const REFINE_COLUMNS: u32 = 2048u;
 const NO_ENTRY: f32 = 1e30;
+// Set in a mark kept by the gap walk's block maxima alone (`sliced.wgsl`).
+const MARK_MAYBE: u32 = 0x80000000u;
 
 struct Crossing {
     found: bool,
@@ -166,7 +168,11 @@ fn gaps_walked(d: vec3<f32>, spacing: f32) -> bool {
 
 @fragment
 fn fs_sliced_refine(@builtin(position) pos: vec4<f32>) -> RefinedOut {
-    let mark = textureLoad(slice_marks, vec2<i32>(pos.xy), 0).x;
+    let marked = textureLoad(slice_marks, vec2<i32>(pos.xy), 0).x;
+    // A maybe-mark: the slice's gap came down to a block's maximum, not
+    // necessarily to the ground.
+    let maybe = (marked & MARK_MAYBE) != 0u;
+    let mark = marked & ~MARK_MAYBE;
     let n = footprint.count.y;
     let spacing = SLICE_TOP / f32(n);
     let d = camera_ray(pos.x, pos.y);
@@ -190,12 +196,22 @@ fn fs_sliced_refine(@builtin(position) pos: vec4<f32>) -> RefinedOut {
     }
     var t = t_k;
     var cell = vec2<i32>(floor((e + d * t_k).xy));
-    let x = first_crossing_tiled(e, d, t_near, t_k);
+    var x = first_crossing_tiled(e, d, t_near, t_k);
+    if (!x.found && maybe) {
+        // Its depth hid the slices behind: the rest of the ray.
+        x = first_crossing_tiled(e, d, t_k, t_far);
+    }
     if (x.found) {
         t = x.t;
         cell = x.cell;
     } else if (mark == 0u) {
         discard;
+    } else if (maybe) {
+        // Sky after all: over the slice plane's depth.
+        var sky: RefinedOut;
+        sky.depth = 1.0;
+        sky.color = vec4<f32>(globals.sky.rgb, 1.0);
+        return sky;
     }
     let q = e + d * t;
     let clip = globals.view_proj * vec4<f32>(q, 1.0);

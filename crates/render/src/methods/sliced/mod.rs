@@ -25,12 +25,12 @@ use strata_level::Level;
 use tiles::SliceTiles;
 
 /// Most texel columns a slice fragment whose point is air walks along its
-/// pixel's ray from the previous slice's crossing, where grazing rays cross
-/// the slices more than a texel apart (`sliced.wgsl::slice_hit`); capped at
-/// the culling tiles' side, so that a walk stays within a tile's neighbours.
-/// 32: the slices cover rays without gaps down to slopes of about 1/48 at
-/// 512 slices (the horizon rows of a level view are left to the refine pass's
-/// whole-ray search).
+/// pixel's ray towards it from the previous slice's crossing, where grazing
+/// rays cross the slices more than two texels apart (`sliced.wgsl::slice_hit`),
+/// at most the culling tiles' side. 32: the slices cover rays without gaps
+/// down to slopes of about 1/48 at 512 slices (the first slice a ray meets
+/// walks from the eye however far; the rays of longer gaps are left to the
+/// refine pass's whole-ray search).
 pub const GAP_TEXELS: u32 = 32;
 
 /// More slices than this sample far below the 256 quantised altitudes and
@@ -80,6 +80,11 @@ fn slices_binding(
                 wgpu::TextureSampleType::Uint,
                 wgpu::TextureViewDimension::D2,
             ),
+            texture_entry(
+                3,
+                wgpu::TextureSampleType::Uint,
+                wgpu::TextureViewDimension::D2,
+            ),
         ],
     });
     let group = crate::frame::bind_group(
@@ -89,7 +94,8 @@ fn slices_binding(
         &[
             params.as_entire_binding(),
             tiles.params.as_entire_binding(),
-            wgpu::BindingResource::TextureView(&tiles.view),
+            wgpu::BindingResource::TextureView(tiles.view()),
+            wgpu::BindingResource::TextureView(tiles.blocks_view()),
         ],
     );
     (layout, group)

@@ -54,7 +54,7 @@ impl Marks {
                 params.as_entire_binding(),
                 wgpu::BindingResource::TextureView(&view),
                 tiles.params.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&tiles.view),
+                wgpu::BindingResource::TextureView(tiles.view()),
             ],
         );
         Marks {
