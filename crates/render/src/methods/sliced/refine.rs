@@ -52,9 +52,9 @@ impl Marks {
             layout,
             &[
                 params.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&view),
                 tiles.params.as_entire_binding(),
-                wgpu::BindingResource::TextureView(tiles.view()),
+                wgpu::BindingResource::TextureView(&view),
+                wgpu::BindingResource::TextureView(tiles.blocks_view()),
             ],
         );
         Marks {
@@ -67,7 +67,7 @@ impl Marks {
 
 impl Refine {
     /// `params`: the slicer's footprint uniform (slice count, gap walks);
-    /// `tiles`: its culling tiles, whose maxima let the search skip air.
+    /// `tiles`: its block maxima, which let the search step over air.
     pub fn new(shared: &Shared, params: &wgpu::Buffer, tiles: &SliceTiles) -> anyhow::Result<Self> {
         let layout = shared
             .device
@@ -75,12 +75,12 @@ impl Refine {
                 label: Some("sliced refine"),
                 entries: &[
                     uniform_layout_entry(0),
+                    uniform_layout_entry(1),
                     texture_entry(
-                        1,
+                        2,
                         wgpu::TextureSampleType::Uint,
                         wgpu::TextureViewDimension::D2,
                     ),
-                    uniform_layout_entry(2),
                     texture_entry(
                         3,
                         wgpu::TextureSampleType::Uint,
