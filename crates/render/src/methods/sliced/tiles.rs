@@ -368,6 +368,22 @@ mod tests {
         Level::from_planes(w, h, heights, metas, MidRule::default()).unwrap()
     }
 
+    /// Raise texel (x, y) (x even) to 255 and make its pair single: the
+    /// edit's rectangle.
+    fn raise_pair(level: &mut Level, x: u32, y: u32) -> DirtyRect {
+        let i = (y * level.width() + x) as usize;
+        let (heights, metas) = level.planes_mut();
+        heights[i] = 255;
+        metas[i] = 0;
+        metas[i + 1] = 0;
+        DirtyRect {
+            x,
+            y,
+            width: 2,
+            height: 1,
+        }
+    }
+
     fn check(level: &Level, t: &TileMaxima) {
         for ty in 0..t.height {
             for tx in 0..t.width {
@@ -406,19 +422,8 @@ mod tests {
         let mut t = TileMaxima::new(&level);
         // Raise texel (0, 40), one row into tile row 1 and on the map's left
         // edge: the margins wrap, so tiles in the last column change too.
-        let (w, h) = (level.width() as usize, level.height());
-        {
-            let (heights, metas) = level.planes_mut();
-            heights[40 * w] = 255;
-            metas[40 * w] = 0;
-            metas[40 * w + 1] = 0;
-        }
-        let rect = DirtyRect {
-            x: 0,
-            y: 40,
-            width: 2,
-            height: 1,
-        };
+        let h = level.height();
+        let rect = raise_pair(&mut level, 0, 40);
         assert_eq!(t.update(&level, &[rect]), vec![1]);
         check(&level, &t);
         assert_eq!(t.data[(t.width + t.width - 1) as usize], 255);
@@ -440,19 +445,7 @@ mod tests {
         let mut b = TileMaxima::with_log2(&level, BLOCK_LOG2);
         assert_eq!((b.log2, b.width, b.height), (3, 16, 8));
         check(&level, &b);
-        let w = level.width() as usize;
-        {
-            let (heights, metas) = level.planes_mut();
-            heights[17 * w + 40] = 255;
-            metas[17 * w + 40] = 0;
-            metas[17 * w + 41] = 0;
-        }
-        let rect = DirtyRect {
-            x: 40,
-            y: 17,
-            width: 2,
-            height: 1,
-        };
+        let rect = raise_pair(&mut level, 40, 17);
         // Row 17 is inside block row 2 only (its margin rows are 15 and 24).
         assert_eq!(b.update(&level, &[rect]), vec![2]);
         assert_eq!(b, TileMaxima::with_log2(&level, BLOCK_LOG2));
