@@ -35,7 +35,9 @@ fn walk_gap(e: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, blocks: u32, exact: bo
     // The map's blocks across and down - 1, from its tiles'.
     let mask = ((slice_tiles.tiles.yz + vec2<u32>(1u)) << vec2<u32>(slice_tiles.tiles.x - k)) - vec2<u32>(1u);
     let pos = d.xy > vec2<f32>(0.0);
-    let step = select(vec2<i32>(-1), vec2<i32>(1), pos);
+    // vec2<i32>(bool) rather than select: GLSL ES 3.00 (WebGL2) has no
+    // mix() on ints.
+    let step = 2 * vec2<i32>(pos) - vec2<i32>(1);
     let still = d.xy == vec2<f32>(0.0);
     let inv = select(vec2<f32>(1.0) / d.xy, vec2<f32>(0.0), still);
     var block = vec2<i32>(floor((e.xy + d.xy * t0) / side));
