@@ -39,7 +39,7 @@ pub struct Args {
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=8))]
     climb: u32,
     /// Try another traversal on paper: the visited level rays start at (0
-    /// texels .. 4 the 256-texel tiles; the GPU's: 4).
+    /// texels, 1 .. 4 tiles of 4, 16, 64, 256 texels; the GPU's: 3).
     #[arg(long, value_parser = clap::value_parser!(u32).range(0..=4))]
     start_level: Option<u32>,
 }
@@ -112,7 +112,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let mut replay = Replay::new(&world.level, &pyramid);
     replay.traversal = Traversal {
         climb: args.climb,
-        start: args.start_level,
+        start: args.start_level.or(Traversal::GPU.start),
     };
     let shape = LevelShape::of(&world.level);
     let mut out = std::io::stdout().lock();

@@ -69,8 +69,14 @@ pub struct Traversal {
 }
 
 impl Traversal {
-    /// The compute pipelines' traversal.
+    /// The whole map's compute pipelines' traversal (`START_LEVEL`).
     pub const GPU: Traversal = Traversal {
+        climb: 1,
+        start: Some(super::START_LEVEL / LOG_RATIO),
+    };
+
+    /// Starting at the 256-texel tiles (the GPU's before `START_LEVEL`).
+    pub const FROM_TOP: Traversal = Traversal {
         climb: 1,
         start: None,
     };
