@@ -529,6 +529,32 @@ fn first_frame_after_the_crater_matches_a_fresh_build() {
     }
 }
 
+/// One frame of `m` recorded by hand (the renderer owns its methods): the
+/// globals written, the exact shadow map cast, the march.
+fn record_frame(
+    shared: &Shared,
+    m: &mut RayExact,
+    camera: &Camera,
+    globals: &crate::frame::Globals,
+    timer: &crate::timing::PassTimer,
+    index: usize,
+) {
+    shared
+        .queue
+        .write_buffer(&shared.globals, 0, bytemuck::bytes_of(globals));
+    m.prepare(shared, camera).unwrap();
+    let frame = super::super::Frame {
+        camera,
+        timer,
+        index: index as u64,
+        depth_attachment: true,
+    };
+    let mut encoder = shared.device.create_command_encoder(&Default::default());
+    assert!(m.record_shadow_map(shared, &frame, &mut encoder));
+    m.record(shared, &frame, &mut encoder);
+    shared.queue.submit([encoder.finish()]);
+}
+
 #[test]
 fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
     for gpu in common::gpus() {
@@ -622,20 +648,7 @@ fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
                 &crate::frame::LevelShape::of(&w.level),
                 &shadow,
             );
-            shared
-                .queue
-                .write_buffer(&shared.globals, 0, bytemuck::bytes_of(&globals));
-            m.prepare(&shared, &camera).unwrap();
-            let frame = super::super::Frame {
-                camera: &camera,
-                timer: &timer,
-                index: index as u64,
-                depth_attachment: true,
-            };
-            let mut encoder = shared.device.create_command_encoder(&Default::default());
-            assert!(m.record_shadow_map(&shared, &frame, &mut encoder));
-            m.record(&shared, &frame, &mut encoder);
-            shared.queue.submit([encoder.finish()]);
+            record_frame(&shared, &mut m, &camera, &globals, &timer, index);
         }
         let stats = m.stats().unwrap();
         eprintln!("over every view: {stats:?}");
@@ -726,20 +739,7 @@ fn the_replay_takes_the_gpu_steps() {
             let mut m = build(&shared, &w.level, ExactOptions::DEFAULT).unwrap();
             let shadow = crate::shadow::ShadowFrame::fit(camera, true);
             let globals = crate::frame::Globals::new(camera, &shape, &shadow);
-            shared
-                .queue
-                .write_buffer(&shared.globals, 0, bytemuck::bytes_of(&globals));
-            m.prepare(&shared, camera).unwrap();
-            let frame = super::super::Frame {
-                camera,
-                timer: &timer,
-                index: index as u64,
-                depth_attachment: true,
-            };
-            let mut encoder = shared.device.create_command_encoder(&Default::default());
-            assert!(m.record_shadow_map(&shared, &frame, &mut encoder));
-            m.record(&shared, &frame, &mut encoder);
-            shared.queue.submit([encoder.finish()]);
+            record_frame(&shared, &mut m, camera, &globals, &timer, index);
             let s = m.stats().unwrap();
             eprintln!(
                 "view {index}: most iterations GPU {} / {} (shadow), replay {} / {}",

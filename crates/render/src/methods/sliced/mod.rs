@@ -62,6 +62,27 @@ fn checked_slices(settings: &MethodSettings) -> anyhow::Result<u32> {
     Ok(slices)
 }
 
+/// The layout both passes' groups share: uniforms at bindings 0 and 1 (the
+/// footprint, the tile grid), integer textures at 2 and 3.
+fn uniforms_and_textures_layout(device: &wgpu::Device, label: &str) -> wgpu::BindGroupLayout {
+    let uint_texture = |binding| {
+        texture_entry(
+            binding,
+            wgpu::TextureSampleType::Uint,
+            wgpu::TextureViewDimension::D2,
+        )
+    };
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some(label),
+        entries: &[
+            uniform_layout_entry(0),
+            uniform_layout_entry(1),
+            uint_texture(2),
+            uint_texture(3),
+        ],
+    })
+}
+
 /// The slices' group: the footprint uniform, the tile grid uniform and the
 /// tile maxima.
 fn slices_binding(
@@ -70,23 +91,7 @@ fn slices_binding(
     tiles: &SliceTiles,
 ) -> (wgpu::BindGroupLayout, wgpu::BindGroup) {
     let device = &shared.device;
-    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("sliced"),
-        entries: &[
-            uniform_layout_entry(0),
-            uniform_layout_entry(1),
-            texture_entry(
-                2,
-                wgpu::TextureSampleType::Uint,
-                wgpu::TextureViewDimension::D2,
-            ),
-            texture_entry(
-                3,
-                wgpu::TextureSampleType::Uint,
-                wgpu::TextureViewDimension::D2,
-            ),
-        ],
-    });
+    let layout = uniforms_and_textures_layout(device, "sliced");
     let group = crate::frame::bind_group(
         device,
         "sliced",

@@ -14,7 +14,7 @@
 use super::super::common::{draw_fullscreen_with_depth, fullscreen_pipeline};
 use super::super::contract::{Frame, RetainedBytes};
 use super::tiles::SliceTiles;
-use crate::frame::{Shared, texture_entry, uniform_layout_entry};
+use crate::frame::Shared;
 
 /// Format of the slice marks: rank + 1 of the kept slice, 0 = none. An
 /// integer format renders everywhere (WebGL2 included), unlike R32Float.
@@ -69,25 +69,7 @@ impl Refine {
     /// `params`: the slicer's footprint uniform (slice count, gap walks);
     /// `tiles`: its block maxima, which let the search step over air.
     pub fn new(shared: &Shared, params: &wgpu::Buffer, tiles: &SliceTiles) -> anyhow::Result<Self> {
-        let layout = shared
-            .device
-            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("sliced refine"),
-                entries: &[
-                    uniform_layout_entry(0),
-                    uniform_layout_entry(1),
-                    texture_entry(
-                        2,
-                        wgpu::TextureSampleType::Uint,
-                        wgpu::TextureViewDimension::D2,
-                    ),
-                    texture_entry(
-                        3,
-                        wgpu::TextureSampleType::Uint,
-                        wgpu::TextureViewDimension::D2,
-                    ),
-                ],
-            });
+        let layout = super::uniforms_and_textures_layout(&shared.device, "sliced refine");
         let pipeline = fullscreen_pipeline(
             shared,
             "sliced refine",
