@@ -39,6 +39,14 @@ override EXACT_CLIMB: u32 = 1u;
 // other one (4, 16, 64, 256, as the CPU reference does).
 override EXACT_LOG_RATIO: u32 = 1u;
 
+// The pyramid level rays start at (a pipeline constant): the coarsest kept
+// level at or below it. The whole map's compute pipelines start at 6 (tiles
+// of 64 texels; `ray_exact::START_LEVEL`): on the default views that takes
+// 4 % fewer iterations than starting at the 256-texel tiles, with the same
+// hits (`strata exact-counts --start-level`). Paged terrain starts at the
+// top, its coarse level.
+override EXACT_START_LEVEL: u32 = 255u;
+
 // The coarsest tile: `base` is a multiple of it.
 const EXACT_BASE_TILE: f32 = 256.0;
 const EXACT_BIG: f32 = 3.0e38;
@@ -77,7 +85,7 @@ fn exact_march(o: vec3<f32>, base: vec2<i32>, d: vec3<f32>, t0: f32, t1: f32) ->
     let inv = select(vec2<f32>(1.0) / d.xy, vec2<f32>(0.0), still);
     let ratio = EXACT_LOG_RATIO;
     // Visited levels are lvl * ratio (pyramid level 0 = the texels).
-    var lvl = top / ratio;
+    var lvl = min(top, EXACT_START_LEVEL) / ratio;
     var t = t0;
     var cell = texel_after(o.xy + d.xy * t, d.xy) >> vec2<u32>(lvl * ratio);
     loop {

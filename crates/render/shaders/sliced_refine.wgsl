@@ -13,99 +13,45 @@
 #include "shading.wgsl"
 #include "forward.wgsl"
 #include "fullscreen.wgsl"
+#include "sliced_walk.wgsl"
 
-// count.y: slices N.
+// count.y: slices N; count.w: the most columns a slice fragment's gap walk
+// takes (`sliced.wgsl::slice_hit`).
 @group(1) @binding(0) var<uniform> footprint: Footprint;
-@group(1) @binding(1) var slice_marks: texture_2d<u32>;
+@group(1) @binding(2) var slice_marks: texture_2d<u32>;
 
 // Top of the sliced range (Rust: `forward::Z_MAX`).
 const SLICE_TOP: f32 = 256.0;
-// Most texel columns one search walks (far 600 crosses at most ~850): past it
-// the slice point is kept.
-const REFINE_COLUMNS: u32 = 2048u;
-const NO_ENTRY: f32 = 1e30;
-
-struct Crossing {
-    found: bool,
-    t: f32,
-    cell: vec2<i32>,
-}
-
-// First t in [t0, t1] with a <= oz + t dz <= b, or NO_ENTRY.
-fn interval_entry(a: f32, b: f32, oz: f32, dz: f32, t0: f32, t1: f32) -> f32 {
-    var lo = -NO_ENTRY;
-    var hi = NO_ENTRY;
-    if (abs(dz) < 1e-12) {
-        if (oz < a || oz > b) {
-            return NO_ENTRY;
-        }
-    } else {
-        let ta = (a - oz) / dz;
-        let tb = (b - oz) / dz;
-        lo = min(ta, tb);
-        hi = max(ta, tb);
-    }
-    let enter = max(lo, t0);
-    return select(NO_ENTRY, enter, enter <= min(hi, t1));
-}
-
-// The first solid point of e + t d over [t0, t1]: a 2D walk over the texel
-// columns the segment crosses, each column's solid intervals ([.., low] and
-// a slab's [mid, high]) intersected exactly.
-fn first_crossing(e: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32) -> Crossing {
-    var out: Crossing;
-    out.found = false;
-    out.t = t1;
-    let p0 = e + d * t0;
-    var cell = vec2<i32>(floor(p0.xy));
-    let step = vec2<i32>(select(-1, 1, d.x > 0.0), select(-1, 1, d.y > 0.0));
-    let moves = abs(d.xy) > vec2<f32>(1e-12);
-    let inv = select(vec2<f32>(0.0), vec2<f32>(1.0) / d.xy, moves);
-    var t = t0;
-    for (var i = 0u; i < REFINE_COLUMNS; i = i + 1u) {
-        // Each boundary from its own integer coordinate, never accumulated.
-        let next = vec2<f32>(cell + max(step, vec2<i32>(0)));
-        let tb = select(vec2<f32>(NO_ENTRY), (next - e.xy) * inv, moves);
-        let t_exit = min(min(tb.x, tb.y), t1);
-        let c = decode_column(cell.x, cell.y);
-        var hit = interval_entry(-NO_ENTRY, c.low, e.z, d.z, t, t_exit);
-        if (c.dual) {
-            hit = min(hit, interval_entry(c.mid, c.high, e.z, d.z, t, t_exit));
-        }
-        if (hit < NO_ENTRY) {
-            out.found = true;
-            out.t = hit;
-            out.cell = cell;
-            return out;
-        }
-        if (t_exit >= t1) {
-            break;
-        }
-        t = t_exit;
-        if (tb.x <= tb.y) {
-            cell.x = cell.x + step.x;
-        } else {
-            cell.y = cell.y + step.y;
-        }
-    }
-    return out;
-}
+// Most blocks one search crosses (far 600 crosses at most ~1300 columns).
+const REFINE_BLOCKS: u32 = 512u;
+// Set in a mark kept by the gap walk's block maxima alone (`sliced.wgsl`).
+const MARK_MAYBE: u32 = 0x80000000u;
 
 struct RefinedOut {
     @location(0) color: vec4<f32>,
     @builtin(frag_depth) depth: f32,
 }
 
-// A ray whose altitude changes by less than this many slice spacings between
-// the near and the far plane meets at most a few slices, or none (the rows
-// at the horizon of a level view): no mark says it is empty, so the pass
-// searches it whole. Measured at 640x400 on the generated world's 0° views:
-// most of the plain slicer's see-through were such rays.
-const UNSAMPLED_SPACINGS: f32 = 4.0;
+// An unmarked ray is empty only where the slices sampled it without gaps:
+// each slice fragment in air walks the ray to its own point
+// from the previous slice's crossing (`sliced.wgsl::slice_hit`; the first
+// from the near plane), at most count.w columns. A ray whose gap
+// between crossings needs more (near the horizon of a level view) may have
+// slipped past a thin wall or peak, or crossed no slice at all, so the pass
+// searches it whole. A segment whose ends are `dx`, `dy` apart crosses at
+// most |dx| + |dy| + 2 columns.
+fn gaps_walked(d: vec3<f32>, spacing: f32) -> bool {
+    let gap = spacing / abs(d.z);
+    return gap * (abs(d.x) + abs(d.y)) + 2.0 <= f32(footprint.count.w);
+}
 
 @fragment
 fn fs_sliced_refine(@builtin(position) pos: vec4<f32>) -> RefinedOut {
-    let mark = textureLoad(slice_marks, vec2<i32>(pos.xy), 0).x;
+    let marked = textureLoad(slice_marks, vec2<i32>(pos.xy), 0).x;
+    // A maybe-mark: the slice's gap came down to a block's maximum, not
+    // necessarily to the ground.
+    let maybe = (marked & MARK_MAYBE) != 0u;
+    let mark = marked & ~MARK_MAYBE;
     let n = footprint.count.y;
     let spacing = SLICE_TOP / f32(n);
     let d = camera_ray(pos.x, pos.y);
@@ -113,26 +59,38 @@ fn fs_sliced_refine(@builtin(position) pos: vec4<f32>) -> RefinedOut {
     // View depth = t * focal.
     let t_near = globals.forward.w / globals.eye.w;
     let t_far = globals.right.w / globals.eye.w;
-    // Search up to the slice point (edge-on: as far as the view goes).
+    // Search up to the slice point (edge-on or unmarked: as far as the view
+    // goes).
     var t_k = t_far;
+    let edge_on = abs(d.z) <= 1e-6 * length(d);
     if (mark == 0u) {
-        if (abs(d.z) * (t_far - t_near) >= UNSAMPLED_SPACINGS * spacing) {
+        if (!edge_on && gaps_walked(d, spacing)) {
             // The slices sampled this ray and found it empty: sky, as the
             // plain slicer leaves it (colour cleared here, depth by pass 1).
             discard;
         }
-    } else if (abs(d.z) > 1e-6 * length(d)) {
+    } else if (!edge_on) {
         let altitude = SLICE_TOP - f32(mark) * spacing;
         t_k = clamp((altitude - e.z) / d.z, t_near, t_far);
     }
     var t = t_k;
     var cell = vec2<i32>(floor((e + d * t_k).xy));
-    let x = first_crossing(e, d, t_near, t_k);
-    if (x.found) {
+    var x = walk_gap(e, d, t_near, t_k, REFINE_BLOCKS, true);
+    if (!x.hit && maybe) {
+        // Its depth hid the slices behind: the rest of the ray.
+        x = walk_gap(e, d, t_k, t_far, REFINE_BLOCKS, true);
+    }
+    if (x.hit) {
         t = x.t;
-        cell = x.cell;
+        cell = x.column;
     } else if (mark == 0u) {
         discard;
+    } else if (maybe) {
+        // Sky after all: over the slice plane's depth.
+        var sky: RefinedOut;
+        sky.depth = 1.0;
+        sky.color = vec4<f32>(globals.sky.rgb, 1.0);
+        return sky;
     }
     let q = e + d * t;
     let clip = globals.view_proj * vec4<f32>(q, 1.0);

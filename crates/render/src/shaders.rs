@@ -97,6 +97,10 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("painted.wgsl", include_str!("../shaders/painted.wgsl")),
     ("sliced.wgsl", include_str!("../shaders/sliced.wgsl")),
     (
+        "sliced_walk.wgsl",
+        include_str!("../shaders/sliced_walk.wgsl"),
+    ),
+    (
         "sliced_refine.wgsl",
         include_str!("../shaders/sliced_refine.wgsl"),
     ),

@@ -95,11 +95,13 @@ fn sliced_matches_the_reference() {
         assert!(m.see_through <= 0.1 && m.covers_sky <= 0.2, "{m:?}");
         assert!(m.depth_p95 <= 1.5, "{m:?}");
         // At the horizon a 100 px image is all grazing rays (11 degrees of
-        // view): they cross slices 0.5/slope apart and slip through thin
-        // features — the method's bands. Measured: 13.1 % at horizon-b.
+        // view): they cross slices 0.5/slope apart, and a fragment in air
+        // walks the gap from the previous slice (at most 32 columns; the
+        // first slice from the eye as far as it takes). Measured: 0.39 % at
+        // worst (13.1 % at horizon-b before the gap walks).
         let m = worst_over(&gpu, &level, &colors, &level_views, "sliced", (W, H));
         eprintln!("sliced worst (synthetic, level): {m:?}");
-        assert!(m.see_through <= 16.0 && m.covers_sky <= 0.2, "{m:?}");
+        assert!(m.see_through <= 1.5 && m.covers_sky <= 0.2, "{m:?}");
     }
 }
 
@@ -116,9 +118,9 @@ fn sliced_matches_the_reference_on_a_generated_world() {
             (320, 200),
         );
         eprintln!("sliced worst (generated, 320x200): {m:?}");
-        // Measured: worst 0.94 % (hangar, pitch 0), 0 % looking down; the issue
-        // asks <= 3 %.
-        assert!(m.see_through <= 2.0, "{m:?}");
+        // Measured: 0 % at every view (0.94 % at hangar, pitch 0, before the
+        // gap walks); issue 36 asks <= 1.5 %.
+        assert!(m.see_through <= 1.5, "{m:?}");
         assert!(m.covers_sky <= 0.2, "{m:?}");
     }
 }
@@ -198,7 +200,8 @@ fn sliced_means(
 /// views: the exact crossing behind each kept slice writes depth, so the
 /// bands go, and the see-through can only drop (rays the slices do not
 /// sample are searched whole). Measured at 160x100: plain see-through
-/// 4.73 %, coherence 6.25 %, depth p95 164.8; refined 3.12 %, 0.00 %, 0.03.
+/// 0.10 %, coherence 3.08 %, depth p95 97.6 (4.73 %, 6.25 %, 164.8 before the
+/// slices walked their gaps); refined 0.00 %, 0.00 %, 0.03.
 #[test]
 fn refined_slices_are_more_coherent_than_plain_ones() {
     let Some(gpu) = common::gpu() else { return };
@@ -226,8 +229,9 @@ fn refined_slices_are_more_coherent_than_plain_ones() {
 /// Issue 16's target on the generated world's 0° views at 320x200: the
 /// refined slicer's coherence mean at most 1 %, its see-through no worse
 /// than the plain slicer's, its depth the exact surface's. Measured: plain
-/// see-through 0.61 %, coherence 14.31 %, depth p95 73.3 (it fails all
-/// three bounds); refined 0.00 %, 0.00 %, 0.00.
+/// see-through 0.00 %, coherence 10.93 %, depth p95 27.4 (0.61 %, 14.31 %,
+/// 73.3 before the slices walked their gaps; it fails the coherence and
+/// depth bounds); refined 0.00 %, 0.00 %, 0.00.
 #[test]
 fn refined_slices_meet_the_coherence_target_on_a_generated_world() {
     let Some(gpu) = common::gpu() else { return };
@@ -253,4 +257,40 @@ fn refined_slices_meet_the_coherence_target_on_a_generated_world() {
         "refined see-through {see} vs {plain_see}"
     );
     assert!(p95 <= 0.05, "refined depth p95 {p95}");
+}
+
+/// Issue 36, item 4: grazing views of a world no setting was tuned on (seed
+/// 5, 512x1024; its 0° views) at 320x200, plain and refined: see-through at
+/// most 1.5 % on every view. Rays that cross the slices more than a texel
+/// apart walk the gap from the previous slice (`sliced.wgsl::slice_hit`), and
+/// the refine pass searches whole only the rays whose gaps were too long to
+/// walk. Measured before: plain 2.58 % and refined 1.09 % at `hangar` (the
+/// eye at a thin wall 44 texels off, rays at the horizon crossing no slice
+/// before it); after: 0 % and 0 %.
+#[test]
+fn slices_cover_grazing_views_of_an_unseen_world() {
+    let Some(gpu) = common::gpu() else { return };
+    let w = strata_level::generate::generate(&strata_level::generate::GenerateParams {
+        seed: 5,
+        width: 512,
+        height: 1024,
+    })
+    .expect("generated world");
+    let colors = TerrainColors::from_world(&w);
+    let views: Vec<ViewSpec> = w.views.iter().filter(|v| v.pitch == 0.0).cloned().collect();
+    assert!(views.iter().any(|v| v.name == "hangar"), "no hangar view");
+    for refine in [false, true] {
+        let settings = MethodSettings {
+            sliced_refine: refine,
+            ..MethodSettings::default()
+        };
+        let mut r = Renderer::new(&gpu, &w.level, &colors, "sliced", &settings, 320, 200).unwrap();
+        let label = if refine { "refined" } else { "sliced" };
+        let m =
+            common::worst_over_views(&mut r, &w.level, &views, (320, 200), label, |_, _, _, _| {});
+        eprintln!("{label} worst (seed 5, 0°, 320x200): {m:?}");
+        assert!(m.see_through <= 1.5, "{label}: {m:?}");
+        assert!(m.covers_sky <= 0.2, "{label}: {m:?}");
+    }
+    gpu.errors.check().unwrap();
 }

@@ -52,6 +52,8 @@ enum Command {
     Survey(cmd::survey::Args),
     /// Build the terrain collider: build time, memory, crater refit, ray-cast throughput.
     Collide(cmd::collide::Args),
+    /// `ray-exact`'s frame on paper: a CPU replay of its traversal counting steps, texel reads and bytes per pass.
+    ExactCounts(cmd::exact_counts::Args),
     /// Export the fitted mesh with terrain colours as glTF (.glb binary or .gltf JSON) or OBJ.
     Export(cmd::export::Args),
     /// The one-command comparison of every method over the level's views.
@@ -84,6 +86,7 @@ fn main() -> std::process::ExitCode {
         Command::Fit(args) => cmd::fit::run(args),
         Command::Fly(args) => cmd::fly::run(args),
         Command::Collide(args) => cmd::collide::run(args),
+        Command::ExactCounts(args) => cmd::exact_counts::run(args),
         Command::Export(args) => cmd::export::run(args),
         Command::Compare(args) => cmd::compare::run(args),
         Command::Survey(args) => cmd::survey::run(args),

@@ -29,7 +29,8 @@ pub struct FootprintParams {
     /// sample within a row (both clamped into the bound).
     pub size: [u32; 4],
     /// Samples drawn (rows x row length, clamped to [`MAX_SAMPLES`]), then
-    /// two method-specific words (`sliced`: slice count, eye's slice rank).
+    /// three method-specific words (`sliced`: slice count, eye's slice rank,
+    /// gap walk columns).
     pub count: [u32; 4],
 }
 

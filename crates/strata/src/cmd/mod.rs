@@ -4,6 +4,7 @@ pub mod adapters;
 pub mod collide;
 pub mod compare;
 pub mod convert;
+pub mod exact_counts;
 pub mod export;
 pub mod fit;
 pub mod fly;

@@ -152,20 +152,28 @@ pub(super) fn march_group(
 pub(super) fn exact_pipeline(
     shared: &Shared,
     label: &str,
+    levels: &Levels,
     shader: &str,
     layout: &wgpu::PipelineLayout,
     entry: &str,
     options: ExactOptions,
 ) -> anyhow::Result<wgpu::ComputePipeline> {
+    // Paged terrain starts at its coarse level, the whole map lower down.
+    let start = if levels.is_paged() {
+        strata_maxmip::MAX_LEVEL
+    } else {
+        super::START_LEVEL
+    };
     super::super::common::compute_pipeline_with_constants(
         shared,
         label,
-        shader,
+        &levels.shader(shader),
         layout,
         entry,
         &[
             ("EXACT_CLIMB", f64::from(options.climb)),
             ("EXACT_LOG_RATIO", f64::from(options.log_ratio)),
+            ("EXACT_START_LEVEL", f64::from(start)),
         ],
     )
 }

@@ -105,7 +105,8 @@ impl Deferred {
             exact_pipeline(
                 shared,
                 label,
-                &levels.shader("ray_exact_deferred.wgsl"),
+                levels,
+                "ray_exact_deferred.wgsl",
                 &pipeline_layout,
                 entry,
                 options,

@@ -571,6 +571,32 @@ fn first_frame_after_the_crater_matches_a_fresh_build() {
     }
 }
 
+/// One frame of `m` recorded by hand (the renderer owns its methods): the
+/// globals written, the exact shadow map cast, the march.
+fn record_frame(
+    shared: &Shared,
+    m: &mut RayExact,
+    camera: &Camera,
+    globals: &crate::frame::Globals,
+    timer: &crate::timing::PassTimer,
+    index: usize,
+) {
+    shared
+        .queue
+        .write_buffer(&shared.globals, 0, bytemuck::bytes_of(globals));
+    m.prepare(shared, camera).unwrap();
+    let frame = super::super::Frame {
+        camera,
+        timer,
+        index: index as u64,
+        depth_attachment: true,
+    };
+    let mut encoder = shared.device.create_command_encoder(&Default::default());
+    assert!(m.record_shadow_map(shared, &frame, &mut encoder));
+    m.record(shared, &frame, &mut encoder);
+    shared.queue.submit([encoder.finish()]);
+}
+
 #[test]
 fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
     for gpu in common::gpus() {
@@ -664,20 +690,7 @@ fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
                 &crate::frame::LevelShape::of(&w.level),
                 &shadow,
             );
-            shared
-                .queue
-                .write_buffer(&shared.globals, 0, bytemuck::bytes_of(&globals));
-            m.prepare(&shared, &camera).unwrap();
-            let frame = super::super::Frame {
-                camera: &camera,
-                timer: &timer,
-                index: index as u64,
-                depth_attachment: true,
-            };
-            let mut encoder = shared.device.create_command_encoder(&Default::default());
-            assert!(m.record_shadow_map(&shared, &frame, &mut encoder));
-            m.record(&shared, &frame, &mut encoder);
-            shared.queue.submit([encoder.finish()]);
+            record_frame(&shared, &mut m, &camera, &globals, &timer, index);
         }
         let stats = m.stats().unwrap();
         eprintln!("over every view: {stats:?}");
@@ -691,6 +704,98 @@ fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
         );
         m.reset_stats();
         assert_eq!(m.stats().unwrap(), ExactStats::default());
+        gpu.errors.check().unwrap();
+    }
+}
+
+/// The CPU replay (`replay.rs`) takes the GPU's steps: on every generated
+/// view its hits are the reference's (hit or miss, and the distance), and
+/// the most iterations of a camera ray and of a shadow ray in the frame are
+/// the GPU's own counts (`ExactStats`), up to a step or two where f32
+/// rounding differs on a grazed boundary.
+#[test]
+fn the_replay_takes_the_gpu_steps() {
+    use super::replay::{Replay, compute_pyramid, replay_frame};
+    let w = common::generated_world();
+    let pyramid = compute_pyramid(&w.level);
+    let mut replay = Replay::new(&w.level, &pyramid);
+    let shape = crate::frame::LevelShape::of(&w.level);
+    let mut frames = Vec::new();
+    for view in &w.views {
+        let camera = Camera::from_view(&w.level, view, W, H).unwrap();
+        let shadow = crate::shadow::ShadowFrame::fit(&camera, true);
+        let globals = crate::frame::Globals::new(&camera, &shape, &shadow);
+        let f = replay_frame(&mut replay, &globals);
+        // Hits against the CPU reference, pixel by pixel.
+        let reference = render_reference(&w.level, &camera);
+        let (mut disagree, mut worst) = (0, 0.0f32);
+        for y in 0..H {
+            for x in 0..W {
+                let (d, m) = replay.pixel(&globals, x as f32 + 0.5, y as f32 + 0.5);
+                let r = reference.distance[(y * W + x) as usize];
+                match (m.hit, r.is_finite()) {
+                    (Some((t, _)), true) => {
+                        worst = worst.max((t * d.length() - r).abs() / r.max(1.0));
+                    }
+                    (None, false) => {}
+                    _ => disagree += 1,
+                }
+            }
+        }
+        eprintln!(
+            "{:10} replay: {} hits, march {:.1} iterations/ray (p99 {}, most {}), shadow {} rays \
+             {:.1} (most {}), {} bytes; vs reference: {disagree} pixels disagree, worst relative \
+             distance {worst:.2e}",
+            view.name,
+            f.hits,
+            f.march.iterations.mean,
+            f.march.iterations.p99,
+            f.most_iterations,
+            f.shadow.rays,
+            f.shadow.iterations.mean,
+            f.shadow_most_iterations,
+            f.bytes(),
+        );
+        assert!(disagree <= 2, "{}: {disagree} pixels", view.name);
+        assert!(worst < 1e-3, "{}: {worst}", view.name);
+        assert!(f.march.rays == u64::from(W * H) && f.hits > 0);
+        assert!(f.shadow.rays == f.shadow_blocks * 64 && f.shadow_blocks > 0);
+        frames.push((camera, f));
+    }
+    // The GPU's counts, one fresh method per view.
+    for gpu in common::gpus() {
+        let colors = TerrainColors::from_world(&w);
+        let r = Renderer::new(
+            &gpu,
+            &w.level,
+            &colors,
+            "ray-exact",
+            &MethodSettings::default(),
+            W,
+            H,
+        )
+        .unwrap();
+        let shared = r.shared_handle();
+        let timer = crate::timing::PassTimer::new(&shared.device, &shared.queue, false);
+        for (index, (camera, f)) in frames.iter().enumerate() {
+            let mut m = build(&shared, &w.level, ExactOptions::DEFAULT).unwrap();
+            let shadow = crate::shadow::ShadowFrame::fit(camera, true);
+            let globals = crate::frame::Globals::new(camera, &shape, &shadow);
+            record_frame(&shared, &mut m, camera, &globals, &timer, index);
+            let s = m.stats().unwrap();
+            eprintln!(
+                "view {index}: most iterations GPU {} / {} (shadow), replay {} / {}",
+                s.most_iterations,
+                s.shadow_most_iterations,
+                f.most_iterations,
+                f.shadow_most_iterations
+            );
+            assert!(
+                s.most_iterations.abs_diff(f.most_iterations) <= 2
+                    && s.shadow_most_iterations.abs_diff(f.shadow_most_iterations) <= 2,
+                "view {index}: GPU {s:?}, replay {f:?}"
+            );
+        }
         gpu.errors.check().unwrap();
     }
 }

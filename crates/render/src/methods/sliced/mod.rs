@@ -24,6 +24,15 @@ use strata_camera::Camera;
 use strata_level::Level;
 use tiles::SliceTiles;
 
+/// Most texel columns a slice fragment whose point is air walks along its
+/// pixel's ray towards it from the previous slice's crossing, where grazing
+/// rays cross the slices more than two texels apart (`sliced.wgsl::slice_hit`),
+/// at most the culling tiles' side. 32: the slices cover rays without gaps
+/// down to slopes of about 1/48 at 512 slices (the first slice a ray meets
+/// walks from the eye however far; the rays of longer gaps are left to the
+/// refine pass's whole-ray search).
+pub const GAP_TEXELS: u32 = 32;
+
 /// More slices than this sample far below the 256 quantised altitudes and
 /// only multiply overdraw; refuse them rather than draw for seconds.
 pub const MAX_SLICES: u32 = 1 << 16;
@@ -53,6 +62,27 @@ fn checked_slices(settings: &MethodSettings) -> anyhow::Result<u32> {
     Ok(slices)
 }
 
+/// The layout both passes' groups share: uniforms at bindings 0 and 1 (the
+/// footprint, the tile grid), integer textures at 2 and 3.
+fn uniforms_and_textures_layout(device: &wgpu::Device, label: &str) -> wgpu::BindGroupLayout {
+    let uint_texture = |binding| {
+        texture_entry(
+            binding,
+            wgpu::TextureSampleType::Uint,
+            wgpu::TextureViewDimension::D2,
+        )
+    };
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some(label),
+        entries: &[
+            uniform_layout_entry(0),
+            uniform_layout_entry(1),
+            uint_texture(2),
+            uint_texture(3),
+        ],
+    })
+}
+
 /// The slices' group: the footprint uniform, the tile grid uniform and the
 /// tile maxima.
 fn slices_binding(
@@ -61,18 +91,7 @@ fn slices_binding(
     tiles: &SliceTiles,
 ) -> (wgpu::BindGroupLayout, wgpu::BindGroup) {
     let device = &shared.device;
-    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("sliced"),
-        entries: &[
-            uniform_layout_entry(0),
-            uniform_layout_entry(1),
-            texture_entry(
-                2,
-                wgpu::TextureSampleType::Uint,
-                wgpu::TextureViewDimension::D2,
-            ),
-        ],
-    });
+    let layout = uniforms_and_textures_layout(device, "sliced");
     let group = crate::frame::bind_group(
         device,
         "sliced",
@@ -80,7 +99,8 @@ fn slices_binding(
         &[
             params.as_entire_binding(),
             tiles.params.as_entire_binding(),
-            wgpu::BindingResource::TextureView(&tiles.view),
+            wgpu::BindingResource::TextureView(tiles.view()),
+            wgpu::BindingResource::TextureView(tiles.blocks_view()),
         ],
     );
     (layout, group)
@@ -111,7 +131,7 @@ pub fn create(
             ("vs_sliced", "fs_slice_mark"),
             MARK_FORMAT,
         )?;
-        (marks, Some(Refine::new(shared, &params)?))
+        (marks, Some(Refine::new(shared, &params, &tiles)?))
     } else {
         let plain = forward_pipeline(
             shared,
@@ -172,7 +192,7 @@ impl Method for Sliced {
 
     fn resize(&mut self, shared: &Shared) -> anyhow::Result<()> {
         if let Some(refine) = &mut self.refine {
-            refine.resize(shared, &self.params);
+            refine.resize(shared, &self.params, &self.tiles);
         }
         Ok(())
     }
@@ -183,6 +203,7 @@ impl Method for Sliced {
         self.empty = f.size[0] == 0 || f.size[1] == 0;
         f.count[1] = self.slices;
         f.count[2] = slice_near(camera.position.z, self.slices);
+        f.count[3] = GAP_TEXELS.min(self.tiles.side());
         self.tiles_per_slice = self
             .tiles
             .prepare(shared, [f.origin[0], f.origin[1]], f.extent());

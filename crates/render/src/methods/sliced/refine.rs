@@ -13,7 +13,8 @@
 
 use super::super::common::{draw_fullscreen_with_depth, fullscreen_pipeline};
 use super::super::contract::{Frame, RetainedBytes};
-use crate::frame::{Shared, texture_entry, uniform_layout_entry};
+use super::tiles::SliceTiles;
+use crate::frame::Shared;
 
 /// Format of the slice marks: rank + 1 of the kept slice, 0 = none. An
 /// integer format renders everywhere (WebGL2 included), unlike R32Float.
@@ -34,7 +35,12 @@ struct Marks {
 }
 
 impl Marks {
-    fn new(shared: &Shared, layout: &wgpu::BindGroupLayout, params: &wgpu::Buffer) -> Self {
+    fn new(
+        shared: &Shared,
+        layout: &wgpu::BindGroupLayout,
+        params: &wgpu::Buffer,
+        tiles: &SliceTiles,
+    ) -> Self {
         let (_, view) = shared.target_texture(
             "sliced marks",
             MARK_FORMAT,
@@ -46,7 +52,9 @@ impl Marks {
             layout,
             &[
                 params.as_entire_binding(),
+                tiles.params.as_entire_binding(),
                 wgpu::BindingResource::TextureView(&view),
+                wgpu::BindingResource::TextureView(tiles.blocks_view()),
             ],
         );
         Marks {
@@ -58,21 +66,10 @@ impl Marks {
 }
 
 impl Refine {
-    /// `params`: the slicer's footprint uniform (slice count, search budget).
-    pub fn new(shared: &Shared, params: &wgpu::Buffer) -> anyhow::Result<Self> {
-        let layout = shared
-            .device
-            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("sliced refine"),
-                entries: &[
-                    uniform_layout_entry(0),
-                    texture_entry(
-                        1,
-                        wgpu::TextureSampleType::Uint,
-                        wgpu::TextureViewDimension::D2,
-                    ),
-                ],
-            });
+    /// `params`: the slicer's footprint uniform (slice count, gap walks);
+    /// `tiles`: its block maxima, which let the search step over air.
+    pub fn new(shared: &Shared, params: &wgpu::Buffer, tiles: &SliceTiles) -> anyhow::Result<Self> {
+        let layout = super::uniforms_and_textures_layout(&shared.device, "sliced refine");
         let pipeline = fullscreen_pipeline(
             shared,
             "sliced refine",
@@ -80,7 +77,7 @@ impl Refine {
             &shared.pipeline_layout("sliced refine", &[&layout]),
             "fs_sliced_refine",
         )?;
-        let marks = Marks::new(shared, &layout, params);
+        let marks = Marks::new(shared, &layout, params, tiles);
         Ok(Refine {
             layout,
             pipeline,
@@ -89,8 +86,8 @@ impl Refine {
     }
 
     /// A marks image at the shared targets' new size.
-    pub fn resize(&mut self, shared: &Shared, params: &wgpu::Buffer) {
-        self.marks = Marks::new(shared, &self.layout, params);
+    pub fn resize(&mut self, shared: &Shared, params: &wgpu::Buffer, tiles: &SliceTiles) {
+        self.marks = Marks::new(shared, &self.layout, params, tiles);
     }
 
     /// The slice pass's colour target: the marks, cleared to 0 (no slice).

@@ -53,16 +53,17 @@ fn row_tops(level: &Level, y: u32, out: &mut Vec<u8>) {
 }
 
 impl TileMaxima {
-    /// The tile side for `level` (its log2).
-    fn log2_for(level: &Level) -> u32 {
-        TILE_LOG2
-            .min(level.width().trailing_zeros())
-            .min(level.height().trailing_zeros())
-    }
-
     /// Every tile of `level`.
     pub fn new(level: &Level) -> Self {
-        let log2 = Self::log2_for(level);
+        Self::with_log2(level, TILE_LOG2)
+    }
+
+    /// Every tile of side `2^log2` (smaller on a map narrower than that) of
+    /// `level`.
+    pub fn with_log2(level: &Level, log2: u32) -> Self {
+        let log2 = log2
+            .min(level.width().trailing_zeros())
+            .min(level.height().trailing_zeros());
         let (width, height) = (level.width() >> log2, level.height() >> log2);
         let mut t = TileMaxima {
             log2,
@@ -161,7 +162,8 @@ pub struct SliceTileParams {
     /// per slice over the whole footprint).
     pub grid: [i32; 4],
     /// x: log2 of the tile side; y, z: the map's tiles across and down - 1
-    /// (wrapping masks).
+    /// (wrapping masks); w: log2 of the block side ([`BLOCK_LOG2`], set by
+    /// [`SliceTiles::prepare`]).
     pub tiles: [u32; 4],
 }
 
@@ -194,20 +196,24 @@ pub fn tile_grid(log2: u32, map: [u32; 2], origin: [i32; 2], extent: [u32; 2]) -
     }
 }
 
-/// The tile maxima on the GPU, and the per-frame grid over the footprint.
-pub struct SliceTiles {
+/// log2 of the side of the finer blocks the slices' gap walks step over
+/// (`sliced.wgsl::walk_gap`): a walk of up to 32 columns reads a few block
+/// maxima where the air is open and walks columns only in blocks the ray
+/// comes down to.
+pub const BLOCK_LOG2: u32 = 3;
+
+/// One set of maxima on the GPU: the CPU copy (kept for edits) and its
+/// texture.
+struct GpuMaxima {
     cpu: TileMaxima,
     texture: wgpu::Texture,
-    pub view: wgpu::TextureView,
-    pub params: wgpu::Buffer,
+    view: wgpu::TextureView,
 }
 
-impl SliceTiles {
-    /// Build the maxima of `level` and upload them.
-    pub fn new(shared: &Shared, level: &Level) -> Self {
-        let cpu = TileMaxima::new(level);
+impl GpuMaxima {
+    fn new(shared: &Shared, cpu: TileMaxima, label: &str) -> Self {
         let texture = shared.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("sliced tile maxima"),
+            label: Some(label),
             size: wgpu::Extent3d {
                 width: cpu.width,
                 height: cpu.height,
@@ -221,18 +227,9 @@ impl SliceTiles {
             view_formats: &[],
         });
         let view = texture.create_view(&Default::default());
-        let params = shared.uniform_buffer(
-            "sliced tiles",
-            bytemuck::bytes_of(&SliceTileParams::default()),
-        );
-        let tiles = SliceTiles {
-            cpu,
-            texture,
-            view,
-            params,
-        };
-        tiles.upload_rows(shared, 0, tiles.cpu.height);
-        tiles
+        let m = GpuMaxima { cpu, texture, view };
+        m.upload_rows(shared, 0, m.cpu.height);
+        m
     }
 
     /// Write tile rows `first..first + count` to the texture.
@@ -265,18 +262,62 @@ impl SliceTiles {
     }
 
     /// Rebuild the tiles `rects` touch and upload their rows.
-    pub fn apply_edit(&mut self, shared: &Shared, level: &Level, rects: &[DirtyRect]) {
+    fn apply_edit(&mut self, shared: &Shared, level: &Level, rects: &[DirtyRect]) {
         for ty in self.cpu.update(level, rects) {
             self.upload_rows(shared, ty, 1);
         }
+    }
+}
+
+/// The tile maxima on the GPU, the finer block maxima of the gap walks, and
+/// the per-frame grid over the footprint.
+pub struct SliceTiles {
+    tiles: GpuMaxima,
+    blocks: GpuMaxima,
+    pub params: wgpu::Buffer,
+}
+
+impl SliceTiles {
+    /// Build the maxima of `level` and upload them.
+    pub fn new(shared: &Shared, level: &Level) -> Self {
+        let params = shared.uniform_buffer(
+            "sliced tiles",
+            bytemuck::bytes_of(&SliceTileParams::default()),
+        );
+        SliceTiles {
+            tiles: GpuMaxima::new(shared, TileMaxima::new(level), "sliced tile maxima"),
+            blocks: GpuMaxima::new(
+                shared,
+                TileMaxima::with_log2(level, BLOCK_LOG2),
+                "sliced block maxima",
+            ),
+            params,
+        }
+    }
+
+    /// The tile maxima.
+    pub fn view(&self) -> &wgpu::TextureView {
+        &self.tiles.view
+    }
+
+    /// The block maxima.
+    pub fn blocks_view(&self) -> &wgpu::TextureView {
+        &self.blocks.view
+    }
+
+    /// Rebuild the tiles and blocks `rects` touch and upload their rows.
+    pub fn apply_edit(&mut self, shared: &Shared, level: &Level, rects: &[DirtyRect]) {
+        self.tiles.apply_edit(shared, level, rects);
+        self.blocks.apply_edit(shared, level, rects);
     }
 
     /// The tile grid over the footprint bound `[origin, origin + extent)`
     /// (unwrapped texels), written for the next draw; returns the tiles per
     /// slice (1 when the slices are drawn whole).
     pub fn prepare(&self, shared: &Shared, origin: [i32; 2], extent: [u32; 2]) -> u32 {
-        let map = [self.cpu.width, self.cpu.height];
-        let p = tile_grid(self.cpu.log2, map, origin, extent);
+        let cpu = &self.tiles.cpu;
+        let mut p = tile_grid(cpu.log2, [cpu.width, cpu.height], origin, extent);
+        p.tiles[3] = self.blocks.cpu.log2;
         shared
             .queue
             .write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
@@ -287,14 +328,19 @@ impl SliceTiles {
         }
     }
 
-    /// GPU bytes: the texture and the uniform.
+    /// The tiles' side, texels.
+    pub fn side(&self) -> u32 {
+        1 << self.tiles.cpu.log2
+    }
+
+    /// GPU bytes: the textures and the uniform.
     pub fn gpu_bytes(&self) -> u64 {
-        self.cpu.data.len() as u64 + std::mem::size_of::<SliceTileParams>() as u64
+        self.cpu_bytes() + std::mem::size_of::<SliceTileParams>() as u64
     }
 
     /// CPU bytes kept for edits: the maxima.
     pub fn cpu_bytes(&self) -> u64 {
-        self.cpu.data.len() as u64
+        (self.tiles.cpu.data.len() + self.blocks.cpu.data.len()) as u64
     }
 }
 
@@ -320,6 +366,22 @@ mod tests {
             }
         }
         Level::from_planes(w, h, heights, metas, MidRule::default()).unwrap()
+    }
+
+    /// Raise texel (x, y) (x even) to 255 and make its pair single: the
+    /// edit's rectangle.
+    fn raise_pair(level: &mut Level, x: u32, y: u32) -> DirtyRect {
+        let i = (y * level.width() + x) as usize;
+        let (heights, metas) = level.planes_mut();
+        heights[i] = 255;
+        metas[i] = 0;
+        metas[i + 1] = 0;
+        DirtyRect {
+            x,
+            y,
+            width: 2,
+            height: 1,
+        }
     }
 
     fn check(level: &Level, t: &TileMaxima) {
@@ -360,19 +422,8 @@ mod tests {
         let mut t = TileMaxima::new(&level);
         // Raise texel (0, 40), one row into tile row 1 and on the map's left
         // edge: the margins wrap, so tiles in the last column change too.
-        let (w, h) = (level.width() as usize, level.height());
-        {
-            let (heights, metas) = level.planes_mut();
-            heights[40 * w] = 255;
-            metas[40 * w] = 0;
-            metas[40 * w + 1] = 0;
-        }
-        let rect = DirtyRect {
-            x: 0,
-            y: 40,
-            width: 2,
-            height: 1,
-        };
+        let h = level.height();
+        let rect = raise_pair(&mut level, 0, 40);
         assert_eq!(t.update(&level, &[rect]), vec![1]);
         check(&level, &t);
         assert_eq!(t.data[(t.width + t.width - 1) as usize], 255);
@@ -386,6 +437,19 @@ mod tests {
         };
         assert_eq!(t.update(&level, &[top]), vec![0, h / 32 - 1]);
         assert_eq!(t, TileMaxima::new(&level));
+    }
+
+    #[test]
+    fn block_maxima_cover_each_block_and_follow_edits() {
+        let mut level = level();
+        let mut b = TileMaxima::with_log2(&level, BLOCK_LOG2);
+        assert_eq!((b.log2, b.width, b.height), (3, 16, 8));
+        check(&level, &b);
+        let rect = raise_pair(&mut level, 40, 17);
+        // Row 17 is inside block row 2 only (its margin rows are 15 and 24).
+        assert_eq!(b.update(&level, &[rect]), vec![2]);
+        assert_eq!(b, TileMaxima::with_log2(&level, BLOCK_LOG2));
+        assert_eq!(b.data[(2 * b.width + 5) as usize], 255);
     }
 
     #[test]

@@ -1,0 +1,627 @@
+//! A CPU replay of `ray-exact`'s frame (issue 36, item 1: the bound on
+//! paper): the same traversal as the WGSL, step for step in f32
+//! (`ray_exact_core.wgsl::exact_march` with the compute pipelines' constants,
+//! `EXACT_LOG_RATIO` 2 and `EXACT_CLIMB` 1, over the pyramid they build), run
+//! for the three passes of the deferred frame, counting per ray what the GPU
+//! does:
+//!
+//! 1. **march** (`cs_exact_march_hits`, one ray per pixel): iterations of the
+//!    traversal loop, pyramid words read (`maxmip_get`), terrain texels read
+//!    (`decode_column`), the hit and the 8x8 shadow blocks it stamps;
+//! 2. **shadow** (`cs_exact_shadow_blocks`, one ray per texel of every
+//!    stamped block): the same march along the light;
+//! 3. **shade** (`cs_exact_shade`, one per hit pixel): the column and its four
+//!    neighbours (`surface_normal_at`) and the shadow map's 4-tap PCF where
+//!    the point is not under a slab.
+//!
+//! Bytes: every read and write the passes issue (terrain texels are 4 bytes,
+//! pyramid reads one 4-byte word, shadow and depth texels 4 bytes, colour 4),
+//! and the distinct bytes each resource had read (the least that must come
+//! from memory once). f32 on the CPU rounds as IEEE; the GPU may fuse a
+//! multiply-add or divide less exactly, so a ray can differ by a step at a
+//! boundary it grazes (the tests bound that).
+
+use crate::frame::Globals;
+use glam::{IVec2, Vec2, Vec3};
+use strata_level::Level;
+use strata_maxmip::Pyramid;
+
+/// `EXACT_LOG_RATIO` of the compute pipelines ([`crate::options::ExactOptions`]).
+pub const LOG_RATIO: u32 = 2;
+const BASE_TILE: f32 = 256.0;
+const BIG: f32 = 3.0e38;
+const MAX_ALTITUDE: f32 = 255.0;
+const MARK_BLOCK: i32 = 8;
+const SHADOW_BLOCK_TEXELS: u64 = (MARK_BLOCK * MARK_BLOCK) as u64;
+
+/// Bytes of one read or write of each resource.
+const TERRAIN_TEXEL_BYTES: u64 = 4;
+const PYRAMID_WORD_BYTES: u64 = 4;
+const TEXEL_BYTES: u64 = 4;
+
+/// What one march did.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct MarchCount {
+    /// Hit: ray parameter and column (absolute texels).
+    pub hit: Option<(f32, IVec2)>,
+    /// Traversal loop iterations (`ExactHit::iterations`).
+    pub iterations: u32,
+    /// Pyramid words read.
+    pub pyramid_reads: u32,
+    /// Terrain texels read.
+    pub terrain_reads: u32,
+    /// Iterations that went down a level.
+    pub descents: u32,
+    /// Levels climbed after steps that left the parent tile.
+    pub climbs: u32,
+}
+
+/// Traversal knobs to try on paper; [`Traversal::GPU`] is what the compute
+/// pipelines run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Traversal {
+    /// Most levels climbed after a step leaves its parent tile
+    /// (`EXACT_CLIMB`).
+    pub climb: u32,
+    /// The visited level (0 = texels, top = 256-texel tiles) camera and
+    /// shadow rays start at (`None`: the top).
+    pub start: Option<u32>,
+}
+
+impl Traversal {
+    /// The whole map's compute pipelines' traversal (`START_LEVEL`).
+    pub const GPU: Traversal = Traversal {
+        climb: 1,
+        start: Some(super::START_LEVEL / LOG_RATIO),
+    };
+
+    /// Starting at the 256-texel tiles (the GPU's before `START_LEVEL`).
+    pub const FROM_TOP: Traversal = Traversal {
+        climb: 1,
+        start: None,
+    };
+}
+
+/// Distinct elements read of one resource (a bit per element).
+#[derive(Clone, Debug)]
+struct Touched {
+    bits: Vec<u64>,
+    count: u64,
+}
+
+impl Touched {
+    fn new(elements: u64) -> Self {
+        Touched {
+            bits: vec![0; elements.div_ceil(64) as usize],
+            count: 0,
+        }
+    }
+
+    fn clear(&mut self) {
+        self.bits.fill(0);
+        self.count = 0;
+    }
+
+    fn touch(&mut self, i: u64) {
+        let (w, b) = ((i / 64) as usize, 1u64 << (i % 64));
+        if self.bits[w] & b == 0 {
+            self.bits[w] |= b;
+            self.count += 1;
+        }
+    }
+}
+
+/// The world the replay reads: the level, its pyramid as the compute
+/// pipelines build it, and what was read of them.
+pub struct Replay<'a> {
+    level: &'a Level,
+    pyramid: &'a Pyramid,
+    top: u32,
+    /// The traversal replayed ([`Traversal::GPU`] unless changed).
+    pub traversal: Traversal,
+    terrain_touched: Touched,
+    pyramid_touched: Touched,
+}
+
+/// The pyramid `ray-exact`'s compute pipelines read.
+pub fn compute_pyramid(level: &Level) -> Pyramid {
+    Pyramid::with_step(level, LOG_RATIO)
+}
+
+/// `texel_after` of `column_segment.wgsl`.
+fn texel_after(p: Vec2, d: Vec2) -> IVec2 {
+    let f = p.floor();
+    let on = |a: f32, b: f32, dd: f32| i32::from(a == b && dd < 0.0);
+    IVec2::new(
+        f.x as i32 - on(f.x, p.x, d.x),
+        f.y as i32 - on(f.y, p.y, d.y),
+    )
+}
+
+/// `column_entry` of `column_segment.wgsl`: the first t in [t0, t1] at which
+/// `oz + t dz` is solid, or -1.
+fn column_entry(c: &strata_level::model::Column, oz: f32, dz: f32, t0: f32, t1: f32) -> f32 {
+    let low = f32::from(c.low);
+    let mut best = -1.0f32;
+    if dz < 0.0 {
+        let e = t0.max((low - oz) / dz);
+        if e <= t1 {
+            best = e;
+        }
+    } else if oz + dz * t0 <= low {
+        best = t0;
+    }
+    if c.dual {
+        let (mid, high) = (f32::from(c.mid), f32::from(c.high));
+        let (mut lo, mut hi) = (t0, t1);
+        if dz == 0.0 {
+            if oz < mid || oz > high {
+                (lo, hi) = (1.0, 0.0);
+            }
+        } else {
+            let (ta, tb) = ((mid - oz) / dz, (high - oz) / dz);
+            lo = t0.max(ta.min(tb));
+            hi = t1.min(ta.max(tb));
+        }
+        if lo <= hi && (best < 0.0 || lo < best) {
+            best = lo;
+        }
+    }
+    best
+}
+
+/// `exact_base` of `ray_exact_core.wgsl`.
+fn exact_base(p: Vec2) -> IVec2 {
+    (p / BASE_TILE).floor().as_ivec2() * BASE_TILE as i32
+}
+
+/// `exact_clip` of `ray_exact_core.wgsl`: empty (x > y) when the segment
+/// stays above 255.
+fn exact_clip(o: Vec3, d: Vec3, t0: f32, t1: f32) -> (f32, f32) {
+    let (mut a, mut b) = (t0, t1);
+    if d.z < 0.0 {
+        a = a.max((MAX_ALTITUDE - o.z) / d.z);
+    } else if o.z > MAX_ALTITUDE {
+        return (1.0, 0.0);
+    } else if d.z > 0.0 {
+        b = b.min((MAX_ALTITUDE - o.z) / d.z);
+    }
+    (a, b)
+}
+
+impl<'a> Replay<'a> {
+    /// A replay over `level` and its compute pyramid ([`compute_pyramid`]).
+    pub fn new(level: &'a Level, pyramid: &'a Pyramid) -> Self {
+        let pairs = u64::from(level.width() / 2) * u64::from(level.height());
+        Replay {
+            level,
+            pyramid,
+            top: pyramid.top(),
+            traversal: Traversal::GPU,
+            terrain_touched: Touched::new(pairs),
+            pyramid_touched: Touched::new(u64::from(pyramid.layout.bytes / 4)),
+        }
+    }
+
+    /// `decode_column` (one terrain texel: the pair holding (x, y)).
+    fn column(&mut self, x: i32, y: i32) -> strata_level::model::Column {
+        let (w, h) = (self.level.width() as i32, self.level.height() as i32);
+        let pair = ((x & (w - 1)) >> 1) as u64 + (y & (h - 1)) as u64 * (w / 2) as u64;
+        self.terrain_touched.touch(pair);
+        self.level.column(i64::from(x), i64::from(y))
+    }
+
+    /// `maxmip_get` (one word).
+    fn maxmip(&mut self, k: u32, tx: i32, ty: i32) -> f32 {
+        let i = self
+            .pyramid
+            .layout
+            .level(k)
+            .index(i64::from(tx), i64::from(ty));
+        self.pyramid_touched.touch((i / 4) as u64);
+        f32::from(self.pyramid.data[i])
+    }
+
+    /// `exact_march` of `ray_exact_core.wgsl` on the whole map (level of
+    /// detail 0), counting.
+    pub fn march(&mut self, o: Vec3, base: IVec2, d: Vec3, t0: f32, t1: f32) -> MarchCount {
+        let mut r = MarchCount::default();
+        if t1 < t0 {
+            return r;
+        }
+        let ratio = LOG_RATIO;
+        let (dxy, oxy) = (d.truncate(), o.truncate());
+        let pos = [d.x > 0.0, d.y > 0.0];
+        let step = IVec2::new(if pos[0] { 1 } else { -1 }, if pos[1] { 1 } else { -1 });
+        let far_side = IVec2::new(i32::from(pos[0]), i32::from(pos[1]));
+        let still = [d.x == 0.0, d.y == 0.0];
+        let inv = Vec2::new(
+            if still[0] { 0.0 } else { 1.0 / d.x },
+            if still[1] { 0.0 } else { 1.0 / d.y },
+        );
+        let top = self.top / ratio;
+        let mut lvl = self.traversal.start.map_or(top, |s| s.min(top));
+        let mut t = t0;
+        let mut cell = texel_after(oxy + dxy * t, dxy) >> (lvl * ratio) as i32;
+        loop {
+            if r.iterations >= super::ITERATION_CAP {
+                return r;
+            }
+            r.iterations += 1;
+            let shift = lvl * ratio;
+            let size = (1u32 << shift) as f32;
+            let edge = (cell + far_side).as_vec2() * size;
+            let tb = (edge - oxy) * inv;
+            let tb = Vec2::new(
+                if still[0] { BIG } else { tb.x },
+                if still[1] { BIG } else { tb.y },
+            );
+            let t_exit = tb.x.min(tb.y);
+            let t_out = t_exit.min(t1);
+            if lvl > 0 {
+                let z_min = (o.z + d.z * t).min(o.z + d.z * t_out);
+                let tile = (base >> shift as i32) + cell;
+                r.pyramid_reads += 1;
+                if z_min <= self.maxmip(shift, tile.x, tile.y) {
+                    r.descents += 1;
+                    lvl -= 1;
+                    let child = texel_after(oxy + dxy * t, dxy) >> (shift - ratio) as i32;
+                    let first = cell << ratio as i32;
+                    cell = child.clamp(first, first + IVec2::splat((1 << ratio) - 1));
+                    continue;
+                }
+            } else {
+                let column = base + cell;
+                r.terrain_reads += 1;
+                let c = self.column(column.x, column.y);
+                let e = column_entry(&c, o.z, d.z, t, t_out);
+                if e >= 0.0 {
+                    r.hit = Some((e, column));
+                    return r;
+                }
+            }
+            if t_exit >= t1 {
+                return r;
+            }
+            t = t_exit;
+            let old = cell;
+            if tb.x <= tb.y {
+                cell.x += step.x;
+            }
+            if tb.y <= tb.x {
+                cell.y += step.y;
+            }
+            // EXACT_CLIMB.
+            let mut was = old;
+            for _ in 0..self.traversal.climb {
+                if lvl >= top || (was >> ratio as i32) == (cell >> ratio as i32) {
+                    break;
+                }
+                was >>= ratio as i32;
+                cell >>= ratio as i32;
+                lvl += 1;
+                r.climbs += 1;
+            }
+        }
+    }
+
+    /// `exact_pixel_hit` of `ray_exact_pixel.wgsl` (the eye's tile as base):
+    /// the ray and what its march did.
+    pub fn pixel(&mut self, g: &Globals, px: f32, py: f32) -> (Vec3, MarchCount) {
+        let eye = Vec3::from_slice(&g.eye[..3]);
+        let d = camera_ray(g, px, py);
+        let focal = g.eye[3];
+        let (a, b) = exact_clip(eye, d, g.forward[3] / focal, g.right[3] / focal);
+        let base = exact_base(eye.truncate());
+        let o = (eye.truncate() - base.as_vec2()).extend(eye.z);
+        (d, self.march(o, base, d, a, b))
+    }
+
+    /// `cast_texel` of `ray_exact_shadow.wgsl`: shadow texel (i, j).
+    pub fn shadow_texel(&mut self, g: &Globals, i: u32, j: u32) -> MarchCount {
+        let texel = g.shadow_origin[3];
+        let o = Vec3::from_slice(&g.shadow_origin[..3])
+            + Vec3::from_slice(&g.shadow_u[..3]) * ((i as f32 + 0.5) * texel)
+            + Vec3::from_slice(&g.shadow_v[..3]) * ((j as f32 + 0.5) * texel);
+        let d = Vec3::from_slice(&g.light_dir[..3]);
+        let t_in = (MAX_ALTITUDE - o.z) / d.z;
+        let t_out = (-1.0 - o.z) / d.z;
+        let p = o + d * t_in;
+        let base = exact_base(p.truncate());
+        let rel = (p.truncate() - base.as_vec2()).extend(p.z);
+        self.march(rel, base, d, 0.0, t_out - t_in)
+    }
+}
+
+/// `camera_ray` of `frame.wgsl`.
+pub fn camera_ray(g: &Globals, px: f32, py: f32) -> Vec3 {
+    let sx = px - g.screen[0] * 0.5;
+    let sy = g.screen[1] * 0.5 - py;
+    Vec3::from_slice(&g.forward[..3]) * g.eye[3] - Vec3::from_slice(&g.right[..3]) * sx
+        + Vec3::from_slice(&g.up[..3]) * sy
+}
+
+/// Per-ray figures of one pass: mean, 99th percentile and most.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct Spread {
+    /// Mean per ray.
+    pub mean: f64,
+    /// 99th percentile per ray (nearest rank).
+    pub p99: u32,
+    /// Most of any ray.
+    pub max: u32,
+    /// Sum over the pass.
+    pub total: u64,
+}
+
+impl Spread {
+    fn of(mut v: Vec<u32>) -> Self {
+        if v.is_empty() {
+            return Spread::default();
+        }
+        let total: u64 = v.iter().map(|&x| u64::from(x)).sum();
+        v.sort_unstable();
+        let rank = ((0.99 * v.len() as f64).ceil() as usize).clamp(1, v.len());
+        Spread {
+            mean: total as f64 / v.len() as f64,
+            p99: v[rank - 1],
+            max: v[v.len() - 1],
+            total,
+        }
+    }
+}
+
+/// One pass of the frame.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct PassCount {
+    /// Rays (invocations that march or shade).
+    pub rays: u64,
+    /// Traversal iterations per ray (0 in the shading pass).
+    pub iterations: Spread,
+    /// Pyramid words read per ray.
+    pub pyramid_reads: Spread,
+    /// Terrain texels read per ray.
+    pub terrain_reads: Spread,
+    /// Descents per ray (mean).
+    pub descents: f64,
+    /// Levels climbed per ray (mean).
+    pub climbs: f64,
+    /// Shadow-map texels read per ray (the shading pass).
+    pub shadow_reads: u64,
+    /// Mean over 32-lane warps (8x4 pixels or texels of an 8x8 workgroup) of
+    /// the most iterations of a lane: a warp steps as long as its longest ray.
+    pub warp_iterations: f64,
+    /// Iterations over warp steps x 32: the share of lanes doing work.
+    pub simd_efficiency: f64,
+    /// Bytes read, all requests (terrain, pyramid, shadow map, the pass's
+    /// own images).
+    pub bytes_read: u64,
+    /// Bytes written (images, stamps, lists).
+    pub bytes_written: u64,
+}
+
+/// The replayed frame of one view.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+pub struct FrameCount {
+    /// Image width and height.
+    pub size: [u32; 2],
+    /// Pixels whose ray hit.
+    pub hits: u64,
+    /// The camera march.
+    pub march: PassCount,
+    /// The shadow casts of the stamped blocks (empty with shadows off).
+    pub shadow: PassCount,
+    /// The shading of the hits.
+    pub shade: PassCount,
+    /// Shadow blocks stamped (8x8 texels each).
+    pub shadow_blocks: u64,
+    /// Distinct terrain bytes read over the frame.
+    pub terrain_bytes_touched: u64,
+    /// Distinct pyramid bytes read over the frame.
+    pub pyramid_bytes_touched: u64,
+    /// The march's most iterations of a camera ray (`ExactStats`'s twin).
+    pub most_iterations: u32,
+    /// The most iterations of a shadow ray.
+    pub shadow_most_iterations: u32,
+}
+
+impl FrameCount {
+    /// Bytes read and written by the three passes together.
+    pub fn bytes(&self) -> u64 {
+        [self.march, self.shadow, self.shade]
+            .iter()
+            .map(|p| p.bytes_read + p.bytes_written)
+            .sum()
+    }
+}
+
+/// Per-ray counts of a pass into a [`PassCount`].
+#[derive(Default)]
+struct PassAcc {
+    descents: u64,
+    climbs: u64,
+    iterations: Vec<u32>,
+    pyramid: Vec<u32>,
+    terrain: Vec<u32>,
+}
+
+impl PassAcc {
+    fn add(&mut self, m: &MarchCount) {
+        self.descents += u64::from(m.descents);
+        self.climbs += u64::from(m.climbs);
+        self.iterations.push(m.iterations);
+        self.pyramid.push(m.pyramid_reads);
+        self.terrain.push(m.terrain_reads);
+    }
+
+    /// `warps`: the lanes of each warp, as indices into the rays.
+    fn finish(self, warps: impl Iterator<Item = Vec<usize>>) -> PassCount {
+        let rays = self.iterations.len() as u64;
+        let (mut count, mut steps) = (0u64, 0u64);
+        for lanes in warps {
+            let most = lanes.iter().map(|&i| self.iterations[i]).max().unwrap_or(0);
+            count += 1;
+            steps += u64::from(most);
+        }
+        let work: u64 = self.iterations.iter().map(|&x| u64::from(x)).sum();
+        let pyramid = Spread::of(self.pyramid);
+        let terrain = Spread::of(self.terrain);
+        PassCount {
+            rays,
+            bytes_read: pyramid.total * PYRAMID_WORD_BYTES + terrain.total * TERRAIN_TEXEL_BYTES,
+            descents: self.descents as f64 / rays.max(1) as f64,
+            climbs: self.climbs as f64 / rays.max(1) as f64,
+            warp_iterations: steps as f64 / count.max(1) as f64,
+            simd_efficiency: work as f64 / (steps * 32).max(1) as f64,
+            iterations: Spread::of(self.iterations),
+            pyramid_reads: pyramid,
+            terrain_reads: terrain,
+            ..PassCount::default()
+        }
+    }
+}
+
+/// `mark_shadow_blocks` of `ray_exact_deferred.wgsl`: the blocks shading
+/// point `p` can read.
+fn shadow_blocks_of(g: &Globals, p: Vec3, out: &mut impl FnMut(u32)) {
+    let texel = g.shadow_origin[3];
+    let rel = p - Vec3::from_slice(&g.shadow_origin[..3]);
+    let uv = Vec2::new(
+        rel.dot(Vec3::from_slice(&g.shadow_u[..3])),
+        rel.dot(Vec3::from_slice(&g.shadow_v[..3])),
+    ) / texel;
+    let side = g.shadow_u[3] as i32;
+    let lo = (uv - Vec2::splat(2.5)).floor().as_ivec2();
+    let hi = (uv + Vec2::splat(2.5)).floor().as_ivec2();
+    if hi.x < 0 || hi.y < 0 || lo.x >= side || lo.y >= side {
+        return;
+    }
+    let blocks = side / MARK_BLOCK;
+    let b0 = lo.clamp(IVec2::ZERO, IVec2::splat(side - 1)) / MARK_BLOCK;
+    let b1 = hi.clamp(IVec2::ZERO, IVec2::splat(side - 1)) / MARK_BLOCK;
+    for by in b0.y..=b1.y {
+        for bx in b0.x..=b1.x {
+            out((by * blocks + bx) as u32);
+        }
+    }
+}
+
+/// Whether the shading of a hit at `p` in column `c` reads the shadow map
+/// (`shade_with_normal`: not under a slab or on its underside), and how many
+/// of its four taps fall on the map.
+fn shadow_taps(g: &Globals, p: Vec3, c: &strata_level::model::Column, d: Vec3) -> u64 {
+    if g.light_dir[3] == 0.0 {
+        return 0;
+    }
+    let (z, low, mid, high) = (p.z, f32::from(c.low), f32::from(c.mid), f32::from(c.high));
+    // `surface_kind`.
+    let floor = !c.dual || z < 0.5 * (low + mid);
+    let ceiling = !floor && d.z > 0.0 && z - mid < high - z;
+    if c.dual && (z < mid || ceiling) {
+        return 0;
+    }
+    // The taps lie within 2 texels of p's own map coordinates; all four are
+    // on the map except at its very edge, where the count is a bound.
+    4
+}
+
+/// Replay `ray-exact`'s deferred frame for globals `g` (shadows as `g` says).
+pub fn replay_frame(replay: &mut Replay<'_>, g: &Globals) -> FrameCount {
+    replay.terrain_touched.clear();
+    replay.pyramid_touched.clear();
+    let (w, h) = (g.screen[0] as u32, g.screen[1] as u32);
+    let shadows = g.light_dir[3] != 0.0;
+    let side = g.shadow_u[3] as u32;
+    let mut march = PassAcc::default();
+    let mut hits = Vec::new();
+    let mut stamped = vec![false; ((side / MARK_BLOCK as u32).pow(2)) as usize];
+    let mut listed = Vec::new();
+    for y in 0..h {
+        for x in 0..w {
+            let (d, m) = replay.pixel(g, x as f32 + 0.5, y as f32 + 0.5);
+            march.add(&m);
+            if let Some((t, column)) = m.hit {
+                let p = Vec3::from_slice(&g.eye[..3]) + d * t;
+                if shadows {
+                    shadow_blocks_of(g, p, &mut |b| {
+                        if !std::mem::replace(&mut stamped[b as usize], true) {
+                            listed.push(b);
+                        }
+                    });
+                }
+                hits.push((p, d, column));
+            }
+        }
+    }
+    let pixels = u64::from(w) * u64::from(h);
+    // Warps of 8x8 workgroups over the image: 8x4 pixels each.
+    let warps = (0..h.div_ceil(4)).flat_map(|wy| {
+        (0..w.div_ceil(8)).map(move |wx| {
+            (wy * 4..(wy * 4 + 4).min(h))
+                .flat_map(|y| (wx * 8..(wx * 8 + 8).min(w)).map(move |x| (y * w + x) as usize))
+                .collect()
+        })
+    });
+    let mut march = march.finish(warps);
+    // hits (4 B each pixel), depth_io (4 B per hit), stamps and list.
+    march.bytes_written =
+        pixels * TEXEL_BYTES + hits.len() as u64 * TEXEL_BYTES + listed.len() as u64 * 8;
+    let most_iterations = march.iterations.max;
+
+    let mut shadow = PassAcc::default();
+    if shadows {
+        let across = side / MARK_BLOCK as u32;
+        for &b in &listed {
+            let (bx, by) = (b % across, b / across);
+            for j in 0..MARK_BLOCK as u32 {
+                for i in 0..MARK_BLOCK as u32 {
+                    shadow.add(&replay.shadow_texel(g, bx * 8 + i, by * 8 + j));
+                }
+            }
+        }
+    }
+    // Each listed block is a workgroup, its texels in rows: two warps.
+    let rays = shadow.iterations.len();
+    let mut shadow = shadow.finish((0..rays / 32).map(|k| (k * 32..k * 32 + 32).collect()));
+    shadow.bytes_read += listed.len() as u64 * 4;
+    shadow.bytes_written = listed.len() as u64 * SHADOW_BLOCK_TEXELS * TEXEL_BYTES;
+    let shadow_most_iterations = shadow.iterations.max;
+
+    // Shading: the column, its four neighbours, the taps.
+    let mut shade_terrain = Vec::with_capacity(hits.len());
+    let mut taps = 0;
+    for &(p, d, column) in &hits {
+        let c = replay.column(column.x, column.y);
+        for (dx, dy) in [(1, 0), (-1, 0), (0, 1), (0, -1)] {
+            replay.column(column.x + dx, column.y + dy);
+        }
+        shade_terrain.push(5);
+        taps += shadow_taps(g, p, &c, d);
+    }
+    let terrain = Spread::of(shade_terrain);
+    let shade = PassCount {
+        rays: hits.len() as u64,
+        terrain_reads: terrain,
+        shadow_reads: taps,
+        // hits for every pixel, depth_io and the taps for the hits.
+        bytes_read: pixels * TEXEL_BYTES
+            + hits.len() as u64 * TEXEL_BYTES
+            + terrain.total * TERRAIN_TEXEL_BYTES
+            + taps * TEXEL_BYTES,
+        // colour and depth of every pixel.
+        bytes_written: pixels * 2 * TEXEL_BYTES,
+        ..PassCount::default()
+    };
+    FrameCount {
+        size: [w, h],
+        hits: hits.len() as u64,
+        march,
+        shadow,
+        shade,
+        shadow_blocks: listed.len() as u64,
+        terrain_bytes_touched: replay.terrain_touched.count * TERRAIN_TEXEL_BYTES,
+        pyramid_bytes_touched: replay.pyramid_touched.count * PYRAMID_WORD_BYTES,
+        most_iterations,
+        shadow_most_iterations,
+    }
+}

@@ -1,0 +1,178 @@
+//! `strata exact-counts`: `ray-exact`'s frame on paper (issue 36, item 1).
+//! A CPU replay of the GPU traversal, step for step
+//! (`strata_render::methods::ray_exact::replay`), over every view: per pass
+//! (the camera march, the shadow casts of the blocks the hits sample, the
+//! shading) the traversal iterations, pyramid words and terrain texels read
+//! per ray (mean, 99th percentile, most), and the bytes the frame reads and
+//! writes, all requests and the distinct bytes of terrain and pyramid. Set
+//! against a GPU's texture and memory rates, they bound each pass's time.
+
+use anyhow::{Context, bail};
+use serde::Serialize;
+use std::io::Write;
+use std::path::PathBuf;
+use strata_level::{ViewSpec, views::parse_views};
+use strata_render::frame::{Globals, LevelShape};
+use strata_render::methods::ray_exact::replay::{
+    FrameCount, PassCount, Replay, Traversal, compute_pyramid, replay_frame,
+};
+
+#[derive(clap::Args)]
+pub struct Args {
+    #[command(flatten)]
+    world: crate::world_arg::WorldArgs,
+    /// Every view of a views file (`NAME X,Y:YAW:EYE[:under] PITCH` per
+    /// line); without it the world's own views (the protocol's twelve).
+    #[arg(long, value_name = "FILE")]
+    views: Option<PathBuf>,
+    /// Image size in pixels.
+    #[arg(long, default_value = "1280x800", value_parser = super::reference::parse_image_size)]
+    size: (u32, u32),
+    /// Shadows off: no shadow pass, no shadow taps.
+    #[arg(long)]
+    no_shadows: bool,
+    /// Print one JSON object instead of text.
+    #[arg(long)]
+    json: bool,
+    /// Try another traversal on paper: most levels climbed per step
+    /// (`EXACT_CLIMB`; the GPU's: 1).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=8))]
+    climb: u32,
+    /// Try another traversal on paper: the visited level rays start at (0
+    /// texels, 1 .. 4 tiles of 4, 16, 64, 256 texels; the GPU's: 3).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=4))]
+    start_level: Option<u32>,
+}
+
+#[derive(Serialize)]
+struct ViewCount {
+    view: String,
+    pitch: f32,
+    #[serde(flatten)]
+    frame: FrameCount,
+    bytes: u64,
+}
+
+#[derive(Serialize)]
+struct Report {
+    world: String,
+    size: [u32; 2],
+    shadows: bool,
+    views: Vec<ViewCount>,
+    /// Means over the views.
+    mean_bytes: f64,
+    mean_march_iterations: f64,
+    mean_shadow_rays: f64,
+}
+
+fn pass_line(name: &str, p: &PassCount) -> String {
+    format!(
+        "  {name:7} {:>9} rays  iter {:6.1} (p99 {:4}, max {:4}; warp {:6.1}, SIMD {:3.0} %; down {:5.1}, up {:5.1})  pyramid {:6.1} (p99 {:4})  \
+         terrain {:5.1} (p99 {:3})  shadow taps {:>8}  read {:8.2} MB  written {:6.2} MB",
+        p.rays,
+        p.iterations.mean,
+        p.iterations.p99,
+        p.iterations.max,
+        p.warp_iterations,
+        100.0 * p.simd_efficiency,
+        p.descents,
+        p.climbs,
+        p.pyramid_reads.mean,
+        p.pyramid_reads.p99,
+        p.terrain_reads.mean,
+        p.terrain_reads.p99,
+        p.shadow_reads,
+        p.bytes_read as f64 / 1e6,
+        p.bytes_written as f64 / 1e6,
+    )
+}
+
+pub fn run(args: Args) -> anyhow::Result<()> {
+    let world = args.world.load()?;
+    let views: Vec<ViewSpec> = match &args.views {
+        Some(file) => {
+            let text = std::fs::read_to_string(file)
+                .with_context(|| format!("reading views file {}", file.display()))?;
+            parse_views(&text).with_context(|| format!("views file {}", file.display()))?
+        }
+        None => world.views.clone(),
+    };
+    if views.is_empty() {
+        bail!("no views: give --views FILE (the world has none of its own)");
+    }
+    let (w, h) = args.size;
+    let cameras = views
+        .iter()
+        .map(|v| {
+            strata_camera::Camera::from_view(&world.level, v, w, h)
+                .with_context(|| format!("view {}", v.name))
+        })
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    let pyramid = compute_pyramid(&world.level);
+    let mut replay = Replay::new(&world.level, &pyramid);
+    replay.traversal = Traversal {
+        climb: args.climb,
+        start: args.start_level.or(Traversal::GPU.start),
+    };
+    let shape = LevelShape::of(&world.level);
+    let mut out = std::io::stdout().lock();
+    let mut counts = Vec::new();
+    for (view, camera) in views.iter().zip(&cameras) {
+        let shadow = strata_render::shadow::ShadowFrame::fit(camera, !args.no_shadows);
+        let globals = Globals::new(camera, &shape, &shadow);
+        let frame = replay_frame(&mut replay, &globals);
+        if !args.json {
+            writeln!(
+                out,
+                "{} (pitch {}): {} of {} pixels hit, {} shadow blocks; {:.2} MB a frame \
+                 (distinct: terrain {:.2} MB, pyramid {:.2} MB)",
+                view.name,
+                view.pitch,
+                frame.hits,
+                u64::from(w) * u64::from(h),
+                frame.shadow_blocks,
+                frame.bytes() as f64 / 1e6,
+                frame.terrain_bytes_touched as f64 / 1e6,
+                frame.pyramid_bytes_touched as f64 / 1e6,
+            )?;
+            for (name, pass) in [
+                ("march", &frame.march),
+                ("shadow", &frame.shadow),
+                ("shade", &frame.shade),
+            ] {
+                writeln!(out, "{}", pass_line(name, pass))?;
+            }
+        }
+        counts.push(ViewCount {
+            view: view.name.clone(),
+            pitch: view.pitch,
+            bytes: frame.bytes(),
+            frame,
+        });
+    }
+    let n = counts.len() as f64;
+    let mean = |f: &dyn Fn(&ViewCount) -> f64| counts.iter().map(f).sum::<f64>() / n;
+    let report = Report {
+        world: world.name.clone(),
+        size: [w, h],
+        shadows: !args.no_shadows,
+        mean_bytes: mean(&|c| c.bytes as f64),
+        mean_march_iterations: mean(&|c| c.frame.march.iterations.mean),
+        mean_shadow_rays: mean(&|c| c.frame.shadow.rays as f64),
+        views: counts,
+    };
+    if args.json {
+        serde_json::to_writer_pretty(&mut out, &report)?;
+        writeln!(out)?;
+    } else {
+        writeln!(
+            out,
+            "mean over {} views: {:.2} MB a frame, {:.1} march iterations a pixel, {:.0} shadow rays",
+            report.views.len(),
+            report.mean_bytes / 1e6,
+            report.mean_march_iterations,
+            report.mean_shadow_rays,
+        )?;
+    }
+    Ok(())
+}
