@@ -195,6 +195,7 @@ pub mod error;
 pub mod format;
 #[cfg(feature = "fs")]
 pub mod fs;
+pub mod http;
 pub mod lod;
 pub mod read;
 pub mod store;
