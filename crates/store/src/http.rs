@@ -79,11 +79,13 @@ pub fn world_attrs(what: &str, root_json: &[u8]) -> Result<WorldAttrs, StoreErro
     if json.get("node_type").and_then(|t| t.as_str()) != Some("group") {
         return Err(not_world("its zarr.json is not a Zarr v3 group".into()));
     }
-    let raw = json.pointer(&format!("/attributes/{ATTR}")).ok_or_else(|| {
-        not_world(format!(
-            "a Zarr group without a `{ATTR}` attribute: not a Strata world"
-        ))
-    })?;
+    let raw = json
+        .pointer(&format!("/attributes/{ATTR}"))
+        .ok_or_else(|| {
+            not_world(format!(
+                "a Zarr group without a `{ATTR}` attribute: not a Strata world"
+            ))
+        })?;
     if raw.get("format").and_then(|f| f.as_str()) != Some(FORMAT_NAME) {
         return Err(not_world(format!(
             "its `{ATTR}.format` attribute is not \"{FORMAT_NAME}\": not a Strata world"
@@ -256,6 +258,14 @@ pub fn chunk_tops(gy: u64, gx: u64, objects: &[Vec<u8>]) -> Result<Vec<u8>, Stor
     Ok(tops)
 }
 
+/// The world without its map (a 2x1 stand-in level, as
+/// [`crate::WorldStore::world_shell`]) from its attributes; water levels
+/// from the attributes (the `.vpr` bytes are not fetched).
+pub fn world_shell(what: &str, attrs: &WorldAttrs) -> Result<strata_level::World, StoreError> {
+    let stand_in = strata_level::Level::flat(2, 1, 0, 0).expect("2x1 is a valid map size");
+    crate::store::world_from_attrs(what, attrs, stand_in, None)
+}
+
 /// Complete level-of-detail levels from the `lod` group's `zarr.json` text
 /// (`None`: no such group, which means none).
 pub fn lod_levels(lod_json: Option<&[u8]>) -> u32 {
@@ -289,6 +299,12 @@ mod tests {
         let root = std::fs::read(dir.join("zarr.json")).unwrap();
         let attrs = world_attrs("test", &root).unwrap();
         assert_eq!((attrs.width, attrs.height), (512, 1024));
+        let shell = world_shell("test", &attrs).unwrap();
+        let native = s.world_shell().unwrap();
+        assert_eq!(shell.views, native.views);
+        assert_eq!(shell.edit, native.edit);
+        assert_eq!(shell.water, native.water);
+        assert_eq!(shell.palette.colors, native.palette.colors);
         for name in [HEIGHTS, METAS] {
             let json = std::fs::read(dir.join(name).join("zarr.json")).unwrap();
             check_array(name, &json, "uint8", &[1024, 512], &[256, 256]).unwrap();
@@ -306,7 +322,10 @@ mod tests {
                 let mut bad = bytes.clone();
                 bad[bytes.len() / 3] ^= 0x10;
                 let e = decode_chunk(name, &[cy, cx], &bad, 65536).unwrap_err();
-                assert!(e.to_string().contains(&format!("chunk [{cy}, {cx}]")), "{e}");
+                assert!(
+                    e.to_string().contains(&format!("chunk [{cy}, {cx}]")),
+                    "{e}"
+                );
                 assert!(decode_chunk(name, &[cy, cx], &bytes[..3], 65536).is_err());
             }
         }

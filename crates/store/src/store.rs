@@ -634,46 +634,57 @@ impl WorldStore {
     /// (this store's map, or a stand-in where the map is read through a
     /// [`crate::ChunkCache`] instead).
     pub fn world_with_level(&self, level: Level) -> Result<World, StoreError> {
-        let a = &self.attrs;
-        let what = Path::new(&self.what);
-        let config = strata_level::WorldConfig::parse_store_bytes(
-            a.world_ini.as_bytes(),
-            &what.join("zarr.json#strata.world_ini"),
-        )?;
-        if (config.width(), config.height()) != (a.width, a.height) {
-            return Err(StoreError::NotAWorld {
-                what: self.what.clone(),
-                msg: format!(
-                    "its world.ini says {}x{}, its arrays {}x{}",
-                    config.width(),
-                    config.height(),
-                    a.width,
-                    a.height
-                ),
-            });
-        }
         let vpr = match Array::open(self.storage.clone(), &format!("/{VPR}")) {
             Ok(array) => Some(read_cell(&array, VPR, &[0])?),
             Err(_) => None,
         };
-        let views = (!a.views.is_empty()).then_some(a.views.as_bytes());
-        let mut world = world_from_parts(
-            a.name.clone(),
-            what,
-            config,
-            level,
-            WorldFiles {
-                palette: &a.palette,
-                vpr: vpr.as_deref(),
-                views,
-                edit: a.edit.as_ref().map(|e| e.as_bytes()),
-            },
-        )?;
-        if world.water.is_none() {
-            world.water = a.water.clone();
-        }
-        Ok(world)
+        world_from_attrs(&self.what, &self.attrs, level, vpr.as_deref())
     }
+}
+
+/// The world of a store's attributes with `level` as its map and `vpr`
+/// (the `vangers_vpr` array's bytes, when read) as its `.vpr`; `what` names
+/// the store in errors.
+pub fn world_from_attrs(
+    what: &str,
+    a: &WorldAttrs,
+    level: Level,
+    vpr: Option<&[u8]>,
+) -> Result<World, StoreError> {
+    let path = Path::new(what);
+    let config = strata_level::WorldConfig::parse_store_bytes(
+        a.world_ini.as_bytes(),
+        &path.join("zarr.json#strata.world_ini"),
+    )?;
+    if (config.width(), config.height()) != (a.width, a.height) {
+        return Err(StoreError::NotAWorld {
+            what: what.into(),
+            msg: format!(
+                "its world.ini says {}x{}, its arrays {}x{}",
+                config.width(),
+                config.height(),
+                a.width,
+                a.height
+            ),
+        });
+    }
+    let views = (!a.views.is_empty()).then_some(a.views.as_bytes());
+    let mut world = world_from_parts(
+        a.name.clone(),
+        path,
+        config,
+        level,
+        WorldFiles {
+            palette: &a.palette,
+            vpr,
+            views,
+            edit: a.edit.as_ref().map(|e| e.as_bytes()),
+        },
+    )?;
+    if world.water.is_none() {
+        world.water = a.water.clone();
+    }
+    Ok(world)
 }
 
 /// The chunk grid (rows, columns) of a world's attributes.
