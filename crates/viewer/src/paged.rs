@@ -21,6 +21,12 @@ use strata_render::paged::{
 
 /// Why `method` cannot draw a paged world (`None`: it can).
 pub fn refusal(method: &str) -> Option<String> {
+    // A browser page has no threads to fit the paged mesh's chunks on.
+    if cfg!(target_arch = "wasm32") && method == "mesh" {
+        return Some(
+            "`mesh` over paged terrain fits its chunks on worker threads, which the page does not have; in the page paged worlds are drawn by ray-exact, ray-exact-fragment".into(),
+        );
+    }
     (!strata_render::paged::PAGED_METHODS.contains(&method)).then(|| {
         format!(
             "`{method}` draws whole worlds only; paged worlds are drawn by {}",
@@ -145,6 +151,11 @@ impl EditedPages {
     /// Chunks edited since the world was opened or last saved.
     pub fn edited_chunks(&self) -> usize {
         self.edited.lock().expect("edit lock").len()
+    }
+
+    /// The streamed store's reads, when the world is one.
+    pub fn remote(&self) -> Option<&Arc<RemoteChunks>> {
+        self.remote.as_ref()
     }
 
     /// Whether the world is a store (saved in place, chunk by chunk).

@@ -29,7 +29,14 @@ pub struct Params {
     pub views: Option<Vec<String>>,
     /// `&methods=A,B:setting`: the protocol's methods (default: every one).
     pub methods: Option<String>,
+    /// `?gpu-budget=MIB`: the paged terrain's GPU budget for a streamed store.
+    pub gpu_budget: u64,
 }
+
+/// The paged terrain's GPU budget in the page by default: well inside
+/// WebGPU's default limits (an atlas of 2048x2048-texel layers, 128 MiB per
+/// storage binding), and what a CPU adapter (SwiftShader) holds easily.
+pub const DEFAULT_GPU_BUDGET_MIB: u64 = 64;
 
 impl Params {
     pub fn from_url() -> anyhow::Result<Params> {
@@ -82,7 +89,16 @@ impl Params {
                     .with_context(|| format!("?{}={text}: {}", m.name, m.knobs.grammar))?;
             }
         }
+        let gpu_budget = match get("gpu-budget") {
+            Some(text) => text
+                .parse::<u64>()
+                .ok()
+                .filter(|m| (1..=4096).contains(m))
+                .with_context(|| format!("?gpu-budget={text}: MiB, 1..=4096"))?,
+            None => DEFAULT_GPU_BUDGET_MIB,
+        } << 20;
         Ok(Params {
+            gpu_budget,
             backend,
             settings,
             method: get("method").unwrap_or_else(|| "ray".into()),
@@ -101,6 +117,16 @@ impl Params {
 /// Read the URL, get the world, start the viewer.
 pub async fn run() -> anyhow::Result<()> {
     let params = Params::from_url()?;
+    if let Some(url) = &params.level
+        && !params.compare
+    {
+        let base = with_slash(url);
+        progress(Some(0.0), &format!("opening {base}"));
+        let start = now_ms();
+        if let Some(streamed) = crate::stream::open(&base).await? {
+            return start_streamed(params, streamed, start).await;
+        }
+    }
     let world = match &params.level {
         Some(url) => fetch_world(url).await?,
         None => generate(&params.world).await?,
@@ -135,6 +161,101 @@ pub async fn run() -> anyhow::Result<()> {
         },
         params.backend,
     )
+}
+
+/// The viewer over a streamed store: paged terrain whose pages the pump
+/// fetches as the view asks for them.
+async fn start_streamed(
+    params: Params,
+    streamed: crate::stream::Streamed,
+    start: f64,
+) -> anyhow::Result<()> {
+    use strata_render::paged::PageSource;
+    use strata_viewer::paged::{Base, EditedPages, PagedWorld};
+    if params.backend == Backend::WebGl2 {
+        bail!(
+            "{}: a streamed store is drawn through paged terrain, which needs WebGPU \
+             (its page table, atlas pyramids and feedback are storage buffers, which WebGL2 \
+             does not have); open it without ?backend=webgl2",
+            streamed.base
+        );
+    }
+    let world = streamed.world;
+    // The camera is placed on the column under the view: that chunk first.
+    let view = match &params.view {
+        Some(name) => world.views.iter().find(|v| &v.name == name),
+        None => world.views.first(),
+    };
+    let (w, h) = streamed.remote.size();
+    let (x, y) = view.map_or((w as f32 / 2.0, h as f32 / 2.0), |v| (v.x, v.y));
+    let opened = crate::stream::Streamed {
+        world: world.clone(),
+        remote: streamed.remote.clone(),
+        base: streamed.base.clone(),
+    };
+    crate::stream::prefetch_at(&opened, x, y).await?;
+    let metadata_ms = now_ms() - start;
+    strata_viewer::web::set_page_info("stream_open_ms", metadata_ms.into());
+    strata_viewer::web::set_page_info("world_size", serde_json::json!([w, h]));
+    web_sys::console::log_1(
+        &format!(
+            "strata: streaming {} ({w}x{h}): metadata and the first view's chunk in {metadata_ms:.0} ms",
+            opened.base
+        )
+        .into(),
+    );
+    crate::stream::start_pump(opened.remote.clone(), opened.base.clone());
+    // The other views' chunks (a view switch places its camera there).
+    let mut spots: Vec<(f32, f32)> = world.views.iter().map(|v| (v.x, v.y)).collect();
+    if let Some(edit) = &world.edit {
+        spots.push((edit.camera.x, edit.camera.y));
+    }
+    wasm_bindgen_futures::spawn_local(async move {
+        for (x, y) in spots {
+            if let Err(e) = crate::stream::prefetch_at(&opened, x, y).await {
+                web_sys::console::warn_1(&format!("strata: {e:#}").into());
+            }
+        }
+    });
+    let pages = EditedPages::new(Base::Remote(streamed.remote), world.level.mid_rule)?;
+    let options = strata_render::paged::PagedOptions {
+        gpu_budget: params.gpu_budget,
+        // No threads in the page: the pump's fetches are the reads.
+        threads: 0,
+        ..Default::default()
+    };
+    progress(None, "");
+    strata_viewer::web::start(
+        strata_viewer::Options {
+            world,
+            method: params.method,
+            settings: params.settings,
+            size: params.size,
+            render_scale: params.scale,
+            view: params.view,
+            script: None,
+            vsync: true,
+            adapter: Default::default(),
+            render: Default::default(),
+            out: "screenshots".into(),
+            save: Default::default(),
+            physics: false,
+            paged: Some(PagedWorld {
+                pages: std::sync::Arc::new(pages),
+                options,
+            }),
+        },
+        params.backend,
+    )
+}
+
+/// `url` ending in `/`.
+fn with_slash(url: &str) -> String {
+    if url.ends_with('/') {
+        url.to_string()
+    } else {
+        format!("{url}/")
+    }
 }
 
 /// The built-in world, generated here a band of rows per turn of the
@@ -180,7 +301,7 @@ async fn generate(params: &GenerateParams) -> anyhow::Result<World> {
 }
 
 /// GET `url`: its bytes, `None` on 404, an error on anything else.
-async fn fetch(url: &str) -> anyhow::Result<Option<Vec<u8>>> {
+pub(crate) async fn fetch(url: &str) -> anyhow::Result<Option<Vec<u8>>> {
     let window = web_sys::window().context("no window")?;
     let response = JsFuture::from(window.fetch_with_str(url))
         .await
@@ -272,12 +393,7 @@ fn relative_path(file: &web_sys::File) -> String {
 /// A world directory served over HTTP (`world.ini`, the map, the palette,
 /// optionally `.vpr`, `views.txt`, `edit.txt`), through the native readers.
 async fn fetch_world(url: &str) -> anyhow::Result<World> {
-    let base = if url.ends_with('/') {
-        url.to_string()
-    } else {
-        format!("{url}/")
-    };
-    load_world(&Folder::Http(base)).await
+    load_world(&Folder::Http(with_slash(url))).await
 }
 
 /// A world folder from the page's file picker.

@@ -50,6 +50,8 @@ struct State {
     finished: VecDeque<(u32, Result<Planes, String>)>,
     /// The last pages read, by (level, cx, cy), with the tick of their use.
     cache: HashMap<(u32, u32, u32), (Arc<Planes>, u64)>,
+    /// Pages the caller read itself ([`RemoteChunks::pin`]), never evicted.
+    pinned: HashMap<(u32, u32, u32), Arc<Planes>>,
     tick: u64,
     stats: RemoteStats,
 }
@@ -158,6 +160,9 @@ impl RemoteChunks {
     /// The planes of page (`cx`, `cy`) of `level` if read lately.
     pub fn cached(&self, level: u32, cx: u32, cy: u32) -> Option<Arc<Planes>> {
         let mut s = self.state();
+        if let Some(p) = s.pinned.get(&(level, cx, cy)) {
+            return Some(p.clone());
+        }
         s.tick += 1;
         let tick = s.tick;
         let entry = s.cache.get_mut(&(level, cx, cy))?;
@@ -165,13 +170,13 @@ impl RemoteChunks {
         Some(entry.0.clone())
     }
 
-    /// Keep `planes` as page (`cx`, `cy`) of `level` (read by the caller
-    /// itself, e.g. the chunk under the first view before the viewer starts).
-    pub fn insert(&self, level: u32, cx: u32, cy: u32, planes: Planes) {
-        let mut s = self.state();
-        s.tick += 1;
-        let tick = s.tick;
-        s.cache.insert((level, cx, cy), (Arc::new(planes), tick));
+    /// Keep `planes` as page (`cx`, `cy`) of `level` for good (read by the
+    /// caller itself: the chunks under the world's views, where the viewer
+    /// places its camera).
+    pub fn pin(&self, level: u32, cx: u32, cy: u32, planes: Planes) {
+        self.state()
+            .pinned
+            .insert((level, cx, cy), Arc::new(planes));
     }
 
     /// What the reads did so far.

@@ -106,6 +106,17 @@ impl PagedState {
                 s.in_flight
             ),
         ];
+        if let Some(remote) = self.world.pages.remote() {
+            let r = remote.stats();
+            lines.push(format!(
+                "streamed: {} pages fetched ({:.2} MiB), {} in flight, {} failed, {} cancelled",
+                r.done,
+                mib(r.bytes),
+                r.in_flight,
+                r.failed,
+                r.cancelled
+            ));
+        }
         if s.read_errors > 0 {
             lines.push(format!(
                 "read errors: {} ({})",
@@ -158,7 +169,7 @@ pub(super) fn camera_over(
 /// The paged method to open with: `method` when it draws paged terrain,
 /// else the first that does.
 pub(super) fn first_method(method: &str) -> &str {
-    if PAGED_METHODS.contains(&method) {
+    if refusal(method).is_none() {
         method
     } else {
         PAGED_METHODS[0]
