@@ -371,6 +371,10 @@ impl Folder {
 
     async fn required(&self, name: &str) -> anyhow::Result<Vec<u8>> {
         self.get(name).await?.with_context(|| match self {
+            Folder::Http(base) if name == strata_level::io::WORLD_INI => format!(
+                "GET {base}{name}: 404 Not Found: no Strata store (zarr.json) and no world \
+                 directory (world.ini) at {base}"
+            ),
             Folder::Http(base) => {
                 format!("GET {base}{name}: 404 Not Found (a world directory needs this file)")
             }

@@ -237,14 +237,16 @@ impl Viewer {
         }
         let stats = self.renderer.paged_terrain().map(|t| t.stats());
         let render_size = self.render_size();
+        let mut report = None;
         if let Some(p) = &mut self.paged {
             if let Some(s) = &stats {
                 p.uploaded_total += s.uploaded_bytes;
                 if s.read_errors > 0 && p.stats.as_ref().is_none_or(|o| o.read_errors == 0) {
-                    eprintln!(
-                        "strata view: paged read error: {}",
+                    report = Some(format!(
+                        "paged read error (after {} tries; resident pages keep drawing): {}",
+                        p.world.options.read_tries,
                         s.first_error.as_deref().unwrap_or("")
-                    );
+                    ));
                 }
             }
             p.frames += 1;
@@ -258,6 +260,12 @@ impl Viewer {
             p.resident_max = p
                 .resident_max
                 .max(p.stats.as_ref().map_or(0, |s| s.resident_bytes));
+        }
+        if let Some(line) = report {
+            // In a page also above the canvas (the overlay may be off).
+            #[cfg(target_arch = "wasm32")]
+            crate::page::show_notice(&line);
+            self.say(line);
         }
     }
 
