@@ -56,11 +56,20 @@ pub fn free_port() -> u16 {
 
 /// `strata serve` on a free port (with `level` at `/level/`); its URL.
 pub fn serve(bundle: &Path, level: &Path) -> (Killed, String) {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_strata"))
+    serve_with(bundle, Some(level))
+}
+
+/// `strata serve` on a free port with `level` at `/level/`, or without
+/// `--level` (the built-in world as a store, made once and cached); its URL.
+pub fn serve_with(bundle: &Path, level: Option<&Path>) -> (Killed, String) {
+    let mut command = Command::new(env!("CARGO_BIN_EXE_strata"));
+    command
         .args(["serve", "--port", "0", "--bundle"])
-        .arg(bundle)
-        .arg("--level")
-        .arg(level)
+        .arg(bundle);
+    if let Some(level) = level {
+        command.arg("--level").arg(level);
+    }
+    let mut child = command
         .stdout(Stdio::piped())
         .spawn()
         .expect("starting strata serve");
