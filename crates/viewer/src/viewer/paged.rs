@@ -322,6 +322,11 @@ impl Viewer {
     /// frame's depth (what is on screen), the crater cut into the edit layer,
     /// the touched pages refreshed.
     pub(super) fn dig_paged(&mut self, at: (f32, f32)) -> anyhow::Result<()> {
+        if cfg!(target_arch = "wasm32") {
+            return self.refuse(
+                "digging paged terrain picks the point from the frame's depth read back at once, which a page cannot wait for; not in the browser yet".into(),
+            );
+        }
         let camera = self.camera()?;
         let start = Instant::now();
         let depth = self.renderer.read_depth()?;
