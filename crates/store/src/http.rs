@@ -86,6 +86,17 @@ pub fn world_attrs(what: &str, root_json: &[u8]) -> Result<WorldAttrs, StoreErro
                 "a Zarr group without a `{ATTR}` attribute: not a Strata world"
             ))
         })?;
+    check_attrs(what, raw)
+}
+
+/// The world's attributes from the root group's `strata` attribute: a
+/// Strata world of a version this build reads, whose map and chunk sides
+/// are powers of two, chunks even and inside the map.
+pub(crate) fn check_attrs(what: &str, raw: &serde_json::Value) -> Result<WorldAttrs, StoreError> {
+    let not_world = |msg: String| StoreError::NotAWorld {
+        what: what.into(),
+        msg,
+    };
     if raw.get("format").and_then(|f| f.as_str()) != Some(FORMAT_NAME) {
         return Err(not_world(format!(
             "its `{ATTR}.format` attribute is not \"{FORMAT_NAME}\": not a Strata world"
@@ -108,6 +119,7 @@ pub fn world_attrs(what: &str, root_json: &[u8]) -> Result<WorldAttrs, StoreErro
     let [ch, cw] = attrs.chunk;
     let ok = w.is_power_of_two()
         && h.is_power_of_two()
+        && w >= 2
         && ch.is_power_of_two()
         && cw.is_power_of_two()
         && cw >= 2

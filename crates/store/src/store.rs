@@ -174,34 +174,9 @@ impl WorldStore {
                 "a Zarr group without a `{ATTR}` attribute: not a Strata world"
             ))
         })?;
-        if raw.get("format").and_then(|f| f.as_str()) != Some(FORMAT_NAME) {
-            return Err(not_world(format!(
-                "its `{ATTR}.format` attribute is not \"{FORMAT_NAME}\": not a Strata world"
-            )));
-        }
-        let version = raw
-            .get("format_version")
-            .and_then(|v| v.as_u64())
-            .ok_or_else(|| not_world(format!("no `{ATTR}.format_version` attribute")))?;
-        if version > u64::from(FORMAT_VERSION) {
-            return Err(StoreError::NewerVersion {
-                what: what.into(),
-                found: u32::try_from(version).unwrap_or(u32::MAX),
-                supported: FORMAT_VERSION,
-            });
-        }
-        let attrs: WorldAttrs = serde_json::from_value(raw.clone())
-            .map_err(|e| not_world(format!("its `{ATTR}` attribute is malformed: {e}")))?;
+        let attrs = crate::http::check_attrs(what, raw)?;
         let (w, h) = (attrs.width, attrs.height);
         let [ch, cw] = attrs.chunk;
-        let ok_size = w.is_power_of_two() && h.is_power_of_two() && w >= 2;
-        let ok_chunk =
-            ch.is_power_of_two() && cw.is_power_of_two() && cw >= 2 && ch <= h && cw <= w;
-        if !ok_size || !ok_chunk {
-            return Err(not_world(format!(
-                "map {w}x{h} with chunks {cw}x{ch}: sizes must be powers of two, chunks even and inside the map"
-            )));
-        }
         let heights = open_array(&storage, HEIGHTS)?;
         let metas = open_array(&storage, METAS)?;
         let summary = open_array(&storage, SUMMARY)?;

@@ -142,25 +142,32 @@ pub async fn run() -> anyhow::Result<()> {
     }
     watch_folder_picker();
     progress(None, "");
-    strata_viewer::web::start(
-        strata_viewer::Options {
-            world,
-            method: params.method,
-            settings: params.settings,
-            size: params.size,
-            render_scale: params.scale,
-            view: params.view,
-            script: None,
-            vsync: true,
-            adapter: Default::default(),
-            render: Default::default(),
-            out: "screenshots".into(),
-            save: Default::default(),
-            physics: false,
-            paged: None,
-        },
-        params.backend,
-    )
+    let backend = params.backend;
+    strata_viewer::web::start(viewer_options(params, world, None), backend)
+}
+
+/// The viewer's options from the URL's, over `world` (paged or not).
+fn viewer_options(
+    params: Params,
+    world: World,
+    paged: Option<strata_viewer::paged::PagedWorld>,
+) -> strata_viewer::Options {
+    strata_viewer::Options {
+        world,
+        method: params.method,
+        settings: params.settings,
+        size: params.size,
+        render_scale: params.scale,
+        view: params.view,
+        script: None,
+        vsync: true,
+        adapter: Default::default(),
+        render: Default::default(),
+        out: "screenshots".into(),
+        save: Default::default(),
+        physics: false,
+        paged,
+    }
 }
 
 /// The viewer over a streamed store: paged terrain whose pages the pump
@@ -225,28 +232,12 @@ async fn start_streamed(
         ..Default::default()
     };
     progress(None, "");
-    strata_viewer::web::start(
-        strata_viewer::Options {
-            world,
-            method: params.method,
-            settings: params.settings,
-            size: params.size,
-            render_scale: params.scale,
-            view: params.view,
-            script: None,
-            vsync: true,
-            adapter: Default::default(),
-            render: Default::default(),
-            out: "screenshots".into(),
-            save: Default::default(),
-            physics: false,
-            paged: Some(PagedWorld {
-                pages: std::sync::Arc::new(pages),
-                options,
-            }),
-        },
-        params.backend,
-    )
+    let backend = params.backend;
+    let paged = PagedWorld {
+        pages: std::sync::Arc::new(pages),
+        options,
+    };
+    strata_viewer::web::start(viewer_options(params, world, Some(paged)), backend)
 }
 
 /// `url` ending in `/`.
