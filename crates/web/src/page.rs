@@ -123,7 +123,8 @@ pub async fn run() -> anyhow::Result<()> {
         let base = with_slash(url);
         progress(Some(0.0), &format!("opening {base}"));
         let start = now_ms();
-        if let Some(streamed) = crate::stream::open(&base).await? {
+        let origin = crate::stream::Origin::Http(base);
+        if let Some(streamed) = crate::stream::open(origin).await? {
             return start_streamed(params, streamed, start).await;
         }
     }
@@ -177,67 +178,81 @@ async fn start_streamed(
     streamed: crate::stream::Streamed,
     start: f64,
 ) -> anyhow::Result<()> {
-    use strata_render::paged::PageSource;
-    use strata_viewer::paged::{Base, EditedPages, PagedWorld};
     if params.backend == Backend::WebGl2 {
         bail!(
             "{}: a streamed store is drawn through paged terrain, which needs WebGPU \
              (its page table, atlas pyramids and feedback are storage buffers, which WebGL2 \
              does not have); open it without ?backend=webgl2",
-            streamed.base
+            streamed.origin.label()
         );
     }
-    let world = streamed.world;
-    // The camera is placed on the column under the view: that chunk first.
-    let view = match &params.view {
-        Some(name) => world.views.iter().find(|v| &v.name == name),
+    let (world, paged) =
+        streamed_world(streamed, params.view.as_deref(), params.gpu_budget).await?;
+    strata_viewer::web::set_page_info("stream_open_ms", (now_ms() - start).into());
+    progress(None, "");
+    let backend = params.backend;
+    strata_viewer::web::start(viewer_options(params, world, Some(paged)), backend)
+}
+
+/// A streamed store ready for the viewer: the chunk under `view` (default
+/// the first) fetched (the camera stands on it), the pump started, the
+/// other views' chunks fetched behind it; paged terrain of `gpu_budget`
+/// bytes without reader threads.
+pub async fn streamed_world(
+    streamed: crate::stream::Streamed,
+    view: Option<&str>,
+    gpu_budget: u64,
+) -> anyhow::Result<(World, strata_viewer::paged::PagedWorld)> {
+    use strata_render::paged::PageSource;
+    use strata_viewer::paged::{Base, EditedPages, PagedWorld};
+    let start = now_ms();
+    let crate::stream::Streamed {
+        world,
+        remote,
+        origin,
+    } = streamed;
+    let chosen = match view {
+        Some(name) => world.views.iter().find(|v| v.name == name),
         None => world.views.first(),
     };
-    let (w, h) = streamed.remote.size();
-    let (x, y) = view.map_or((w as f32 / 2.0, h as f32 / 2.0), |v| (v.x, v.y));
-    let opened = crate::stream::Streamed {
-        world: world.clone(),
-        remote: streamed.remote.clone(),
-        base: streamed.base.clone(),
-    };
-    crate::stream::prefetch_at(&opened, x, y).await?;
-    let metadata_ms = now_ms() - start;
-    strata_viewer::web::set_page_info("stream_open_ms", metadata_ms.into());
-    strata_viewer::web::set_page_info("world_size", serde_json::json!([w, h]));
+    let (w, h) = remote.size();
+    let (x, y) = chosen.map_or((w as f32 / 2.0, h as f32 / 2.0), |v| (v.x, v.y));
+    crate::stream::prefetch_at(&origin, &remote, x, y).await?;
     web_sys::console::log_1(
         &format!(
-            "strata: streaming {} ({w}x{h}): metadata and the first view's chunk in {metadata_ms:.0} ms",
-            opened.base
+            "strata: streaming {} ({w}x{h}): the first view's chunk in {:.0} ms",
+            origin.label(),
+            now_ms() - start
         )
         .into(),
     );
-    crate::stream::start_pump(opened.remote.clone(), opened.base.clone());
+    strata_viewer::web::set_page_info("world_size", serde_json::json!([w, h]));
+    crate::stream::start_pump(remote.clone(), origin.clone());
     // The other views' chunks (a view switch places its camera there).
     let mut spots: Vec<(f32, f32)> = world.views.iter().map(|v| (v.x, v.y)).collect();
     if let Some(edit) = &world.edit {
         spots.push((edit.camera.x, edit.camera.y));
     }
+    let behind = remote.clone();
     wasm_bindgen_futures::spawn_local(async move {
         for (x, y) in spots {
-            if let Err(e) = crate::stream::prefetch_at(&opened, x, y).await {
+            if let Err(e) = crate::stream::prefetch_at(&origin, &behind, x, y).await {
                 web_sys::console::warn_1(&format!("strata: {e:#}").into());
             }
         }
     });
-    let pages = EditedPages::new(Base::Remote(streamed.remote), world.level.mid_rule)?;
+    let pages = EditedPages::new(Base::Remote(remote), world.level.mid_rule)?;
     let options = strata_render::paged::PagedOptions {
-        gpu_budget: params.gpu_budget,
+        gpu_budget,
         // No threads in the page: the pump's fetches are the reads.
         threads: 0,
         ..Default::default()
     };
-    progress(None, "");
-    let backend = params.backend;
     let paged = PagedWorld {
         pages: std::sync::Arc::new(pages),
         options,
     };
-    strata_viewer::web::start(viewer_options(params, world, Some(paged)), backend)
+    Ok((world, paged))
 }
 
 /// `url` ending in `/`.
@@ -393,15 +408,51 @@ async fn fetch_world(url: &str) -> anyhow::Result<World> {
 
 /// A world folder from the page's file picker.
 pub async fn picked_world(files: Vec<web_sys::File>) -> anyhow::Result<World> {
-    let name = files
+    let name = picked_name(&files);
+    let world = load_world(&Folder::Picked { name, files }).await?;
+    progress(None, "");
+    Ok(world)
+}
+
+/// The picked folder's name (its files' first path component).
+fn picked_name(files: &[web_sys::File]) -> String {
+    files
         .first()
         .map(relative_path)
         .and_then(|p| p.split('/').next().map(str::to_string))
         .filter(|n| !n.is_empty())
-        .unwrap_or_else(|| "world".into());
-    let world = load_world(&Folder::Picked { name, files }).await?;
-    progress(None, "");
-    Ok(world)
+        .unwrap_or_else(|| "world".into())
+}
+
+/// A picked folder that is a Strata store, ready to stream from its files
+/// (`None`: no zarr.json at its top; maybe a world directory).
+async fn picked_store(
+    files: &[web_sys::File],
+) -> anyhow::Result<Option<(World, strata_viewer::paged::PagedWorld)>> {
+    let name = picked_name(files);
+    // Paths under the picked folder (`heights/c/3/1`).
+    let by_path: std::collections::HashMap<String, web_sys::File> = files
+        .iter()
+        .filter_map(|f| {
+            let path = relative_path(f);
+            let (_, under) = path.split_once('/')?;
+            Some((under.to_string(), f.clone()))
+        })
+        .collect();
+    if !by_path.contains_key("zarr.json") {
+        return Ok(None);
+    }
+    let origin = crate::stream::Origin::Picked {
+        name,
+        files: std::rc::Rc::new(by_path),
+    };
+    progress(Some(0.0), &format!("opening {}", origin.label()));
+    let Some(streamed) = crate::stream::open(origin).await? else {
+        return Ok(None);
+    };
+    streamed_world(streamed, None, DEFAULT_GPU_BUDGET_MIB << 20)
+        .await
+        .map(Some)
 }
 
 async fn load_world(folder: &Folder) -> anyhow::Result<World> {
@@ -467,6 +518,21 @@ pub fn watch_folder_picker() {
         }
         strata_viewer::web::clear_error();
         wasm_bindgen_futures::spawn_local(async move {
+            // A store (a zarr.json at its top) is streamed from the files.
+            match picked_store(&files).await {
+                Ok(Some((world, paged))) => {
+                    progress(None, "");
+                    web_sys::console::log_1(&format!("strata: streaming {}", world.name).into());
+                    strata_viewer::web::open_paged_world(world, paged);
+                    return;
+                }
+                Ok(None) => {}
+                Err(error) => {
+                    progress(None, "");
+                    strata_viewer::web::show_error(&format!("{error:#}"));
+                    return;
+                }
+            }
             match picked_world(files).await {
                 Ok(world) => {
                     web_sys::console::log_1(&format!("strata: opened {}", world.name).into());

@@ -17,6 +17,7 @@ use crate::page::fetch;
 use anyhow::Context;
 use std::cell::RefCell;
 use std::collections::HashMap;
+use std::rc::Rc;
 use std::sync::Arc;
 use strata_level::{MidRule, World};
 use strata_render::paged::{PAGE, PageRef, PageSource, RemoteChunks};
@@ -35,20 +36,88 @@ pub const TIMEOUT_MS: i32 = 10_000;
 /// a dig's chunks.
 const CACHE_PAGES: usize = 64;
 
+/// Where a store's objects come from: a URL (fetched, cancellable), or a
+/// folder the person picked (its files by path under the folder).
+#[derive(Clone)]
+pub enum Origin {
+    /// The store's URL, ending in `/`.
+    Http(String),
+    /// A picked folder: its name and its files by path under it.
+    Picked {
+        name: String,
+        files: Rc<HashMap<String, web_sys::File>>,
+    },
+}
+
+impl Origin {
+    /// How messages name the store.
+    pub fn label(&self) -> String {
+        match self {
+            Origin::Http(base) => base.clone(),
+            Origin::Picked { name, .. } => format!("the picked folder `{name}`"),
+        }
+    }
+
+    /// Object `key` (`heights/c/3/1`), `None` when there is none.
+    async fn get(
+        &self,
+        key: &str,
+        signal: Option<&web_sys::AbortSignal>,
+    ) -> Result<Option<Vec<u8>>, String> {
+        match self {
+            Origin::Http(base) => {
+                let url = format!("{base}{key}");
+                match signal {
+                    Some(signal) => fetch_with(&url, signal).await,
+                    None => fetch(&url).await.map_err(|e| format!("{e:#}")),
+                }
+            }
+            Origin::Picked { files, .. } => {
+                let Some(file) = files.get(key) else {
+                    return Ok(None);
+                };
+                let buffer = JsFuture::from(file.array_buffer())
+                    .await
+                    .map_err(|e| format!("reading {key}: {}", describe(&e)))?;
+                Ok(Some(js_sys::Uint8Array::new(&buffer).to_vec()))
+            }
+        }
+    }
+
+    /// Object `key`, which the store must have.
+    async fn required(
+        &self,
+        key: &str,
+        signal: Option<&web_sys::AbortSignal>,
+    ) -> Result<Vec<u8>, String> {
+        self.get(key, signal).await?.ok_or_else(|| match self {
+            Origin::Http(base) => format!("GET {base}{key}: 404 Not Found (a store needs it)"),
+            Origin::Picked { name, .. } => {
+                format!("the picked folder `{name}` has no {key} (a store needs it)")
+            }
+        })
+    }
+}
+
 /// A streamed store, opened: the world without its map, its pages.
 pub struct Streamed {
     pub world: World,
     pub remote: Arc<RemoteChunks>,
-    pub base: String,
+    pub origin: Origin,
 }
 
-/// Open the store at `base` (ending in `/`): `None` when it has no
-/// `zarr.json` (not a store: maybe a Vangers world directory).
-pub async fn open(base: &str) -> anyhow::Result<Option<Streamed>> {
-    let Some(root) = fetch(&format!("{base}zarr.json")).await? else {
+/// Open the store at `origin`: `None` when it has no `zarr.json` (not a
+/// store: maybe a Vangers world directory).
+pub async fn open(origin: Origin) -> anyhow::Result<Option<Streamed>> {
+    let Some(root) = origin
+        .get("zarr.json", None)
+        .await
+        .map_err(anyhow::Error::msg)?
+    else {
         return Ok(None);
     };
-    let what = base.trim_end_matches('/');
+    let label = origin.label();
+    let what = label.trim_end_matches('/');
     let attrs = http::world_attrs(what, &root)?;
     let (w, h) = (attrs.width, attrs.height);
     if attrs.chunk != [PAGE, PAGE] {
@@ -59,10 +128,14 @@ pub async fn open(base: &str) -> anyhow::Result<Option<Streamed>> {
         );
     }
     let (gy, gx) = (u64::from(h / PAGE), u64::from(w / PAGE));
-    let required = |name: String| async move {
-        fetch(&format!("{base}{name}"))
-            .await?
-            .with_context(|| format!("GET {base}{name}: 404 Not Found (a store needs it)"))
+    let required = |name: String| {
+        let origin = origin.clone();
+        async move {
+            origin
+                .required(&name, None)
+                .await
+                .map_err(anyhow::Error::msg)
+        }
     };
     // Started together, awaited in turn.
     let plane_meta = [HEIGHTS, METAS].map(|a| required(format!("{a}/zarr.json")));
@@ -94,13 +167,13 @@ pub async fn open(base: &str) -> anyhow::Result<Option<Streamed>> {
     Ok(Some(Streamed {
         world,
         remote,
-        base: base.to_string(),
+        origin,
     }))
 }
 
 /// The chunk objects of page `page`, fetched and decoded.
 async fn read_page(
-    base: &str,
+    origin: &Origin,
     page: PageRef,
     signal: &web_sys::AbortSignal,
 ) -> (Result<strata_render::paged::Planes, String>, u64) {
@@ -113,14 +186,18 @@ async fn read_page(
     let mut bytes = 0u64;
     // Both requests go out before either is awaited.
     let requests = [HEIGHTS, METAS].map(|name| {
-        let url = format!("{base}{prefix}{}", http::chunk_key(name, &cell));
-        (name, url.clone(), fetch_with(url, signal.clone()))
+        let key = format!("{prefix}{}", http::chunk_key(name, &cell));
+        let request = {
+            let (origin, key) = (origin.clone(), key.clone());
+            async move { origin.required(&key, Some(signal)).await }
+        };
+        (name, format!("{}{key}", origin.label()), request)
     });
     let mut planes = Vec::new();
     for (name, url, request) in requests {
         let raw = match request.await {
             Ok(raw) => raw,
-            Err(e) => return (Err(format!("GET {url}: {e}")), bytes),
+            Err(e) => return (Err(e), bytes),
         };
         bytes += raw.len() as u64;
         let array = format!("{prefix}{name}");
@@ -134,40 +211,45 @@ async fn read_page(
     (Ok((heights, metas)), bytes)
 }
 
-/// GET `url` with `signal`: its bytes, or why not (a 404 is an error here:
-/// every chunk of a store is stored).
-async fn fetch_with(url: String, signal: web_sys::AbortSignal) -> Result<Vec<u8>, String> {
+/// GET `url` with `signal`: its bytes, `None` on 404, or why not.
+async fn fetch_with(url: &str, signal: &web_sys::AbortSignal) -> Result<Option<Vec<u8>>, String> {
     let window = web_sys::window().ok_or("no window")?;
     let init = web_sys::RequestInit::new();
-    init.set_signal(Some(&signal));
-    let response = JsFuture::from(window.fetch_with_str_and_init(&url, &init))
+    init.set_signal(Some(signal));
+    let response = JsFuture::from(window.fetch_with_str_and_init(url, &init))
         .await
         .map_err(|e| {
             if signal.aborted() {
-                format!("no answer in {} s (aborted)", TIMEOUT_MS / 1000)
+                format!("GET {url}: no answer in {} s (aborted)", TIMEOUT_MS / 1000)
             } else {
-                format!("request failed: {}", describe(&e))
+                format!("GET {url}: request failed: {}", describe(&e))
             }
         })?;
     let response: web_sys::Response = response.dyn_into().map_err(|_| "not a response")?;
+    if response.status() == 404 {
+        return Ok(None);
+    }
     if !response.ok() {
         return Err(format!(
-            "HTTP {} {}",
+            "GET {url}: HTTP {} {}",
             response.status(),
             response.status_text()
         ));
     }
     let buffer = response
         .array_buffer()
-        .map_err(|e| format!("no body: {}", describe(&e)))?;
+        .map_err(|e| format!("GET {url}: no body: {}", describe(&e)))?;
     let buffer = JsFuture::from(buffer).await.map_err(|e| {
         if signal.aborted() {
-            format!("body cut off: no answer in {} s", TIMEOUT_MS / 1000)
+            format!(
+                "GET {url}: body cut off: no answer in {} s",
+                TIMEOUT_MS / 1000
+            )
         } else {
-            format!("reading the body failed: {}", describe(&e))
+            format!("GET {url}: reading the body failed: {}", describe(&e))
         }
     })?;
-    Ok(js_sys::Uint8Array::new(&buffer).to_vec())
+    Ok(Some(js_sys::Uint8Array::new(&buffer).to_vec()))
 }
 
 fn describe(e: &JsValue) -> String {
@@ -183,17 +265,24 @@ fn describe(e: &JsValue) -> String {
 thread_local! {
     /// The abort controllers of reads in flight, by page id.
     static FLIGHTS: RefCell<HashMap<u32, (u64, web_sys::AbortController)>> = RefCell::new(HashMap::new());
+    /// The pump's interval timer.
+    static PUMP: std::cell::Cell<Option<i32>> = const { std::cell::Cell::new(None) };
     /// Numbers the reads, so a cancelled one's late answer is told apart.
     static SEQ: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
 }
 
 /// Fetch the chunk under map point (`x`, `y`) now and keep it (the viewer
 /// places a view's camera on the column there).
-pub async fn prefetch_at(streamed: &Streamed, x: f32, y: f32) -> anyhow::Result<()> {
-    let (w, h) = streamed.remote.size();
+pub async fn prefetch_at(
+    origin: &Origin,
+    remote: &RemoteChunks,
+    x: f32,
+    y: f32,
+) -> anyhow::Result<()> {
+    let (w, h) = remote.size();
     let cx = (x.floor() as i64).rem_euclid(i64::from(w)) as u32 / PAGE;
     let cy = (y.floor() as i64).rem_euclid(i64::from(h)) as u32 / PAGE;
-    if streamed.remote.cached(0, cx, cy).is_some() {
+    if remote.cached(0, cx, cy).is_some() {
         return Ok(());
     }
     let page = PageRef {
@@ -204,26 +293,32 @@ pub async fn prefetch_at(streamed: &Streamed, x: f32, y: f32) -> anyhow::Result<
     };
     let controller =
         web_sys::AbortController::new().map_err(|_| anyhow::anyhow!("no AbortController"))?;
-    let (planes, _) = read_page(&streamed.base, page, &controller.signal()).await;
+    let (planes, _) = read_page(origin, page, &controller.signal()).await;
     let planes = planes.map_err(|e| anyhow::anyhow!("the chunk under a view: {e}"))?;
-    streamed.remote.pin(0, cx, cy, planes);
+    remote.pin(0, cx, cy, planes);
     Ok(())
 }
 
-/// Run the pump for `remote` (every few milliseconds, for the page's life).
-pub fn start_pump(remote: Arc<RemoteChunks>, base: String) {
-    let tick = Closure::<dyn FnMut()>::new(move || pump(&remote, &base));
-    if let Some(window) = web_sys::window() {
-        let _ = window.set_interval_with_callback_and_timeout_and_arguments_0(
-            tick.as_ref().unchecked_ref(),
-            4,
-        );
+/// Run the pump for `remote` (every few milliseconds, until another store
+/// is opened).
+pub fn start_pump(remote: Arc<RemoteChunks>, origin: Origin) {
+    let tick = Closure::<dyn FnMut()>::new(move || pump(&remote, &origin));
+    let Some(window) = web_sys::window() else {
+        return;
+    };
+    if let Some(old) = PUMP.with(|p| p.take()) {
+        window.clear_interval_with_handle(old);
     }
-    // The pump lives as long as the page.
+    if let Ok(id) = window
+        .set_interval_with_callback_and_timeout_and_arguments_0(tick.as_ref().unchecked_ref(), 4)
+    {
+        PUMP.with(|p| p.set(Some(id)));
+    }
+    // A stopped pump's closure is a few bytes: kept for the page's life.
     tick.forget();
 }
 
-fn pump(remote: &Arc<RemoteChunks>, base: &str) {
+fn pump(remote: &Arc<RemoteChunks>, origin: &Origin) {
     for id in remote.take_cancelled() {
         if let Some((_, c)) = FLIGHTS.with(|f| f.borrow_mut().remove(&id)) {
             c.abort();
@@ -252,9 +347,9 @@ fn pump(remote: &Arc<RemoteChunks>, base: &str) {
             s.get()
         });
         FLIGHTS.with(|f| f.borrow_mut().insert(page.id, (seq, controller)));
-        let (remote, base) = (remote.clone(), base.to_string());
+        let (remote, origin) = (remote.clone(), origin.clone());
         wasm_bindgen_futures::spawn_local(async move {
-            let (planes, bytes) = read_page(&base, page, &signal).await;
+            let (planes, bytes) = read_page(&origin, page, &signal).await;
             if let (Some(w), Some(t)) = (web_sys::window(), timer) {
                 w.clear_timeout_with_handle(t);
             }
@@ -274,7 +369,7 @@ fn pump(remote: &Arc<RemoteChunks>, base: &str) {
             remote.deliver(page, planes, bytes);
             publish(&remote);
             // Start the next read at once rather than at the next tick.
-            pump(&remote, &base);
+            pump(&remote, &origin);
         });
     }
 }
