@@ -12,9 +12,9 @@
 //! misread.
 
 use crate::error::StoreError;
-use crate::format::{FORMAT_NAME, FORMAT_VERSION, SUMMARY, SUMMARY_FIELDS, WorldAttrs};
-use crate::lod::LOD_ATTR;
-use crate::store::ATTR;
+use crate::format::{
+    ATTR, FORMAT_NAME, FORMAT_VERSION, LOD_ATTR, SUMMARY, SUMMARY_FIELDS, WorldAttrs,
+};
 use std::io::Read;
 
 /// The object key of chunk `cell` of array `array` (Zarr v3's default
@@ -271,11 +271,11 @@ pub fn chunk_tops(gy: u64, gx: u64, objects: &[Vec<u8>]) -> Result<Vec<u8>, Stor
 }
 
 /// The world without its map (a 2x1 stand-in level, as
-/// [`crate::WorldStore::world_shell`]) from its attributes; water levels
+/// `WorldStore::world_shell`) from its attributes; water levels
 /// from the attributes (the `.vpr` bytes are not fetched).
 pub fn world_shell(what: &str, attrs: &WorldAttrs) -> Result<strata_level::World, StoreError> {
     let stand_in = strata_level::Level::flat(2, 1, 0, 0).expect("2x1 is a valid map size");
-    crate::store::world_from_attrs(what, attrs, stand_in, None)
+    crate::format::world_from_attrs(what, attrs, stand_in, None)
 }
 
 /// Complete level-of-detail levels from the `lod` group's `zarr.json` text
@@ -287,7 +287,7 @@ pub fn lod_levels(lod_json: Option<&[u8]>) -> u32 {
             j.pointer(&format!("/attributes/{LOD_ATTR}/levels"))
                 .and_then(|l| l.as_u64())
         })
-        .map_or(0, |l| l.min(u64::from(crate::lod::MAX_LOD)) as u32)
+        .map_or(0, |l| l.min(u64::from(strata_level::lod::MAX_LOD)) as u32)
 }
 
 #[cfg(all(test, feature = "fs"))]

@@ -11,7 +11,6 @@ use crate::format::{
 use rayon::prelude::*;
 use std::path::Path;
 use std::sync::Arc;
-use strata_level::io::{WorldFiles, world_from_parts};
 use strata_level::views::format_views;
 use strata_level::{Level, MidRule, World, vpr};
 use zarrs::array::codec::{Crc32cCodec, GzipCodec};
@@ -27,8 +26,7 @@ pub type StoreArray = Array<dyn ReadableWritableListableStorageTraits>;
 /// Makes the chunk at grid row `cy`, column `cx` (for [`WorldStore::create_with`]).
 pub type ChunkFn<'a> = dyn Fn(u64, u64) -> Result<Chunk, StoreError> + Sync + 'a;
 
-/// The attribute of the root group that holds [`WorldAttrs`].
-pub const ATTR: &str = "strata";
+pub use crate::format::{ATTR, world_from_attrs};
 
 /// Summary records per side of one summary-array chunk.
 const SUMMARY_CHUNK: u64 = 64;
@@ -615,51 +613,6 @@ impl WorldStore {
         };
         world_from_attrs(&self.what, &self.attrs, level, vpr.as_deref())
     }
-}
-
-/// The world of a store's attributes with `level` as its map and `vpr`
-/// (the `vangers_vpr` array's bytes, when read) as its `.vpr`; `what` names
-/// the store in errors.
-pub fn world_from_attrs(
-    what: &str,
-    a: &WorldAttrs,
-    level: Level,
-    vpr: Option<&[u8]>,
-) -> Result<World, StoreError> {
-    let path = Path::new(what);
-    let config = strata_level::WorldConfig::parse_store_bytes(
-        a.world_ini.as_bytes(),
-        &path.join("zarr.json#strata.world_ini"),
-    )?;
-    if (config.width(), config.height()) != (a.width, a.height) {
-        return Err(StoreError::NotAWorld {
-            what: what.into(),
-            msg: format!(
-                "its world.ini says {}x{}, its arrays {}x{}",
-                config.width(),
-                config.height(),
-                a.width,
-                a.height
-            ),
-        });
-    }
-    let views = (!a.views.is_empty()).then_some(a.views.as_bytes());
-    let mut world = world_from_parts(
-        a.name.clone(),
-        path,
-        config,
-        level,
-        WorldFiles {
-            palette: &a.palette,
-            vpr,
-            views,
-            edit: a.edit.as_ref().map(|e| e.as_bytes()),
-        },
-    )?;
-    if world.water.is_none() {
-        world.water = a.water.clone();
-    }
-    Ok(world)
 }
 
 /// The chunk grid (rows, columns) of a world's attributes.
