@@ -27,4 +27,17 @@ wasm-bindgen --target web --no-typescript --out-dir "$out/pkg" \
     target/wasm32-unknown-unknown/release/strata_web.wasm
 cp crates/web/www/index.html "$out/"
 wasm="$out/pkg/strata_web_bg.wasm"
+# Binaryen's wasm-opt (Debian's `binaryen`) when present: -Oz took main's
+# bundle from 10.46 MB (3.55 MB gzipped) to 8.14 MB (3.16 MB) in 1.4 CPU
+# minutes. The features are those rustc emits for wasm32-unknown-unknown.
+# STRATA_WASM_OPT=0 skips it.
+if [ "${STRATA_WASM_OPT:-1}" != 0 ] && command -v wasm-opt >/dev/null; then
+    echo "wasm-opt -Oz: $(wc -c <"$wasm") bytes before"
+    wasm-opt -Oz --enable-bulk-memory --enable-sign-ext --enable-mutable-globals \
+        --enable-nontrapping-float-to-int --enable-reference-types --enable-multivalue \
+        "$wasm" -o "$wasm.opt"
+    mv "$wasm.opt" "$wasm"
+else
+    echo "no wasm-opt (apt-get install binaryen): the bundle is not shrunk" >&2
+fi
 echo "bundle: $out ($(wc -c <"$wasm") bytes of wasm, $(gzip -9c "$wasm" | wc -c) gzipped)"
