@@ -157,9 +157,11 @@ fn a_store_past_the_texture_limit_streams_into_the_page() {
         start.elapsed().as_secs_f64()
     );
     let (_driver, driver_url) = chromedriver(&driver);
+    let store = fixture.store.clone();
     with_browser(&driver_url, &chromium, move |client| async move {
         drive(client.clone(), url, fixture, bundle).await;
         built_in_world(&client, &default_url).await;
+        picked_store(&client, &store).await;
     });
 }
 
@@ -182,6 +184,29 @@ async fn built_in_world(client: &Client, url: &str) {
         first_ms <= FIRST_FRAME_BOUND_MS,
         "first frame {first_ms} ms after navigation, bound {FIRST_FRAME_BOUND_MS}"
     );
+}
+
+/// The folder picker on a store: the viewer swaps to it, streamed from
+/// the picked files.
+async fn picked_store(client: &Client, store: &Path) {
+    client
+        .find(fantoccini::Locator::Id("strata-open"))
+        .await
+        .expect("the folder picker")
+        .send_keys(&store.to_string_lossy())
+        .await
+        .expect("picking the store folder");
+    let s = wait_for(client, "the picked store drawn", 300, |s| {
+        s["level_size"] == serde_json::json!([512, 16384])
+            && paging(s).0["resident_pages"].as_u64().unwrap_or(0) > 0
+    })
+    .await;
+    let (p, stream) = paging(&s);
+    eprintln!(
+        "picked store: {} pages resident, {} drawing; stream {stream}",
+        p["resident_pages"], s["active"]
+    );
+    assert_eq!(s["active"], "ray-exact", "{s}");
 }
 
 /// The page's paging numbers (`paging.stats`) and the stream's (`stream`).

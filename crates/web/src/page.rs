@@ -189,6 +189,7 @@ async fn start_streamed(
     let (world, paged) =
         streamed_world(streamed, params.view.as_deref(), params.gpu_budget).await?;
     strata_viewer::web::set_page_info("stream_open_ms", (now_ms() - start).into());
+    watch_folder_picker();
     progress(None, "");
     let backend = params.backend;
     strata_viewer::web::start(viewer_options(params, world, Some(paged)), backend)
