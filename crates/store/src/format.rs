@@ -1,11 +1,19 @@
 //! The store's layout: array names, the group attributes and the per-chunk
 //! summary record.
 
+use crate::error::StoreError;
 use serde::{Deserialize, Serialize};
+use std::path::Path;
+use strata_level::World;
+use strata_level::io::{WorldFiles, world_from_parts};
 use strata_level::model::{Level, decode_column, pair_disagrees, pair_is_dual};
 
 /// The format version this build writes and the newest it reads.
 pub const FORMAT_VERSION: u32 = 1;
+/// The attribute of the root group that holds [`WorldAttrs`].
+pub const ATTR: &str = "strata";
+/// The `lod` group's attribute that says how many levels are complete.
+pub const LOD_ATTR: &str = "strata_lod";
 /// The value of the `strata.format` attribute.
 pub const FORMAT_NAME: &str = "strata-world";
 /// The height plane (`uint8 [height, width]`).
@@ -198,4 +206,49 @@ pub fn cut_chunk(level: &Level, y0: u32, x0: u32, rows: u32, cols: u32) -> (Vec<
         m.extend_from_slice(&mr[x0 as usize..(x0 + cols) as usize]);
     }
     (h, m)
+}
+
+/// The world of a store's attributes with `level` as its map and `vpr`
+/// (the `vangers_vpr` array's bytes, when read) as its `.vpr`; `what` names
+/// the store in errors.
+pub fn world_from_attrs(
+    what: &str,
+    a: &WorldAttrs,
+    level: Level,
+    vpr: Option<&[u8]>,
+) -> Result<World, StoreError> {
+    let path = Path::new(what);
+    let config = strata_level::WorldConfig::parse_store_bytes(
+        a.world_ini.as_bytes(),
+        &path.join("zarr.json#strata.world_ini"),
+    )?;
+    if (config.width(), config.height()) != (a.width, a.height) {
+        return Err(StoreError::NotAWorld {
+            what: what.into(),
+            msg: format!(
+                "its world.ini says {}x{}, its arrays {}x{}",
+                config.width(),
+                config.height(),
+                a.width,
+                a.height
+            ),
+        });
+    }
+    let views = (!a.views.is_empty()).then_some(a.views.as_bytes());
+    let mut world = world_from_parts(
+        a.name.clone(),
+        path,
+        config,
+        level,
+        WorldFiles {
+            palette: &a.palette,
+            vpr,
+            views,
+            edit: a.edit.as_ref().map(|e| e.as_bytes()),
+        },
+    )?;
+    if world.water.is_none() {
+        world.water = a.water.clone();
+    }
+    Ok(world)
 }

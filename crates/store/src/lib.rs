@@ -187,6 +187,10 @@
 
 #![warn(missing_docs)]
 
+// The `zarr` feature (default; `fs` needs it): the store through zarrs.
+// Without it (a browser page streaming a store: `http`) zarrs is not built
+// at all, which keeps its codec registry out of the .wasm.
+#[cfg(feature = "zarr")]
 pub mod cache;
 #[cfg(feature = "fs")]
 #[doc(hidden)]
@@ -195,13 +199,19 @@ pub mod error;
 pub mod format;
 #[cfg(feature = "fs")]
 pub mod fs;
+pub mod http;
+#[cfg(feature = "zarr")]
 pub mod lod;
+#[cfg(feature = "zarr")]
 pub mod read;
+#[cfg(feature = "zarr")]
 pub mod store;
 
+#[cfg(feature = "zarr")]
 pub use cache::{CacheStats, CachedChunk, ChunkCache};
 pub use error::StoreError;
 pub use format::{ChunkSummary, FORMAT_VERSION, Layout, WorldAttrs};
 #[cfg(feature = "fs")]
 pub use fs::{DirKind, DirStore, dir_kind, load_any};
+#[cfg(feature = "zarr")]
 pub use store::{Chunk, Storage, WorldStore};

@@ -27,8 +27,7 @@ use zarrs::group::{Group, GroupBuilder};
 
 /// The group holding the levels.
 pub const LOD_GROUP: &str = "lod";
-/// The group attribute that says how many levels are complete.
-pub const LOD_ATTR: &str = "strata_lod";
+pub use crate::format::LOD_ATTR;
 pub use strata_level::lod::MAX_LOD;
 /// gzip level of the coarse chunks (see the module docs).
 const LOD_GZIP: u32 = 1;

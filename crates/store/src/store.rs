@@ -11,7 +11,6 @@ use crate::format::{
 use rayon::prelude::*;
 use std::path::Path;
 use std::sync::Arc;
-use strata_level::io::{WorldFiles, world_from_parts};
 use strata_level::views::format_views;
 use strata_level::{Level, MidRule, World, vpr};
 use zarrs::array::codec::{Crc32cCodec, GzipCodec};
@@ -27,8 +26,7 @@ pub type StoreArray = Array<dyn ReadableWritableListableStorageTraits>;
 /// Makes the chunk at grid row `cy`, column `cx` (for [`WorldStore::create_with`]).
 pub type ChunkFn<'a> = dyn Fn(u64, u64) -> Result<Chunk, StoreError> + Sync + 'a;
 
-/// The attribute of the root group that holds [`WorldAttrs`].
-pub const ATTR: &str = "strata";
+pub use crate::format::{ATTR, world_from_attrs};
 
 /// Summary records per side of one summary-array chunk.
 const SUMMARY_CHUNK: u64 = 64;
@@ -174,34 +172,9 @@ impl WorldStore {
                 "a Zarr group without a `{ATTR}` attribute: not a Strata world"
             ))
         })?;
-        if raw.get("format").and_then(|f| f.as_str()) != Some(FORMAT_NAME) {
-            return Err(not_world(format!(
-                "its `{ATTR}.format` attribute is not \"{FORMAT_NAME}\": not a Strata world"
-            )));
-        }
-        let version = raw
-            .get("format_version")
-            .and_then(|v| v.as_u64())
-            .ok_or_else(|| not_world(format!("no `{ATTR}.format_version` attribute")))?;
-        if version > u64::from(FORMAT_VERSION) {
-            return Err(StoreError::NewerVersion {
-                what: what.into(),
-                found: u32::try_from(version).unwrap_or(u32::MAX),
-                supported: FORMAT_VERSION,
-            });
-        }
-        let attrs: WorldAttrs = serde_json::from_value(raw.clone())
-            .map_err(|e| not_world(format!("its `{ATTR}` attribute is malformed: {e}")))?;
+        let attrs = crate::http::check_attrs(what, raw)?;
         let (w, h) = (attrs.width, attrs.height);
         let [ch, cw] = attrs.chunk;
-        let ok_size = w.is_power_of_two() && h.is_power_of_two() && w >= 2;
-        let ok_chunk =
-            ch.is_power_of_two() && cw.is_power_of_two() && cw >= 2 && ch <= h && cw <= w;
-        if !ok_size || !ok_chunk {
-            return Err(not_world(format!(
-                "map {w}x{h} with chunks {cw}x{ch}: sizes must be powers of two, chunks even and inside the map"
-            )));
-        }
         let heights = open_array(&storage, HEIGHTS)?;
         let metas = open_array(&storage, METAS)?;
         let summary = open_array(&storage, SUMMARY)?;
@@ -634,45 +607,11 @@ impl WorldStore {
     /// (this store's map, or a stand-in where the map is read through a
     /// [`crate::ChunkCache`] instead).
     pub fn world_with_level(&self, level: Level) -> Result<World, StoreError> {
-        let a = &self.attrs;
-        let what = Path::new(&self.what);
-        let config = strata_level::WorldConfig::parse_store_bytes(
-            a.world_ini.as_bytes(),
-            &what.join("zarr.json#strata.world_ini"),
-        )?;
-        if (config.width(), config.height()) != (a.width, a.height) {
-            return Err(StoreError::NotAWorld {
-                what: self.what.clone(),
-                msg: format!(
-                    "its world.ini says {}x{}, its arrays {}x{}",
-                    config.width(),
-                    config.height(),
-                    a.width,
-                    a.height
-                ),
-            });
-        }
         let vpr = match Array::open(self.storage.clone(), &format!("/{VPR}")) {
             Ok(array) => Some(read_cell(&array, VPR, &[0])?),
             Err(_) => None,
         };
-        let views = (!a.views.is_empty()).then_some(a.views.as_bytes());
-        let mut world = world_from_parts(
-            a.name.clone(),
-            what,
-            config,
-            level,
-            WorldFiles {
-                palette: &a.palette,
-                vpr: vpr.as_deref(),
-                views,
-                edit: a.edit.as_ref().map(|e| e.as_bytes()),
-            },
-        )?;
-        if world.water.is_none() {
-            world.water = a.water.clone();
-        }
-        Ok(world)
+        world_from_attrs(&self.what, &self.attrs, level, vpr.as_deref())
     }
 }
 

@@ -99,6 +99,16 @@ pub fn show_error(message: &str) {
     });
 }
 
+/// Show `message` on the page's status line (above the canvas): news that
+/// is not an error of the page, such as chunks of a streamed store that
+/// failed to read while the rest draws.
+pub fn show_notice(message: &str) {
+    web_sys::console::warn_1(&message.into());
+    if let Some(line) = document().and_then(|d| d.get_element_by_id("strata-status")) {
+        line.set_text_content(Some(message));
+    }
+}
+
 /// Hide the page's error box (a new attempt is under way).
 pub fn clear_error() {
     if let Some(element) = document().and_then(|d| d.get_element_by_id(ERROR_ID)) {

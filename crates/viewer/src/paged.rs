@@ -15,10 +15,18 @@ use std::collections::HashMap;
 use std::sync::{Arc, Mutex};
 use strata_level::edit::{crater, crater_rect};
 use strata_level::{Column, EditSite, Level, MidRule};
-use strata_render::paged::{PAGE, PageData, PageSource, PagedOptions};
+use strata_render::paged::{
+    AsyncPages, PAGE, PageData, PageRef, PageSource, PagedOptions, RemoteChunks,
+};
 
 /// Why `method` cannot draw a paged world (`None`: it can).
 pub fn refusal(method: &str) -> Option<String> {
+    // A browser page has no threads to fit the paged mesh's chunks on.
+    if cfg!(target_arch = "wasm32") && method == "mesh" {
+        return Some(
+            "`mesh` over paged terrain fits its chunks on worker threads, which the page does not have; in the page paged worlds are drawn by ray-exact, ray-exact-fragment".into(),
+        );
+    }
     (!strata_render::paged::PAGED_METHODS.contains(&method)).then(|| {
         format!(
             "`{method}` draws whole worlds only; paged worlds are drawn by {}",
@@ -69,6 +77,9 @@ pub enum Base {
         cache: Arc<strata_store::ChunkCache>,
         dir: std::path::PathBuf,
     },
+    /// A store streamed over HTTP (a browser page, issue 34): chunks come
+    /// through a pump's asynchronous reads; the last ones read are kept.
+    Remote(Arc<RemoteChunks>),
 }
 
 /// One chunk's two planes, row-major (`PAGE * PAGE` bytes each).
@@ -93,6 +104,8 @@ pub struct EditedPages {
     mid_rule: MidRule,
     /// Edited chunks by grid index (row-major).
     edited: Mutex<HashMap<u32, Arc<Planes>>>,
+    /// The streamed store, when the base is one (its reads are asynchronous).
+    remote: Option<Arc<RemoteChunks>>,
 }
 
 impl EditedPages {
@@ -102,6 +115,11 @@ impl EditedPages {
             Base::Level(level) => (level.width(), level.height()),
             #[cfg(not(target_arch = "wasm32"))]
             Base::Store { cache, .. } => (cache.store().width(), cache.store().height()),
+            Base::Remote(remote) => remote.size(),
+        };
+        let remote = match &base {
+            Base::Remote(remote) => Some(remote.clone()),
+            _ => None,
         };
         if size.0 < PAGE || size.1 < PAGE || !size.0.is_power_of_two() || !size.1.is_power_of_two()
         {
@@ -116,6 +134,7 @@ impl EditedPages {
             size,
             mid_rule,
             edited: Mutex::new(HashMap::new()),
+            remote,
         })
     }
 
@@ -132,6 +151,11 @@ impl EditedPages {
     /// Chunks edited since the world was opened or last saved.
     pub fn edited_chunks(&self) -> usize {
         self.edited.lock().expect("edit lock").len()
+    }
+
+    /// The streamed store's reads, when the world is one.
+    pub fn remote(&self) -> Option<&Arc<RemoteChunks>> {
+        self.remote.as_ref()
     }
 
     /// Whether the world is a store (saved in place, chunk by chunk).
@@ -165,6 +189,15 @@ impl EditedPages {
                 Ok(Planes {
                     heights: c.heights.clone(),
                     metas: c.metas.clone(),
+                })
+            }
+            Base::Remote(remote) => {
+                let p = remote.cached(0, cx, cy).ok_or_else(|| {
+                    format!("chunk ({cx}, {cy}) of the streamed store has not been fetched yet")
+                })?;
+                Ok(Planes {
+                    heights: p.0.clone(),
+                    metas: p.1.clone(),
                 })
             }
         }
@@ -413,6 +446,7 @@ impl PageSource for EditedPages {
                     .map_err(|e| e.to_string())?
                     .chunk_tops()?
             }
+            Base::Remote(remote) => remote.chunk_tops()?,
         };
         for (&index, p) in self.edited.lock().expect("edit lock").iter() {
             tops[index as usize] =
@@ -424,6 +458,45 @@ impl PageSource for EditedPages {
     fn read_page(&self, cx: u32, cy: u32, step: u32) -> Result<PageData, String> {
         let p = self.planes(cx, cy)?;
         PageData::from_planes(&p.heights, &p.metas, self.mid_rule, step)
+    }
+
+    fn async_pages(&self) -> Option<&dyn AsyncPages> {
+        self.remote.as_ref().map(|_| self as &dyn AsyncPages)
+    }
+}
+
+/// A streamed store's reads, with the session's edits over what they bring.
+impl AsyncPages for EditedPages {
+    fn want(&self, pages: &[PageRef]) {
+        if let Some(remote) = &self.remote {
+            remote.want(pages);
+        }
+    }
+
+    fn take_finished(
+        &self,
+        most: usize,
+    ) -> Vec<(u32, Result<strata_render::paged::Planes, String>)> {
+        let Some(remote) = &self.remote else {
+            return Vec::new();
+        };
+        let edited = self.edited.lock().expect("edit lock");
+        remote
+            .take_finished(most)
+            .into_iter()
+            .map(|(id, read)| match edited.get(&id) {
+                Some(p) => (id, Ok((p.heights.clone(), p.metas.clone()))),
+                None => (id, read),
+            })
+            .collect()
+    }
+
+    fn in_flight(&self) -> usize {
+        self.remote.as_ref().map_or(0, |r| r.in_flight())
+    }
+
+    fn is_in_flight(&self, id: u32) -> bool {
+        self.remote.as_ref().is_some_and(|r| r.is_in_flight(id))
     }
 }
 

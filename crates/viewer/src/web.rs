@@ -34,15 +34,24 @@ impl Backend {
     }
 }
 
+/// A world the page loaded for the viewer to show next, paged or not.
+type NextWorld = (strata_level::World, Option<crate::paged::PagedWorld>);
+
 thread_local! {
     /// A world the page loaded (a picked folder) for the viewer to show next.
-    static NEXT_WORLD: RefCell<Option<strata_level::World>> = const { RefCell::new(None) };
+    static NEXT_WORLD: RefCell<Option<NextWorld>> = const { RefCell::new(None) };
 }
 
 /// Show `world` in the viewer from its next frame on (the window, device,
 /// method and settings stay; the camera goes to the world's first view).
 pub fn open_world(world: strata_level::World) {
-    NEXT_WORLD.with(|w| *w.borrow_mut() = Some(world));
+    NEXT_WORLD.with(|w| *w.borrow_mut() = Some((world, None)));
+}
+
+/// Show a paged world (a picked store, streamed) from the next frame on,
+/// as [`open_world`] (`world` its files besides the map).
+pub fn open_paged_world(world: strata_level::World, paged: crate::paged::PagedWorld) {
+    NEXT_WORLD.with(|w| *w.borrow_mut() = Some((world, Some(paged))));
 }
 
 /// Hand the viewer to the browser's event loop (returns at once; the page
@@ -112,7 +121,7 @@ impl App {
     pub(crate) fn poll_opening(&mut self, event_loop: &ActiveEventLoop) {
         self.poll_device(event_loop);
         if self.viewer.is_some()
-            && let Some(world) = NEXT_WORLD.with(|w| w.borrow_mut().take())
+            && let Some((world, paged)) = NEXT_WORLD.with(|w| w.borrow_mut().take())
             && let Some(viewer) = self.viewer.take()
         {
             let parts = viewer.hand_over();
@@ -131,7 +140,7 @@ impl App {
                 out: parts.out,
                 save: Default::default(),
                 physics: false,
-                paged: None,
+                paged,
             };
             let opened = Viewer::new(parts.window, parts.surface, parts.gpu, options);
             self.opened(event_loop, opened);

@@ -15,6 +15,7 @@
 mod compare;
 mod page;
 mod progress;
+mod stream;
 
 use wasm_bindgen::prelude::*;
 

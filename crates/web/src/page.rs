@@ -29,7 +29,14 @@ pub struct Params {
     pub views: Option<Vec<String>>,
     /// `&methods=A,B:setting`: the protocol's methods (default: every one).
     pub methods: Option<String>,
+    /// `?gpu-budget=MIB`: the paged terrain's GPU budget for a streamed store.
+    pub gpu_budget: u64,
 }
+
+/// The paged terrain's GPU budget in the page by default: well inside
+/// WebGPU's default limits (an atlas of 2048x2048-texel layers, 128 MiB per
+/// storage binding), and what a CPU adapter (SwiftShader) holds easily.
+pub const DEFAULT_GPU_BUDGET_MIB: u64 = 64;
 
 impl Params {
     pub fn from_url() -> anyhow::Result<Params> {
@@ -82,7 +89,16 @@ impl Params {
                     .with_context(|| format!("?{}={text}: {}", m.name, m.knobs.grammar))?;
             }
         }
+        let gpu_budget = match get("gpu-budget") {
+            Some(text) => text
+                .parse::<u64>()
+                .ok()
+                .filter(|m| (1..=4096).contains(m))
+                .with_context(|| format!("?gpu-budget={text}: MiB, 1..=4096"))?,
+            None => DEFAULT_GPU_BUDGET_MIB,
+        } << 20;
         Ok(Params {
+            gpu_budget,
             backend,
             settings,
             method: get("method").unwrap_or_else(|| "ray".into()),
@@ -101,6 +117,17 @@ impl Params {
 /// Read the URL, get the world, start the viewer.
 pub async fn run() -> anyhow::Result<()> {
     let params = Params::from_url()?;
+    if let Some(url) = &params.level
+        && !params.compare
+    {
+        let base = with_slash(url);
+        progress(Some(0.0), &format!("opening {base}"));
+        let start = now_ms();
+        let origin = crate::stream::Origin::Http(base);
+        if let Some(streamed) = crate::stream::open(origin).await? {
+            return start_streamed(params, streamed, start).await;
+        }
+    }
     let world = match &params.level {
         Some(url) => fetch_world(url).await?,
         None => generate(&params.world).await?,
@@ -116,25 +143,126 @@ pub async fn run() -> anyhow::Result<()> {
     }
     watch_folder_picker();
     progress(None, "");
-    strata_viewer::web::start(
-        strata_viewer::Options {
-            world,
-            method: params.method,
-            settings: params.settings,
-            size: params.size,
-            render_scale: params.scale,
-            view: params.view,
-            script: None,
-            vsync: true,
-            adapter: Default::default(),
-            render: Default::default(),
-            out: "screenshots".into(),
-            save: Default::default(),
-            physics: false,
-            paged: None,
-        },
-        params.backend,
-    )
+    let backend = params.backend;
+    strata_viewer::web::start(viewer_options(params, world, None), backend)
+}
+
+/// The viewer's options from the URL's, over `world` (paged or not).
+fn viewer_options(
+    params: Params,
+    world: World,
+    paged: Option<strata_viewer::paged::PagedWorld>,
+) -> strata_viewer::Options {
+    strata_viewer::Options {
+        world,
+        method: params.method,
+        settings: params.settings,
+        size: params.size,
+        render_scale: params.scale,
+        view: params.view,
+        script: None,
+        vsync: true,
+        adapter: Default::default(),
+        render: Default::default(),
+        out: "screenshots".into(),
+        save: Default::default(),
+        physics: false,
+        paged,
+    }
+}
+
+/// The viewer over a streamed store: paged terrain whose pages the pump
+/// fetches as the view asks for them.
+async fn start_streamed(
+    params: Params,
+    streamed: crate::stream::Streamed,
+    start: f64,
+) -> anyhow::Result<()> {
+    if params.backend == Backend::WebGl2 {
+        bail!(
+            "{}: a streamed store is drawn through paged terrain, which needs WebGPU \
+             (its page table, atlas pyramids and feedback are storage buffers, which WebGL2 \
+             does not have); open it without ?backend=webgl2",
+            streamed.origin.label()
+        );
+    }
+    let (world, paged) =
+        streamed_world(streamed, params.view.as_deref(), params.gpu_budget).await?;
+    strata_viewer::web::set_page_info("stream_open_ms", (now_ms() - start).into());
+    watch_folder_picker();
+    progress(None, "");
+    let backend = params.backend;
+    strata_viewer::web::start(viewer_options(params, world, Some(paged)), backend)
+}
+
+/// A streamed store ready for the viewer: the chunk under `view` (default
+/// the first) fetched (the camera stands on it), the pump started, the
+/// other views' chunks fetched behind it; paged terrain of `gpu_budget`
+/// bytes without reader threads.
+pub async fn streamed_world(
+    streamed: crate::stream::Streamed,
+    view: Option<&str>,
+    gpu_budget: u64,
+) -> anyhow::Result<(World, strata_viewer::paged::PagedWorld)> {
+    use strata_render::paged::PageSource;
+    use strata_viewer::paged::{Base, EditedPages, PagedWorld};
+    let start = now_ms();
+    let crate::stream::Streamed {
+        world,
+        remote,
+        origin,
+    } = streamed;
+    let chosen = match view {
+        Some(name) => world.views.iter().find(|v| v.name == name),
+        None => world.views.first(),
+    };
+    let (w, h) = remote.size();
+    let (x, y) = chosen.map_or((w as f32 / 2.0, h as f32 / 2.0), |v| (v.x, v.y));
+    crate::stream::prefetch_at(&origin, &remote, x, y).await?;
+    web_sys::console::log_1(
+        &format!(
+            "strata: streaming {} ({w}x{h}): the first view's chunk in {:.0} ms",
+            origin.label(),
+            now_ms() - start
+        )
+        .into(),
+    );
+    strata_viewer::web::set_page_info("world_size", serde_json::json!([w, h]));
+    crate::stream::start_pump(remote.clone(), origin.clone());
+    // The other views' chunks (a view switch places its camera there).
+    let mut spots: Vec<(f32, f32)> = world.views.iter().map(|v| (v.x, v.y)).collect();
+    if let Some(edit) = &world.edit {
+        spots.push((edit.camera.x, edit.camera.y));
+    }
+    let behind = remote.clone();
+    wasm_bindgen_futures::spawn_local(async move {
+        for (x, y) in spots {
+            if let Err(e) = crate::stream::prefetch_at(&origin, &behind, x, y).await {
+                web_sys::console::warn_1(&format!("strata: {e:#}").into());
+            }
+        }
+    });
+    let pages = EditedPages::new(Base::Remote(remote), world.level.mid_rule)?;
+    let options = strata_render::paged::PagedOptions {
+        gpu_budget,
+        // No threads in the page: the pump's fetches are the reads.
+        threads: 0,
+        ..Default::default()
+    };
+    let paged = PagedWorld {
+        pages: std::sync::Arc::new(pages),
+        options,
+    };
+    Ok((world, paged))
+}
+
+/// `url` ending in `/`.
+fn with_slash(url: &str) -> String {
+    if url.ends_with('/') {
+        url.to_string()
+    } else {
+        format!("{url}/")
+    }
 }
 
 /// The built-in world, generated here a band of rows per turn of the
@@ -180,7 +308,7 @@ async fn generate(params: &GenerateParams) -> anyhow::Result<World> {
 }
 
 /// GET `url`: its bytes, `None` on 404, an error on anything else.
-async fn fetch(url: &str) -> anyhow::Result<Option<Vec<u8>>> {
+pub(crate) async fn fetch(url: &str) -> anyhow::Result<Option<Vec<u8>>> {
     let window = web_sys::window().context("no window")?;
     let response = JsFuture::from(window.fetch_with_str(url))
         .await
@@ -250,6 +378,10 @@ impl Folder {
 
     async fn required(&self, name: &str) -> anyhow::Result<Vec<u8>> {
         self.get(name).await?.with_context(|| match self {
+            Folder::Http(base) if name == strata_level::io::WORLD_INI => format!(
+                "GET {base}{name}: 404 Not Found: no Strata store (zarr.json) and no world \
+                 directory (world.ini) at {base}"
+            ),
             Folder::Http(base) => {
                 format!("GET {base}{name}: 404 Not Found (a world directory needs this file)")
             }
@@ -272,25 +404,56 @@ fn relative_path(file: &web_sys::File) -> String {
 /// A world directory served over HTTP (`world.ini`, the map, the palette,
 /// optionally `.vpr`, `views.txt`, `edit.txt`), through the native readers.
 async fn fetch_world(url: &str) -> anyhow::Result<World> {
-    let base = if url.ends_with('/') {
-        url.to_string()
-    } else {
-        format!("{url}/")
-    };
-    load_world(&Folder::Http(base)).await
+    load_world(&Folder::Http(with_slash(url))).await
 }
 
 /// A world folder from the page's file picker.
 pub async fn picked_world(files: Vec<web_sys::File>) -> anyhow::Result<World> {
-    let name = files
+    let name = picked_name(&files);
+    let world = load_world(&Folder::Picked { name, files }).await?;
+    progress(None, "");
+    Ok(world)
+}
+
+/// The picked folder's name (its files' first path component).
+fn picked_name(files: &[web_sys::File]) -> String {
+    files
         .first()
         .map(relative_path)
         .and_then(|p| p.split('/').next().map(str::to_string))
         .filter(|n| !n.is_empty())
-        .unwrap_or_else(|| "world".into());
-    let world = load_world(&Folder::Picked { name, files }).await?;
-    progress(None, "");
-    Ok(world)
+        .unwrap_or_else(|| "world".into())
+}
+
+/// A picked folder that is a Strata store, ready to stream from its files
+/// (`None`: no zarr.json at its top; maybe a world directory).
+async fn picked_store(
+    files: &[web_sys::File],
+) -> anyhow::Result<Option<(World, strata_viewer::paged::PagedWorld)>> {
+    let name = picked_name(files);
+    // Paths under the picked folder (`heights/c/3/1`).
+    let by_path: std::collections::HashMap<String, web_sys::File> = files
+        .iter()
+        .filter_map(|f| {
+            let path = relative_path(f);
+            let (_, under) = path.split_once('/')?;
+            Some((under.to_string(), f.clone()))
+        })
+        .collect();
+    if !by_path.contains_key("zarr.json") {
+        return Ok(None);
+    }
+    let origin = crate::stream::Origin::Picked {
+        name,
+        files: std::rc::Rc::new(by_path),
+    };
+    progress(Some(0.0), &format!("opening {}", origin.label()));
+    let Some(streamed) = crate::stream::open(origin).await? else {
+        return Ok(None);
+    };
+    streamed_world(streamed, None, DEFAULT_GPU_BUDGET_MIB << 20)
+        .await
+        .map(Some)
 }
 
 async fn load_world(folder: &Folder) -> anyhow::Result<World> {
@@ -356,6 +519,21 @@ pub fn watch_folder_picker() {
         }
         strata_viewer::web::clear_error();
         wasm_bindgen_futures::spawn_local(async move {
+            // A store (a zarr.json at its top) is streamed from the files.
+            match picked_store(&files).await {
+                Ok(Some((world, paged))) => {
+                    progress(None, "");
+                    web_sys::console::log_1(&format!("strata: streaming {}", world.name).into());
+                    strata_viewer::web::open_paged_world(world, paged);
+                    return;
+                }
+                Ok(None) => {}
+                Err(error) => {
+                    progress(None, "");
+                    strata_viewer::web::show_error(&format!("{error:#}"));
+                    return;
+                }
+            }
             match picked_world(files).await {
                 Ok(world) => {
                     web_sys::console::log_1(&format!("strata: opened {}", world.name).into());

@@ -48,15 +48,19 @@
 //! the same bytes (tested on lavapipe).
 
 pub mod pages;
+pub mod remote;
 pub mod residency;
 pub mod source;
 pub mod streamer;
 
 pub use pages::PageIds;
+pub use remote::RemoteChunks;
 pub use residency::{BudgetPlan, Residency};
 #[cfg(not(target_arch = "wasm32"))]
 pub use source::StorePages;
-pub use source::{LevelPages, PAGE, PageData, PageSource, page_pyramid_layout};
+pub use source::{
+    AsyncPages, LevelPages, PAGE, PageData, PageRef, PageSource, Planes, page_pyramid_layout,
+};
 pub use streamer::Streamer;
 
 use crate::frame::Shared;
@@ -189,6 +193,12 @@ pub struct PagedTerrain {
     read_stamp: u32,
     /// A frame copied its feedback to `readback`, not yet read.
     readback_due: std::cell::Cell<bool>,
+    /// The stamp of the frame whose feedback `readback` holds.
+    readback_stamp: std::cell::Cell<u32>,
+    /// In a browser, where a map completes only after the page yields:
+    /// the map of `readback` asked for and not yet read (no frame copies
+    /// into it meanwhile), and its result once it came.
+    map: Option<MapState>,
     /// The eye's map position this frame (placement prefers near pages).
     eye: glam::Vec2,
     /// Tries so far per failing chunk.
@@ -403,6 +413,8 @@ impl PagedTerrain {
             stamp: 0,
             read_stamp: 0,
             readback_due: std::cell::Cell::new(false),
+            readback_stamp: std::cell::Cell::new(0),
+            map: None,
             eye: glam::Vec2::ZERO,
             failures: HashMap::new(),
             stale: Default::default(),
@@ -456,23 +468,41 @@ impl PagedTerrain {
     }
 
     /// Record the copy of this frame's feedback for [`PagedTerrain::read_feedback`].
+    /// In a browser a frame whose read-back buffer is still being mapped
+    /// records none (its feedback is skipped; the next one's is read).
     pub fn record_feedback(&self, encoder: &mut wgpu::CommandEncoder) {
+        if self.map.is_some() || self.readback_due.get() && cfg!(target_arch = "wasm32") {
+            return;
+        }
         encoder.copy_buffer_to_buffer(&self.feedback, 0, &self.readback, 0, self.readback.size());
         self.readback_due.set(true);
+        self.readback_stamp.set(self.stamp);
     }
 
-    /// Read the recorded frame's feedback (blocks until that frame is done):
-    /// pending pixels, requests, and which slots it read.
+    /// Read the recorded frame's feedback (blocks until that frame is done;
+    /// in a browser, where nothing blocks, a frame or two later): pending
+    /// pixels, requests, and which slots it read.
     pub fn read_feedback(&mut self, shared: &Shared) -> anyhow::Result<()> {
-        if !self.readback_due.replace(false) {
-            return Ok(());
-        }
-        let raw = crate::gpu::read_buffer(
-            &shared.device,
-            &crate::gpu::ErrorSink::default(),
-            &self.readback,
-            self.readback.size(),
-        )?;
+        #[cfg(target_arch = "wasm32")]
+        let raw = {
+            let Some(raw) = self.poll_feedback()? else {
+                return Ok(());
+            };
+            raw
+        };
+        #[cfg(not(target_arch = "wasm32"))]
+        let raw = {
+            if !self.readback_due.replace(false) {
+                return Ok(());
+            }
+            crate::gpu::read_buffer(
+                &shared.device,
+                &crate::gpu::ErrorSink::default(),
+                &self.readback,
+                self.readback.size(),
+            )?
+        };
+        let _ = shared;
         let words: &[u32] = bytemuck::cast_slice(&raw);
         let n = (words[1]).min(MAX_REQUESTS) as usize;
         self.stats.pending_pixels = words[0];
@@ -490,8 +520,43 @@ impl PagedTerrain {
                 self.residency.touch(slot as u32, s);
             }
         }
-        self.read_stamp = self.stamp;
+        self.read_stamp = self.readback_stamp.get();
         Ok(())
+    }
+
+    /// In a browser: ask for the map of a recorded frame's feedback (its
+    /// copy was submitted with that frame), or take it once it came.
+    #[cfg(target_arch = "wasm32")]
+    fn poll_feedback(&mut self) -> anyhow::Result<Option<Vec<u8>>> {
+        let Some(map) = &self.map else {
+            if self.readback_due.get() {
+                let state = MapState::default();
+                let sink = Arc::clone(&state);
+                self.readback
+                    .slice(..)
+                    .map_async(wgpu::MapMode::Read, move |r| {
+                        if let Ok(mut s) = sink.lock() {
+                            *s = Some(r);
+                        }
+                    });
+                self.map = Some(state);
+            }
+            return Ok(None);
+        };
+        let Some(result) = map.lock().ok().and_then(|mut s| s.take()) else {
+            return Ok(None);
+        };
+        self.map = None;
+        self.readback_due.set(false);
+        result.map_err(|e| anyhow::anyhow!("mapping the page feedback failed: {e}"))?;
+        let raw = self
+            .readback
+            .slice(..)
+            .get_mapped_range()
+            .map_err(|e| anyhow::anyhow!("reading the page feedback failed: {e}"))?
+            .to_vec();
+        self.readback.unmap();
+        Ok(Some(raw))
     }
 
     /// The chunks to read, most wanted first: what the last frame asked for
@@ -752,6 +817,9 @@ impl PagedTerrain {
         &self.ids
     }
 }
+
+/// A buffer map's result once its callback ran (a browser's read-back).
+type MapState = Arc<std::sync::Mutex<Option<Result<(), wgpu::BufferAsyncError>>>>;
 
 /// The page ids of `source` drawn with `options`: coarse levels only with
 /// the level of detail on.

@@ -141,6 +141,49 @@ pub trait PageSource: Send + Sync {
             Err(format!("this source has no level of detail {level}"))
         }
     }
+
+    /// A source whose reads complete later, on their own (a browser's
+    /// fetches): the [`super::Streamer`] then hands it the wanted pages and
+    /// takes the finished ones back instead of calling
+    /// [`PageSource::read_lod_page`]. `None` (the default): reads block.
+    fn async_pages(&self) -> Option<&dyn AsyncPages> {
+        None
+    }
+}
+
+/// A page to read: its id and where it lies.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PageRef {
+    /// The page's id ([`super::PageIds`]).
+    pub id: u32,
+    /// Its level (0: the map's chunks).
+    pub level: u32,
+    /// Its column in that level's grid.
+    pub cx: u32,
+    /// Its row in that level's grid.
+    pub cy: u32,
+}
+
+/// One chunk's two planes (heights, metas), `PAGE * PAGE` bytes each.
+pub type Planes = (Vec<u8>, Vec<u8>);
+
+/// The seam for reads that cannot block (issue 34: a browser page has no
+/// threads; its fetches complete after the page yields). The streamer
+/// calls [`AsyncPages::want`] with each frame's wanted pages and
+/// [`AsyncPages::take_finished`] before uploading; whoever does the reads
+/// (see [`super::remote::RemoteChunks`]) starts, caps and cancels them.
+pub trait AsyncPages: Send + Sync {
+    /// Make `pages` (most wanted first) the wanted reads: those not started
+    /// yet replace the queue, reads in flight that are not among them are
+    /// cancelled.
+    fn want(&self, pages: &[PageRef]);
+    /// Reads finished since the last call, at most `most`: the page id and
+    /// its planes, or why the read failed.
+    fn take_finished(&self, most: usize) -> Vec<(u32, Result<Planes, String>)>;
+    /// Reads queued, in flight, or finished and not yet taken.
+    fn in_flight(&self) -> usize;
+    /// Whether page `id` is queued, in flight, or finished and not taken.
+    fn is_in_flight(&self, id: u32) -> bool;
 }
 
 /// Pages cut from a world in memory.
@@ -341,7 +384,7 @@ impl PageSource for StorePages {
 }
 
 /// Paged worlds are whole pages, powers of two a side.
-fn check_size(width: u32, height: u32) -> anyhow::Result<()> {
+pub(crate) fn check_size(width: u32, height: u32) -> anyhow::Result<()> {
     if width < PAGE || height < PAGE || !width.is_power_of_two() || !height.is_power_of_two() {
         anyhow::bail!(
             "paged rendering needs a world of at least {PAGE}x{PAGE} texels, powers of two a side; this one is {width}x{height}"

@@ -3,10 +3,13 @@
 //! worker threads that read them through the [`PageSource`], and finished
 //! pages handed back to the render thread to upload. Where there are no
 //! threads (a browser page without workers), [`Streamer::poll`] reads on the
-//! calling thread within a time budget: the one platform seam.
+//! calling thread within a time budget, or, for a source whose reads
+//! complete on their own ([`PageSource::async_pages`]: a browser's
+//! fetches), hands the wanted pages to it and takes back what finished:
+//! the one platform seam.
 
 use super::pages::PageIds;
-use super::source::{PageData, PageSource};
+use super::source::{AsyncPages, PageData, PageRef, PageSource};
 use std::collections::{HashSet, VecDeque};
 use std::sync::mpsc::{Receiver, Sender, channel};
 use std::sync::{Arc, Condvar, Mutex};
@@ -77,6 +80,17 @@ impl Streamer {
     /// Make `chunks` (most wanted first) the queue: earlier wants not in it
     /// are dropped unread; chunks being read stay being read.
     pub fn want(&self, chunks: &[u32]) {
+        if let Some(reads) = self.async_reads() {
+            let pages: Vec<PageRef> = chunks
+                .iter()
+                .filter_map(|&id| {
+                    let (level, cx, cy) = self.ids.locate(id)?;
+                    Some(PageRef { id, level, cx, cy })
+                })
+                .collect();
+            reads.want(&pages);
+            return;
+        }
         let mut q = self.shared.queue.lock().expect("page queue");
         let wanted = chunks
             .iter()
@@ -90,12 +104,18 @@ impl Streamer {
 
     /// Chunks queued or being read.
     pub fn in_flight(&self) -> usize {
+        if let Some(reads) = self.async_reads() {
+            return reads.in_flight();
+        }
         let q = self.shared.queue.lock().expect("page queue");
         q.wanted.len() + q.reading.len() + q.finished.len()
     }
 
     /// Whether `chunk` is queued or being read.
     pub fn is_in_flight(&self, chunk: u32) -> bool {
+        if let Some(reads) = self.async_reads() {
+            return reads.is_in_flight(chunk);
+        }
         let q = self.shared.queue.lock().expect("page queue");
         q.reading.contains(&chunk) || q.finished.contains(&chunk) || q.wanted.contains(&chunk)
     }
@@ -103,6 +123,17 @@ impl Streamer {
     /// Finished pages, at most `most`. Without worker threads, first reads
     /// queued chunks here for up to `budget_ms`.
     pub fn poll(&self, most: usize, budget_ms: f64) -> Vec<PageResult> {
+        if let Some(reads) = self.async_reads() {
+            let (rule, step) = (self.source.mid_rule(), self.step);
+            return reads
+                .take_finished(most)
+                .into_iter()
+                .map(|(id, planes)| {
+                    let page = planes.and_then(|(h, m)| PageData::from_planes(&h, &m, rule, step));
+                    (id, page)
+                })
+                .collect();
+        }
         if self.workers.is_empty() {
             let start = web_time::Instant::now();
             while start.elapsed().as_secs_f64() * 1e3 < budget_ms {
@@ -127,6 +158,17 @@ impl Streamer {
             q.finished.remove(chunk);
         }
         taken
+    }
+}
+
+impl Streamer {
+    /// The source's own asynchronous reads, used where no worker thread runs.
+    fn async_reads(&self) -> Option<&dyn AsyncPages> {
+        if self.workers.is_empty() {
+            self.source.async_pages()
+        } else {
+            None
+        }
     }
 }
 

@@ -1,15 +1,26 @@
 //! `strata serve`: the browser bundle (built by `crates/web/build.sh`) and a
 //! world directory over HTTP on localhost, for `strata view` in a browser.
+//!
+//! A Strata store is served as it lies on disk, one request per chunk
+//! object (the page streams it: `crates/web/src/stream.rs`); without
+//! `--level` the built-in world is served as a store, written once next to
+//! the default world's cache (`generated-v…-2048x16384.store`). Static files
+//! only, so any static server or object store serves a store the same way.
 
 use anyhow::{Context, bail};
 use std::path::{Component, Path, PathBuf};
 
 #[derive(clap::Args, Clone, Debug)]
 pub struct Args {
-    /// A world directory to offer to the page (`?level=/level/`); without it
-    /// the page generates the built-in world.
+    /// A world directory to offer to the page (`?level=/level/`): a Vangers
+    /// world (`world.ini`) or a Strata store (`zarr.json`, streamed chunk by
+    /// chunk). Default: the built-in world as a store, made once and cached.
     #[arg(long, value_name = "DIR")]
     pub level: Option<PathBuf>,
+    /// Without `--level`: serve no world (the page then generates the
+    /// built-in one itself, `?world=WxH&seed=N`).
+    #[arg(long, conflicts_with = "level")]
+    pub no_level: bool,
     /// Port on 127.0.0.1 (0: any free one; the URL printed says which).
     #[arg(long, default_value_t = 8080)]
     pub port: u16,
@@ -33,8 +44,16 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     }
     if let Some(dir) = &args.level
         && !dir.join("world.ini").is_file()
+        && !dir.join("zarr.json").is_file()
     {
-        bail!("--level {}: no world.ini there", dir.display());
+        bail!(
+            "--level {}: no world.ini (a Vangers world) or zarr.json (a Strata store) there",
+            dir.display()
+        );
+    }
+    let mut args = args;
+    if args.level.is_none() && !args.no_level {
+        args.level = Some(default_store()?);
     }
     let server = tiny_http::Server::http(("127.0.0.1", args.port))
         .map_err(|e| anyhow::anyhow!("cannot listen on 127.0.0.1:{}: {e}", args.port))?;
@@ -51,13 +70,65 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     println!("strata serve: http://127.0.0.1:{port}/{query}");
     use std::io::Write;
     std::io::stdout().flush()?;
-    for request in server.incoming_requests() {
-        let response = respond(&args, request.url());
-        if let Err(e) = request.respond(response) {
-            eprintln!("strata serve: answering failed: {e}");
+    // A few answering threads: the page fetches several chunks at once.
+    std::thread::scope(|scope| {
+        for _ in 0..4 {
+            scope.spawn(|| {
+                while let Ok(request) = server.recv() {
+                    let response = respond(&args, request.url());
+                    if let Err(e) = request.respond(response) {
+                        eprintln!("strata serve: answering failed: {e}");
+                    }
+                }
+            });
+        }
+    });
+    Ok(())
+}
+
+/// The built-in world as a store, next to its native cache: written the
+/// first time (into a temporary sibling, renamed into place), then reused.
+fn default_store() -> anyhow::Result<PathBuf> {
+    use crate::world_arg::{cache_dir, cache_root, load_default};
+    use strata_level::generate::GenerateParams;
+    let params = GenerateParams::default();
+    let root = cache_root().context(
+        "no cache directory for the built-in world's store (set STRATA_CACHE_DIR or HOME), or pass --level",
+    )?;
+    let native = cache_dir(&root, &params);
+    let dir = native.with_file_name(format!(
+        "{}.store",
+        native
+            .file_name()
+            .map_or_else(|| "generated".into(), |n| n.to_string_lossy().into_owned())
+    ));
+    if dir.join("zarr.json").is_file() {
+        return Ok(dir);
+    }
+    eprintln!(
+        "strata serve: writing the built-in world as a store in {} (once)",
+        dir.display()
+    );
+    let start = std::time::Instant::now();
+    let world = load_default(&params, Some(&root))?;
+    let tmp = dir.with_file_name(format!(".store.tmp-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&tmp);
+    strata_store::DirStore::create(&tmp, &world, &strata_store::Layout::default())
+        .with_context(|| format!("writing the store {}", tmp.display()))?;
+    strata_store::DirStore::build_lods(&tmp, &|_, _| {})
+        .with_context(|| format!("writing the levels of detail of {}", tmp.display()))?;
+    if let Err(e) = std::fs::rename(&tmp, &dir) {
+        let _ = std::fs::remove_dir_all(&tmp);
+        // Another server may have finished first: that copy is as good.
+        if !dir.join("zarr.json").is_file() {
+            return Err(e).with_context(|| format!("renaming into {}", dir.display()));
         }
     }
-    Ok(())
+    eprintln!(
+        "strata serve: the store is written ({:.1} s)",
+        start.elapsed().as_secs_f64()
+    );
+    Ok(dir)
 }
 
 /// The file a URL path names: `/level/…` inside the world directory, the
@@ -118,6 +189,7 @@ mod tests {
     fn paths_stay_inside_the_bundle_and_the_level() {
         let args = Args {
             level: Some("/worlds/a".into()),
+            no_level: false,
             port: 0,
             bundle: "/b".into(),
         };
@@ -132,6 +204,12 @@ mod tests {
         );
         assert_eq!(resolve(&args, "/../etc/passwd"), None);
         assert_eq!(resolve(&args, "/level/../../etc/passwd"), None);
+        // A store's chunk objects, as they lie on disk.
+        assert_eq!(
+            resolve(&args, "/level/heights/c/3/1"),
+            Some("/worlds/a/heights/c/3/1".into())
+        );
+        assert_eq!(resolve(&args, "/level/heights/c/../../../x"), None);
         let without = Args {
             level: None,
             ..args

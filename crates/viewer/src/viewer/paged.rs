@@ -106,6 +106,17 @@ impl PagedState {
                 s.in_flight
             ),
         ];
+        if let Some(remote) = self.world.pages.remote() {
+            let r = remote.stats();
+            lines.push(format!(
+                "streamed: {} pages fetched ({:.2} MiB), {} in flight, {} failed, {} cancelled",
+                r.done,
+                mib(r.bytes),
+                r.in_flight,
+                r.failed,
+                r.cancelled
+            ));
+        }
         if s.read_errors > 0 {
             lines.push(format!(
                 "read errors: {} ({})",
@@ -158,7 +169,7 @@ pub(super) fn camera_over(
 /// The paged method to open with: `method` when it draws paged terrain,
 /// else the first that does.
 pub(super) fn first_method(method: &str) -> &str {
-    if PAGED_METHODS.contains(&method) {
+    if refusal(method).is_none() {
         method
     } else {
         PAGED_METHODS[0]
@@ -226,14 +237,16 @@ impl Viewer {
         }
         let stats = self.renderer.paged_terrain().map(|t| t.stats());
         let render_size = self.render_size();
+        let mut report = None;
         if let Some(p) = &mut self.paged {
             if let Some(s) = &stats {
                 p.uploaded_total += s.uploaded_bytes;
                 if s.read_errors > 0 && p.stats.as_ref().is_none_or(|o| o.read_errors == 0) {
-                    eprintln!(
-                        "strata view: paged read error: {}",
+                    report = Some(format!(
+                        "paged read error (after {} tries; resident pages keep drawing): {}",
+                        p.world.options.read_tries,
                         s.first_error.as_deref().unwrap_or("")
-                    );
+                    ));
                 }
             }
             p.frames += 1;
@@ -247,6 +260,12 @@ impl Viewer {
             p.resident_max = p
                 .resident_max
                 .max(p.stats.as_ref().map_or(0, |s| s.resident_bytes));
+        }
+        if let Some(line) = report {
+            // In a page also above the canvas (the overlay may be off).
+            #[cfg(target_arch = "wasm32")]
+            crate::page::show_notice(&line);
+            self.say(line);
         }
     }
 
@@ -303,6 +322,11 @@ impl Viewer {
     /// frame's depth (what is on screen), the crater cut into the edit layer,
     /// the touched pages refreshed.
     pub(super) fn dig_paged(&mut self, at: (f32, f32)) -> anyhow::Result<()> {
+        if cfg!(target_arch = "wasm32") {
+            return self.refuse(
+                "digging paged terrain picks the point from the frame's depth read back at once, which a page cannot wait for; not in the browser yet".into(),
+            );
+        }
         let camera = self.camera()?;
         let start = Instant::now();
         let depth = self.renderer.read_depth()?;
