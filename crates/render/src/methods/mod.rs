@@ -48,6 +48,7 @@
 //!   `create` must redo that in `resize` (the viewer follows its window).
 
 mod build_bindings;
+mod coalesce;
 mod common;
 pub mod contract;
 #[doc(hidden)]
