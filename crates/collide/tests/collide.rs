@@ -40,6 +40,15 @@ fn agree(c: &TerrainCollider, tracer: &Tracer, level: &Level, o: DVec3, d: DVec3
 fn rays(level: &Level, n: usize, seed: u64) -> Vec<(&'static str, DVec3, DVec3)> {
     let mut rng = Lcg(seed);
     let (w, h) = (f64::from(level.width()), f64::from(level.height()));
+    // The cave kinds need a dual column with room under its slab; a level
+    // without one (every slab dug away) gets rays from above instead, or the
+    // search for one would never end.
+    let caves = (0..level.height()).any(|y| {
+        (0..level.width()).any(|x| {
+            let c = level.column(i64::from(x), i64::from(y));
+            c.dual && c.mid > c.low + 2
+        })
+    });
     let mut out = Vec::new();
     while out.len() < n {
         let x = rng.next_f64() * w;
@@ -48,6 +57,10 @@ fn rays(level: &Level, n: usize, seed: u64) -> Vec<(&'static str, DVec3, DVec3)>
         let az = rng.next_f64() * std::f64::consts::TAU;
         let dir = |el: f64| DVec3::new(el.cos() * az.cos(), el.cos() * az.sin(), el.sin());
         match out.len() % 4 {
+            1 | 3 if !caves => {
+                let el = -(0.05 + rng.next_f64() * 1.5);
+                out.push(("down", DVec3::new(x, y, 260.0), dir(el)));
+            }
             0 => {
                 let el = -(0.05 + rng.next_f64() * 1.5);
                 out.push(("down", DVec3::new(x, y, 260.0), dir(el)));
