@@ -1,9 +1,12 @@
 //! What `Renderer::render_into` adds to a frame: the GPU time of getting
-//! Strata's colour and depth into the caller's views — two texture copies
-//! where the targets allow (`Rgba8Unorm`/`Rgba8UnormSrgb` + `Depth32Float`
-//! made with `COPY_DST`, one sample), else the full-screen pass — per
-//! target format pair, by timestamp queries (wall clock of a submit-and-wait
-//! where the adapter has none). Each line says which path it took.
+//! Strata's colour and depth into the caller's views, per target format
+//! pair and usage, by timestamp queries (wall clock of a submit-and-wait
+//! where the adapter has none). Each line names the road it took
+//! (`strata_render::composite_split`): colour by compute or by copy, depth
+//! by a pass from the method's image or by copy, or the full-screen pass.
+//! The roads that read Strata's own depth target (a depth copy, the pass)
+//! also make a compute method blit its depth image into that target: the
+//! first line's two frame times show what that blit costs.
 //!
 //! ```text
 //! cargo run --release -p strata-render --example composite_cost -- [--size WxH] [--frames N] [--method NAME]
@@ -48,21 +51,27 @@ fn main() -> anyhow::Result<()> {
     };
     let colors = TerrainColors::test_ramps();
     let mut r = Renderer::new(&gpu, &level, &colors, &method, &settings, size.0, size.1)?;
-    // `record_copy_into` below copies from Strata's own depth target.
+    let frame_ms = |r: &mut Renderer| -> anyhow::Result<f64> {
+        let times: Vec<f64> = (0..frames.min(20))
+            .map(|_| {
+                r.render_frame(&camera)
+                    .map(|t| t.gpu_ms.unwrap_or(t.cpu_ms))
+            })
+            .collect::<anyhow::Result<_>>()?;
+        Ok(median(times))
+    };
+    let alone = frame_ms(&mut r)?;
+    // The roads that read Strata's own depth target need it filled.
     r.set_depth_attachment(true);
-    let frame_ms: Vec<f64> = (0..frames.min(20))
-        .map(|_| {
-            r.render_frame(&camera)
-                .map(|t| t.gpu_ms.unwrap_or(t.cpu_ms))
-        })
-        .collect::<anyhow::Result<_>>()?;
+    let filled = frame_ms(&mut r)?;
     println!(
-        "adapter {} ({}); {method} frame at {}x{}: median {:.3} ms ({})",
+        "adapter {} ({}); {method} frame at {}x{}: median {:.3} ms, {:.3} ms with Strata's depth target filled ({})",
         gpu.report.name,
         gpu.report.backend,
         size.0,
         size.1,
-        median(frame_ms),
+        alone,
+        filled,
         if gpu.caps.timestamps {
             "GPU timestamps"
         } else {
@@ -90,16 +99,19 @@ fn main() -> anyhow::Result<()> {
         (set, resolve, read)
     });
     let period_ms = f64::from(gpu.queue.get_timestamp_period()) * 1e-6;
-    for (color, depth, samples, copy_dst) in [
-        (F::Rgba8Unorm, F::Depth32Float, 1, true),
-        (F::Rgba8UnormSrgb, F::Depth32Float, 1, true),
-        (F::Rgba8Unorm, F::Depth32Float, 1, false),
-        (F::Bgra8UnormSrgb, F::Depth24Plus, 1, false),
-        (F::Rgba16Float, F::Depth24PlusStencil8, 1, false),
-        (F::Bgra8Unorm, F::Depth24Plus, 1, false),
-        (F::Rgba8Unorm, F::Depth24Plus, 1, false),
-        (F::Bgra8UnormSrgb, F::Depth32Float, 1, false),
-        (F::Bgra8UnormSrgb, F::Depth24Plus, 4, false),
+    use wgpu::TextureUsages as U;
+    let (plain, copy) = (U::RENDER_ATTACHMENT, U::RENDER_ATTACHMENT | U::COPY_DST);
+    let storage = copy | U::STORAGE_BINDING;
+    for (color, depth, samples, usage) in [
+        (F::Rgba8Unorm, F::Depth32Float, 1, storage),
+        (F::Rgba16Float, F::Depth32Float, 1, storage),
+        (F::Rgba8Unorm, F::Depth24Plus, 1, storage),
+        (F::Rgba8Unorm, F::Depth32Float, 1, copy),
+        (F::Rgba8UnormSrgb, F::Depth32Float, 1, copy),
+        (F::Rgba8Unorm, F::Depth32Float, 1, plain),
+        (F::Bgra8UnormSrgb, F::Depth24Plus, 1, plain),
+        (F::Rgba16Float, F::Depth24PlusStencil8, 1, plain),
+        (F::Bgra8UnormSrgb, F::Depth24Plus, 4, plain),
     ] {
         let target = |format| {
             gpu.device
@@ -114,11 +126,10 @@ fn main() -> anyhow::Result<()> {
                     sample_count: samples,
                     dimension: wgpu::TextureDimension::D2,
                     format,
-                    usage: match copy_dst {
-                        true => {
-                            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_DST
-                        }
-                        false => wgpu::TextureUsages::RENDER_ATTACHMENT,
+                    // Depth textures cannot be storage.
+                    usage: match format.is_depth_stencil_format() {
+                        true => usage - U::STORAGE_BINDING,
+                        false => usage,
                     },
                     view_formats: &[],
                 })
@@ -127,7 +138,7 @@ fn main() -> anyhow::Result<()> {
         let (cv, dv) = (target(color), target(depth));
         let targets = TargetViews::new(&cv, &dv);
         let mut times = Vec::new();
-        let mut copied = false;
+        let mut road = None;
         for _ in 0..frames {
             let mut encoder = gpu.device.create_command_encoder(&Default::default());
             let writes = queries
@@ -137,7 +148,7 @@ fn main() -> anyhow::Result<()> {
                     beginning_of_pass_write_index: Some(0),
                     end_of_pass_write_index: Some(1),
                 });
-            copied = r.record_copy_into(&mut encoder, &targets, writes)?;
+            road = Some(r.record_copy_into(&mut encoder, &targets, writes)?);
             if let Some((set, resolve, read)) = &queries {
                 encoder.resolve_query_set(set, 0..2, resolve, 0);
                 encoder.copy_buffer_to_buffer(resolve, 0, read, 0, 16);
@@ -155,9 +166,9 @@ fn main() -> anyhow::Result<()> {
                 None => wall,
             });
         }
+        let road = road.map_or("no frames".to_string(), |r| r.to_string());
         println!(
-            "{} into {color:?} + {depth:?} x{samples}: median {:.3} ms, min {:.3} ms over {frames}",
-            if copied { "copies" } else { "pass" },
+            "into {color:?} + {depth:?} x{samples} ({usage:?}): median {:.3} ms, min {:.3} ms over {frames}: {road}",
             median(times.clone()),
             times.iter().copied().fold(f64::INFINITY, f64::min)
         );

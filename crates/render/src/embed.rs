@@ -23,9 +23,8 @@
 //! **1.0**. Draw your objects with the same `view_proj`, depth compare
 //! [`wgpu::CompareFunction::Less`] and `LoadOp::Load` on both views.
 
-use crate::composite::{
-    TargetError, TargetViews, copyable, key_of, record_composite, record_copies,
-};
+use crate::composite::{TargetError, TargetViews, key_of, record_composite};
+use crate::composite_split::{CompositeRoute, DepthRoute, RouteInputs, route};
 use crate::gpu::catching;
 use crate::renderer::Renderer;
 use strata_camera::Camera;
@@ -67,26 +66,41 @@ impl Renderer {
     ) -> anyhow::Result<()> {
         let size = (self.shared().width, self.shared().height);
         let key = key_of(targets, size)?;
+        let route = self.composite_route(targets, key);
         let device = self.shared().device.clone();
         // Errors from here on concern the caller's views (a foreign device,
         // a view wgpu refuses): caught here to name them, not left to the
         // device's error sink (in a browser they reach the sink).
         let mut composite = std::mem::take(&mut self.composite);
-        let copies = copyable(targets, key, &self.shared().caps);
+        let mut split = std::mem::take(&mut self.split);
         let (recorded, error) = catching(&device, wgpu::ErrorFilter::Validation, || {
-            // The copy or the composite reads the shared depth target: fill it.
-            if copies {
-                let mut encoder = self.record_frame_with(camera, true)?;
-                record_copies(&mut encoder, self.shared(), targets);
-                return anyhow::Ok(encoder.finish());
+            match route {
+                CompositeRoute::Split { color, depth } => {
+                    // Depth from the method's own image skips the blit into
+                    // Strata's depth target; a copy reads that target.
+                    let fill_depth = depth == DepthRoute::Copy;
+                    let mut encoder = self.record_frame_with(camera, fill_depth)?;
+                    split.record(
+                        &mut encoder,
+                        self.shared(),
+                        targets,
+                        (color, depth),
+                        self.active_depth_image(),
+                    )?;
+                    anyhow::Ok(encoder.finish())
+                }
+                CompositeRoute::Pass => {
+                    // The composite reads the shared depth target: fill it.
+                    let pipeline = composite.pipeline(&device, key)?;
+                    let group = composite.group(self.shared());
+                    let mut encoder = self.record_frame_with(camera, true)?;
+                    record_composite(&mut encoder, targets, key, &pipeline, &group, None);
+                    anyhow::Ok(encoder.finish())
+                }
             }
-            let pipeline = composite.pipeline(&device, key)?;
-            let group = composite.group(self.shared());
-            let mut encoder = self.record_frame_with(camera, true)?;
-            record_composite(&mut encoder, targets, key, &pipeline, &group, None);
-            anyhow::Ok(encoder.finish())
         });
         self.composite = composite;
+        self.split = split;
         if let Some(error) = error {
             let message = error_chain(&error);
             if message.contains("doesn't match") {
@@ -109,26 +123,34 @@ impl Renderer {
     /// Record only the copy of the frame last drawn (by
     /// [`Renderer::render_frame`] or [`Renderer::render_into`]) into the
     /// caller's views, in the caller's encoder: to show one frame in more
-    /// targets, or to time the copy (`timestamp_writes`; what
-    /// `examples/composite_cost.rs` measures). The same checks and the same
-    /// choice of texture copies or the pass as `render_into` (with copies,
-    /// the stamps are written by an empty compute pass before and one
-    /// after them); wgpu errors reach the device's error sink. Returns
-    /// whether it copied.
+    /// targets, or to time what `render_into` adds to a frame
+    /// (`timestamp_writes`; what `examples/composite_cost.rs` measures).
+    /// The same checks and the same road as `render_into`
+    /// ([`CompositeRoute`]; on the split road the stamps are written by an
+    /// empty compute pass before and one after it); wgpu errors reach the
+    /// device's error sink. Returns the road taken.
     pub fn record_copy_into(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
         targets: &TargetViews<'_>,
         timestamp_writes: Option<wgpu::RenderPassTimestampWrites<'_>>,
-    ) -> anyhow::Result<bool> {
+    ) -> anyhow::Result<CompositeRoute> {
         let key = key_of(targets, (self.shared().width, self.shared().height))?;
-        if !self.depth_target_current {
+        let route = self.composite_route(targets, key);
+        let reads_shared_depth = !matches!(
+            route,
+            CompositeRoute::Split {
+                depth: DepthRoute::FromImage,
+                ..
+            }
+        );
+        if reads_shared_depth && !self.depth_target_current {
             anyhow::bail!(
                 "the frame last drawn ({}) left its depth in the method's own image, not in the shared depth target this copy reads: draw it with `render_into`, or call `set_depth_attachment(true)` before `render_frame`",
                 self.method_name()
             );
         }
-        if copyable(targets, key, &self.shared().caps) {
+        if let CompositeRoute::Split { color, depth } = route {
             let stamp = |encoder: &mut wgpu::CommandEncoder, start: bool| {
                 let Some(w) = &timestamp_writes else { return };
                 let index = match start {
@@ -136,7 +158,7 @@ impl Renderer {
                     false => w.end_of_pass_write_index,
                 };
                 encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                    label: Some("composite copy stamp"),
+                    label: Some("composite stamp"),
                     timestamp_writes: Some(wgpu::ComputePassTimestampWrites {
                         query_set: w.query_set,
                         beginning_of_pass_write_index: index.filter(|_| !start),
@@ -145,9 +167,18 @@ impl Renderer {
                 });
             };
             stamp(encoder, true);
-            record_copies(encoder, self.shared(), targets);
+            let mut split = std::mem::take(&mut self.split);
+            let recorded = split.record(
+                encoder,
+                self.shared(),
+                targets,
+                (color, depth),
+                self.active_depth_image(),
+            );
+            self.split = split;
+            recorded?;
             stamp(encoder, false);
-            return Ok(true);
+            return Ok(route);
         }
         let device = self.shared().device.clone();
         let mut composite = std::mem::take(&mut self.composite);
@@ -155,7 +186,25 @@ impl Renderer {
         let group = composite.group(self.shared());
         self.composite = composite;
         record_composite(encoder, targets, key, &pipeline?, &group, timestamp_writes);
-        Ok(false)
+        Ok(route)
+    }
+
+    /// The road [`Renderer::render_into`] takes into `targets`.
+    fn composite_route(
+        &self,
+        targets: &TargetViews<'_>,
+        key: crate::composite::Key,
+    ) -> CompositeRoute {
+        let caps = &self.shared().caps;
+        route(
+            targets,
+            key,
+            RouteInputs {
+                compute: caps.compute,
+                depth_copies: caps.depth_copies,
+                depth_image: self.active_depth_image().is_some(),
+            },
+        )
     }
 }
 

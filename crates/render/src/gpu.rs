@@ -189,7 +189,8 @@ pub struct TextureReadback {
 }
 
 impl TextureReadback {
-    /// Submit a copy of `texture` (4 bytes per texel of `aspect`) and ask for its map.
+    /// Submit a copy of `texture` (its `aspect`'s bytes per texel, 4 where
+    /// the format does not say) and ask for its map.
     pub fn start(
         device: &wgpu::Device,
         queue: &wgpu::Queue,
@@ -197,7 +198,8 @@ impl TextureReadback {
         aspect: wgpu::TextureAspect,
     ) -> Self {
         let (w, h) = (texture.width(), texture.height());
-        let row = 4 * w;
+        let texel = texture.format().block_copy_size(Some(aspect)).unwrap_or(4);
+        let row = texel * w;
         let align = wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
         let padded = row.div_ceil(align) * align;
         let size = u64::from(padded) * u64::from(h);

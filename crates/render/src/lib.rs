@@ -74,6 +74,7 @@ pub mod adapter;
 pub mod build_guard;
 pub mod caps;
 pub mod composite;
+pub mod composite_split;
 #[doc(hidden)]
 pub mod depth_read;
 pub mod embed;

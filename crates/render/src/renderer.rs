@@ -67,6 +67,8 @@ pub struct Renderer {
     edit_listener: Option<EditListener>,
     /// Pipelines that copy the frame into a caller's targets ([`Renderer::render_into`]).
     pub(crate) composite: crate::composite::CompositeCache,
+    /// Colour and depth each by its cheapest way ([`crate::composite_split`]).
+    pub(crate) split: crate::composite_split::SplitCache,
 }
 
 /// Frames [`Renderer::hold_busy`] lets queue up before it waits for the oldest.
@@ -155,6 +157,7 @@ impl Renderer {
             depth_reader,
             edit_listener: None,
             composite: Default::default(),
+            split: Default::default(),
         };
         wait_device(&renderer.shared.device, &renderer.errors)?;
         renderer.setup_ms = ms(start);
@@ -290,6 +293,12 @@ impl Renderer {
                 .map(|e| format!("; {e}"))
                 .unwrap_or_else(|| " (a larger --gpu-budget holds more of the view)".into())
         )
+    }
+
+    /// The active method's `R32Float` depth image, where it keeps one
+    /// (the compute marches; [`methods::Method::depth_image`]).
+    pub(crate) fn active_depth_image(&self) -> Option<&wgpu::Texture> {
+        self.methods[self.active].method.depth_image()
     }
 
     /// The active method's name.

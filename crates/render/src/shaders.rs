@@ -71,6 +71,10 @@ pub const SOURCES: &[(&str, &str)] = &[
         include_str!("../shaders/depth_read.wgsl"),
     ),
     ("composite.wgsl", include_str!("../shaders/composite.wgsl")),
+    (
+        "composite_color.wgsl",
+        include_str!("../shaders/composite_color.wgsl"),
+    ),
     ("shadow.wgsl", include_str!("../shaders/shadow.wgsl")),
     (
         "decode_test.wgsl",
@@ -152,6 +156,7 @@ pub const ENTRY_SHADERS: &[&str] = &[
     "depth_blit.wgsl",
     "depth_read.wgsl",
     "composite.wgsl",
+    "composite_color.wgsl",
     "shadow.wgsl",
     "decode_test.wgsl",
     "voxel.wgsl",

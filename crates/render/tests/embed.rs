@@ -258,13 +258,23 @@ fn bad_targets_get_named_errors() {
     gpu.wait().unwrap();
 }
 
-/// Issue 35: targets of Strata's own formats made with `COPY_DST` take the
-/// frame by texture copies instead of the full-screen pass; both paths
-/// store the same bytes, for every method.
+/// Issue 35: targets that allow it take the frame by cheaper roads than the
+/// full-screen pass (`composite_split`): colour by a compute dispatch into a
+/// storage texture or by a copy, depth by a pass from a compute method's
+/// depth image or by a copy. Every road stores what the pass stores, for
+/// every method.
 #[test]
-fn the_copy_path_stores_what_the_pass_stores() {
+fn every_road_stores_what_the_pass_stores() {
+    // Every backend here: GL (llvmpipe) has no depth copies, so its roads differ.
+    for gpu in common::gpus() {
+        every_road_on(&gpu);
+    }
+}
+
+fn every_road_on(gpu: &Gpu) {
+    use strata_render::composite_split::{ColorRoute, CompositeRoute, DepthRoute};
     use wgpu::TextureFormat as F;
-    let Some(gpu) = common::gpu() else { return };
+    use wgpu::TextureUsages as U;
     let (level, camera) = scene();
     let settings = MethodSettings {
         shadows: false,
@@ -294,64 +304,111 @@ fn the_copy_path_stores_what_the_pass_stores() {
             .unwrap(),
         }
     };
-    let copy_usage = USAGE | wgpu::TextureUsages::COPY_DST;
-    let mut tested = 0;
+    let copy_usage = USAGE | U::COPY_DST;
+    let storage_usage = copy_usage | U::STORAGE_BINDING;
+    let (mut tested, mut roads) = (0, Vec::new());
     for name in strata_render::methods::names() {
-        let mut r = match Renderer::new(&gpu, &level, &colors, name, &settings, W, H) {
+        let mut r = match Renderer::new(gpu, &level, &colors, name, &settings, W, H) {
             Ok(r) => r,
             Err(e) => {
                 eprintln!("{name}: not on this adapter ({e:#})");
                 continue;
             }
         };
-        for color_format in [F::Rgba8Unorm, F::Rgba8UnormSrgb] {
+        for color_format in [F::Rgba8Unorm, F::Rgba8UnormSrgb, F::Rgba16Float] {
             let mut images = Vec::new();
-            for usage in [USAGE, copy_usage] {
-                let (color_tex, color_view) = target(&gpu, color_format, (W, H), 1, usage);
-                let (depth_tex, depth_view) = target(&gpu, F::Depth32Float, (W, H), 1, usage);
+            for usage in [USAGE, copy_usage, storage_usage] {
+                if usage == storage_usage && color_format == F::Rgba8UnormSrgb {
+                    continue; // sRGB textures cannot be storage
+                }
+                let (color_tex, color_view) = target(gpu, color_format, (W, H), 1, usage);
+                let depth_usage = usage - U::STORAGE_BINDING;
+                let (depth_tex, depth_view) = target(gpu, F::Depth32Float, (W, H), 1, depth_usage);
                 let targets = TargetViews::new(&color_view, &depth_view);
                 r.render_into(&camera, &targets).unwrap();
                 gpu.wait().unwrap();
-                // The same choice as `render_into` made, said by the copy-only call.
+                images.push((read(&color_tex), read(&depth_tex)));
+                // The road `render_into` took, said by the copy-only call
+                // (after a frame that also fills Strata's depth target).
+                r.set_depth_attachment(true);
+                r.render_frame(&camera).unwrap();
+                r.set_depth_attachment(false);
                 let mut encoder = gpu.device.create_command_encoder(&Default::default());
-                let copied = r.record_copy_into(&mut encoder, &targets, None).unwrap();
+                let road = r.record_copy_into(&mut encoder, &targets, None).unwrap();
                 gpu.queue.submit([encoder.finish()]);
                 gpu.wait().unwrap();
-                assert_eq!(
-                    copied,
-                    usage == copy_usage && gpu.caps.depth_copies,
-                    "{name}: {usage:?}"
-                );
-                images.push((read(&color_tex), read(&depth_tex)));
+                let expected_color = match usage {
+                    u if u == storage_usage && gpu.caps.compute => Some(ColorRoute::Storage {
+                        linear: color_format == F::Rgba16Float,
+                    }),
+                    u if u != USAGE && color_format != F::Rgba16Float => Some(ColorRoute::Copy),
+                    _ => None,
+                };
+                match (road, expected_color) {
+                    (CompositeRoute::Split { color, depth }, Some(expected)) => {
+                        assert_eq!(color, expected, "{name} {color_format:?} {usage:?}");
+                        roads.push((name, color, depth));
+                    }
+                    (CompositeRoute::Pass, None) => {}
+                    // No depth copies (GL): a fragment method's depth takes the pass.
+                    (CompositeRoute::Pass, Some(_)) if !gpu.caps.depth_copies => {}
+                    (road, expected) => panic!(
+                        "{name} {color_format:?} {usage:?}: took {road}, expected colour {expected:?}"
+                    ),
+                }
             }
-            let ((pass_color, pass_depth), (copy_color, copy_depth)) = (&images[0], &images[1]);
-            let worst = pass_color
-                .iter()
-                .zip(copy_color)
-                .map(|(a, b)| a.abs_diff(*b))
-                .max()
-                .unwrap_or(0);
-            let depths_differ = pass_depth
-                .chunks_exact(4)
-                .zip(copy_depth.chunks_exact(4))
-                .filter(|(a, b)| a != b)
-                .count();
-            let terrain = bytemuck::cast_slice::<u8, f32>(copy_depth)
-                .iter()
-                .filter(|d| **d < 1.0)
-                .count();
-            println!(
-                "{name} into {color_format:?}: copy vs pass: worst channel difference {worst}, \
-                 {depths_differ} depths differ, {terrain} terrain pixels"
-            );
-            // Rgba8Unorm: the very bytes; the sRGB twin: the pass's decode +
-            // encode round trip may move a byte by one.
-            let allowed = u8::from(color_format == F::Rgba8UnormSrgb);
-            assert!(worst <= allowed, "{name} {color_format:?}: {worst}");
-            assert_eq!(depths_differ, 0, "{name} {color_format:?}");
-            assert!(terrain > (W * H / 4) as usize, "{name}: {terrain}");
+            let (pass_color, pass_depth) = &images[0];
+            for (i, (color, depth)) in images.iter().enumerate().skip(1) {
+                // 8-bit targets: the very bytes (the sRGB twin: the pass's
+                // decode + encode round trip may move a byte by one); the
+                // float target: within one half-float step.
+                let worst = match color_format {
+                    F::Rgba16Float => bytemuck::cast_slice::<u8, u16>(pass_color)
+                        .iter()
+                        .zip(bytemuck::cast_slice::<u8, u16>(color))
+                        .map(|(a, b)| a.abs_diff(*b))
+                        .max()
+                        .unwrap_or(0),
+                    _ => pass_color
+                        .iter()
+                        .zip(color)
+                        .map(|(a, b)| u16::from(a.abs_diff(*b)))
+                        .max()
+                        .unwrap_or(0),
+                };
+                let depths_differ = pass_depth
+                    .chunks_exact(4)
+                    .zip(depth.chunks_exact(4))
+                    .filter(|(a, b)| a != b)
+                    .count();
+                let terrain = bytemuck::cast_slice::<u8, f32>(depth)
+                    .iter()
+                    .filter(|d| **d < 1.0)
+                    .count();
+                println!(
+                    "{name} into {color_format:?} (road {i}) vs the pass: worst channel difference \
+                     {worst}, {depths_differ} depths differ, {terrain} terrain pixels"
+                );
+                let allowed = u16::from(color_format != F::Rgba8Unorm);
+                assert!(
+                    worst <= allowed,
+                    "{name} {color_format:?} road {i}: {worst}"
+                );
+                assert_eq!(depths_differ, 0, "{name} {color_format:?} road {i}");
+                assert!(terrain > (W * H / 4) as usize, "{name}: {terrain}");
+            }
         }
         tested += 1;
     }
     assert!(tested >= 2, "{tested} methods ran");
+    if gpu.caps.compute {
+        // The roads this test exists for were taken at least once each.
+        for wanted in [
+            |c: &ColorRoute, _: &DepthRoute| matches!(c, ColorRoute::Storage { linear: false }),
+            |c: &ColorRoute, _: &DepthRoute| matches!(c, ColorRoute::Storage { linear: true }),
+            |_: &ColorRoute, d: &DepthRoute| *d == DepthRoute::FromImage,
+        ] {
+            assert!(roads.iter().any(|(_, c, d)| wanted(c, d)), "{roads:?}");
+        }
+    }
 }
