@@ -4,15 +4,15 @@
 //!
 //! How: the active method renders into Strata's own targets as in
 //! [`Renderer::render_frame`], then, in the same command buffer, the
-//! frame's colour and depth reach the caller's views: by two texture copies
-//! where the targets allow (colour `Rgba8Unorm` or `Rgba8UnormSrgb`, depth
-//! `Depth32Float`, one sample, both made with `COPY_DST`, and an adapter
-//! with depth copies; GL has none), else by one full-screen pass that
-//! writes colour and depth (`frag_depth`) and serves every format pair and
-//! sample count. Both store the same bytes (`tests/embed.rs`); the copies
-//! cost a fraction of the pass. A multisampled target receives each pixel's
-//! colour and depth in all its samples (the terrain is drawn at one sample
-//! per pixel; your objects get the MSAA).
+//! frame's colour and depth reach the caller's views by the cheapest road
+//! the targets allow ([`crate::composite_split`]): colour by a compute
+//! dispatch into a storage texture or by a copy, depth by a depth-only pass
+//! from a compute method's depth image or by a copy; else by one
+//! full-screen pass that writes colour and depth (`frag_depth`) and serves
+//! every format pair and sample count. Every road stores the same bytes
+//! (`tests/embed.rs`). A multisampled target receives each pixel's colour
+//! and depth in all its samples (the terrain is drawn at one sample per
+//! pixel; your objects get the MSAA).
 //!
 //! # Depth convention
 //! The depth written is Strata's depth-buffer value under
