@@ -10,15 +10,20 @@ use crate::results::*;
 use crate::session::{GridMode, Session, color_image};
 use crate::stats::summarize;
 use crate::video;
+mod records;
+mod references;
+
 pub use crate::warm::{INCREMENTAL_BUDGET_TEXELS, WarmUp, build_frames, ms, warm_up};
 use anyhow::Context;
 use indicatif::{ProgressBar, ProgressStyle};
+pub(crate) use records::adapter_info;
+use records::save_edit_pictures;
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
 use strata_camera::Camera;
 use strata_level::{EditSite, ViewSpec, World};
-use strata_reference::{ColorImage, Reference, ReferenceCache, Tracer};
+use strata_reference::{ColorImage, Reference};
 use strata_render::paged::{LevelPages, PAGED_METHODS, PageSource, PagedOptions};
 use strata_render::{Gpu, MethodSettings, Renderer, TerrainColors};
 
@@ -573,92 +578,6 @@ impl Plan {
         Ok(())
     }
 
-    /// The reference of every view (from the cache when present) and its picture.
-    fn references(&self, session: &mut Session) -> anyhow::Result<Vec<Reference>> {
-        let cache = ReferenceCache::new(&self.opts.cache_dir);
-        let bar = ProgressBar::new(self.cameras.len() as u64);
-        bar.set_style(
-            ProgressStyle::with_template(
-                "{bar:30} {pos}/{len} references  {msg}  [{elapsed_precise}]",
-            )
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-        );
-        // Hash the level once (64 MiB for a Fostral-sized map) and build the
-        // tracer's pyramid only if some view misses the cache.
-        let level = &self.world.level;
-        let hash = level.content_hash();
-        let mut tracer: Option<Tracer> = None;
-        let mut out = Vec::new();
-        for (v, (view, camera)) in self.opts.views.iter().zip(&self.cameras).enumerate() {
-            bar.set_message(view.name.clone());
-            let r = match cache.get(&hash, camera) {
-                Some(r) => r,
-                None => {
-                    let tracer = tracer.get_or_insert_with(|| Tracer::new(level));
-                    cache
-                        .get_or_compute_traced(tracer, &hash, camera)
-                        .with_context(|| format!("reference of view `{}`", view.name))?
-                        .0
-                }
-            };
-            session.save_reference(v, &view.name, &r, camera.far)?;
-            out.push(r);
-            bar.inc(1);
-        }
-        bar.finish_and_clear();
-        Ok(out)
-    }
-
-    /// The CPU colour reference of every view (cached), saved as the
-    /// view's colour picture; `None` per view where ꟻLIP is not measured
-    /// (the browser build).
-    fn color_references(&self, session: &mut Session) -> anyhow::Result<Vec<Option<ColorImage>>> {
-        #[cfg(not(target_arch = "wasm32"))]
-        {
-            let cache = ReferenceCache::new(&self.opts.cache_dir);
-            let level = &self.world.level;
-            let hash = level.content_hash();
-            let ramps = strata_reference::TerrainRamps::from_world(&self.world);
-            let bar = ProgressBar::new(self.cameras.len() as u64);
-            bar.set_style(
-                ProgressStyle::with_template(
-                    "{bar:30} {pos}/{len} colour references  {msg}  [{elapsed_precise}]",
-                )
-                .unwrap_or_else(|_| ProgressStyle::default_bar()),
-            );
-            let mut tracer: Option<Tracer> = None;
-            let mut out = Vec::new();
-            for (v, (view, camera)) in self.opts.views.iter().zip(&self.cameras).enumerate() {
-                bar.set_message(view.name.clone());
-                let c = match cache.get_color(&hash, camera, &ramps, self.opts.shadows) {
-                    Some(c) => c,
-                    None => {
-                        let tracer = tracer.get_or_insert_with(|| Tracer::new(level));
-                        cache
-                            .get_or_compute_color(tracer, &hash, camera, &ramps, self.opts.shadows)
-                            .with_context(|| format!("colour reference of view `{}`", view.name))?
-                            .0
-                    }
-                };
-                session.save_picture(
-                    GridMode::Flip,
-                    (v, 0),
-                    &format!("{}-color-reference", view.name),
-                    crate::flip::reference_picture(&c),
-                )?;
-                out.push(Some(c));
-                bar.inc(1);
-            }
-            bar.finish_and_clear();
-            Ok(out)
-        }
-        #[cfg(target_arch = "wasm32")]
-        {
-            let _ = session;
-            Ok(vec![None; self.cameras.len()])
-        }
-    }
-
     /// Every view of method `m`, one renderer.
     #[allow(clippy::too_many_arguments)]
     fn method_column(
@@ -972,41 +891,4 @@ pub struct Measured {
     /// The renderer's setup (paid once per method, recorded on each row).
     pub setup_ms: f64,
     pub retained: strata_render::RetainedBytes,
-}
-
-/// Save the edit camera's before and first-post-edit pictures and record them.
-fn save_edit_pictures(
-    session: &mut Session,
-    camera: &Camera,
-    label: &str,
-    pictures: edits::EditPictures,
-) -> anyhow::Result<()> {
-    let save = |when: &str, rgba: Vec<u8>| -> anyhow::Result<String> {
-        let rel = format!("cells/edit-{}-{when}.png", file_part(label));
-        let path = session.out.join(&rel);
-        color_image(camera.width, camera.height, rgba)?
-            .save(&path)
-            .with_context(|| format!("writing {}", path.display()))?;
-        Ok(rel)
-    };
-    let before = save("before", pictures.before)?;
-    let after = save("after", pictures.after)?;
-    session.results.edit_images.push(EditImages {
-        method: label.to_string(),
-        before,
-        after,
-    });
-    Ok(())
-}
-
-/// The results file's record of the adapter `gpu` runs on.
-pub(crate) fn adapter_info(gpu: &strata_render::Gpu) -> AdapterInfo {
-    AdapterInfo {
-        name: gpu.report.name.clone(),
-        backend: gpu.report.backend.clone(),
-        driver: format!("{} {}", gpu.report.driver, gpu.report.driver_info)
-            .trim()
-            .to_string(),
-        timestamps: gpu.report.timestamps,
-    }
 }
