@@ -228,7 +228,7 @@ pub async fn streamed_world(
     };
     let (w, h) = remote.size();
     let (x, y) = chosen.map_or((w as f32 / 2.0, h as f32 / 2.0), |v| (v.x, v.y));
-    crate::stream::prefetch_at(&origin, &remote, x, y).await?;
+    crate::stream::prefetch_at(&origin, &remote, x, y, pump.timeout_ms).await?;
     web_sys::console::log_1(
         &format!(
             "strata: streaming {} ({w}x{h}): the first view's chunk in {:.0} ms",
@@ -247,7 +247,9 @@ pub async fn streamed_world(
     let behind = remote.clone();
     wasm_bindgen_futures::spawn_local(async move {
         for (x, y) in spots {
-            if let Err(e) = crate::stream::prefetch_at(&origin, &behind, x, y).await {
+            if let Err(e) =
+                crate::stream::prefetch_at(&origin, &behind, x, y, pump.timeout_ms).await
+            {
                 web_sys::console::warn_1(&format!("strata: {e:#}").into());
             }
         }

@@ -460,12 +460,14 @@ fn get(object: &JsValue, key: &str) -> JsValue {
 }
 
 /// Fetch the chunk under map point (`x`, `y`) now and keep it (the viewer
-/// places a view's camera on the column there).
+/// places a view's camera on the column there), on the page's thread;
+/// aborted after `timeout_ms`.
 pub async fn prefetch_at(
     origin: &Origin,
     remote: &RemoteChunks,
     x: f32,
     y: f32,
+    timeout_ms: u32,
 ) -> anyhow::Result<()> {
     let (w, h) = remote.size();
     let cx = (x.floor() as i64).rem_euclid(i64::from(w)) as u32 / PAGE;
@@ -481,7 +483,9 @@ pub async fn prefetch_at(
     };
     let controller =
         web_sys::AbortController::new().map_err(|_| anyhow::anyhow!("no AbortController"))?;
-    let read = read_page(origin, page, &controller.signal(), TIMEOUT_MS).await;
+    let timer = abort_after(Abort::Here(controller.clone()), timeout_ms);
+    let read = read_page(origin, page, &controller.signal(), timeout_ms).await;
+    clear_timer(timer);
     let planes = read
         .planes
         .map_err(|e| anyhow::anyhow!("the chunk under a view: {e}"))?;
@@ -763,17 +767,7 @@ fn pump(remote: &Arc<RemoteChunks>, origin: &Origin, options: PumpOptions) {
             }
         };
         // The timeout aborts through the same path as a cancel.
-        let on_timeout = {
-            let abort = abort.clone();
-            Closure::once_into_js(move || abort.abort())
-        };
-        let timer = web_sys::window().and_then(|w| {
-            w.set_timeout_with_callback_and_timeout_and_arguments_0(
-                on_timeout.unchecked_ref(),
-                i32::try_from(options.timeout_ms).unwrap_or(i32::MAX),
-            )
-            .ok()
-        });
+        let timer = abort_after(abort.clone(), options.timeout_ms);
         FLIGHTS.with(|f| f.borrow_mut().insert(page.id, Flight { seq, abort, timer }));
     }
 }
@@ -783,6 +777,18 @@ fn page_url() -> String {
     web_sys::window()
         .and_then(|w| w.location().href().ok())
         .unwrap_or_default()
+}
+
+/// A timer that aborts a read after `ms` (its handle, to clear).
+fn abort_after(abort: Abort, ms: u32) -> Option<i32> {
+    let on_timeout = Closure::once_into_js(move || abort.abort());
+    web_sys::window().and_then(|w| {
+        w.set_timeout_with_callback_and_timeout_and_arguments_0(
+            on_timeout.unchecked_ref(),
+            i32::try_from(ms).unwrap_or(i32::MAX),
+        )
+        .ok()
+    })
 }
 
 fn clear_timer(timer: Option<i32>) {
