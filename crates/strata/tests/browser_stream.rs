@@ -350,19 +350,27 @@ fn a_large_store_streams_within_webgpus_default_limits() {
 }
 
 /// The built-in world as `strata serve` offers it (the URL it prints, the
-/// page's default canvas): the first frame within the bound.
+/// page's default canvas): the first frame within the bound, with the
+/// chunks decoded in workers (the default) and on the page's thread.
 async fn built_in_world(client: &Client, url: &str) {
-    // A page left behind may still have frames queued in the GPU process
-    // (SwiftShader's, on the CPU), which would delay this one's.
-    client.goto("about:blank").await.expect("a blank page");
-    tokio::time::sleep(Duration::from_secs(2)).await;
-    let (s, _) = open(client, &format!("{url}/?level=/level/")).await;
-    let first_ms = s["page_to_first_frame_ms"].as_f64().unwrap_or(f64::NAN);
-    eprintln!(
-        "the built-in world streamed: first frame {first_ms:.0} ms after navigation (metadata and first chunk {:.0} ms), drawing {}",
-        s["stream_open_ms"].as_f64().unwrap_or(f64::NAN),
-        s["active"]
-    );
+    for query in ["&decode=main", ""] {
+        // A page left behind may still have frames queued in the GPU process
+        // (SwiftShader's, on the CPU), which would delay this one's.
+        client.goto("about:blank").await.expect("a blank page");
+        tokio::time::sleep(Duration::from_secs(2)).await;
+        let (s, _) = open(client, &format!("{url}/?level=/level/{query}")).await;
+        let first_ms = s["page_to_first_frame_ms"].as_f64().unwrap_or(f64::NAN);
+        eprintln!(
+            "the built-in world streamed{query}: first frame {first_ms:.0} ms after navigation (metadata and first chunk {:.0} ms), drawing {}; decoder {}",
+            s["stream_open_ms"].as_f64().unwrap_or(f64::NAN),
+            s["active"],
+            s["stream_decoder"]
+        );
+        built_in_first_frame(&s, first_ms);
+    }
+}
+
+fn built_in_first_frame(s: &Value, first_ms: f64) {
     assert_eq!(s["level_size"], serde_json::json!([2048, 16384]), "{s}");
     assert!(
         first_ms <= FIRST_FRAME_BOUND_MS,
@@ -644,10 +652,13 @@ fn a_server_that_stops_answering_mid_flight() {
         .as_str()
         .expect("the store's views")
         .to_string();
-    let keep: HashSet<(u64, u64)> = views.lines().map(|l| view_chunk(l, size)).collect();
-    let view = views
+    let lines: Vec<&str> = views
         .lines()
-        .next()
+        .filter(|l| !l.trim().is_empty() && !l.starts_with('#'))
+        .collect();
+    let keep: HashSet<(u64, u64)> = lines.iter().map(|l| view_chunk(l, size)).collect();
+    let view = lines
+        .first()
         .and_then(|l| l.split_whitespace().next())
         .expect("a view")
         .to_string();
@@ -659,7 +670,8 @@ fn a_server_that_stops_answering_mid_flight() {
             SIZE.0, SIZE.1
         );
         let start = Instant::now();
-        let (s, _) = open(&client, &page).await;
+        open(&client, &page).await;
+        let s = run(&client, "overlay off\nframes 2", 60).await;
         let frames = s["frames"].as_u64().unwrap_or(0);
         let s = wait_for(&client, "a stalled chunk given up", 180, |s| {
             paging(s).0["read_errors"].as_u64().unwrap_or(0) > 0
