@@ -17,8 +17,8 @@
 //! dedicated Web Workers (`www/decode-worker.js`): each instantiates this
 //! same wasm module (compiled once, posted to it) and calls
 //! [`worker_read`]; the planes come back as transferred `ArrayBuffer`s, and
-//! an abort (cancel or timeout) is forwarded to the worker. Until a worker
-//! says it is ready, when Workers are unavailable, for a picked folder's
+//! an abort (cancel or timeout) is forwarded to the worker. The workers
+//! start once the first frame is drawn; until a worker says it is ready, when Workers are unavailable, for a picked folder's
 //! files, or with `?decode=main`, reads run on the page's thread; the page
 //! state's `stream_decoder` says where and why, with the page thread's
 //! milliseconds spent on chunk bytes.
@@ -497,7 +497,17 @@ pub async fn prefetch_at(
 /// is opened).
 pub fn start_pump(remote: Arc<RemoteChunks>, origin: Origin, options: PumpOptions) {
     match (&origin, options.workers) {
-        (Origin::Http(_), true) => start_workers(),
+        // After the first frame: the workers' start (a module instance
+        // each) would delay it on a machine of few cores (measured: 0.9 s
+        // without them, 4.0 s while two start; bench/web-stream/README.md).
+        (Origin::Http(_), true) => {
+            if POOL.with(|p| p.borrow().is_none()) {
+                decoder_info(
+                    "main thread",
+                    Some("the workers start after the first frame".into()),
+                );
+            }
+        }
         (Origin::Http(_), false) => decoder_info("main thread", Some("?decode=main".into())),
         (Origin::Picked { .. }, _) => decoder_info(
             "main thread",
@@ -702,6 +712,13 @@ fn next_worker() -> Option<(usize, web_sys::Worker)> {
 }
 
 fn pump(remote: &Arc<RemoteChunks>, origin: &Origin, options: PumpOptions) {
+    if options.workers
+        && matches!(origin, Origin::Http(_))
+        && POOL.with(|p| p.borrow().is_none())
+        && strata_viewer::web::state().contains("\"page_to_first_frame_ms\"")
+    {
+        start_workers();
+    }
     for id in remote.take_cancelled() {
         if let Some(flight) = FLIGHTS.with(|f| f.borrow_mut().remove(&id)) {
             clear_timer(flight.timer);
