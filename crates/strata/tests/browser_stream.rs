@@ -905,3 +905,23 @@ const plans = (keys) => {
         assert!(result.get("error").is_none(), "{result}");
     });
 }
+
+/// The built-in world's first frame through `strata serve`, chunks decoded
+/// in workers and on the page's thread, alternating, three times each: a
+/// measurement (`-- --ignored first_frames --nocapture`; numbers in
+/// `bench/web-stream/README.md`).
+#[test]
+#[ignore = "a measurement: run it with --ignored first_frames --nocapture"]
+fn built_in_world_first_frames() {
+    let Some((chromium, driver, bundle)) = tools() else {
+        return;
+    };
+    let _one = one_browser();
+    let (_server, url) = serve_with(&bundle, None);
+    let (_driver, driver_url) = chromedriver(&driver);
+    with_browser(&driver_url, &chromium, move |client| async move {
+        for _ in 0..3 {
+            built_in_world(&client, &url).await;
+        }
+    });
+}

@@ -60,8 +60,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     if args.level.is_none() && !args.no_level {
         args.level = Some(default_store()?);
     }
-    let server = tiny_http::Server::http(("127.0.0.1", args.port))
-        .map_err(|e| anyhow::anyhow!("cannot listen on 127.0.0.1:{}: {e}", args.port))?;
+    let server = tiny_http::Server::from_listener(listen(args.port)?, None)
+        .map_err(|e| anyhow::anyhow!("cannot serve on 127.0.0.1:{}: {e}", args.port))?;
     let port = server
         .server_addr()
         .to_ip()
@@ -94,6 +94,23 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         }
     });
     Ok(())
+}
+
+/// A socket listening on 127.0.0.1:`port` whose connections send at once
+/// (TCP_NODELAY, which accepted sockets inherit on Linux): tiny_http writes
+/// a response's headers and its body apart, and with Nagle's algorithm the
+/// body's last segment waited for the browser's delayed ACK, about 40 ms a
+/// request (bench/web-stream/README.md).
+fn listen(port: u16) -> anyhow::Result<std::net::TcpListener> {
+    use socket2::{Domain, Socket, Type};
+    let fail = |e: std::io::Error| anyhow::anyhow!("cannot listen on 127.0.0.1:{port}: {e}");
+    let socket = Socket::new(Domain::IPV4, Type::STREAM, None).map_err(fail)?;
+    socket.set_tcp_nodelay(true).map_err(fail)?;
+    socket.set_reuse_address(true).map_err(fail)?;
+    let address = std::net::SocketAddr::from(([127, 0, 0, 1], port));
+    socket.bind(&address.into()).map_err(fail)?;
+    socket.listen(128).map_err(fail)?;
+    Ok(socket.into())
 }
 
 /// The built-in world as a store, next to its native cache: written the
