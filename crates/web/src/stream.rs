@@ -498,8 +498,9 @@ pub async fn prefetch_at(
 pub fn start_pump(remote: Arc<RemoteChunks>, origin: Origin, options: PumpOptions) {
     match (&origin, options.workers) {
         // After the first frame: the workers' start (a module instance
-        // each) would delay it on a machine of few cores (measured: 0.9 s
-        // without them, 4.0 s while two start; bench/web-stream/README.md).
+        // each) competes with it for a machine of few cores (seen once at
+        // 4.0 s against 0.9 s without them, though in one browser session
+        // where later pages came later either way; bench/web-stream/README.md).
         (Origin::Http(_), true) => {
             if POOL.with(|p| p.borrow().is_none()) {
                 decoder_info(
