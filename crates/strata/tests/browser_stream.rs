@@ -65,6 +65,17 @@ struct Fixture {
     chunks: u64,
 }
 
+/// A store's `views.txt` text (its root group's `strata.views` attribute).
+fn store_views(store: &Path) -> String {
+    let root: Value =
+        serde_json::from_slice(&std::fs::read(store.join("zarr.json")).expect("zarr.json"))
+            .expect("JSON");
+    root["attributes"]["strata"]["views"]
+        .as_str()
+        .expect("the store's views")
+        .to_string()
+}
+
 /// A store's width and height from its `heights` array's shape (rows, columns).
 fn store_size(store: &Path) -> (u64, u64) {
     let meta: Value = serde_json::from_slice(
@@ -102,13 +113,7 @@ impl Fixture {
     /// The fixture over an existing `store` (its first view at `pitch`
     /// degrees, the CPU reference of it in `dir`).
     fn over(dir: PathBuf, store: PathBuf, pitch: &str) -> Self {
-        let root: Value =
-            serde_json::from_slice(&std::fs::read(store.join("zarr.json")).expect("zarr.json"))
-                .expect("JSON");
-        let views = root["attributes"]["strata"]["views"]
-            .as_str()
-            .expect("the store's views")
-            .to_string();
+        let views = store_views(&store);
         // A view that looks along the world, not down: many chunks to stream.
         let line = views
             .lines()
@@ -426,12 +431,7 @@ async fn drive(client: Client, url: String, fixture: Fixture, bundle: PathBuf) {
     // Corrupt and truncated chunks: the chunk under the view draws, every
     // other chunk fails its checks, is retried a bounded number of times,
     // then reported; the page goes on drawing.
-    let root: Value =
-        serde_json::from_slice(&std::fs::read(fixture.store.join("zarr.json")).expect("zarr.json"))
-            .expect("JSON");
-    let line = root["attributes"]["strata"]["views"]
-        .as_str()
-        .unwrap_or_default()
+    let line = store_views(&fixture.store)
         .lines()
         .find(|l| l.split_whitespace().next() == Some(fixture.view.as_str()))
         .unwrap_or_default()
@@ -646,13 +646,7 @@ fn a_server_that_stops_answering_mid_flight() {
         .status()
         .expect("running strata generate");
     assert!(status.success(), "strata generate --to store failed");
-    let root: Value =
-        serde_json::from_slice(&std::fs::read(store.join("zarr.json")).expect("zarr.json"))
-            .expect("JSON");
-    let views = root["attributes"]["strata"]["views"]
-        .as_str()
-        .expect("the store's views")
-        .to_string();
+    let views = store_views(&store);
     let lines: Vec<&str> = views
         .lines()
         .filter(|l| !l.trim().is_empty() && !l.starts_with('#'))

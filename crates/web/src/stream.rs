@@ -442,6 +442,21 @@ struct Sent {
     page: PageRef,
 }
 
+impl Sent {
+    /// The worker's answer `read` to read `seq`.
+    fn finish(self, seq: u64, read: Read) {
+        finish(
+            &self.remote,
+            &self.origin,
+            self.options,
+            self.page,
+            seq,
+            read,
+            true,
+        );
+    }
+}
+
 /// The decoding workers: each is used once it said it is ready.
 struct Pool {
     workers: Vec<web_sys::Worker>,
@@ -645,15 +660,7 @@ fn from_worker(index: usize, data: &JsValue) {
                 bytes: get(data, "bytes").as_f64().unwrap_or(0.0) as u64,
                 ms: clock_ms() - start,
             };
-            finish(
-                &sent.remote,
-                &sent.origin,
-                sent.options,
-                sent.page,
-                seq,
-                read,
-                true,
-            );
+            sent.finish(seq, read);
         }
     }
 }
@@ -684,15 +691,7 @@ fn worker_failed(index: usize, why: &str) {
             bytes: 0,
             ms: 0.0,
         };
-        finish(
-            &sent.remote,
-            &sent.origin,
-            sent.options,
-            sent.page,
-            seq,
-            read,
-            true,
-        );
+        sent.finish(seq, read);
     }
 }
 
