@@ -287,9 +287,12 @@ async fn stream_and_compare(client: &Client, url: &str, fixture: &Fixture, query
     let pages = thread["pages"].as_u64().unwrap_or(0);
     let in_workers = thread["in_workers"].as_u64().unwrap_or(0);
     let ms = thread["ms"].as_f64().unwrap_or(f64::NAN);
+    let workers_ms = thread["workers_ms"].as_f64().unwrap_or(f64::NAN);
+    let here = pages - in_workers;
     eprintln!(
-        "chunks decoded: {decoder}; the page's thread spent {ms:.1} ms on {pages} pages' bytes ({:.3} ms a page; {in_workers} read in workers)",
-        ms / pages.max(1) as f64
+        "chunks decoded: {decoder}; the page's thread spent {ms:.1} ms on {pages} pages' bytes: {:.3} ms a page read there ({here}), {:.3} ms a page read in a worker ({in_workers})",
+        (ms - workers_ms) / here.max(1) as f64,
+        workers_ms / in_workers.max(1) as f64
     );
     assert!(pages > 0, "{thread}");
     if query.contains("decode=main") {

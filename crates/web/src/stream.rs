@@ -388,7 +388,7 @@ thread_local! {
     /// Numbers the reads, so a cancelled one's late answer is told apart.
     static SEQ: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
     /// The page thread's work on the pump's reads.
-    static PAGE_THREAD: std::cell::Cell<PageThread> = const { std::cell::Cell::new(PageThread { ms: 0.0, pages: 0, in_workers: 0 }) };
+    static PAGE_THREAD: std::cell::Cell<PageThread> = const { std::cell::Cell::new(PageThread { ms: 0.0, pages: 0, in_workers: 0, workers_ms: 0.0 }) };
 }
 
 /// The page thread's work on the pump's reads (delivered ones), in the
@@ -402,6 +402,8 @@ struct PageThread {
     pages: u64,
     /// Of those, read and decoded in a worker.
     in_workers: u64,
+    /// Of `ms`, what the reads in workers cost (their planes copied in).
+    workers_ms: f64,
 }
 
 /// A read in flight.
@@ -843,6 +845,9 @@ fn finish(
         t.ms += read.ms;
         t.pages += 1;
         t.in_workers += u64::from(in_worker);
+        if in_worker {
+            t.workers_ms += read.ms;
+        }
         PAGE_THREAD.set(t);
     });
     remote.deliver(page, read.planes, read.bytes);
@@ -899,6 +904,11 @@ fn publish(remote: &RemoteChunks) {
     let t = PAGE_THREAD.with(|t| t.get());
     strata_viewer::web::set_page_info(
         "stream_page_thread",
-        serde_json::json!({ "ms": t.ms, "pages": t.pages, "in_workers": t.in_workers }),
+        serde_json::json!({
+            "ms": t.ms,
+            "pages": t.pages,
+            "in_workers": t.in_workers,
+            "workers_ms": t.workers_ms,
+        }),
     );
 }
