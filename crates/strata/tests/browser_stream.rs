@@ -65,6 +65,25 @@ struct Fixture {
     chunks: u64,
 }
 
+/// Three more frames drawn (past `frames`), no error in the page: its state.
+async fn still_drawing(client: &Client, frames: u64) -> Value {
+    let s = run(client, "frames 3", 120).await;
+    assert!(
+        s["frames"].as_u64().unwrap_or(0) >= frames + 3,
+        "the page stopped drawing: {s}"
+    );
+    assert!(s.get("error").is_none(), "{s}");
+    s
+}
+
+/// An empty directory `name` under the tests' scratch directory.
+fn fresh_dir(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("the fixture directory");
+    dir
+}
+
 /// A store's `views.txt` text (its root group's `strata.views` attribute).
 fn store_views(store: &Path) -> String {
     let root: Value =
@@ -91,9 +110,7 @@ fn store_size(store: &Path) -> (u64, u64) {
 
 impl Fixture {
     fn new() -> Self {
-        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("browser-stream");
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).expect("the fixture directory");
+        let dir = fresh_dir("browser-stream");
         let store = dir.join("store");
         let start = Instant::now();
         let status = Command::new(env!("CARGO_BIN_EXE_strata"))
@@ -353,9 +370,7 @@ fn a_large_store_streams_within_webgpus_default_limits() {
         return;
     };
     let _one = one_browser();
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("browser-stream-large");
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("the fixture directory");
+    let dir = fresh_dir("browser-stream-large");
     let start = Instant::now();
     // A view at -30°: the generated worlds' first 0° view can stand on a
     // ridge whose 160x100 picture is all sky.
@@ -490,12 +505,7 @@ async fn drive(client: Client, url: String, fixture: Fixture, bundle: PathBuf) {
         log.contains("failed to read"),
         "no message in the log: {log}"
     );
-    let s = run(&client, "frames 3", 120).await;
-    assert!(
-        s["frames"].as_u64().unwrap_or(0) >= frames + 3,
-        "the page stopped drawing: {s}"
-    );
-    assert!(s.get("error").is_none(), "{s}");
+    let s = still_drawing(&client, frames).await;
     assert!(
         paging(&s).0["resident_pages"].as_u64().unwrap_or(0) >= 1,
         "the good chunk is not resident: {}",
@@ -651,9 +661,7 @@ fn a_server_that_stops_answering_mid_flight() {
         return;
     };
     let _one = one_browser();
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("browser-stream-stall");
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("the fixture directory");
+    let dir = fresh_dir("browser-stream-stall");
     let store = dir.join("store");
     let size = (512u64, 4096u64);
     let status = Command::new(env!("CARGO_BIN_EXE_strata"))
@@ -745,12 +753,7 @@ fn a_server_that_stops_answering_mid_flight() {
         // Given up: no more requests for it, and the page goes on drawing
         // what it has.
         tokio::time::sleep(Duration::from_millis(3 * STALL_TIMEOUT_MS + 1000)).await;
-        let s = run(&client, "frames 3", 120).await;
-        assert!(
-            s["frames"].as_u64().unwrap_or(0) >= frames + 3,
-            "the page stopped drawing: {s}"
-        );
-        assert!(s.get("error").is_none(), "{s}");
+        let s = still_drawing(&client, frames).await;
         assert_eq!(
             count(&path),
             tries,
