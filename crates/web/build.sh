@@ -29,6 +29,6 @@ mkdir -p "$out"
 # (`WebAssembly.Table.set(): Argument 1 is invalid`), so it is not used.
 wasm-bindgen --target web --no-typescript --remove-name-section --remove-producers-section \
     --out-dir "$out/pkg" target/wasm32-unknown-unknown/release/strata_web.wasm
-cp crates/web/www/index.html "$out/"
+cp crates/web/www/index.html crates/web/www/decode-worker.js "$out/"
 wasm="$out/pkg/strata_web_bg.wasm"
 echo "bundle: $out ($(wc -c <"$wasm") bytes of wasm, $(gzip -9c "$wasm" | wc -c) gzipped)"

@@ -7,9 +7,15 @@
 //! URL parameters: `backend=webgl2`, `method=NAME`, `view=NAME`,
 //! `NAME=SETTING` (a method's knobs: `voxel=X,Y,Z`, `ray=64`, `mesh=0.75`),
 //! `size=WxH` (canvas), `scale=F` (picture / canvas), `world=WxH` and
-//! `seed=N` (the generated world), `level=URL` (a world directory),
-//! `compare` (the quick protocol instead of the viewer; `views=A,B` to
-//! narrow it; see `compare.rs`).
+//! `seed=N` (the generated world), `level=URL` (a world directory or a
+//! store; a store's chunks with `chunk-timeout-ms=MS` and `decode=main` to
+//! decode them on the page's thread, see `stream.rs`), `compare` (the
+//! quick protocol instead of the viewer; `views=A,B` to narrow it; see
+//! `compare.rs`).
+//!
+//! The same module also runs in the page's decoding workers
+//! (`www/decode-worker.js`), where there is no window: there it only
+//! answers [`stream::worker_read`].
 #![cfg(target_arch = "wasm32")]
 
 mod compare;
@@ -19,9 +25,16 @@ mod stream;
 
 use wasm_bindgen::prelude::*;
 
-/// Runs when the module is instantiated.
+/// Runs when the module is instantiated (in a decoding worker: nothing
+/// but a panic hook that logs).
 #[wasm_bindgen(start)]
 pub fn main() {
+    if web_sys::window().is_none() {
+        std::panic::set_hook(Box::new(|info| {
+            web_sys::console::error_1(&format!("Strata's decoding worker panicked: {info}").into());
+        }));
+        return;
+    }
     std::panic::set_hook(Box::new(|info| {
         strata_viewer::web::show_error(&format!("Strata panicked: {info}"));
     }));

@@ -31,6 +31,8 @@ pub struct Params {
     pub methods: Option<String>,
     /// `?gpu-budget=MIB`: the paged terrain's GPU budget for a streamed store.
     pub gpu_budget: u64,
+    /// `?chunk-timeout-ms=MS`, `?decode=worker|main`: how a streamed store's chunks are read.
+    pub pump: crate::stream::PumpOptions,
 }
 
 /// The paged terrain's GPU budget in the page by default: well inside
@@ -97,8 +99,10 @@ impl Params {
                 .with_context(|| format!("?gpu-budget={text}: MiB, 1..=4096"))?,
             None => DEFAULT_GPU_BUDGET_MIB,
         } << 20;
+        let pump = crate::stream::PumpOptions::parse(get("chunk-timeout-ms"), get("decode"))?;
         Ok(Params {
             gpu_budget,
+            pump,
             backend,
             settings,
             method: get("method").unwrap_or_else(|| "ray".into()),
@@ -186,8 +190,13 @@ async fn start_streamed(
             streamed.origin.label()
         );
     }
-    let (world, paged) =
-        streamed_world(streamed, params.view.as_deref(), params.gpu_budget).await?;
+    let (world, paged) = streamed_world(
+        streamed,
+        params.view.as_deref(),
+        params.gpu_budget,
+        params.pump,
+    )
+    .await?;
     strata_viewer::web::set_page_info("stream_open_ms", (now_ms() - start).into());
     watch_folder_picker();
     progress(None, "");
@@ -203,6 +212,7 @@ pub async fn streamed_world(
     streamed: crate::stream::Streamed,
     view: Option<&str>,
     gpu_budget: u64,
+    pump: crate::stream::PumpOptions,
 ) -> anyhow::Result<(World, strata_viewer::paged::PagedWorld)> {
     use strata_render::paged::PageSource;
     use strata_viewer::paged::{Base, EditedPages, PagedWorld};
@@ -218,7 +228,7 @@ pub async fn streamed_world(
     };
     let (w, h) = remote.size();
     let (x, y) = chosen.map_or((w as f32 / 2.0, h as f32 / 2.0), |v| (v.x, v.y));
-    crate::stream::prefetch_at(&origin, &remote, x, y).await?;
+    crate::stream::prefetch_at(&origin, &remote, x, y, pump.timeout_ms).await?;
     web_sys::console::log_1(
         &format!(
             "strata: streaming {} ({w}x{h}): the first view's chunk in {:.0} ms",
@@ -228,7 +238,7 @@ pub async fn streamed_world(
         .into(),
     );
     strata_viewer::web::set_page_info("world_size", serde_json::json!([w, h]));
-    crate::stream::start_pump(remote.clone(), origin.clone());
+    crate::stream::start_pump(remote.clone(), origin.clone(), pump);
     // The other views' chunks (a view switch places its camera there).
     let mut spots: Vec<(f32, f32)> = world.views.iter().map(|v| (v.x, v.y)).collect();
     if let Some(edit) = &world.edit {
@@ -237,7 +247,9 @@ pub async fn streamed_world(
     let behind = remote.clone();
     wasm_bindgen_futures::spawn_local(async move {
         for (x, y) in spots {
-            if let Err(e) = crate::stream::prefetch_at(&origin, &behind, x, y).await {
+            if let Err(e) =
+                crate::stream::prefetch_at(&origin, &behind, x, y, pump.timeout_ms).await
+            {
                 web_sys::console::warn_1(&format!("strata: {e:#}").into());
             }
         }
@@ -451,9 +463,14 @@ async fn picked_store(
     let Some(streamed) = crate::stream::open(origin).await? else {
         return Ok(None);
     };
-    streamed_world(streamed, None, DEFAULT_GPU_BUDGET_MIB << 20)
-        .await
-        .map(Some)
+    streamed_world(
+        streamed,
+        None,
+        DEFAULT_GPU_BUDGET_MIB << 20,
+        crate::stream::PumpOptions::default(),
+    )
+    .await
+    .map(Some)
 }
 
 async fn load_world(folder: &Folder) -> anyhow::Result<World> {

@@ -5,13 +5,23 @@
 //!
 //! The seam to the renderer is [`RemoteChunks`]: the streamer tells it each
 //! frame what it wants; the pump here, run by a timer (no threads in the
-//! page), starts `fetch`es up to the cap ([`MOST_IN_FLIGHT`] pages, two
-//! requests each), aborts those the camera no longer wants
-//! (`AbortController`), gives up on a request after [`TIMEOUT_MS`], and
-//! hands the decoded planes (gzip inflated and the crc32c checked on the
-//! page's thread: `strata_store::http`) or the error back. The paged
-//! terrain retries a failed chunk `read_tries` times, then reports it;
-//! resident pages keep drawing.
+//! page), starts reads up to the cap ([`MOST_IN_FLIGHT`] pages, two
+//! requests each), aborts those the camera no longer wants, gives up on a
+//! request after the chunk timeout ([`TIMEOUT_MS`], `?chunk-timeout-ms=`),
+//! and hands the decoded planes or the error back. The paged terrain
+//! retries a failed chunk `read_tries` times, then reports it; resident
+//! pages keep drawing.
+//!
+//! Where the browser allows, a read (the `fetch`es, the crc32c check and
+//! the gzip inflate: `strata_store::http`) runs in one of [`WORKERS`]
+//! dedicated Web Workers (`www/decode-worker.js`): each instantiates this
+//! same wasm module (compiled once, posted to it) and calls
+//! [`worker_read`]; the planes come back as transferred `ArrayBuffer`s, and
+//! an abort (cancel or timeout) is forwarded to the worker. The workers
+//! start once the first frame is drawn; until a worker says it is ready, when Workers are unavailable, for a picked folder's
+//! files, or with `?decode=main`, reads run on the page's thread; the page
+//! state's `stream_decoder` says where and why, with the page thread's
+//! milliseconds spent on chunk bytes.
 
 use crate::page::fetch;
 use anyhow::Context;
@@ -30,8 +40,53 @@ use wasm_bindgen_futures::JsFuture;
 /// Pages fetched at a time (two requests each: Chromium opens six
 /// connections per host over HTTP/1.1).
 pub const MOST_IN_FLIGHT: usize = 3;
-/// A request not answered in this time is aborted and counts as failed.
-pub const TIMEOUT_MS: i32 = 10_000;
+/// A request not answered in this time is aborted and counts as failed
+/// (default of `?chunk-timeout-ms=`).
+pub const TIMEOUT_MS: u32 = 10_000;
+/// Decoding workers (each fetches and decodes whole pages).
+pub const WORKERS: usize = 2;
+/// The worker script, next to `index.html` (`crates/web/build.sh` copies it).
+const WORKER_SCRIPT: &str = "decode-worker.js";
+
+/// How the pump reads: `?chunk-timeout-ms=MS`, `?decode=worker|main`.
+#[derive(Clone, Copy, Debug)]
+pub struct PumpOptions {
+    /// A request not answered in this time is aborted and counts as failed.
+    pub timeout_ms: u32,
+    /// Decode in Web Workers where the browser allows (else on the page's thread).
+    pub workers: bool,
+}
+
+impl Default for PumpOptions {
+    fn default() -> Self {
+        PumpOptions {
+            timeout_ms: TIMEOUT_MS,
+            workers: true,
+        }
+    }
+}
+
+impl PumpOptions {
+    /// From the URL's `chunk-timeout-ms` and `decode` values.
+    pub fn parse(timeout: Option<String>, decode: Option<String>) -> anyhow::Result<Self> {
+        let mut options = PumpOptions::default();
+        if let Some(text) = timeout {
+            options.timeout_ms = text
+                .parse::<u32>()
+                .ok()
+                .filter(|ms| (100..=600_000).contains(ms))
+                .ok_or_else(|| {
+                    anyhow::anyhow!("?chunk-timeout-ms={text}: milliseconds, 100..=600000")
+                })?;
+        }
+        match decode.as_deref() {
+            None | Some("worker") => {}
+            Some("main") => options.workers = false,
+            Some(other) => anyhow::bail!("?decode={other}: use worker (default) or main"),
+        }
+        Ok(options)
+    }
+}
 /// Decoded chunks kept on the CPU (128 KiB each): the column under a view,
 /// a dig's chunks.
 const CACHE_PAGES: usize = 64;
@@ -58,18 +113,22 @@ impl Origin {
         }
     }
 
-    /// Object `key` (`heights/c/3/1`), `None` when there is none.
+    /// Object `key` (`heights/c/3/1`), `None` when there is none (still
+    /// in JS memory: the caller copies it in).
     async fn get(
         &self,
         key: &str,
-        signal: Option<&web_sys::AbortSignal>,
-    ) -> Result<Option<Vec<u8>>, String> {
+        signal: Option<(&web_sys::AbortSignal, u32)>,
+    ) -> Result<Option<js_sys::Uint8Array>, String> {
         match self {
             Origin::Http(base) => {
                 let url = format!("{base}{key}");
                 match signal {
-                    Some(signal) => fetch_with(&url, signal).await,
-                    None => fetch(&url).await.map_err(|e| format!("{e:#}")),
+                    Some((signal, timeout_ms)) => fetch_with(&url, signal, timeout_ms).await,
+                    None => fetch(&url)
+                        .await
+                        .map(|b| b.map(|b| js_sys::Uint8Array::from(&b[..])))
+                        .map_err(|e| format!("{e:#}")),
                 }
             }
             Origin::Picked { files, .. } => {
@@ -79,7 +138,7 @@ impl Origin {
                 let buffer = JsFuture::from(file.array_buffer())
                     .await
                     .map_err(|e| format!("reading {key}: {}", describe(&e)))?;
-                Ok(Some(js_sys::Uint8Array::new(&buffer).to_vec()))
+                Ok(Some(js_sys::Uint8Array::new(&buffer)))
             }
         }
     }
@@ -88,8 +147,8 @@ impl Origin {
     async fn required(
         &self,
         key: &str,
-        signal: Option<&web_sys::AbortSignal>,
-    ) -> Result<Vec<u8>, String> {
+        signal: Option<(&web_sys::AbortSignal, u32)>,
+    ) -> Result<js_sys::Uint8Array, String> {
         self.get(key, signal).await?.ok_or_else(|| match self {
             Origin::Http(base) => format!("GET {base}{key}: 404 Not Found (a store needs it)"),
             Origin::Picked { name, .. } => {
@@ -116,6 +175,7 @@ pub async fn open(origin: Origin) -> anyhow::Result<Option<Streamed>> {
     else {
         return Ok(None);
     };
+    let root = root.to_vec();
     let label = origin.label();
     let what = label.trim_end_matches('/');
     let attrs = http::world_attrs(what, &root)?;
@@ -134,6 +194,7 @@ pub async fn open(origin: Origin) -> anyhow::Result<Option<Streamed>> {
             origin
                 .required(&name, None)
                 .await
+                .map(|b| b.to_vec())
                 .map_err(anyhow::Error::msg)
         }
     };
@@ -171,12 +232,22 @@ pub async fn open(origin: Origin) -> anyhow::Result<Option<Streamed>> {
     }))
 }
 
+/// A page read: its planes or why not, the bytes fetched, and the
+/// milliseconds of the reading thread spent on them (copies, checksums,
+/// inflating; not the waits).
+struct Read {
+    planes: Result<strata_render::paged::Planes, String>,
+    bytes: u64,
+    ms: f64,
+}
+
 /// The chunk objects of page `page`, fetched and decoded.
 async fn read_page(
     origin: &Origin,
     page: PageRef,
     signal: &web_sys::AbortSignal,
-) -> (Result<strata_render::paged::Planes, String>, u64) {
+    timeout_ms: u32,
+) -> Read {
     let cell = [u64::from(page.cy), u64::from(page.cx)];
     let prefix = if page.level == 0 {
         String::new()
@@ -184,12 +255,13 @@ async fn read_page(
         format!("lod/{}/", page.level)
     };
     let mut bytes = 0u64;
+    let mut ms = 0.0;
     // Both requests go out before either is awaited.
     let requests = [HEIGHTS, METAS].map(|name| {
         let key = format!("{prefix}{}", http::chunk_key(name, &cell));
         let request = {
             let (origin, key) = (origin.clone(), key.clone());
-            async move { origin.required(&key, Some(signal)).await }
+            async move { origin.required(&key, Some((signal, timeout_ms))).await }
         };
         (name, format!("{}{key}", origin.label()), request)
     });
@@ -197,34 +269,66 @@ async fn read_page(
     for (name, url, request) in requests {
         let raw = match request.await {
             Ok(raw) => raw,
-            Err(e) => return (Err(e), bytes),
+            Err(e) => {
+                return Read {
+                    planes: Err(e),
+                    bytes,
+                    ms,
+                };
+            }
         };
+        let start = clock_ms();
+        let raw = raw.to_vec();
         bytes += raw.len() as u64;
         let array = format!("{prefix}{name}");
-        match http::decode_chunk(&array, &cell, &raw, (PAGE * PAGE) as usize) {
+        let decoded = http::decode_chunk(&array, &cell, &raw, (PAGE * PAGE) as usize);
+        ms += clock_ms() - start;
+        match decoded {
             Ok(plane) => planes.push(plane),
-            Err(e) => return (Err(format!("{url}: {e}")), bytes),
+            Err(e) => {
+                return Read {
+                    planes: Err(format!("{url}: {e}")),
+                    bytes,
+                    ms,
+                };
+            }
         }
     }
     let metas = planes.pop().unwrap_or_default();
     let heights = planes.pop().unwrap_or_default();
-    (Ok((heights, metas)), bytes)
+    Read {
+        planes: Ok((heights, metas)),
+        bytes,
+        ms,
+    }
 }
 
 /// GET `url` with `signal`: its bytes, `None` on 404, or why not.
-async fn fetch_with(url: &str, signal: &web_sys::AbortSignal) -> Result<Option<Vec<u8>>, String> {
-    let window = web_sys::window().ok_or("no window")?;
+/// (The page's or a worker's global `fetch`; `timeout_ms` names the
+/// timeout in the message when `signal` fired.)
+async fn fetch_with(
+    url: &str,
+    signal: &web_sys::AbortSignal,
+    timeout_ms: u32,
+) -> Result<Option<js_sys::Uint8Array>, String> {
     let init = web_sys::RequestInit::new();
     init.set_signal(Some(signal));
-    let response = JsFuture::from(window.fetch_with_str_and_init(url, &init))
-        .await
-        .map_err(|e| {
-            if signal.aborted() {
-                format!("GET {url}: no answer in {} s (aborted)", TIMEOUT_MS / 1000)
-            } else {
-                format!("GET {url}: request failed: {}", describe(&e))
-            }
-        })?;
+    let global = js_sys::global();
+    let request = if let Some(window) = global.dyn_ref::<web_sys::Window>() {
+        window.fetch_with_str_and_init(url, &init)
+    } else if let Some(worker) = global.dyn_ref::<web_sys::WorkerGlobalScope>() {
+        worker.fetch_with_str_and_init(url, &init)
+    } else {
+        return Err(format!("GET {url}: no window or worker to fetch from"));
+    };
+    let secs = f64::from(timeout_ms) / 1000.0;
+    let response = JsFuture::from(request).await.map_err(|e| {
+        if signal.aborted() {
+            format!("GET {url}: no answer in {secs} s (aborted)")
+        } else {
+            format!("GET {url}: request failed: {}", describe(&e))
+        }
+    })?;
     let response: web_sys::Response = response.dyn_into().map_err(|_| "not a response")?;
     if response.status() == 404 {
         return Ok(None);
@@ -241,15 +345,25 @@ async fn fetch_with(url: &str, signal: &web_sys::AbortSignal) -> Result<Option<V
         .map_err(|e| format!("GET {url}: no body: {}", describe(&e)))?;
     let buffer = JsFuture::from(buffer).await.map_err(|e| {
         if signal.aborted() {
-            format!(
-                "GET {url}: body cut off: no answer in {} s",
-                TIMEOUT_MS / 1000
-            )
+            format!("GET {url}: body cut off: no answer in {secs} s")
         } else {
             format!("GET {url}: reading the body failed: {}", describe(&e))
         }
     })?;
-    Ok(Some(js_sys::Uint8Array::new(&buffer).to_vec()))
+    Ok(Some(js_sys::Uint8Array::new(&buffer)))
+}
+
+/// `performance.now()` of the page or the worker (0 without one).
+fn clock_ms() -> f64 {
+    let global = js_sys::global();
+    let performance = if let Some(window) = global.dyn_ref::<web_sys::Window>() {
+        window.performance()
+    } else if let Some(worker) = global.dyn_ref::<web_sys::WorkerGlobalScope>() {
+        worker.performance()
+    } else {
+        None
+    };
+    performance.map_or(0.0, |p| p.now())
 }
 
 fn describe(e: &JsValue) -> String {
@@ -263,21 +377,114 @@ fn describe(e: &JsValue) -> String {
 }
 
 thread_local! {
-    /// The abort controllers of reads in flight, by page id.
-    static FLIGHTS: RefCell<HashMap<u32, (u64, web_sys::AbortController)>> = RefCell::new(HashMap::new());
+    /// The reads in flight, by page id.
+    static FLIGHTS: RefCell<HashMap<u32, Flight>> = RefCell::new(HashMap::new());
+    /// Reads handed to a worker, by number: what its answer is for.
+    static SENT: RefCell<HashMap<u64, Sent>> = RefCell::new(HashMap::new());
+    /// The decoding workers (created with the first streamed URL's pump).
+    static POOL: RefCell<Option<Pool>> = const { RefCell::new(None) };
     /// The pump's interval timer.
     static PUMP: std::cell::Cell<Option<i32>> = const { std::cell::Cell::new(None) };
     /// Numbers the reads, so a cancelled one's late answer is told apart.
     static SEQ: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
+    /// The page thread's work on the pump's reads.
+    static PAGE_THREAD: std::cell::Cell<PageThread> = const { std::cell::Cell::new(PageThread { ms: 0.0, pages: 0, in_workers: 0, workers_ms: 0.0 }) };
+}
+
+/// The page thread's work on the pump's reads (delivered ones), in the
+/// page state as `stream_page_thread`.
+#[derive(Clone, Copy)]
+struct PageThread {
+    /// Milliseconds spent on chunk bytes: copied in, and (read here) checked
+    /// and inflated.
+    ms: f64,
+    /// Reads delivered.
+    pages: u64,
+    /// Of those, read and decoded in a worker.
+    in_workers: u64,
+    /// Of `ms`, what the reads in workers cost (their planes copied in).
+    workers_ms: f64,
+}
+
+/// A read in flight.
+struct Flight {
+    seq: u64,
+    abort: Abort,
+    timer: Option<i32>,
+}
+
+/// How a read in flight is stopped (the camera moved on, or the timeout).
+#[derive(Clone)]
+enum Abort {
+    /// A `fetch` on the page's thread.
+    Here(web_sys::AbortController),
+    /// Read `seq` in a worker: the abort is forwarded to it.
+    Worker(web_sys::Worker, u64),
+}
+
+impl Abort {
+    fn abort(&self) {
+        match self {
+            Abort::Here(controller) => controller.abort(),
+            Abort::Worker(worker, seq) => {
+                let message = js_sys::Object::new();
+                set(&message, "kind", &"abort".into());
+                set(&message, "id", &(*seq as f64).into());
+                let _ = worker.post_message(&message);
+            }
+        }
+    }
+}
+
+/// A read handed to worker `worker`.
+struct Sent {
+    remote: Arc<RemoteChunks>,
+    origin: Origin,
+    options: PumpOptions,
+    page: PageRef,
+}
+
+impl Sent {
+    /// The worker's answer `read` to read `seq`.
+    fn finish(self, seq: u64, read: Read) {
+        finish(
+            &self.remote,
+            &self.origin,
+            self.options,
+            self.page,
+            seq,
+            read,
+            true,
+        );
+    }
+}
+
+/// The decoding workers: each is used once it said it is ready.
+struct Pool {
+    workers: Vec<web_sys::Worker>,
+    ready: Vec<bool>,
+    next: usize,
+    /// Why reads run on the page's thread now (none while a worker can take them).
+    broken: Option<String>,
+}
+
+fn set(object: &js_sys::Object, key: &str, value: &JsValue) {
+    let _ = js_sys::Reflect::set(object, &key.into(), value);
+}
+
+fn get(object: &JsValue, key: &str) -> JsValue {
+    js_sys::Reflect::get(object, &key.into()).unwrap_or(JsValue::UNDEFINED)
 }
 
 /// Fetch the chunk under map point (`x`, `y`) now and keep it (the viewer
-/// places a view's camera on the column there).
+/// places a view's camera on the column there), on the page's thread;
+/// aborted after `timeout_ms`.
 pub async fn prefetch_at(
     origin: &Origin,
     remote: &RemoteChunks,
     x: f32,
     y: f32,
+    timeout_ms: u32,
 ) -> anyhow::Result<()> {
     let (w, h) = remote.size();
     let cx = (x.floor() as i64).rem_euclid(i64::from(w)) as u32 / PAGE;
@@ -293,16 +500,39 @@ pub async fn prefetch_at(
     };
     let controller =
         web_sys::AbortController::new().map_err(|_| anyhow::anyhow!("no AbortController"))?;
-    let (planes, _) = read_page(origin, page, &controller.signal()).await;
-    let planes = planes.map_err(|e| anyhow::anyhow!("the chunk under a view: {e}"))?;
+    let timer = abort_after(Abort::Here(controller.clone()), timeout_ms);
+    let read = read_page(origin, page, &controller.signal(), timeout_ms).await;
+    clear_timer(timer);
+    let planes = read
+        .planes
+        .map_err(|e| anyhow::anyhow!("the chunk under a view: {e}"))?;
     remote.pin(0, cx, cy, planes);
     Ok(())
 }
 
 /// Run the pump for `remote` (every few milliseconds, until another store
 /// is opened).
-pub fn start_pump(remote: Arc<RemoteChunks>, origin: Origin) {
-    let tick = Closure::<dyn FnMut()>::new(move || pump(&remote, &origin));
+pub fn start_pump(remote: Arc<RemoteChunks>, origin: Origin, options: PumpOptions) {
+    match (&origin, options.workers) {
+        // After the first frame: the workers' start (a module instance
+        // each) competes with it for a machine of few cores (seen once at
+        // 4.0 s against 0.9 s without them, though in one browser session
+        // where later pages came later either way; bench/web-stream/README.md).
+        (Origin::Http(_), true) => {
+            if POOL.with(|p| p.borrow().is_none()) {
+                decoder_info(
+                    "main thread",
+                    Some("the workers start after the first frame".into()),
+                );
+            }
+        }
+        (Origin::Http(_), false) => decoder_info("main thread", Some("?decode=main".into())),
+        (Origin::Picked { .. }, _) => decoder_info(
+            "main thread",
+            Some("a picked folder's files are read on the page's thread".into()),
+        ),
+    }
+    let tick = Closure::<dyn FnMut()>::new(move || pump(&remote, &origin, options));
     let Some(window) = web_sys::window() else {
         return;
     };
@@ -318,65 +548,367 @@ pub fn start_pump(remote: Arc<RemoteChunks>, origin: Origin) {
     tick.forget();
 }
 
-fn pump(remote: &Arc<RemoteChunks>, origin: &Origin) {
+/// Where chunks are decoded, in the page state (`stream_decoder`) and the console.
+fn decoder_info(place: &str, why: Option<String>) {
+    let text = match &why {
+        Some(why) => format!("strata: chunks are decoded on the {place} ({why})"),
+        None => format!("strata: chunks are decoded in {WORKERS} Web Workers"),
+    };
+    web_sys::console::log_1(&text.into());
+    strata_viewer::web::set_page_info(
+        "stream_decoder",
+        serde_json::json!({ "where": place, "why": why }),
+    );
+}
+
+/// Start the decoding workers once (they serve every store the page opens).
+fn start_workers() {
+    if POOL.with(|p| p.borrow().is_some()) {
+        return;
+    }
+    let pool = match spawn_workers() {
+        Ok(workers) => {
+            // Reads run here until a worker says it is ready.
+            decoder_info("main thread", Some("the workers are starting".into()));
+            Pool {
+                ready: vec![false; workers.len()],
+                workers,
+                next: 0,
+                broken: None,
+            }
+        }
+        Err(why) => {
+            decoder_info("main thread", Some(why.clone()));
+            Pool {
+                workers: Vec::new(),
+                ready: Vec::new(),
+                next: 0,
+                broken: Some(why),
+            }
+        }
+    };
+    POOL.with(|p| *p.borrow_mut() = Some(pool));
+}
+
+/// [`WORKERS`] module workers running [`WORKER_SCRIPT`], each handed this
+/// wasm module (compiled once) to instantiate.
+fn spawn_workers() -> Result<Vec<web_sys::Worker>, String> {
+    let options = web_sys::WorkerOptions::new();
+    options.set_type(web_sys::WorkerType::Module);
+    let mut workers = Vec::new();
+    for index in 0..WORKERS {
+        let worker = web_sys::Worker::new_with_options(WORKER_SCRIPT, &options)
+            .map_err(|e| format!("no Web Worker: {}", describe(&e)))?;
+        let on_message = Closure::<dyn FnMut(web_sys::MessageEvent)>::new(
+            move |event: web_sys::MessageEvent| from_worker(index, &event.data()),
+        );
+        worker.set_onmessage(Some(on_message.as_ref().unchecked_ref()));
+        on_message.forget();
+        let on_error = Closure::<dyn FnMut(web_sys::Event)>::new(move |event: web_sys::Event| {
+            let message = get(&event, "message")
+                .as_string()
+                .unwrap_or_else(|| format!("{WORKER_SCRIPT} did not load"));
+            worker_failed(index, &message);
+        });
+        worker.set_onerror(Some(on_error.as_ref().unchecked_ref()));
+        on_error.forget();
+        let init = js_sys::Object::new();
+        set(&init, "kind", &"init".into());
+        set(&init, "module", &wasm_bindgen::module());
+        worker
+            .post_message(&init)
+            .map_err(|e| format!("the worker takes no module: {}", describe(&e)))?;
+        workers.push(worker);
+    }
+    Ok(workers)
+}
+
+/// A worker's message: `ready`, `failed`, or a read's answer.
+fn from_worker(index: usize, data: &JsValue) {
+    match get(data, "kind").as_string().as_deref() {
+        Some("ready") => {
+            let first = POOL.with(|p| {
+                let mut p = p.borrow_mut();
+                let Some(pool) = p.as_mut().filter(|pool| pool.broken.is_none()) else {
+                    return false;
+                };
+                let first = !pool.ready.contains(&true);
+                pool.ready[index] = true;
+                first
+            });
+            if first {
+                decoder_info("worker", None);
+            }
+        }
+        Some("failed") => {
+            let why = get(data, "error").as_string().unwrap_or_default();
+            worker_failed(index, &why);
+        }
+        _ => {
+            let seq = get(data, "id").as_f64().unwrap_or(-1.0) as u64;
+            let Some(sent) = SENT.with(|s| s.borrow_mut().remove(&seq)) else {
+                return;
+            };
+            let start = clock_ms();
+            let planes = match get(data, "error").as_string() {
+                Some(error) => Err(error),
+                None => {
+                    let plane = |key| js_sys::Uint8Array::new(&get(data, key)).to_vec();
+                    Ok((plane("heights"), plane("metas")))
+                }
+            };
+            let read = Read {
+                planes,
+                bytes: get(data, "bytes").as_f64().unwrap_or(0.0) as u64,
+                ms: clock_ms() - start,
+            };
+            sent.finish(seq, read);
+        }
+    }
+}
+
+/// Worker `index` failed (its script did not load, the module did not
+/// instantiate, or it stopped): from now on reads run on the page's thread,
+/// and those it had fail (the paged terrain retries them).
+fn worker_failed(index: usize, why: &str) {
+    let why = format!("decoding worker {index} failed: {why}");
+    let newly = POOL.with(|p| {
+        let mut p = p.borrow_mut();
+        let pool = p.as_mut()?;
+        for worker in &pool.workers {
+            worker.terminate();
+        }
+        pool.ready.iter_mut().for_each(|r| *r = false);
+        pool.broken
+            .is_none()
+            .then(|| pool.broken = Some(why.clone()))
+    });
+    if newly.is_some() {
+        decoder_info("main thread", Some(why.clone()));
+    }
+    let lost: Vec<(u64, Sent)> = SENT.with(|s| s.borrow_mut().drain().collect());
+    for (seq, sent) in lost {
+        let read = Read {
+            planes: Err(why.clone()),
+            bytes: 0,
+            ms: 0.0,
+        };
+        sent.finish(seq, read);
+    }
+}
+
+/// A ready worker to hand the next read to (round robin), if any.
+fn next_worker() -> Option<(usize, web_sys::Worker)> {
+    POOL.with(|p| {
+        let mut p = p.borrow_mut();
+        let pool = p.as_mut().filter(|pool| pool.broken.is_none())?;
+        let n = pool.workers.len();
+        (0..n).find_map(|k| {
+            let i = (pool.next + k) % n;
+            pool.ready[i].then(|| {
+                pool.next = i + 1;
+                (i, pool.workers[i].clone())
+            })
+        })
+    })
+}
+
+fn pump(remote: &Arc<RemoteChunks>, origin: &Origin, options: PumpOptions) {
+    if options.workers
+        && matches!(origin, Origin::Http(_))
+        && POOL.with(|p| p.borrow().is_none())
+        && strata_viewer::web::state().contains("\"page_to_first_frame_ms\"")
+    {
+        start_workers();
+    }
     for id in remote.take_cancelled() {
-        if let Some((_, c)) = FLIGHTS.with(|f| f.borrow_mut().remove(&id)) {
-            c.abort();
+        if let Some(flight) = FLIGHTS.with(|f| f.borrow_mut().remove(&id)) {
+            clear_timer(flight.timer);
+            flight.abort.abort();
         }
     }
     for page in remote.start() {
-        let Ok(controller) = web_sys::AbortController::new() else {
-            remote.deliver(page, Err("no AbortController".into()), 0);
-            continue;
-        };
-        let signal = controller.signal();
-        // The timeout aborts through the same controller.
-        let on_timeout = {
-            let c = controller.clone();
-            Closure::once_into_js(move || c.abort())
-        };
-        let timer = web_sys::window().and_then(|w| {
-            w.set_timeout_with_callback_and_timeout_and_arguments_0(
-                on_timeout.unchecked_ref(),
-                TIMEOUT_MS,
-            )
-            .ok()
-        });
         let seq = SEQ.with(|s| {
             s.set(s.get() + 1);
             s.get()
         });
-        FLIGHTS.with(|f| f.borrow_mut().insert(page.id, (seq, controller)));
-        let (remote, origin) = (remote.clone(), origin.clone());
-        wasm_bindgen_futures::spawn_local(async move {
-            let (planes, bytes) = read_page(&origin, page, &signal).await;
-            if let (Some(w), Some(t)) = (web_sys::window(), timer) {
-                w.clear_timeout_with_handle(t);
-            }
-            // A read cancelled meanwhile (its controller gone, or the page
-            // asked for again by a newer read) says nothing.
-            let ours = FLIGHTS.with(|f| {
-                let mut f = f.borrow_mut();
-                let ours = f.get(&page.id).is_some_and(|(s, _)| *s == seq);
-                if ours {
-                    f.remove(&page.id);
+        let worker = match origin {
+            Origin::Http(base) if options.workers => next_worker().map(|w| (w, base)),
+            _ => None,
+        };
+        let abort = match worker {
+            Some(((index, worker), base)) => {
+                let message = js_sys::Object::new();
+                set(&message, "kind", &"read".into());
+                set(&message, "id", &(seq as f64).into());
+                // Absolute: the worker resolves against its script's URL.
+                let base = web_sys::Url::new_with_base(base, &page_url())
+                    .map_or_else(|_| base.clone(), |u| u.href());
+                set(&message, "base", &base.into());
+                set(&message, "level", &page.level.into());
+                set(&message, "cx", &page.cx.into());
+                set(&message, "cy", &page.cy.into());
+                set(&message, "timeoutMs", &options.timeout_ms.into());
+                if let Err(e) = worker.post_message(&message) {
+                    worker_failed(index, &describe(&e));
+                    remote.deliver(
+                        page,
+                        Err(format!("the decoding worker failed: {}", describe(&e))),
+                        0,
+                    );
+                    continue;
                 }
-                ours
-            });
-            if !ours {
-                return;
+                SENT.with(|s| {
+                    s.borrow_mut().insert(
+                        seq,
+                        Sent {
+                            remote: remote.clone(),
+                            origin: origin.clone(),
+                            options,
+                            page,
+                        },
+                    )
+                });
+                Abort::Worker(worker, seq)
             }
-            remote.deliver(page, planes, bytes);
-            publish(&remote);
-            // Start the next read at once rather than at the next tick.
-            pump(&remote, &origin);
-        });
+            None => {
+                let Ok(controller) = web_sys::AbortController::new() else {
+                    remote.deliver(page, Err("no AbortController".into()), 0);
+                    continue;
+                };
+                let signal = controller.signal();
+                let (remote, origin) = (remote.clone(), origin.clone());
+                wasm_bindgen_futures::spawn_local(async move {
+                    let read = read_page(&origin, page, &signal, options.timeout_ms).await;
+                    finish(&remote, &origin, options, page, seq, read, false);
+                });
+                Abort::Here(controller)
+            }
+        };
+        // The timeout aborts through the same path as a cancel.
+        let timer = abort_after(abort.clone(), options.timeout_ms);
+        FLIGHTS.with(|f| f.borrow_mut().insert(page.id, Flight { seq, abort, timer }));
     }
 }
 
-/// The stream's numbers in the page state (`stream`).
+/// The page's own URL (`location.href`).
+fn page_url() -> String {
+    web_sys::window()
+        .and_then(|w| w.location().href().ok())
+        .unwrap_or_default()
+}
+
+/// A timer that aborts a read after `ms` (its handle, to clear).
+fn abort_after(abort: Abort, ms: u32) -> Option<i32> {
+    let on_timeout = Closure::once_into_js(move || abort.abort());
+    web_sys::window().and_then(|w| {
+        w.set_timeout_with_callback_and_timeout_and_arguments_0(
+            on_timeout.unchecked_ref(),
+            i32::try_from(ms).unwrap_or(i32::MAX),
+        )
+        .ok()
+    })
+}
+
+fn clear_timer(timer: Option<i32>) {
+    if let (Some(w), Some(t)) = (web_sys::window(), timer) {
+        w.clear_timeout_with_handle(t);
+    }
+}
+
+/// Read `seq` of `page` ended (`in_worker`: its bytes checked and inflated
+/// there): delivered unless it was cancelled meanwhile (its flight gone,
+/// or the page asked for again by a newer read); then the next reads start.
+fn finish(
+    remote: &Arc<RemoteChunks>,
+    origin: &Origin,
+    options: PumpOptions,
+    page: PageRef,
+    seq: u64,
+    read: Read,
+    in_worker: bool,
+) {
+    let flight = FLIGHTS.with(|f| {
+        let mut f = f.borrow_mut();
+        if f.get(&page.id).is_some_and(|flight| flight.seq == seq) {
+            f.remove(&page.id)
+        } else {
+            None
+        }
+    });
+    let Some(flight) = flight else {
+        return;
+    };
+    clear_timer(flight.timer);
+    PAGE_THREAD.with(|t| {
+        let mut t = t.get();
+        t.ms += read.ms;
+        t.pages += 1;
+        t.in_workers += u64::from(in_worker);
+        if in_worker {
+            t.workers_ms += read.ms;
+        }
+        PAGE_THREAD.set(t);
+    });
+    remote.deliver(page, read.planes, read.bytes);
+    publish(remote);
+    // Start the next read at once rather than at the next tick.
+    pump(remote, origin, options);
+}
+
+/// Read page (`cx`, `cy`) of `level` of the store at `base` in a worker
+/// (`www/decode-worker.js` calls it): `{heights, metas, bytes}` (the planes
+/// as `Uint8Array`s of their own, to transfer) or `{error, bytes}`.
+#[wasm_bindgen(js_name = strataWorkerRead)]
+pub async fn worker_read(
+    base: String,
+    level: u32,
+    cx: u32,
+    cy: u32,
+    timeout_ms: u32,
+    signal: web_sys::AbortSignal,
+) -> JsValue {
+    let page = PageRef {
+        id: 0,
+        level,
+        cx,
+        cy,
+    };
+    let read = read_page(&Origin::Http(base), page, &signal, timeout_ms).await;
+    let answer = js_sys::Object::new();
+    set(&answer, "bytes", &(read.bytes as f64).into());
+    match read.planes {
+        Ok((heights, metas)) => {
+            set(
+                &answer,
+                "heights",
+                &js_sys::Uint8Array::from(&heights[..]).into(),
+            );
+            set(
+                &answer,
+                "metas",
+                &js_sys::Uint8Array::from(&metas[..]).into(),
+            );
+        }
+        Err(error) => set(&answer, "error", &error.into()),
+    }
+    answer.into()
+}
+
+/// The stream's numbers in the page state (`stream`; `stream_decoder`'s
+/// page-thread time).
 fn publish(remote: &RemoteChunks) {
     if let Ok(value) = serde_json::to_value(remote.stats()) {
         strata_viewer::web::set_page_info("stream", value);
     }
+    let t = PAGE_THREAD.with(|t| t.get());
+    strata_viewer::web::set_page_info(
+        "stream_page_thread",
+        serde_json::json!({
+            "ms": t.ms,
+            "pages": t.pages,
+            "in_workers": t.in_workers,
+            "workers_ms": t.workers_ms,
+        }),
+    );
 }
