@@ -42,6 +42,10 @@ pub struct Args {
     /// texels, 1 .. 4 tiles of 4, 16, 64, 256 texels; the GPU's: 3).
     #[arg(long, value_parser = clap::value_parser!(u32).range(0..=4))]
     start_level: Option<u32>,
+    /// Try another traversal on paper: no beam pre-pass (camera rays start
+    /// at the near plane, as `ray-exact` with `STRATA_EXACT_BEAM=off`).
+    #[arg(long)]
+    no_beam: bool,
 }
 
 #[derive(Serialize)]
@@ -62,6 +66,11 @@ struct Report {
     /// Means over the views.
     mean_bytes: f64,
     mean_march_iterations: f64,
+    /// The beams' iterations over the pixels (each tile's beam shared by its
+    /// 64 pixels).
+    mean_beam_iterations_per_pixel: f64,
+    mean_march_warp_iterations: f64,
+    mean_shadow_iterations: f64,
     mean_shadow_rays: f64,
 }
 
@@ -113,6 +122,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     replay.traversal = Traversal {
         climb: args.climb,
         start: args.start_level.or(Traversal::GPU.start),
+        beam: !args.no_beam,
     };
     let shape = LevelShape::of(&world.level);
     let mut out = std::io::stdout().lock();
@@ -136,6 +146,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                 frame.pyramid_bytes_touched as f64 / 1e6,
             )?;
             for (name, pass) in [
+                ("beam", &frame.beam),
                 ("march", &frame.march),
                 ("shadow", &frame.shadow),
                 ("shade", &frame.shade),
@@ -158,6 +169,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         shadows: !args.no_shadows,
         mean_bytes: mean(&|c| c.bytes as f64),
         mean_march_iterations: mean(&|c| c.frame.march.iterations.mean),
+        mean_beam_iterations_per_pixel: mean(&|c| {
+            c.frame.beam.iterations.total as f64 / c.frame.march.rays.max(1) as f64
+        }),
+        mean_march_warp_iterations: mean(&|c| c.frame.march.warp_iterations),
+        mean_shadow_iterations: mean(&|c| c.frame.shadow.iterations.mean),
         mean_shadow_rays: mean(&|c| c.frame.shadow.rays as f64),
         views: counts,
     };
@@ -167,11 +183,15 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     } else {
         writeln!(
             out,
-            "mean over {} views: {:.2} MB a frame, {:.1} march iterations a pixel, {:.0} shadow rays",
+            "mean over {} views: {:.2} MB a frame, {:.2} march iterations a pixel ({:.2} a warp) \
+             + {:.3} beam iterations a pixel, {:.0} shadow rays of {:.2} iterations",
             report.views.len(),
             report.mean_bytes / 1e6,
             report.mean_march_iterations,
+            report.mean_march_warp_iterations,
+            report.mean_beam_iterations_per_pixel,
             report.mean_shadow_rays,
+            report.mean_shadow_iterations,
         )?;
     }
     Ok(())

@@ -136,11 +136,13 @@ pub(super) fn march_group(
     levels: &Levels,
     stats: &wgpu::Buffer,
     depth: Option<&DepthCopy>,
+    beam: Option<&super::beam::Beam>,
 ) -> wgpu::BindGroup {
     let mut entries = core_bindings(params, levels, stats);
     if let Some(depth) = depth {
         entries.extend(depth.bindings(shared, 3));
     }
+    entries.extend(beam.map(super::beam::Beam::entry));
     shared.device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("ray-exact"),
         layout,
@@ -164,16 +166,20 @@ pub(super) fn exact_pipeline(
     } else {
         super::START_LEVEL
     };
+    let mut constants = vec![
+        ("EXACT_CLIMB", f64::from(options.climb)),
+        ("EXACT_LOG_RATIO", f64::from(options.log_ratio)),
+        ("EXACT_START_LEVEL", f64::from(start)),
+    ];
+    if super::beam::reads_beam(levels, shader) {
+        constants.push(("EXACT_BEAM", f64::from(u8::from(options.beam))));
+    }
     super::super::common::compute_pipeline_with_constants(
         shared,
         label,
         &levels.shader(shader),
         layout,
         entry,
-        &[
-            ("EXACT_CLIMB", f64::from(options.climb)),
-            ("EXACT_LOG_RATIO", f64::from(options.log_ratio)),
-            ("EXACT_START_LEVEL", f64::from(start)),
-        ],
+        &constants,
     )
 }

@@ -3,6 +3,7 @@
 //! those, then a pass shades (`ray_exact_deferred.wgsl`; the why and the
 //! numbers are in the parent module's docs).
 
+use super::beam::Beam;
 use super::bindings::Levels;
 use super::bindings::{buffer_entry, core_bindings, core_entries, exact_pipeline};
 use crate::frame::{Shared, storage_texture_entry, storage_texture_entry_with, texture_2d};
@@ -80,6 +81,7 @@ impl Deferred {
         stats: &wgpu::Buffer,
         marks: &ShadowMarks,
         depth: &DepthCopy,
+        beam: Option<&Beam>,
         options: ExactOptions,
     ) -> anyhow::Result<Self> {
         let device = &shared.device;
@@ -96,6 +98,7 @@ impl Deferred {
                 wgpu::BufferBindingType::Storage { read_only: false },
             ));
         }
+        entries.extend(beam.map(|_| super::beam::layout_entry()));
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("ray-exact deferred"),
             entries: &entries,
@@ -121,6 +124,7 @@ impl Deferred {
             (params, levels, stats, marks),
             depth,
             &hits,
+            beam,
         );
         Ok(Deferred {
             march,
@@ -137,6 +141,7 @@ impl Deferred {
         (params, levels, stats, marks): (&wgpu::Buffer, &Levels, &wgpu::Buffer, &ShadowMarks),
         depth: &DepthCopy,
         hits: &wgpu::TextureView,
+        beam: Option<&Beam>,
     ) -> wgpu::BindGroup {
         let mut entries = core_bindings(params, levels, stats);
         entries.extend(depth.bindings(shared, 3));
@@ -150,6 +155,7 @@ impl Deferred {
                 resource: buffer.as_entire_binding(),
             });
         }
+        entries.extend(beam.map(Beam::entry));
         shared.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("ray-exact deferred"),
             layout,

@@ -130,6 +130,8 @@ pub struct RayExact {
     layout: wgpu::BindGroupLayout,
     group: wgpu::BindGroup,
     variant: Variant,
+    /// The beam pre-pass (compute over the whole map).
+    beam: Option<Beam>,
     shadow: Option<ExactShadow>,
     /// The pyramid update was recorded this frame (before the shadow map).
     updated: Cell<bool>,
@@ -257,14 +259,28 @@ fn build_on(
     } else {
         None
     };
+    let beam = if compute && !levels.is_paged() {
+        Some(Beam::new(shared, (&params, &levels, &stats), options)?)
+    } else {
+        None
+    };
     if compute {
         entries.extend(DepthCopy::layout_entries(3));
     }
+    entries.extend(beam.as_ref().map(|_| beam::layout_entry()));
     let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some(name),
         entries: &entries,
     });
-    let group = march_group(shared, &layout, &params, &levels, &stats, depth.as_ref());
+    let group = march_group(
+        shared,
+        &layout,
+        &params,
+        &levels,
+        &stats,
+        depth.as_ref(),
+        beam.as_ref(),
+    );
     let pipeline_layout = shared.pipeline_layout(name, &[&layout]);
     let variant = match depth {
         Some(depth) => Variant::Compute {
@@ -280,7 +296,14 @@ fn build_on(
             mode: options.depth,
             deferred: if deferred_frame {
                 Some(Box::new(Deferred::new(
-                    shared, &params, &levels, &stats, &marks, &depth, options,
+                    shared,
+                    &params,
+                    &levels,
+                    &stats,
+                    &marks,
+                    &depth,
+                    beam.as_ref(),
+                    options,
                 )?))
             } else {
                 None
@@ -313,6 +336,7 @@ fn build_on(
         layout,
         group,
         variant,
+        beam,
         shadow,
         updated: Cell::new(false),
         device: device.clone(),
@@ -528,10 +552,14 @@ impl Method for RayExact {
         } = &mut self.variant
         {
             depth.resize(shared);
+            if let Some(beam) = &mut self.beam {
+                beam.resize(shared, (&self.params, &self.levels, &self.stats));
+            }
+            let beam = self.beam.as_ref();
             if let Some(d) = deferred {
                 d.hits = hits_image(shared);
                 let buffers = (&self.params, &self.levels, &self.stats, &self.marks);
-                d.group = Deferred::group(shared, &d.layout, buffers, depth, &d.hits);
+                d.group = Deferred::group(shared, &d.layout, buffers, depth, &d.hits, beam);
             }
             self.group = march_group(
                 shared,
@@ -540,6 +568,7 @@ impl Method for RayExact {
                 &self.levels,
                 &self.stats,
                 Some(depth),
+                beam,
             );
         }
         Ok(())
@@ -610,6 +639,9 @@ impl Method for RayExact {
                 mode,
                 deferred,
             } => {
+                if let Some(beam) = &self.beam {
+                    beam.record(shared, frame, encoder);
+                }
                 match (deferred, self.shadow_due.replace(false)) {
                     (Some(d), true) => {
                         let label = "ray-exact march";
@@ -666,7 +698,7 @@ impl Method for RayExact {
             } => {
                 // The hit image: 4 bytes per pixel, as the depth image.
                 let hits = deferred.as_ref().map_or(0, |_| depth.bytes());
-                depth.bytes() + hits + self.marks.bytes()
+                depth.bytes() + hits + self.marks.bytes() + self.beam.as_ref().map_or(0, Beam::bytes)
             }
             Variant::Fragment(_) => self.marks.bytes(),
         };
@@ -707,12 +739,14 @@ impl Drop for RayExact {
     }
 }
 
+mod beam;
 mod bindings;
 mod deferred;
 pub mod replay;
 use crate::paged::PagedTerrain;
 pub use bindings::Levels;
 use bindings::{buffer_entry, core_bindings, core_entries, exact_pipeline, march_group};
+use beam::Beam;
 use deferred::{Deferred, MARK_BLOCK, ShadowMarks, hits_image};
 
 #[cfg(test)]

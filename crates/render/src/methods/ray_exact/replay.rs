@@ -56,6 +56,29 @@ pub struct MarchCount {
     pub climbs: u32,
 }
 
+/// Side of a beam's square pixel tile (`BEAM_TILE` in `ray_exact_beam.wgsl`:
+/// the march's 8x8 workgroup).
+pub const BEAM_TILE: u32 = 8;
+/// Most iterations of one beam (`BEAM_CAP`).
+pub const BEAM_CAP: u32 = 128;
+/// A beam's first interval moves its rays this far (`BEAM_FIRST_STEP`).
+const BEAM_FIRST_STEP: f32 = 4.0;
+/// The beam box's margin for f32 rounding, absolute and relative to its
+/// coordinates (`BEAM_MARGIN`, `BEAM_MARGIN_RELATIVE`).
+const BEAM_MARGIN: f32 = 0.0625;
+const BEAM_MARGIN_RELATIVE: f32 = 1.0e-5;
+
+/// What one beam did.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BeamCount {
+    /// Where its rays start.
+    pub t: f32,
+    /// Search iterations.
+    pub iterations: u32,
+    /// Pyramid words read.
+    pub pyramid_reads: u32,
+}
+
 /// Traversal knobs to try on paper; [`Traversal::GPU`] is what the compute
 /// pipelines run.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -66,6 +89,10 @@ pub struct Traversal {
     /// The visited level (0 = texels, top = 256-texel tiles) camera and
     /// shadow rays start at (`None`: the top).
     pub start: Option<u32>,
+    /// Camera rays start where their 8x8-pixel tile's beam first may meet
+    /// the ground (`cs_exact_beam`, [`Replay::beam`]), else at the near
+    /// plane.
+    pub beam: bool,
 }
 
 impl Traversal {
@@ -73,12 +100,14 @@ impl Traversal {
     pub const GPU: Traversal = Traversal {
         climb: 1,
         start: Some(super::START_LEVEL / LOG_RATIO),
+        beam: true,
     };
 
     /// Starting at the 256-texel tiles (the GPU's before `START_LEVEL`).
     pub const FROM_TOP: Traversal = Traversal {
         climb: 1,
         start: None,
+        beam: false,
     };
 }
 
@@ -308,13 +337,119 @@ impl<'a> Replay<'a> {
     /// `exact_pixel_hit` of `ray_exact_pixel.wgsl` (the eye's tile as base):
     /// the ray and what its march did.
     pub fn pixel(&mut self, g: &Globals, px: f32, py: f32) -> (Vec3, MarchCount) {
+        self.pixel_from(g, px, py, f32::NEG_INFINITY)
+    }
+
+    /// `exact_pixel_hit_from`: the march of pixel (px, py) from no earlier
+    /// than `start` (its tile's beam, [`Replay::tile_beam`]).
+    pub fn pixel_from(&mut self, g: &Globals, px: f32, py: f32, start: f32) -> (Vec3, MarchCount) {
         let eye = Vec3::from_slice(&g.eye[..3]);
         let d = camera_ray(g, px, py);
         let focal = g.eye[3];
         let (a, b) = exact_clip(eye, d, g.forward[3] / focal, g.right[3] / focal);
         let base = exact_base(eye.truncate());
         let o = (eye.truncate() - base.as_vec2()).extend(eye.z);
-        (d, self.march(o, base, d, a, b))
+        (d, self.march(o, base, d, a.max(start), b))
+    }
+
+    /// `exact_beam` of `ray_exact_beam.wgsl`: the least t at which a ray
+    /// o + t d, d in the convex hull of `d`, may meet a solid point, searched
+    /// over [t0, t1] (t1 when none may), and what the search did. Each
+    /// iteration bounds the hull's points over [t, t2] by the box of the
+    /// corner rays' points at t and t2 (a point o + s d with s in [t, t2]
+    /// and d = sum l_i d_i is sum l_i (o + s d_i), and o + s d_i lies between
+    /// o + t d_i and o + t2 d_i), widened by a margin for f32 rounding, and
+    /// compares its lowest altitude with the highest column top of the 2x2
+    /// pyramid tiles, one level, that hold its xy extent: above it, nothing in
+    /// [t, t2] is solid (every solid point of a column is at or below its top).
+    pub fn beam(&mut self, o: Vec3, base: IVec2, d: [Vec3; 4], t0: f32, t1: f32) -> BeamCount {
+        let top = self.top;
+        let ratio = LOG_RATIO;
+        let reach = d
+            .iter()
+            .map(|v| v.abs().max_element())
+            .fold(0.0f32, f32::max);
+        let boxed = |t: f32| {
+            let p = d.map(|v| o + v * t);
+            (
+                p[0].min(p[1]).min(p[2].min(p[3])),
+                p[0].max(p[1]).max(p[2].max(p[3])),
+            )
+        };
+        let mut r = BeamCount {
+            t: t0,
+            ..BeamCount::default()
+        };
+        if reach == 0.0 {
+            return r;
+        }
+        let mut t = t0;
+        let mut dt = BEAM_FIRST_STEP / reach;
+        let mut a = boxed(t);
+        while t < t1 && r.iterations < BEAM_CAP {
+            r.iterations += 1;
+            let t2 = (t + dt).min(t1);
+            let b = boxed(t2);
+            let (lo, hi) = (a.0.min(b.0), a.1.max(b.1));
+            let m = BEAM_MARGIN + BEAM_MARGIN_RELATIVE * lo.abs().max(hi.abs()).max_element();
+            let (lo, hi) = (lo - Vec3::splat(m), hi + Vec3::splat(m));
+            let mut clear = lo.z > MAX_ALTITUDE;
+            if !clear {
+                let ext = (hi.x - lo.x).max(hi.y - lo.y);
+                let mut shift = ratio;
+                while shift < top && ((1u32 << shift) as f32) < ext {
+                    shift += ratio;
+                }
+                let size = (1u32 << shift) as f32;
+                if size >= ext {
+                    let inv = 1.0 / size;
+                    let tiles = base >> shift as i32;
+                    let c0 = (lo.truncate() * inv).floor().as_ivec2() + tiles;
+                    let c1 = (hi.truncate() * inv).floor().as_ivec2() + tiles;
+                    r.pyramid_reads += 4;
+                    let h = self
+                        .maxmip(shift, c0.x, c0.y)
+                        .max(self.maxmip(shift, c1.x, c0.y))
+                        .max(self.maxmip(shift, c0.x, c1.y).max(self.maxmip(shift, c1.x, c1.y)));
+                    clear = lo.z > h;
+                }
+            }
+            if clear {
+                t = t2;
+                a = b;
+                dt *= 2.0;
+            } else if dt * reach <= (a.1.x - a.0.x).max(a.1.y - a.0.y) + 1.0 {
+                break;
+            } else {
+                dt *= 0.5;
+            }
+        }
+        r.t = t;
+        r
+    }
+
+    /// `cs_exact_beam` of `ray_exact_beam.wgsl`: the beam of the
+    /// [`BEAM_TILE`]-pixel square tile (tx, ty), through its corner pixels'
+    /// centres (every pixel's ray is a convex combination of theirs:
+    /// `camera_ray` is affine in the pixel).
+    pub fn tile_beam(&mut self, g: &Globals, tx: u32, ty: u32) -> BeamCount {
+        let (w, h) = (g.screen[0] as u32, g.screen[1] as u32);
+        let (x0, y0) = (tx * BEAM_TILE, ty * BEAM_TILE);
+        let xa = x0 as f32 + 0.5;
+        let ya = y0 as f32 + 0.5;
+        let xb = (x0 + BEAM_TILE).min(w) as f32 - 0.5;
+        let yb = (y0 + BEAM_TILE).min(h) as f32 - 0.5;
+        let d = [
+            camera_ray(g, xa, ya),
+            camera_ray(g, xb, ya),
+            camera_ray(g, xa, yb),
+            camera_ray(g, xb, yb),
+        ];
+        let eye = Vec3::from_slice(&g.eye[..3]);
+        let focal = g.eye[3];
+        let base = exact_base(eye.truncate());
+        let o = (eye.truncate() - base.as_vec2()).extend(eye.z);
+        self.beam(o, base, d, g.forward[3] / focal, g.right[3] / focal)
     }
 
     /// `cast_texel` of `ray_exact_shadow.wgsl`: shadow texel (i, j).
@@ -407,6 +542,8 @@ pub struct FrameCount {
     pub size: [u32; 2],
     /// Pixels whose ray hit.
     pub hits: u64,
+    /// The beams (one ray per 8x8-pixel tile; empty without them).
+    pub beam: PassCount,
     /// The camera march.
     pub march: PassCount,
     /// The shadow casts of the stamped blocks (empty with shadows off).
@@ -428,7 +565,7 @@ pub struct FrameCount {
 impl FrameCount {
     /// Bytes read and written by the three passes together.
     pub fn bytes(&self) -> u64 {
-        [self.march, self.shadow, self.shade]
+        [self.beam, self.march, self.shadow, self.shade]
             .iter()
             .map(|p| p.bytes_read + p.bytes_written)
             .sum()
@@ -525,6 +662,18 @@ fn shadow_taps(g: &Globals, p: Vec3, c: &strata_level::model::Column, d: Vec3) -
     4
 }
 
+/// Warps of 8x8 workgroups over a w x h grid of invocations: 8x4 each, as
+/// indices into the grid's row-major order.
+fn warps_of(w: u32, h: u32) -> impl Iterator<Item = Vec<usize>> {
+    (0..h.div_ceil(4)).flat_map(move |wy| {
+        (0..w.div_ceil(8)).map(move |wx| {
+            (wy * 4..(wy * 4 + 4).min(h))
+                .flat_map(|y| (wx * 8..(wx * 8 + 8).min(w)).map(move |x| (y * w + x) as usize))
+                .collect()
+        })
+    })
+}
+
 /// Replay `ray-exact`'s deferred frame for globals `g` (shadows as `g` says).
 pub fn replay_frame(replay: &mut Replay<'_>, g: &Globals) -> FrameCount {
     replay.terrain_touched.clear();
@@ -536,9 +685,36 @@ pub fn replay_frame(replay: &mut Replay<'_>, g: &Globals) -> FrameCount {
     let mut hits = Vec::new();
     let mut stamped = vec![false; ((side / MARK_BLOCK as u32).pow(2)) as usize];
     let mut listed = Vec::new();
+    // The beams: one per 8x8 tile, one thread each, in 8x8 workgroups of
+    // tiles (a warp: 8x4 tiles).
+    let tiles = (w.div_ceil(BEAM_TILE), h.div_ceil(BEAM_TILE));
+    let mut beam = PassAcc::default();
+    let mut starts = vec![f32::NEG_INFINITY; (tiles.0 * tiles.1) as usize];
+    if replay.traversal.beam {
+        for ty in 0..tiles.1 {
+            for tx in 0..tiles.0 {
+                let b = replay.tile_beam(g, tx, ty);
+                starts[(ty * tiles.0 + tx) as usize] = b.t;
+                beam.add(&MarchCount {
+                    iterations: b.iterations,
+                    pyramid_reads: b.pyramid_reads,
+                    ..MarchCount::default()
+                });
+            }
+        }
+    }
+    let beam = if replay.traversal.beam {
+        let mut p = beam.finish(warps_of(tiles.0, tiles.1));
+        // One f32 per tile.
+        p.bytes_written = u64::from(tiles.0 * tiles.1) * 4;
+        p
+    } else {
+        PassCount::default()
+    };
     for y in 0..h {
         for x in 0..w {
-            let (d, m) = replay.pixel(g, x as f32 + 0.5, y as f32 + 0.5);
+            let start = starts[((y / BEAM_TILE) * tiles.0 + x / BEAM_TILE) as usize];
+            let (d, m) = replay.pixel_from(g, x as f32 + 0.5, y as f32 + 0.5, start);
             march.add(&m);
             if let Some((t, column)) = m.hit {
                 let p = Vec3::from_slice(&g.eye[..3]) + d * t;
@@ -554,18 +730,14 @@ pub fn replay_frame(replay: &mut Replay<'_>, g: &Globals) -> FrameCount {
         }
     }
     let pixels = u64::from(w) * u64::from(h);
-    // Warps of 8x8 workgroups over the image: 8x4 pixels each.
-    let warps = (0..h.div_ceil(4)).flat_map(|wy| {
-        (0..w.div_ceil(8)).map(move |wx| {
-            (wy * 4..(wy * 4 + 4).min(h))
-                .flat_map(|y| (wx * 8..(wx * 8 + 8).min(w)).map(move |x| (y * w + x) as usize))
-                .collect()
-        })
-    });
-    let mut march = march.finish(warps);
+    let mut march = march.finish(warps_of(w, h));
     // hits (4 B each pixel), depth_io (4 B per hit), stamps and list.
     march.bytes_written =
         pixels * TEXEL_BYTES + hits.len() as u64 * TEXEL_BYTES + listed.len() as u64 * 8;
+    if replay.traversal.beam {
+        // Each pixel reads its tile's start.
+        march.bytes_read += pixels * 4;
+    }
     let most_iterations = march.iterations.max;
 
     let mut shadow = PassAcc::default();
@@ -615,6 +787,7 @@ pub fn replay_frame(replay: &mut Replay<'_>, g: &Globals) -> FrameCount {
     FrameCount {
         size: [w, h],
         hits: hits.len() as u64,
+        beam,
         march,
         shadow,
         shade,

@@ -1,0 +1,8 @@
+// Paged terrain's stand-in for `ray_exact_beam.wgsl`: no beam pre-pass (its
+// finer levels live per page, read with feedback), so every camera ray starts
+// at the near plane.
+#include "ray_exact_core.wgsl"
+
+fn exact_tile_start(id: vec2<u32>) -> f32 {
+    return -EXACT_BIG;
+}

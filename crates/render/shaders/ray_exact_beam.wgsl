@@ -1,0 +1,165 @@
+// `ray-exact`'s beam pre-pass (issue 36, item 1): one invocation per 8x8-pixel
+// tile marches the beam that holds the tile's 64 camera rays through the
+// pyramid and writes the least t at which any of them may meet a solid point;
+// the march (`exact_pixel_hit_from`) then starts each ray of the tile there
+// instead of at the near plane. The CPU twin is `replay.rs::Replay::beam`
+// (`strata exact-counts` counts both).
+//
+// Why no ray of the tile is solid before the start (so its march, from the
+// start, finds the hit the march from the near plane finds):
+// - `camera_ray` is affine in the pixel, so every pixel's direction d is a
+//   convex combination sum l_i d_i of the four corner pixels' (l_i >= 0,
+//   sum 1), and the rays share the eye o and the parameter t (t * focal is the
+//   view depth).
+// - For s in [t, t2]: o + s d = sum l_i (o + s d_i), and o + s d_i lies on the
+//   segment from o + t d_i to o + t2 d_i: every point of every ray of the tile
+//   over [t, t2] is in the convex hull of those eight points, so in their
+//   bounding box.
+// - The box, widened by a margin for f32 rounding, spans at most 2x2 tiles
+//   of the level whose tile is at least its xy extent. Every solid point of
+//   a column lies at or below its top, and the pyramid holds the highest top
+//   of each tile: when the box's lowest altitude is above the four tiles'
+//   maxima (or above 255), no point of [t, t2] of any ray of the tile is
+//   solid.
+// - The search only moves t past such intervals, so the start is at or
+//   before every ray's first solid point; a ray's march from it skips only
+//   empty space (its first column is entered at the start instead of its
+//   side, where nothing is solid). Tested: `the_beam_never_passes_a_hit`
+//   (the replay) and `depth_and_shadow_variants_agree...` (the GPU images,
+//   beam on and off, bit for bit).
+//
+// The search: intervals [t, t + dt] double while clear and halve where not,
+// until an interval that is not clear moves the rays no further than the
+// beam is wide (plus a texel); at most `BEAM_CAP` iterations (the start
+// stays where it got: still safe).
+
+#include "frame.wgsl"
+#include "ray_exact_core.wgsl"
+
+// Where each tile's rays start (`cs_exact_beam` writes; the march reads).
+@group(1) @binding(12) var<storage, read_write> exact_beams: array<f32>;
+
+// The march starts at its tile's beam (a pipeline constant; off: every ray
+// starts at the near plane and the buffer is not read).
+override EXACT_BEAM: bool = true;
+
+const BEAM_TILE: u32 = 8u;
+const BEAM_CAP: u32 = 128u;
+const BEAM_FIRST_STEP: f32 = 4.0;
+const BEAM_MARGIN: f32 = 0.0625;
+const BEAM_MARGIN_RELATIVE: f32 = 1.0e-5;
+
+fn beam_tiles_across() -> u32 {
+    return (u32(globals.screen.x) + BEAM_TILE - 1u) / BEAM_TILE;
+}
+
+// Where pixel `id`'s ray starts at the earliest: its tile's beam
+// (-EXACT_BIG without the beam).
+fn exact_tile_start(id: vec2<u32>) -> f32 {
+    if (!EXACT_BEAM) {
+        return -EXACT_BIG;
+    }
+    let tile = id / BEAM_TILE;
+    return exact_beams[tile.y * beam_tiles_across() + tile.x];
+}
+
+struct BeamBox {
+    lo: vec3<f32>,
+    hi: vec3<f32>,
+}
+
+// The box of the four corner rays' points at t.
+fn beam_box(o: vec3<f32>, d0: vec3<f32>, d1: vec3<f32>, d2: vec3<f32>, d3: vec3<f32>, t: f32) -> BeamBox {
+    let p0 = o + d0 * t;
+    let p1 = o + d1 * t;
+    let p2 = o + d2 * t;
+    let p3 = o + d3 * t;
+    return BeamBox(min(min(p0, p1), min(p2, p3)), max(max(p0, p1), max(p2, p3)));
+}
+
+// The least t in [t0, t1] at which a ray o + t d, d in the convex hull of
+// d0..d3, may be solid (t1 when none may); o relative to `base`.
+fn exact_beam(o: vec3<f32>, base: vec2<i32>, d0: vec3<f32>, d1: vec3<f32>, d2: vec3<f32>, d3: vec3<f32>, t0: f32, t1: f32) -> f32 {
+    let top = xparams.config.x;
+    let ratio = EXACT_LOG_RATIO;
+    let q = max(max(abs(d0), abs(d1)), max(abs(d2), abs(d3)));
+    let reach = max(max(q.x, q.y), q.z);
+    var t = t0;
+    if (reach == 0.0) {
+        return t;
+    }
+    var dt = BEAM_FIRST_STEP / reach;
+    var a = beam_box(o, d0, d1, d2, d3, t);
+    var n = 0u;
+    loop {
+        if (t >= t1 || n >= BEAM_CAP) {
+            break;
+        }
+        n = n + 1u;
+        let t2 = min(t + dt, t1);
+        let b = beam_box(o, d0, d1, d2, d3, t2);
+        var lo = min(a.lo, b.lo);
+        var hi = max(a.hi, b.hi);
+        let big = max(abs(lo), abs(hi));
+        let m = BEAM_MARGIN + BEAM_MARGIN_RELATIVE * max(max(big.x, big.y), big.z);
+        lo = lo - vec3<f32>(m);
+        hi = hi + vec3<f32>(m);
+        var clear = lo.z > MAX_ALTITUDE;
+        if (!clear) {
+            let ext = max(hi.x - lo.x, hi.y - lo.y);
+            var shift = ratio;
+            loop {
+                if (shift >= top || f32(1u << shift) >= ext) {
+                    break;
+                }
+                shift = shift + ratio;
+            }
+            let size = f32(1u << shift);
+            if (size >= ext) {
+                let inv = 1.0 / size;
+                let tiles = base >> vec2<u32>(shift);
+                let c0 = vec2<i32>(floor(lo.xy * inv)) + tiles;
+                let c1 = vec2<i32>(floor(hi.xy * inv)) + tiles;
+                let h = max(
+                    max(maxmip_get(shift, c0.x, c0.y), maxmip_get(shift, c1.x, c0.y)),
+                    max(maxmip_get(shift, c0.x, c1.y), maxmip_get(shift, c1.x, c1.y)),
+                );
+                clear = lo.z > h;
+            }
+        }
+        if (clear) {
+            t = t2;
+            a = b;
+            dt = dt * 2.0;
+        } else if (dt * reach <= max(a.hi.x - a.lo.x, a.hi.y - a.lo.y) + 1.0) {
+            break;
+        } else {
+            dt = dt * 0.5;
+        }
+    }
+    return t;
+}
+
+// One invocation per 8x8-pixel tile: its rays' start, through the corner
+// pixels' centres.
+@compute @workgroup_size(8, 8, 1)
+fn cs_exact_beam(@builtin(global_invocation_id) id: vec3<u32>) {
+    let size = vec2<u32>(globals.screen.xy);
+    let across = beam_tiles_across();
+    let down = (size.y + BEAM_TILE - 1u) / BEAM_TILE;
+    if (id.x >= across || id.y >= down) {
+        return;
+    }
+    let first = id.xy * BEAM_TILE;
+    let a = vec2<f32>(first) + vec2<f32>(0.5);
+    let b = vec2<f32>(min(first + vec2<u32>(BEAM_TILE), size)) - vec2<f32>(0.5);
+    let d0 = camera_ray(a.x, a.y);
+    let d1 = camera_ray(b.x, a.y);
+    let d2 = camera_ray(a.x, b.y);
+    let d3 = camera_ray(b.x, b.y);
+    let eye = globals.eye.xyz;
+    let focal = globals.eye.w;
+    let base = exact_base(eye.xy);
+    let o = vec3<f32>(eye.xy - vec2<f32>(base), eye.z);
+    exact_beams[id.y * across + id.x] = exact_beam(o, base, d0, d1, d2, d3, globals.forward.w / focal, globals.right.w / focal);
+}
