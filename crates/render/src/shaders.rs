@@ -122,7 +122,10 @@ pub const SOURCES: &[(&str, &str)] = &[
         "ray_exact_beam.wgsl",
         include_str!("../shaders/ray_exact_beam.wgsl"),
     ),
-    ("paged_beam.wgsl", include_str!("../shaders/paged_beam.wgsl")),
+    (
+        "paged_beam.wgsl",
+        include_str!("../shaders/paged_beam.wgsl"),
+    ),
     ("ray_exact.wgsl", include_str!("../shaders/ray_exact.wgsl")),
     (
         "ray_exact_fragment.wgsl",

@@ -14,7 +14,7 @@ use std::path::PathBuf;
 use strata_level::{ViewSpec, views::parse_views};
 use strata_render::frame::{Globals, LevelShape};
 use strata_render::methods::ray_exact::replay::{
-    FrameCount, PassCount, Replay, Traversal, compute_pyramid, replay_frame,
+    FrameCount, PassCount, Replay, Traversal, beam_disagreements, compute_pyramid, replay_frame,
 };
 
 #[derive(clap::Args)]
@@ -46,6 +46,11 @@ pub struct Args {
     /// at the near plane, as `ray-exact` with `STRATA_EXACT_BEAM=off`).
     #[arg(long)]
     no_beam: bool,
+    /// Also check the beam on every pixel: its ray marched from the near
+    /// plane and from its tile's beam finds the same hit (t to the bit and
+    /// the column), never before the beam; fails otherwise.
+    #[arg(long)]
+    verify_beam: bool,
 }
 
 #[derive(Serialize)]
@@ -131,6 +136,19 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         let shadow = strata_render::shadow::ShadowFrame::fit(camera, !args.no_shadows);
         let globals = Globals::new(camera, &shape, &shadow);
         let frame = replay_frame(&mut replay, &globals);
+        if args.verify_beam {
+            let (differ, early) = beam_disagreements(&mut replay, &globals);
+            eprintln!(
+                "{}: beam check: {differ} pixels' hits differ, {early} hits before their tile's beam",
+                view.name
+            );
+            if differ + early > 0 {
+                bail!(
+                    "{}: the beam changed {differ} hits ({early} before their tile's start)",
+                    view.name
+                );
+            }
+        }
         if !args.json {
             writeln!(
                 out,

@@ -103,13 +103,11 @@ impl Beam {
             binding: BINDING,
             resource: buffer.as_entire_binding(),
         });
-        shared
-            .device
-            .create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("ray-exact beam"),
-                layout,
-                entries: &entries,
-            })
+        shared.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("ray-exact beam"),
+            layout,
+            entries: &entries,
+        })
     }
 
     /// A buffer for the targets' new size (rebind it in the march's groups).
@@ -131,7 +129,12 @@ impl Beam {
     }
 
     /// The pass, before the march (nothing with the beam off).
-    pub(super) fn record(&self, shared: &Shared, frame: &Frame<'_>, encoder: &mut wgpu::CommandEncoder) {
+    pub(super) fn record(
+        &self,
+        shared: &Shared,
+        frame: &Frame<'_>,
+        encoder: &mut wgpu::CommandEncoder,
+    ) {
         let Some(pipeline) = &self.pipeline else {
             return;
         };

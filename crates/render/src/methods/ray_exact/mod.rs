@@ -698,7 +698,10 @@ impl Method for RayExact {
             } => {
                 // The hit image: 4 bytes per pixel, as the depth image.
                 let hits = deferred.as_ref().map_or(0, |_| depth.bytes());
-                depth.bytes() + hits + self.marks.bytes() + self.beam.as_ref().map_or(0, Beam::bytes)
+                depth.bytes()
+                    + hits
+                    + self.marks.bytes()
+                    + self.beam.as_ref().map_or(0, Beam::bytes)
             }
             Variant::Fragment(_) => self.marks.bytes(),
         };
@@ -744,9 +747,9 @@ mod bindings;
 mod deferred;
 pub mod replay;
 use crate::paged::PagedTerrain;
+use beam::Beam;
 pub use bindings::Levels;
 use bindings::{buffer_entry, core_bindings, core_entries, exact_pipeline, march_group};
-use beam::Beam;
 use deferred::{Deferred, MARK_BLOCK, ShadowMarks, hits_image};
 
 #[cfg(test)]

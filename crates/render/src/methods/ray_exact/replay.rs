@@ -410,7 +410,10 @@ impl<'a> Replay<'a> {
                     let h = self
                         .maxmip(shift, c0.x, c0.y)
                         .max(self.maxmip(shift, c1.x, c0.y))
-                        .max(self.maxmip(shift, c0.x, c1.y).max(self.maxmip(shift, c1.x, c1.y)));
+                        .max(
+                            self.maxmip(shift, c0.x, c1.y)
+                                .max(self.maxmip(shift, c1.x, c1.y)),
+                        );
                     clear = lo.z > h;
                 }
             }
@@ -660,6 +663,31 @@ fn shadow_taps(g: &Globals, p: Vec3, c: &strata_level::model::Column, d: Vec3) -
     // The taps lie within 2 texels of p's own map coordinates; all four are
     // on the map except at its very edge, where the count is a bound.
     4
+}
+
+/// Check the beam on every pixel of a frame: march each ray from the near
+/// plane and from its tile's start ([`Replay::tile_beam`]); the pixels whose
+/// hits differ (t to the bit, or the column) and those whose hit lies before
+/// their tile's start (both must be 0).
+pub fn beam_disagreements(replay: &mut Replay<'_>, g: &Globals) -> (u64, u64) {
+    let (w, h) = (g.screen[0] as u32, g.screen[1] as u32);
+    let (mut differ, mut early) = (0, 0);
+    for ty in 0..h.div_ceil(BEAM_TILE) {
+        for tx in 0..w.div_ceil(BEAM_TILE) {
+            let start = replay.tile_beam(g, tx, ty).t;
+            for y in ty * BEAM_TILE..((ty + 1) * BEAM_TILE).min(h) {
+                for x in tx * BEAM_TILE..((tx + 1) * BEAM_TILE).min(w) {
+                    let (px, py) = (x as f32 + 0.5, y as f32 + 0.5);
+                    let old = replay.pixel(g, px, py).1.hit;
+                    let new = replay.pixel_from(g, px, py, start).1.hit;
+                    let bits = |hit: Option<(f32, IVec2)>| hit.map(|(t, c)| (t.to_bits(), c));
+                    differ += u64::from(bits(old) != bits(new));
+                    early += u64::from(old.is_some_and(|(t, _)| t < start));
+                }
+            }
+        }
+    }
+    (differ, early)
 }
 
 /// Warps of 8x8 workgroups over a w x h grid of invocations: 8x4 each, as
