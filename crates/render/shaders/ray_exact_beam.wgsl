@@ -43,6 +43,11 @@
 // starts at the near plane and the buffer is not read).
 override EXACT_BEAM: bool = true;
 
+// The pyramid level camera rays start at from their tile's beam (a pipeline
+// constant, `ray_exact::BEAM_LEVEL`): near the ground, where the beam
+// leaves them, small tiles (4 texels) take fewer steps than `EXACT_START_LEVEL`.
+override EXACT_BEAM_LEVEL: u32 = 2u;
+
 const BEAM_TILE: u32 = 8u;
 const BEAM_CAP: u32 = 128u;
 const BEAM_FIRST_STEP: f32 = 4.0;
@@ -63,25 +68,64 @@ fn exact_tile_start(id: vec2<u32>) -> f32 {
     return exact_beams[tile.y * beam_tiles_across() + tile.x];
 }
 
+// The pyramid level camera rays start at.
+fn exact_tile_level() -> u32 {
+    return select(EXACT_START_LEVEL, EXACT_BEAM_LEVEL, EXACT_BEAM);
+}
+
 struct BeamBox {
     lo: vec3<f32>,
     hi: vec3<f32>,
 }
 
 // The box of the four corner rays' points at t.
-fn beam_box(o: vec3<f32>, d0: vec3<f32>, d1: vec3<f32>, d2: vec3<f32>, d3: vec3<f32>, t: f32) -> BeamBox {
-    let p0 = o + d0 * t;
-    let p1 = o + d1 * t;
-    let p2 = o + d2 * t;
-    let p3 = o + d3 * t;
+fn beam_box(o0: vec3<f32>, o1: vec3<f32>, o2: vec3<f32>, o3: vec3<f32>, d0: vec3<f32>, d1: vec3<f32>, d2: vec3<f32>, d3: vec3<f32>, t: f32) -> BeamBox {
+    let p0 = o0 + d0 * t;
+    let p1 = o1 + d1 * t;
+    let p2 = o2 + d2 * t;
+    let p3 = o3 + d3 * t;
     return BeamBox(min(min(p0, p1), min(p2, p3)), max(max(p0, p1), max(p2, p3)));
+}
+
+// Whether nothing in the box (lo, hi), relative to `base` and widened by the
+// margin, is solid: its lowest altitude above 255, or above the highest top
+// of the 2x2 tiles, of the finest kept level whose tile is at least its
+// extent, that hold it.
+fn beam_clear(base: vec2<i32>, lo_in: vec3<f32>, hi_in: vec3<f32>) -> bool {
+    let big = max(abs(lo_in), abs(hi_in));
+    let m = BEAM_MARGIN + BEAM_MARGIN_RELATIVE * max(max(big.x, big.y), big.z);
+    let lo = lo_in - vec3<f32>(m);
+    let hi = hi_in + vec3<f32>(m);
+    if (lo.z > MAX_ALTITUDE) {
+        return true;
+    }
+    let top = xparams.config.x;
+    let ext = max(hi.x - lo.x, hi.y - lo.y);
+    var shift = EXACT_LOG_RATIO;
+    loop {
+        if (shift >= top || f32(1u << shift) >= ext) {
+            break;
+        }
+        shift = shift + EXACT_LOG_RATIO;
+    }
+    let size = f32(1u << shift);
+    if (size < ext) {
+        return false;
+    }
+    let inv = 1.0 / size;
+    let tiles = base >> vec2<u32>(shift);
+    let c0 = vec2<i32>(floor(lo.xy * inv)) + tiles;
+    let c1 = vec2<i32>(floor(hi.xy * inv)) + tiles;
+    let h = max(
+        max(maxmip_get(shift, c0.x, c0.y), maxmip_get(shift, c1.x, c0.y)),
+        max(maxmip_get(shift, c0.x, c1.y), maxmip_get(shift, c1.x, c1.y)),
+    );
+    return lo.z > h;
 }
 
 // The least t in [t0, t1] at which a ray o + t d, d in the convex hull of
 // d0..d3, may be solid (t1 when none may); o relative to `base`.
 fn exact_beam(o: vec3<f32>, base: vec2<i32>, d0: vec3<f32>, d1: vec3<f32>, d2: vec3<f32>, d3: vec3<f32>, t0: f32, t1: f32) -> f32 {
-    let top = xparams.config.x;
-    let ratio = EXACT_LOG_RATIO;
     let q = max(max(abs(d0), abs(d1)), max(abs(d2), abs(d3)));
     let reach = max(max(q.x, q.y), q.z);
     var t = t0;
@@ -89,7 +133,7 @@ fn exact_beam(o: vec3<f32>, base: vec2<i32>, d0: vec3<f32>, d1: vec3<f32>, d2: v
         return t;
     }
     var dt = BEAM_FIRST_STEP / reach;
-    var a = beam_box(o, d0, d1, d2, d3, t);
+    var a = beam_box(o, o, o, o, d0, d1, d2, d3, t);
     var n = 0u;
     loop {
         if (t >= t1 || n >= BEAM_CAP) {
@@ -97,37 +141,8 @@ fn exact_beam(o: vec3<f32>, base: vec2<i32>, d0: vec3<f32>, d1: vec3<f32>, d2: v
         }
         n = n + 1u;
         let t2 = min(t + dt, t1);
-        let b = beam_box(o, d0, d1, d2, d3, t2);
-        var lo = min(a.lo, b.lo);
-        var hi = max(a.hi, b.hi);
-        let big = max(abs(lo), abs(hi));
-        let m = BEAM_MARGIN + BEAM_MARGIN_RELATIVE * max(max(big.x, big.y), big.z);
-        lo = lo - vec3<f32>(m);
-        hi = hi + vec3<f32>(m);
-        var clear = lo.z > MAX_ALTITUDE;
-        if (!clear) {
-            let ext = max(hi.x - lo.x, hi.y - lo.y);
-            var shift = ratio;
-            loop {
-                if (shift >= top || f32(1u << shift) >= ext) {
-                    break;
-                }
-                shift = shift + ratio;
-            }
-            let size = f32(1u << shift);
-            if (size >= ext) {
-                let inv = 1.0 / size;
-                let tiles = base >> vec2<u32>(shift);
-                let c0 = vec2<i32>(floor(lo.xy * inv)) + tiles;
-                let c1 = vec2<i32>(floor(hi.xy * inv)) + tiles;
-                let h = max(
-                    max(maxmip_get(shift, c0.x, c0.y), maxmip_get(shift, c1.x, c0.y)),
-                    max(maxmip_get(shift, c0.x, c1.y), maxmip_get(shift, c1.x, c1.y)),
-                );
-                clear = lo.z > h;
-            }
-        }
-        if (clear) {
+        let b = beam_box(o, o, o, o, d0, d1, d2, d3, t2);
+        if (beam_clear(base, min(a.lo, b.lo), max(a.hi, b.hi))) {
             t = t2;
             a = b;
             dt = dt * 2.0;
@@ -138,6 +153,45 @@ fn exact_beam(o: vec3<f32>, base: vec2<i32>, d0: vec3<f32>, d1: vec3<f32>, d2: v
         }
     }
     return t;
+}
+
+// The shadow block's first lane k that found its interval not clear, as
+// 64 - k (0: none).
+var<workgroup> beam_first: atomic<u32>;
+
+// Where the rays of the 8x8-texel shadow block whose first texel is `first`
+// start, searched by the block's 64 invocations at once (call it from every
+// invocation of the workgroup, `li` its index): invocation k tests the k-th
+// of 64 equal intervals of [0, span] of the box of the four corner texels'
+// rays (parallel rays whose starts at altitude 255 are affine in the texel,
+// so every ray of the block is a convex combination of theirs, as in the
+// argument at the top), and the rays start at the first interval that is
+// not clear.
+fn exact_shadow_block_start(first: vec2<u32>, li: u32) -> f32 {
+    if (!EXACT_BEAM) {
+        return 0.0;
+    }
+    let far = BEAM_TILE - 1u;
+    let r0 = exact_shadow_ray(first);
+    let r1 = exact_shadow_ray(first + vec2<u32>(far, 0u));
+    let r2 = exact_shadow_ray(first + vec2<u32>(0u, far));
+    let r3 = exact_shadow_ray(first + vec2<u32>(far, far));
+    let base = exact_base(r0.p.xy);
+    let at = vec2<f32>(base);
+    let o0 = vec3<f32>(r0.p.xy - at, r0.p.z);
+    let o1 = vec3<f32>(r1.p.xy - at, r1.p.z);
+    let o2 = vec3<f32>(r2.p.xy - at, r2.p.z);
+    let o3 = vec3<f32>(r3.p.xy - at, r3.p.z);
+    let d = globals.light_dir.xyz;
+    let lanes = f32(BEAM_TILE * BEAM_TILE);
+    let a = beam_box(o0, o1, o2, o3, d, d, d, d, r0.span * (f32(li) / lanes));
+    let b = beam_box(o0, o1, o2, o3, d, d, d, d, r0.span * (f32(li + 1u) / lanes));
+    if (!beam_clear(base, min(a.lo, b.lo), max(a.hi, b.hi))) {
+        atomicMax(&beam_first, BEAM_TILE * BEAM_TILE - li);
+    }
+    workgroupBarrier();
+    let k = BEAM_TILE * BEAM_TILE - atomicLoad(&beam_first);
+    return r0.span * (f32(k) / lanes);
 }
 
 // One invocation per 8x8-pixel tile: its rays' start, through the corner

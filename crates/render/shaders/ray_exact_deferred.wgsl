@@ -93,7 +93,7 @@ fn cs_exact_march_hits(
     let size = vec2<u32>(globals.screen.xy);
     if (all(id.xy < size)) {
         page_pixel_begin();
-        let h = exact_pixel_hit_from(f32(id.x) + 0.5, f32(id.y) + 0.5, exact_tile_start(id.xy));
+        let h = exact_pixel_hit_from(f32(id.x) + 0.5, f32(id.y) + 0.5, exact_tile_start(id.xy), exact_tile_level());
         var packed = HIT_NONE;
         if (h.hit) {
             let rel = h.column - exact_base(globals.eye.xy) + vec2<i32>(32768);

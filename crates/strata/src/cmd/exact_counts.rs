@@ -46,6 +46,10 @@ pub struct Args {
     /// at the near plane, as `ray-exact` with `STRATA_EXACT_BEAM=off`).
     #[arg(long)]
     no_beam: bool,
+    /// Try another traversal on paper: the visited level camera rays start
+    /// at from their tile's beam (the GPU's: 1, tiles of 4 texels).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=4))]
+    beam_level: Option<u32>,
     /// Also check the beam on every pixel: its ray marched from the near
     /// plane and from its tile's beam finds the same hit (t to the bit and
     /// the column), never before the beam; fails otherwise.
@@ -76,6 +80,9 @@ struct Report {
     mean_beam_iterations_per_pixel: f64,
     mean_march_warp_iterations: f64,
     mean_shadow_iterations: f64,
+    mean_shadow_warp_iterations: f64,
+    /// The shadow blocks' beams' iterations over the shadow rays.
+    mean_shadow_beam_iterations_per_ray: f64,
     mean_shadow_rays: f64,
 }
 
@@ -128,6 +135,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         climb: args.climb,
         start: args.start_level.or(Traversal::GPU.start),
         beam: !args.no_beam,
+        beam_level: args.beam_level.unwrap_or(Traversal::GPU.beam_level),
     };
     let shape = LevelShape::of(&world.level);
     let mut out = std::io::stdout().lock();
@@ -139,7 +147,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         if args.verify_beam {
             let (differ, early) = beam_disagreements(&mut replay, &globals);
             eprintln!(
-                "{}: beam check: {differ} pixels' hits differ, {early} hits before their tile's beam",
+                "{}: beam check: {differ} rays' hits differ, {early} hits before their beam (camera rays and shadow rays)",
                 view.name
             );
             if differ + early > 0 {
@@ -192,6 +200,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         }),
         mean_march_warp_iterations: mean(&|c| c.frame.march.warp_iterations),
         mean_shadow_iterations: mean(&|c| c.frame.shadow.iterations.mean),
+        mean_shadow_warp_iterations: mean(&|c| c.frame.shadow.warp_iterations),
+        mean_shadow_beam_iterations_per_ray: mean(&|c| {
+            c.frame.shadow_beam_iterations as f64 / c.frame.shadow.rays.max(1) as f64
+        }),
         mean_shadow_rays: mean(&|c| c.frame.shadow.rays as f64),
         views: counts,
     };
@@ -202,7 +214,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         writeln!(
             out,
             "mean over {} views: {:.2} MB a frame, {:.2} march iterations a pixel ({:.2} a warp) \
-             + {:.3} beam iterations a pixel, {:.0} shadow rays of {:.2} iterations",
+             + {:.3} beam iterations a pixel, {:.0} shadow rays of {:.2} iterations ({:.2} a warp) \
+             + {:.3} beam iterations a ray",
             report.views.len(),
             report.mean_bytes / 1e6,
             report.mean_march_iterations,
@@ -210,6 +223,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             report.mean_beam_iterations_per_pixel,
             report.mean_shadow_rays,
             report.mean_shadow_iterations,
+            report.mean_shadow_warp_iterations,
+            report.mean_shadow_beam_iterations_per_ray,
         )?;
     }
     Ok(())

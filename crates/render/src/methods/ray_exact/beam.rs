@@ -22,7 +22,11 @@ const TILE: u32 = super::replay::BEAM_TILE;
 /// Whether `shader` over `levels` reads the tiles' starts (and takes the
 /// `EXACT_BEAM` constant): the compute frames' marches over the whole map.
 pub(super) fn reads_beam(levels: &Levels, shader: &str) -> bool {
-    !levels.is_paged() && matches!(shader, "ray_exact.wgsl" | "ray_exact_deferred.wgsl")
+    !levels.is_paged()
+        && matches!(
+            shader,
+            "ray_exact.wgsl" | "ray_exact_deferred.wgsl" | "ray_exact_shadow.wgsl"
+        )
 }
 
 /// The layout entry of the tiles' starts.

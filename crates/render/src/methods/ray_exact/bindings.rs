@@ -173,6 +173,7 @@ pub(super) fn exact_pipeline(
     ];
     if super::beam::reads_beam(levels, shader) {
         constants.push(("EXACT_BEAM", f64::from(u8::from(options.beam))));
+        constants.push(("EXACT_BEAM_LEVEL", f64::from(super::BEAM_LEVEL)));
     }
     super::super::common::compute_pipeline_with_constants(
         shared,

@@ -67,6 +67,12 @@ use strata_level::{DirtyRect, Level};
 /// (camera and shadow rays alike), with the same hits.
 pub const START_LEVEL: u32 = 6;
 
+/// The pyramid level camera rays start at from their tile's beam
+/// (`EXACT_BEAM_LEVEL`, [`ExactOptions::beam`]): tiles of 4 texels. Near
+/// the ground, where the beam leaves them, `strata exact-counts` counts
+/// 10.1 iterations a pixel from there against 11.7 from `START_LEVEL`.
+pub const BEAM_LEVEL: u32 = 2;
+
 /// Most traversal iterations of one ray: a guard against a hang, never
 /// reached on the protocol's views (counted in [`ExactStats`]).
 pub const ITERATION_CAP: u32 = 4096;

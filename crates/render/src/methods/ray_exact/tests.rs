@@ -818,7 +818,8 @@ fn the_replay_takes_the_gpu_steps() {
 /// The beam pre-pass (`ray_exact_beam.wgsl`, its replay `Replay::beam`)
 /// never starts a tile past a hit of any of its rays, and a ray marched from
 /// its tile's start finds the very hit (t and column, bit for bit) it finds
-/// from the near plane, on every generated view at 160x100 and 640x400
+/// from the near plane (shadow rays from their block's beam likewise, at
+/// 160x100), on every generated view at 160x100 and 640x400
 /// (every tile, every pixel); and it saves iterations.
 #[test]
 fn the_beam_never_passes_a_hit() {
@@ -847,7 +848,7 @@ fn the_beam_never_passes_a_hit() {
                         for x in tx * BEAM_TILE..((tx + 1) * BEAM_TILE).min(width) {
                             let (px, py) = (x as f32 + 0.5, y as f32 + 0.5);
                             let (_, old) = replay.pixel(&g, px, py);
-                            let (_, new) = replay.pixel_from(&g, px, py, b.t);
+                            let (_, new) = replay.pixel_from(&g, px, py, Some(b.t));
                             before += u64::from(old.iterations);
                             after += u64::from(new.iterations);
                             if let Some((t, _)) = old.hit {
@@ -871,6 +872,12 @@ fn the_beam_never_passes_a_hit() {
                     }
                     tiles_hit += u64::from(any);
                 }
+            }
+            // Shadow rays too (and the pixels again): every texel of the
+            // blocks the hits stamp, from 255 and from its block's beam.
+            if width == W {
+                let (differ, early) = super::replay::beam_disagreements(&mut replay, &g);
+                assert_eq!((differ, early), (0, 0), "{}: shadow beams", view.name);
             }
         }
         let pixels = u64::from(width * height) * w.views.len() as u64;
