@@ -76,10 +76,7 @@ impl ShadowMarks {
 impl Deferred {
     pub(super) fn new(
         shared: &Shared,
-        params: &wgpu::Buffer,
-        levels: &Levels,
-        stats: &wgpu::Buffer,
-        marks: &ShadowMarks,
+        (params, levels, stats, marks): (&wgpu::Buffer, &Levels, &wgpu::Buffer, &ShadowMarks),
         depth: &DepthCopy,
         beam: Option<&Beam>,
         options: ExactOptions,

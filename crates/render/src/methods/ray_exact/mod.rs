@@ -303,10 +303,7 @@ fn build_on(
             deferred: if deferred_frame {
                 Some(Box::new(Deferred::new(
                     shared,
-                    &params,
-                    &levels,
-                    &stats,
-                    &marks,
+                    (&params, &levels, &stats, &marks),
                     &depth,
                     beam.as_ref(),
                     options,
