@@ -571,6 +571,19 @@ fn first_frame_after_the_crater_matches_a_fresh_build() {
     }
 }
 
+/// The camera of `view` at `size` and its frame's globals, shadows on.
+fn view_globals(
+    level: &Level,
+    view: &strata_level::ViewSpec,
+    (width, height): (u32, u32),
+) -> (Camera, crate::frame::Globals) {
+    let camera = Camera::from_view(level, view, width, height).unwrap();
+    let shadow = crate::shadow::ShadowFrame::fit(&camera, true);
+    let globals =
+        crate::frame::Globals::new(&camera, &crate::frame::LevelShape::of(level), &shadow);
+    (camera, globals)
+}
+
 /// One frame of `m` recorded by hand (the renderer owns its methods): the
 /// globals written, the exact shadow map cast, the march.
 fn record_frame(
@@ -698,13 +711,7 @@ fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
         assert_eq!(m.stats().unwrap(), ExactStats::default());
         let timer = crate::timing::PassTimer::new(&shared.device, &shared.queue, false);
         for (index, view) in w.views.iter().enumerate() {
-            let camera = Camera::from_view(&w.level, view, W, H).unwrap();
-            let shadow = crate::shadow::ShadowFrame::fit(&camera, true);
-            let globals = crate::frame::Globals::new(
-                &camera,
-                &crate::frame::LevelShape::of(&w.level),
-                &shadow,
-            );
+            let (camera, globals) = view_globals(&w.level, view, (W, H));
             record_frame(&shared, &mut m, &camera, &globals, &timer, index);
         }
         let stats = m.stats().unwrap();
@@ -737,9 +744,7 @@ fn the_replay_takes_the_gpu_steps() {
     let shape = crate::frame::LevelShape::of(&w.level);
     let mut frames = Vec::new();
     for view in &w.views {
-        let camera = Camera::from_view(&w.level, view, W, H).unwrap();
-        let shadow = crate::shadow::ShadowFrame::fit(&camera, true);
-        let globals = crate::frame::Globals::new(&camera, &shape, &shadow);
+        let (camera, globals) = view_globals(&w.level, view, (W, H));
         let f = replay_frame(&mut replay, &globals);
         // Hits against the CPU reference, pixel by pixel.
         let reference = render_reference(&w.level, &camera);
@@ -831,13 +836,10 @@ fn the_beam_never_passes_a_hit() {
         beam: false,
         ..Traversal::GPU
     };
-    let shape = crate::frame::LevelShape::of(&w.level);
     for (width, height) in [(W, H), (640, 400)] {
         let (mut before, mut after, mut beams, mut tiles_hit) = (0u64, 0u64, 0u64, 0u64);
         for view in &w.views {
-            let camera = Camera::from_view(&w.level, view, width, height).unwrap();
-            let shadow = crate::shadow::ShadowFrame::fit(&camera, true);
-            let g = crate::frame::Globals::new(&camera, &shape, &shadow);
+            let (_, g) = view_globals(&w.level, view, (width, height));
             for ty in 0..height.div_ceil(BEAM_TILE) {
                 for tx in 0..width.div_ceil(BEAM_TILE) {
                     let b = replay.tile_beam(&g, tx, ty);
