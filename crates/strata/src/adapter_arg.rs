@@ -99,10 +99,12 @@ mod tests {
             "STRATA_SHADOW_CULL" => Some("0".into()),
             "STRATA_EXACT_DEPTH" => Some("points".into()),
             "STRATA_EXACT_RATIO" => Some("2".into()),
+            "STRATA_EXACT_BEAM" => Some("off".into()),
             "STRATA_TEST_OVERSIZE_BUILD" => Some("voxel".into()),
             _ => None,
         });
-        assert!(!o.shadow_cull && !o.shadow_reuse);
+        assert!(!o.shadow_cull && !o.shadow_reuse && !o.exact.beam);
+        assert!(render_options_from(|_| None).exact.beam);
         assert_eq!((o.exact.depth, o.exact.log_ratio), (DepthMode::Points, 1));
         assert_eq!(o.oversize_build.as_deref(), Some("voxel"));
     }
