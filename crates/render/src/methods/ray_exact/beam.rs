@@ -8,35 +8,15 @@
 //! skips the pass and the march does not read its buffer. Paged terrain has
 //! none (its finer levels live per page).
 
-use super::bindings::{Levels, buffer_entry, core_bindings, core_entries, exact_pipeline};
+use super::bindings::{
+    Levels, beam_binding, beam_layout_entry, core_bindings, core_entries, exact_pipeline,
+};
 use crate::frame::Shared;
 use crate::methods::contract::Frame;
 use crate::options::ExactOptions;
 
-/// The binding of the tiles' starts in group 1 (`exact_beams`).
-pub(super) const BINDING: u32 = 12;
-
 /// Side of a tile in pixels (`BEAM_TILE`).
 const TILE: u32 = super::replay::BEAM_TILE;
-
-/// Whether `shader` over `levels` reads the tiles' starts (and takes the
-/// `EXACT_BEAM` constant): the compute frames' marches over the whole map.
-pub(super) fn reads_beam(levels: &Levels, shader: &str) -> bool {
-    !levels.is_paged()
-        && matches!(
-            shader,
-            "ray_exact.wgsl" | "ray_exact_deferred.wgsl" | "ray_exact_shadow.wgsl"
-        )
-}
-
-/// The layout entry of the tiles' starts.
-pub(super) fn layout_entry() -> wgpu::BindGroupLayoutEntry {
-    buffer_entry(
-        BINDING,
-        wgpu::ShaderStages::COMPUTE,
-        wgpu::BufferBindingType::Storage { read_only: false },
-    )
-}
 
 /// The pass and the tiles' starts it writes.
 pub(super) struct Beam {
@@ -66,7 +46,7 @@ impl Beam {
         options: ExactOptions,
     ) -> anyhow::Result<Self> {
         let mut entries = core_entries(wgpu::ShaderStages::COMPUTE, false);
-        entries.push(layout_entry());
+        entries.push(beam_layout_entry());
         let layout = shared
             .device
             .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -103,10 +83,7 @@ impl Beam {
         buffer: &wgpu::Buffer,
     ) -> wgpu::BindGroup {
         let mut entries = core_bindings(params, levels, stats);
-        entries.push(wgpu::BindGroupEntry {
-            binding: BINDING,
-            resource: buffer.as_entire_binding(),
-        });
+        entries.push(beam_binding(buffer));
         shared.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("ray-exact beam"),
             layout,
@@ -122,14 +99,6 @@ impl Beam {
     ) {
         self.buffer = starts_buffer(shared);
         self.group = Self::group(shared, &self.layout, buffers, &self.buffer);
-    }
-
-    /// The march's group entry for the starts.
-    pub(super) fn entry(&self) -> wgpu::BindGroupEntry<'_> {
-        wgpu::BindGroupEntry {
-            binding: BINDING,
-            resource: self.buffer.as_entire_binding(),
-        }
     }
 
     /// The pass, before the march (nothing with the beam off).

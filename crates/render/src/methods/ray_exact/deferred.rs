@@ -3,9 +3,10 @@
 //! those, then a pass shades (`ray_exact_deferred.wgsl`; the why and the
 //! numbers are in the parent module's docs).
 
-use super::beam::Beam;
 use super::bindings::Levels;
-use super::bindings::{buffer_entry, core_bindings, core_entries, exact_pipeline};
+use super::bindings::{
+    beam_binding, beam_layout_entry, buffer_entry, core_bindings, core_entries, exact_pipeline,
+};
 use crate::frame::{Shared, storage_texture_entry, storage_texture_entry_with, texture_2d};
 use crate::methods::common::DepthCopy;
 use crate::options::ExactOptions;
@@ -78,7 +79,7 @@ impl Deferred {
         shared: &Shared,
         (params, levels, stats, marks): (&wgpu::Buffer, &Levels, &wgpu::Buffer, &ShadowMarks),
         depth: &DepthCopy,
-        beam: Option<&Beam>,
+        beam: Option<&wgpu::Buffer>,
         options: ExactOptions,
     ) -> anyhow::Result<Self> {
         let device = &shared.device;
@@ -95,7 +96,7 @@ impl Deferred {
                 wgpu::BufferBindingType::Storage { read_only: false },
             ));
         }
-        entries.extend(beam.map(|_| super::beam::layout_entry()));
+        entries.extend(beam.map(|_| beam_layout_entry()));
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("ray-exact deferred"),
             entries: &entries,
@@ -138,7 +139,7 @@ impl Deferred {
         (params, levels, stats, marks): (&wgpu::Buffer, &Levels, &wgpu::Buffer, &ShadowMarks),
         depth: &DepthCopy,
         hits: &wgpu::TextureView,
-        beam: Option<&Beam>,
+        beam: Option<&wgpu::Buffer>,
     ) -> wgpu::BindGroup {
         let mut entries = core_bindings(params, levels, stats);
         entries.extend(depth.bindings(shared, 3));
@@ -152,7 +153,7 @@ impl Deferred {
                 resource: buffer.as_entire_binding(),
             });
         }
-        entries.extend(beam.map(Beam::entry));
+        entries.extend(beam.map(beam_binding));
         shared.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("ray-exact deferred"),
             layout,

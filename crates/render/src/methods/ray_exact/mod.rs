@@ -284,7 +284,7 @@ fn build_on(
     if compute {
         entries.extend(DepthCopy::layout_entries(3));
     }
-    entries.extend(beam.as_ref().map(|_| beam::layout_entry()));
+    entries.extend(beam.as_ref().map(|_| bindings::beam_layout_entry()));
     let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some(name),
         entries: &entries,
@@ -296,7 +296,7 @@ fn build_on(
         &levels,
         &stats,
         depth.as_ref(),
-        beam.as_ref(),
+        beam.as_ref().map(|b| &b.buffer),
     );
     let pipeline_layout = shared.pipeline_layout(name, &[&layout]);
     let variant = match depth {
@@ -316,7 +316,7 @@ fn build_on(
                     shared,
                     (&params, &levels, &stats, &marks),
                     &depth,
-                    beam.as_ref(),
+                    beam.as_ref().map(|b| &b.buffer),
                     options,
                 )?))
             } else {
@@ -569,7 +569,7 @@ impl Method for RayExact {
             if let Some(beam) = &mut self.beam {
                 beam.resize(shared, (&self.params, &self.levels, &self.stats));
             }
-            let beam = self.beam.as_ref();
+            let beam = self.beam.as_ref().map(|b| &b.buffer);
             if let Some(d) = deferred {
                 d.hits = hits_image(shared);
                 let buffers = (&self.params, &self.levels, &self.stats, &self.marks);
