@@ -7,6 +7,7 @@
 #include "ray_core.wgsl"
 #include "ray_exact_core.wgsl"
 #include "ray_exact_pixel.wgsl"
+#include "ray_exact_beam.wgsl"
 
 @group(1) @binding(3) var color_out: texture_storage_2d<rgba8unorm, write>;
 @group(1) @binding(4) var depth_out: texture_storage_2d<r32float, write>;
@@ -21,7 +22,7 @@ fn cs_ray_exact(
     let size = vec2<u32>(globals.screen.xy);
     if (all(id.xy < size)) {
         page_pixel_begin();
-        let s = exact_pixel(f32(id.x) + 0.5, f32(id.y) + 0.5);
+        let s = exact_pixel_from(f32(id.x) + 0.5, f32(id.y) + 0.5, exact_tile_start(id.xy), exact_tile_level());
         page_pixel_end(page_pixel_missed());
         textureStore(color_out, id.xy, s.color);
         textureStore(depth_out, id.xy, vec4<f32>(s.depth, 0.0, 0.0, 0.0));

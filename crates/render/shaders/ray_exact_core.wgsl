@@ -67,6 +67,12 @@ struct ExactHit {
 // The first solid point of o + t d, t in [t0, t1], with o relative to `base`
 // (see the top). t0 must be at or below the altitude 255 along the ray.
 fn exact_march(o: vec3<f32>, base: vec2<i32>, d: vec3<f32>, t0: f32, t1: f32) -> ExactHit {
+    return exact_march_at(o, base, d, t0, t1, EXACT_START_LEVEL);
+}
+
+// `exact_march` from pyramid level `start` (the coarsest kept level at or
+// below it) rather than `EXACT_START_LEVEL`.
+fn exact_march_at(o: vec3<f32>, base: vec2<i32>, d: vec3<f32>, t0: f32, t1: f32, start: u32) -> ExactHit {
     var r: ExactHit;
     r.hit = false;
     r.t = t1;
@@ -85,7 +91,7 @@ fn exact_march(o: vec3<f32>, base: vec2<i32>, d: vec3<f32>, t0: f32, t1: f32) ->
     let inv = select(vec2<f32>(1.0) / d.xy, vec2<f32>(0.0), still);
     let ratio = EXACT_LOG_RATIO;
     // Visited levels are lvl * ratio (pyramid level 0 = the texels).
-    var lvl = min(top, EXACT_START_LEVEL) / ratio;
+    var lvl = min(top, start) / ratio;
     var t = t0;
     var cell = texel_after(o.xy + d.xy * t, d.xy) >> vec2<u32>(lvl * ratio);
     loop {
@@ -168,6 +174,28 @@ fn exact_march(o: vec3<f32>, base: vec2<i32>, d: vec3<f32>, t0: f32, t1: f32) ->
         }
     }
     return r;
+}
+
+// A texel of the shadow map's ray along the light: where it comes down to
+// altitude 255 (`p`, at `t_in` from the map's plane) and the ray parameter
+// from there at which it leaves the map below 0 (`span`).
+struct ShadowRay {
+    p: vec3<f32>,
+    t_in: f32,
+    span: f32,
+}
+
+fn exact_shadow_ray(id: vec2<u32>) -> ShadowRay {
+    let texel = globals.shadow_origin.w;
+    let o = globals.shadow_origin.xyz
+        + globals.shadow_u.xyz * ((f32(id.x) + 0.5) * texel)
+        + globals.shadow_v.xyz * ((f32(id.y) + 0.5) * texel);
+    let d = globals.light_dir.xyz;
+    // The light travels down: from altitude 255 to below 0, where every
+    // column is solid.
+    let t_in = (MAX_ALTITUDE - o.z) / d.z;
+    let t_out = (-1.0 - o.z) / d.z;
+    return ShadowRay(o + d * t_in, t_in, t_out - t_in);
 }
 
 // The base (multiple of the coarsest tile) for a ray starting near world `p`.

@@ -18,6 +18,7 @@
 #include "ray_core.wgsl"
 #include "ray_exact_core.wgsl"
 #include "ray_exact_pixel.wgsl"
+#include "ray_exact_beam.wgsl"
 
 @group(1) @binding(3) var color_out: texture_storage_2d<rgba8unorm, write>;
 // The hit's t after the march, the depth-buffer value after the shading.
@@ -92,7 +93,7 @@ fn cs_exact_march_hits(
     let size = vec2<u32>(globals.screen.xy);
     if (all(id.xy < size)) {
         page_pixel_begin();
-        let h = exact_pixel_hit(f32(id.x) + 0.5, f32(id.y) + 0.5);
+        let h = exact_pixel_hit_from(f32(id.x) + 0.5, f32(id.y) + 0.5, exact_tile_start(id.xy), exact_tile_level());
         var packed = HIT_NONE;
         if (h.hit) {
             let rel = h.column - exact_base(globals.eye.xy) + vec2<i32>(32768);

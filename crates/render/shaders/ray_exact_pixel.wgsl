@@ -21,6 +21,13 @@ struct ExactPixel {
 // The march of pixel (px, py): the hit (its `t` along `camera_ray`, column
 // absolute) or a miss.
 fn exact_pixel_hit(px: f32, py: f32) -> ExactHit {
+    return exact_pixel_hit_from(px, py, -EXACT_BIG, EXACT_START_LEVEL);
+}
+
+// The march of pixel (px, py) from no earlier than `start` (its tile's beam,
+// `ray_exact_beam.wgsl`: no ray of the tile is solid before it), from
+// pyramid level `level`.
+fn exact_pixel_hit_from(px: f32, py: f32, start: f32, level: u32) -> ExactHit {
     lod_camera_rays();
     let eye = globals.eye.xyz;
     let d = camera_ray(px, py);
@@ -28,7 +35,7 @@ fn exact_pixel_hit(px: f32, py: f32) -> ExactHit {
     let seg = exact_clip(eye, d, globals.forward.w / focal, globals.right.w / focal);
     let base = exact_base(eye.xy);
     let o = vec3<f32>(eye.xy - vec2<f32>(base), eye.z);
-    return exact_march(o, base, d, seg.x, seg.y);
+    return exact_march_at(o, base, d, max(seg.x, start), seg.y, level);
 }
 
 // Colour and depth of pixel (px, py) whose ray hit column `column` at `t`.
@@ -53,7 +60,13 @@ fn exact_pixel_sky() -> ExactPixel {
 }
 
 fn exact_pixel(px: f32, py: f32) -> ExactPixel {
-    let h = exact_pixel_hit(px, py);
+    return exact_pixel_from(px, py, -EXACT_BIG, EXACT_START_LEVEL);
+}
+
+// `exact_pixel` from no earlier than `start`, from pyramid level `level`
+// (`exact_pixel_hit_from`).
+fn exact_pixel_from(px: f32, py: f32, start: f32, level: u32) -> ExactPixel {
+    let h = exact_pixel_hit_from(px, py, start, level);
     var out = exact_pixel_sky();
     if (h.hit) {
         out = exact_pixel_shade(px, py, h.t, h.column);

@@ -5,6 +5,7 @@
 #include "frame.wgsl"
 #include "surface.wgsl"
 #include "ray_exact_core.wgsl"
+#include "ray_exact_beam.wgsl"
 
 const SHADOW_MISS: f32 = 1e9;
 
@@ -18,23 +19,21 @@ var<workgroup> group_most: atomic<u32>;
 
 // Cast texel `id`: the distance along the light to its first solid point.
 fn cast_texel(id: vec2<u32>) {
-    let texel = globals.shadow_origin.w;
-    let o = globals.shadow_origin.xyz
-        + globals.shadow_u.xyz * ((f32(id.x) + 0.5) * texel)
-        + globals.shadow_v.xyz * ((f32(id.y) + 0.5) * texel);
+    cast_texel_from(id, 0.0, EXACT_START_LEVEL);
+}
+
+// `cast_texel` from no earlier than `start` (its block's beam,
+// `exact_shadow_block_start`) and pyramid level `level`.
+fn cast_texel_from(id: vec2<u32>, start: f32, level: u32) {
+    let ray = exact_shadow_ray(id);
     let d = globals.light_dir.xyz;
-    // The light travels down: from altitude 255 to below 0, where every
-    // column is solid.
-    let t_in = (MAX_ALTITUDE - o.z) / d.z;
-    let t_out = (-1.0 - o.z) / d.z;
-    let p = o + d * t_in;
-    let base = exact_base(p.xy);
-    let rel = vec3<f32>(p.xy - vec2<f32>(base), p.z);
+    let base = exact_base(ray.p.xy);
+    let rel = vec3<f32>(ray.p.xy - vec2<f32>(base), ray.p.z);
     page_pixel_begin();
     lod_shadow_rays();
-    let h = exact_march(rel, base, d, 0.0, t_out - t_in);
+    let h = exact_march_at(rel, base, d, max(start, 0.0), ray.span, level);
     page_shadow_end(page_pixel_missed());
-    textureStore(shadow_out, id, vec4<f32>(select(SHADOW_MISS, t_in + h.t, h.hit), 0.0, 0.0, 0.0));
+    textureStore(shadow_out, id, vec4<f32>(select(SHADOW_MISS, ray.t_in + h.t, h.hit), 0.0, 0.0, 0.0));
     if (h.capped) {
         atomicAdd(&xstats[2], 1u);
     }
@@ -73,7 +72,11 @@ fn cs_exact_shadow_blocks(
 ) {
     let across = u32(globals.shadow_u.w) / 8u;
     let block = shadow_blocks[group.x];
-    cast_texel(vec2<u32>(block % across, block / across) * 8u + local.xy);
+    let first = vec2<u32>(block % across, block / across) * 8u;
+    // The block's rays start at its beam, searched by the 64 invocations
+    // at once (`ray_exact_beam.wgsl`).
+    let start = exact_shadow_block_start(first, li);
+    cast_texel_from(first + local.xy, start, exact_tile_level());
     workgroupBarrier();
     if (li == 0u) {
         atomicMax(&xstats[3], atomicLoad(&group_most));

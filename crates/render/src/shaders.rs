@@ -122,6 +122,14 @@ pub const SOURCES: &[(&str, &str)] = &[
         "ray_exact_pixel.wgsl",
         include_str!("../shaders/ray_exact_pixel.wgsl"),
     ),
+    (
+        "ray_exact_beam.wgsl",
+        include_str!("../shaders/ray_exact_beam.wgsl"),
+    ),
+    (
+        "paged_beam.wgsl",
+        include_str!("../shaders/paged_beam.wgsl"),
+    ),
     ("ray_exact.wgsl", include_str!("../shaders/ray_exact.wgsl")),
     (
         "ray_exact_fragment.wgsl",
@@ -192,6 +200,8 @@ pub const PAGED: &str = "paged:";
 const PAGED_SWAPS: &[(&str, &str)] = &[
     ("terrain_fetch.wgsl", "paged_fetch.wgsl"),
     ("exact_levels.wgsl", "paged_levels.wgsl"),
+    // `ray-exact`'s beam pre-pass reads the whole map's pyramid: none over pages.
+    ("ray_exact_beam.wgsl", "paged_beam.wgsl"),
 ];
 
 /// The name prefix that composes a shader over paged terrain read without

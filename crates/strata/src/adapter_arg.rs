@@ -43,8 +43,8 @@ pub fn parse_backend(s: &str) -> anyhow::Result<BackendChoice> {
 /// `STRATA_SHADOW_CULL=0` casts the whole map; `STRATA_DEPTH_ATTACHMENT=1`
 /// copies depth into the shared target every frame;
 /// `STRATA_EXACT_SHADOW=shared|exact`, `STRATA_EXACT_DEPTH=blit|points|load`,
-/// `STRATA_EXACT_CLIMB=all`, `STRATA_EXACT_RATIO=2|4` configure
-/// `ray-exact`; `STRATA_EXACT_STATS=1` prints its statistics;
+/// `STRATA_EXACT_CLIMB=all`, `STRATA_EXACT_RATIO=2|4`,
+/// `STRATA_EXACT_BEAM=off` (no beam pre-pass) configure `ray-exact`; `STRATA_EXACT_STATS=1` prints its statistics;
 /// `STRATA_TEST_OVERSIZE_BUILD=METHOD` makes that method's build ask for a
 /// buffer over the device's limit (the README's way to see a refused build).
 pub fn render_options() -> RenderOptions {
@@ -80,6 +80,7 @@ fn render_options_from(var: impl Fn(&str) -> Option<String>) -> RenderOptions {
                 Some("2") => 1,
                 _ => e.log_ratio,
             },
+            beam: !is("STRATA_EXACT_BEAM", "off"),
             ..e
         },
         exact_stats: is("STRATA_EXACT_STATS", "1"),
@@ -98,10 +99,12 @@ mod tests {
             "STRATA_SHADOW_CULL" => Some("0".into()),
             "STRATA_EXACT_DEPTH" => Some("points".into()),
             "STRATA_EXACT_RATIO" => Some("2".into()),
+            "STRATA_EXACT_BEAM" => Some("off".into()),
             "STRATA_TEST_OVERSIZE_BUILD" => Some("voxel".into()),
             _ => None,
         });
-        assert!(!o.shadow_cull && !o.shadow_reuse);
+        assert!(!o.shadow_cull && !o.shadow_reuse && !o.exact.beam);
+        assert!(render_options_from(|_| None).exact.beam);
         assert_eq!((o.exact.depth, o.exact.log_ratio), (DepthMode::Points, 1));
         assert_eq!(o.oversize_build.as_deref(), Some("voxel"));
     }

@@ -14,7 +14,7 @@ use std::path::PathBuf;
 use strata_level::{ViewSpec, views::parse_views};
 use strata_render::frame::{Globals, LevelShape};
 use strata_render::methods::ray_exact::replay::{
-    FrameCount, PassCount, Replay, Traversal, compute_pyramid, replay_frame,
+    FrameCount, PassCount, Replay, Traversal, beam_disagreements, compute_pyramid, replay_frame,
 };
 
 #[derive(clap::Args)]
@@ -42,6 +42,19 @@ pub struct Args {
     /// texels, 1 .. 4 tiles of 4, 16, 64, 256 texels; the GPU's: 3).
     #[arg(long, value_parser = clap::value_parser!(u32).range(0..=4))]
     start_level: Option<u32>,
+    /// Try another traversal on paper: no beam pre-pass (camera rays start
+    /// at the near plane, as `ray-exact` with `STRATA_EXACT_BEAM=off`).
+    #[arg(long)]
+    no_beam: bool,
+    /// Try another traversal on paper: the visited level camera rays start
+    /// at from their tile's beam (the GPU's: 1, tiles of 4 texels).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=4))]
+    beam_level: Option<u32>,
+    /// Also check the beam on every pixel: its ray marched from the near
+    /// plane and from its tile's beam finds the same hit (t to the bit and
+    /// the column), never before the beam; fails otherwise.
+    #[arg(long)]
+    verify_beam: bool,
 }
 
 #[derive(Serialize)]
@@ -62,6 +75,14 @@ struct Report {
     /// Means over the views.
     mean_bytes: f64,
     mean_march_iterations: f64,
+    /// The beams' iterations over the pixels (each tile's beam shared by its
+    /// 64 pixels).
+    mean_beam_iterations_per_pixel: f64,
+    mean_march_warp_iterations: f64,
+    mean_shadow_iterations: f64,
+    mean_shadow_warp_iterations: f64,
+    /// The shadow blocks' beams' iterations over the shadow rays.
+    mean_shadow_beam_iterations_per_ray: f64,
     mean_shadow_rays: f64,
 }
 
@@ -113,6 +134,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     replay.traversal = Traversal {
         climb: args.climb,
         start: args.start_level.or(Traversal::GPU.start),
+        beam: !args.no_beam,
+        beam_level: args.beam_level.unwrap_or(Traversal::GPU.beam_level),
     };
     let shape = LevelShape::of(&world.level);
     let mut out = std::io::stdout().lock();
@@ -121,6 +144,19 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         let shadow = strata_render::shadow::ShadowFrame::fit(camera, !args.no_shadows);
         let globals = Globals::new(camera, &shape, &shadow);
         let frame = replay_frame(&mut replay, &globals);
+        if args.verify_beam {
+            let (differ, early) = beam_disagreements(&mut replay, &globals);
+            eprintln!(
+                "{}: beam check: {differ} rays' hits differ, {early} hits before their beam (camera rays and shadow rays)",
+                view.name
+            );
+            if differ + early > 0 {
+                bail!(
+                    "{}: the beam changed {differ} hits ({early} before their tile's start)",
+                    view.name
+                );
+            }
+        }
         if !args.json {
             writeln!(
                 out,
@@ -136,6 +172,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                 frame.pyramid_bytes_touched as f64 / 1e6,
             )?;
             for (name, pass) in [
+                ("beam", &frame.beam),
                 ("march", &frame.march),
                 ("shadow", &frame.shadow),
                 ("shade", &frame.shade),
@@ -158,6 +195,15 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         shadows: !args.no_shadows,
         mean_bytes: mean(&|c| c.bytes as f64),
         mean_march_iterations: mean(&|c| c.frame.march.iterations.mean),
+        mean_beam_iterations_per_pixel: mean(&|c| {
+            c.frame.beam.iterations.total as f64 / c.frame.march.rays.max(1) as f64
+        }),
+        mean_march_warp_iterations: mean(&|c| c.frame.march.warp_iterations),
+        mean_shadow_iterations: mean(&|c| c.frame.shadow.iterations.mean),
+        mean_shadow_warp_iterations: mean(&|c| c.frame.shadow.warp_iterations),
+        mean_shadow_beam_iterations_per_ray: mean(&|c| {
+            c.frame.shadow_beam_iterations as f64 / c.frame.shadow.rays.max(1) as f64
+        }),
         mean_shadow_rays: mean(&|c| c.frame.shadow.rays as f64),
         views: counts,
     };
@@ -167,11 +213,18 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     } else {
         writeln!(
             out,
-            "mean over {} views: {:.2} MB a frame, {:.1} march iterations a pixel, {:.0} shadow rays",
+            "mean over {} views: {:.2} MB a frame, {:.2} march iterations a pixel ({:.2} a warp) \
+             + {:.3} beam iterations a pixel, {:.0} shadow rays of {:.2} iterations ({:.2} a warp) \
+             + {:.3} beam iterations a ray",
             report.views.len(),
             report.mean_bytes / 1e6,
             report.mean_march_iterations,
+            report.mean_march_warp_iterations,
+            report.mean_beam_iterations_per_pixel,
             report.mean_shadow_rays,
+            report.mean_shadow_iterations,
+            report.mean_shadow_warp_iterations,
+            report.mean_shadow_beam_iterations_per_ray,
         )?;
     }
     Ok(())

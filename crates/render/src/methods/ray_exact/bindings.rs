@@ -136,11 +136,13 @@ pub(super) fn march_group(
     levels: &Levels,
     stats: &wgpu::Buffer,
     depth: Option<&DepthCopy>,
+    beam: Option<&wgpu::Buffer>,
 ) -> wgpu::BindGroup {
     let mut entries = core_bindings(params, levels, stats);
     if let Some(depth) = depth {
         entries.extend(depth.bindings(shared, 3));
     }
+    entries.extend(beam.map(beam_binding));
     shared.device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("ray-exact"),
         layout,
@@ -164,16 +166,52 @@ pub(super) fn exact_pipeline(
     } else {
         super::START_LEVEL
     };
+    let mut constants = vec![
+        ("EXACT_CLIMB", f64::from(options.climb)),
+        ("EXACT_LOG_RATIO", f64::from(options.log_ratio)),
+        ("EXACT_START_LEVEL", f64::from(start)),
+    ];
+    if reads_beam(levels, shader) {
+        constants.push(("EXACT_BEAM", f64::from(u8::from(options.beam))));
+        constants.push(("EXACT_BEAM_LEVEL", f64::from(super::BEAM_LEVEL)));
+    }
     super::super::common::compute_pipeline_with_constants(
         shared,
         label,
         &levels.shader(shader),
         layout,
         entry,
-        &[
-            ("EXACT_CLIMB", f64::from(options.climb)),
-            ("EXACT_LOG_RATIO", f64::from(options.log_ratio)),
-            ("EXACT_START_LEVEL", f64::from(start)),
-        ],
+        &constants,
     )
+}
+
+/// The binding of the beam pre-pass's tile starts in group 1
+/// (`exact_beams` in `ray_exact_beam.wgsl`).
+pub(super) const BEAM_BINDING: u32 = 12;
+
+/// Whether `shader` over `levels` reads the beam's starts (and takes the
+/// `EXACT_BEAM` constants): the compute frames over the whole map.
+pub(super) fn reads_beam(levels: &Levels, shader: &str) -> bool {
+    !levels.is_paged()
+        && matches!(
+            shader,
+            "ray_exact.wgsl" | "ray_exact_deferred.wgsl" | "ray_exact_shadow.wgsl"
+        )
+}
+
+/// The layout entry of the beam's starts.
+pub(super) fn beam_layout_entry() -> wgpu::BindGroupLayoutEntry {
+    buffer_entry(
+        BEAM_BINDING,
+        wgpu::ShaderStages::COMPUTE,
+        wgpu::BufferBindingType::Storage { read_only: false },
+    )
+}
+
+/// The group entry of the beam's starts.
+pub(super) fn beam_binding(buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
+    wgpu::BindGroupEntry {
+        binding: BEAM_BINDING,
+        resource: buffer.as_entire_binding(),
+    }
 }

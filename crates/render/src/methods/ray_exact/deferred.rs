@@ -4,7 +4,9 @@
 //! numbers are in the parent module's docs).
 
 use super::bindings::Levels;
-use super::bindings::{buffer_entry, core_bindings, core_entries, exact_pipeline};
+use super::bindings::{
+    beam_binding, beam_layout_entry, buffer_entry, core_bindings, core_entries, exact_pipeline,
+};
 use crate::frame::{Shared, storage_texture_entry, storage_texture_entry_with, texture_2d};
 use crate::methods::common::DepthCopy;
 use crate::options::ExactOptions;
@@ -75,11 +77,9 @@ impl ShadowMarks {
 impl Deferred {
     pub(super) fn new(
         shared: &Shared,
-        params: &wgpu::Buffer,
-        levels: &Levels,
-        stats: &wgpu::Buffer,
-        marks: &ShadowMarks,
+        (params, levels, stats, marks): (&wgpu::Buffer, &Levels, &wgpu::Buffer, &ShadowMarks),
         depth: &DepthCopy,
+        beam: Option<&wgpu::Buffer>,
         options: ExactOptions,
     ) -> anyhow::Result<Self> {
         let device = &shared.device;
@@ -96,6 +96,7 @@ impl Deferred {
                 wgpu::BufferBindingType::Storage { read_only: false },
             ));
         }
+        entries.extend(beam.map(|_| beam_layout_entry()));
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("ray-exact deferred"),
             entries: &entries,
@@ -121,6 +122,7 @@ impl Deferred {
             (params, levels, stats, marks),
             depth,
             &hits,
+            beam,
         );
         Ok(Deferred {
             march,
@@ -137,6 +139,7 @@ impl Deferred {
         (params, levels, stats, marks): (&wgpu::Buffer, &Levels, &wgpu::Buffer, &ShadowMarks),
         depth: &DepthCopy,
         hits: &wgpu::TextureView,
+        beam: Option<&wgpu::Buffer>,
     ) -> wgpu::BindGroup {
         let mut entries = core_bindings(params, levels, stats);
         entries.extend(depth.bindings(shared, 3));
@@ -150,6 +153,7 @@ impl Deferred {
                 resource: buffer.as_entire_binding(),
             });
         }
+        entries.extend(beam.map(beam_binding));
         shared.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("ray-exact deferred"),
             layout,

@@ -56,6 +56,34 @@ pub struct MarchCount {
     pub climbs: u32,
 }
 
+/// Side of a beam's square pixel tile (`BEAM_TILE` in `ray_exact_beam.wgsl`:
+/// the march's 8x8 workgroup).
+pub const BEAM_TILE: u32 = 8;
+/// Intervals a shadow block's beam tests at once, one per invocation.
+pub const SHADOW_BEAM_LANES: u32 = 64;
+/// Most iterations of one beam (`BEAM_CAP`): the beam pass is a chain of
+/// dependent fetches per tile, and its slowest warp sets its time; on the
+/// default views a cap of 64 costs 0.03 march iterations a pixel against
+/// 128 (10.10 against 10.07) and halves the longest chain.
+pub const BEAM_CAP: u32 = 64;
+/// A beam's first interval moves its rays this far (`BEAM_FIRST_STEP`).
+const BEAM_FIRST_STEP: f32 = 4.0;
+/// The beam box's margin for f32 rounding, absolute and relative to its
+/// coordinates (`BEAM_MARGIN`, `BEAM_MARGIN_RELATIVE`).
+const BEAM_MARGIN: f32 = 0.0625;
+const BEAM_MARGIN_RELATIVE: f32 = 1.0e-5;
+
+/// What one beam did.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BeamCount {
+    /// Where its rays start.
+    pub t: f32,
+    /// Search iterations.
+    pub iterations: u32,
+    /// Pyramid words read.
+    pub pyramid_reads: u32,
+}
+
 /// Traversal knobs to try on paper; [`Traversal::GPU`] is what the compute
 /// pipelines run.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -66,6 +94,14 @@ pub struct Traversal {
     /// The visited level (0 = texels, top = 256-texel tiles) camera and
     /// shadow rays start at (`None`: the top).
     pub start: Option<u32>,
+    /// Camera rays start where their 8x8-pixel tile's beam first may meet
+    /// the ground (`cs_exact_beam`, [`Replay::beam`]), else at the near
+    /// plane; shadow rays where their 8x8-texel block's does
+    /// ([`Replay::shadow_beam`]), else at altitude 255.
+    pub beam: bool,
+    /// The visited level camera and shadow rays start at from their beam
+    /// (`EXACT_BEAM_LEVEL`).
+    pub beam_level: u32,
 }
 
 impl Traversal {
@@ -73,12 +109,16 @@ impl Traversal {
     pub const GPU: Traversal = Traversal {
         climb: 1,
         start: Some(super::START_LEVEL / LOG_RATIO),
+        beam: true,
+        beam_level: super::BEAM_LEVEL / LOG_RATIO,
     };
 
     /// Starting at the 256-texel tiles (the GPU's before `START_LEVEL`).
     pub const FROM_TOP: Traversal = Traversal {
         climb: 1,
         start: None,
+        beam: false,
+        beam_level: super::BEAM_LEVEL / LOG_RATIO,
     };
 }
 
@@ -225,6 +265,19 @@ impl<'a> Replay<'a> {
     /// `exact_march` of `ray_exact_core.wgsl` on the whole map (level of
     /// detail 0), counting.
     pub fn march(&mut self, o: Vec3, base: IVec2, d: Vec3, t0: f32, t1: f32) -> MarchCount {
+        self.march_at(o, base, d, (t0, t1), self.traversal.start)
+    }
+
+    /// `exact_march_at`: [`Replay::march`] from visited level `start`
+    /// (`None`: the top).
+    fn march_at(
+        &mut self,
+        o: Vec3,
+        base: IVec2,
+        d: Vec3,
+        (t0, t1): (f32, f32),
+        start: Option<u32>,
+    ) -> MarchCount {
         let mut r = MarchCount::default();
         if t1 < t0 {
             return r;
@@ -240,7 +293,7 @@ impl<'a> Replay<'a> {
             if still[1] { 0.0 } else { 1.0 / d.y },
         );
         let top = self.top / ratio;
-        let mut lvl = self.traversal.start.map_or(top, |s| s.min(top));
+        let mut lvl = start.map_or(top, |s| s.min(top));
         let mut t = t0;
         let mut cell = texel_after(oxy + dxy * t, dxy) >> (lvl * ratio) as i32;
         loop {
@@ -308,17 +361,206 @@ impl<'a> Replay<'a> {
     /// `exact_pixel_hit` of `ray_exact_pixel.wgsl` (the eye's tile as base):
     /// the ray and what its march did.
     pub fn pixel(&mut self, g: &Globals, px: f32, py: f32) -> (Vec3, MarchCount) {
+        self.pixel_from(g, px, py, None)
+    }
+
+    /// `exact_pixel_hit_from`: the march of pixel (px, py) from no earlier
+    /// than `start` (its tile's beam, [`Replay::tile_beam`]), from visited
+    /// level [`Traversal::beam_level`] then; `None`: as
+    /// [`Replay::pixel`].
+    pub fn pixel_from(
+        &mut self,
+        g: &Globals,
+        px: f32,
+        py: f32,
+        start: Option<f32>,
+    ) -> (Vec3, MarchCount) {
         let eye = Vec3::from_slice(&g.eye[..3]);
         let d = camera_ray(g, px, py);
         let focal = g.eye[3];
         let (a, b) = exact_clip(eye, d, g.forward[3] / focal, g.right[3] / focal);
         let base = exact_base(eye.truncate());
         let o = (eye.truncate() - base.as_vec2()).extend(eye.z);
-        (d, self.march(o, base, d, a, b))
+        let level = match start {
+            Some(_) => Some(self.traversal.beam_level),
+            None => self.traversal.start,
+        };
+        let a = start.map_or(a, |t| a.max(t));
+        (d, self.march_at(o, base, d, (a, b), level))
+    }
+
+    /// `exact_beam` of `ray_exact_beam.wgsl`: the least t at which a ray
+    /// o + t d, d in the convex hull of `d`, may meet a solid point, searched
+    /// over [t0, t1] (t1 when none may), and what the search did. Each
+    /// iteration bounds the hull's points over [t, t2] by the box of the
+    /// corner rays' points at t and t2 (a point o + s d with s in [t, t2]
+    /// and d = sum l_i d_i is sum l_i (o + s d_i), and o + s d_i lies between
+    /// o + t d_i and o + t2 d_i), widened by a margin for f32 rounding, and
+    /// compares its lowest altitude with the highest column top of the 2x2
+    /// pyramid tiles, one level, that hold its xy extent: above it, nothing in
+    /// [t, t2] is solid (every solid point of a column is at or below its top).
+    pub fn beam(&mut self, o: Vec3, base: IVec2, d: [Vec3; 4], t0: f32, t1: f32) -> BeamCount {
+        self.beam_of([o; 4], base, d, t0, t1)
+    }
+
+    /// [`Replay::beam`] of four corner rays o_i + t d_i (rays o + t d with
+    /// (o, d) a convex combination of the corners').
+    pub fn beam_of(
+        &mut self,
+        o: [Vec3; 4],
+        base: IVec2,
+        d: [Vec3; 4],
+        t0: f32,
+        t1: f32,
+    ) -> BeamCount {
+        let reach = d
+            .iter()
+            .map(|v| v.abs().max_element())
+            .fold(0.0f32, f32::max);
+        let boxed = |t: f32| {
+            let p = [0, 1, 2, 3].map(|i| o[i] + d[i] * t);
+            (
+                p[0].min(p[1]).min(p[2].min(p[3])),
+                p[0].max(p[1]).max(p[2].max(p[3])),
+            )
+        };
+        let mut r = BeamCount {
+            t: t0,
+            ..BeamCount::default()
+        };
+        if reach == 0.0 {
+            return r;
+        }
+        let mut t = t0;
+        let mut dt = BEAM_FIRST_STEP / reach;
+        let mut a = boxed(t);
+        while t < t1 && r.iterations < BEAM_CAP {
+            r.iterations += 1;
+            let t2 = (t + dt).min(t1);
+            let b = boxed(t2);
+            let clear = self.box_clear(base, (a.0.min(b.0), a.1.max(b.1)), &mut r.pyramid_reads);
+            if clear {
+                t = t2;
+                a = b;
+                dt *= 2.0;
+            } else if dt * reach <= (a.1.x - a.0.x).max(a.1.y - a.0.y) + 1.0 {
+                break;
+            } else {
+                dt *= 0.5;
+            }
+        }
+        r.t = t;
+        r
+    }
+
+    /// `beam_clear` of `ray_exact_beam.wgsl`: whether nothing in the box
+    /// (lo, hi), relative to `base` and widened by the margin, is solid:
+    /// its lowest altitude above 255 or above the highest top of the 2x2
+    /// tiles, of the finest kept level whose tile is at least its extent,
+    /// that hold it. Counts the pyramid words read into `reads`.
+    fn box_clear(&mut self, base: IVec2, (lo, hi): (Vec3, Vec3), reads: &mut u32) -> bool {
+        let m = BEAM_MARGIN + BEAM_MARGIN_RELATIVE * lo.abs().max(hi.abs()).max_element();
+        let (lo, hi) = (lo - Vec3::splat(m), hi + Vec3::splat(m));
+        if lo.z > MAX_ALTITUDE {
+            return true;
+        }
+        let ext = (hi.x - lo.x).max(hi.y - lo.y);
+        let mut shift = LOG_RATIO;
+        while shift < self.top && ((1u32 << shift) as f32) < ext {
+            shift += LOG_RATIO;
+        }
+        let size = (1u32 << shift) as f32;
+        if size < ext {
+            return false;
+        }
+        let inv = 1.0 / size;
+        let tiles = base >> shift as i32;
+        let c0 = (lo.truncate() * inv).floor().as_ivec2() + tiles;
+        let c1 = (hi.truncate() * inv).floor().as_ivec2() + tiles;
+        *reads += 4;
+        let h = self
+            .maxmip(shift, c0.x, c0.y)
+            .max(self.maxmip(shift, c1.x, c0.y))
+            .max(
+                self.maxmip(shift, c0.x, c1.y)
+                    .max(self.maxmip(shift, c1.x, c1.y)),
+            );
+        lo.z > h
+    }
+
+    /// `exact_shadow_block_start` of `ray_exact_beam.wgsl`: the beam of the
+    /// shadow block whose first texel is (i, j), searched by its 64
+    /// invocations at once: invocation k tests the k-th of 64 equal
+    /// intervals of [0, span] (the four corner texels' rays are parallel;
+    /// each of the block's rays is a convex combination of theirs), and the
+    /// block's rays start at the first that is not clear. One iteration each.
+    pub fn shadow_beam(&mut self, g: &Globals, i: u32, j: u32) -> BeamCount {
+        let d = Vec3::from_slice(&g.light_dir[..3]);
+        let far = (MARK_BLOCK - 1) as u32;
+        let p = [(i, j), (i + far, j), (i, j + far), (i + far, j + far)]
+            .map(|(a, b)| self.shadow_start(g, a, b).0);
+        let base = exact_base(p[0].truncate());
+        let o = p.map(|q| (q.truncate() - base.as_vec2()).extend(q.z));
+        let span = self.shadow_start(g, i, j).1;
+        let boxed = |t: f32| {
+            let p = o.map(|q| q + d * t);
+            (
+                p[0].min(p[1]).min(p[2].min(p[3])),
+                p[0].max(p[1]).max(p[2].max(p[3])),
+            )
+        };
+        let lanes = SHADOW_BEAM_LANES;
+        let mut r = BeamCount {
+            t: span,
+            iterations: 1,
+            pyramid_reads: 0,
+        };
+        for k in 0..lanes {
+            let ta = span * (k as f32 / lanes as f32);
+            let tb = span * ((k + 1) as f32 / lanes as f32);
+            let (a, b) = (boxed(ta), boxed(tb));
+            let mut reads = 0;
+            if !self.box_clear(base, (a.0.min(b.0), a.1.max(b.1)), &mut reads) {
+                r.t = r.t.min(ta);
+            }
+            r.pyramid_reads = r.pyramid_reads.max(reads);
+        }
+        r
+    }
+
+    /// `cs_exact_beam` of `ray_exact_beam.wgsl`: the beam of the
+    /// [`BEAM_TILE`]-pixel square tile (tx, ty), through its corner pixels'
+    /// centres (every pixel's ray is a convex combination of theirs:
+    /// `camera_ray` is affine in the pixel).
+    pub fn tile_beam(&mut self, g: &Globals, tx: u32, ty: u32) -> BeamCount {
+        let (w, h) = (g.screen[0] as u32, g.screen[1] as u32);
+        let (x0, y0) = (tx * BEAM_TILE, ty * BEAM_TILE);
+        let xa = x0 as f32 + 0.5;
+        let ya = y0 as f32 + 0.5;
+        let xb = (x0 + BEAM_TILE).min(w) as f32 - 0.5;
+        let yb = (y0 + BEAM_TILE).min(h) as f32 - 0.5;
+        let d = [
+            camera_ray(g, xa, ya),
+            camera_ray(g, xb, ya),
+            camera_ray(g, xa, yb),
+            camera_ray(g, xb, yb),
+        ];
+        let eye = Vec3::from_slice(&g.eye[..3]);
+        let focal = g.eye[3];
+        let base = exact_base(eye.truncate());
+        let o = (eye.truncate() - base.as_vec2()).extend(eye.z);
+        self.beam(o, base, d, g.forward[3] / focal, g.right[3] / focal)
     }
 
     /// `cast_texel` of `ray_exact_shadow.wgsl`: shadow texel (i, j).
     pub fn shadow_texel(&mut self, g: &Globals, i: u32, j: u32) -> MarchCount {
+        self.shadow_texel_from(g, i, j, None)
+    }
+
+    /// `exact_shadow_ray` of `ray_exact_core.wgsl`: where shadow texel
+    /// (i, j)'s ray comes down to altitude 255, and the ray parameter it
+    /// leaves the map at below 0.
+    fn shadow_start(&self, g: &Globals, i: u32, j: u32) -> (Vec3, f32) {
         let texel = g.shadow_origin[3];
         let o = Vec3::from_slice(&g.shadow_origin[..3])
             + Vec3::from_slice(&g.shadow_u[..3]) * ((i as f32 + 0.5) * texel)
@@ -326,10 +568,28 @@ impl<'a> Replay<'a> {
         let d = Vec3::from_slice(&g.light_dir[..3]);
         let t_in = (MAX_ALTITUDE - o.z) / d.z;
         let t_out = (-1.0 - o.z) / d.z;
-        let p = o + d * t_in;
+        (o + d * t_in, t_out - t_in)
+    }
+
+    /// `cast_texel` from no earlier than `start` (its block's beam).
+    pub fn shadow_texel_from(
+        &mut self,
+        g: &Globals,
+        i: u32,
+        j: u32,
+        start: Option<f32>,
+    ) -> MarchCount {
+        let d = Vec3::from_slice(&g.light_dir[..3]);
+        let (p, span) = self.shadow_start(g, i, j);
         let base = exact_base(p.truncate());
         let rel = (p.truncate() - base.as_vec2()).extend(p.z);
-        self.march(rel, base, d, 0.0, t_out - t_in)
+        match start {
+            None => self.march(rel, base, d, 0.0, span),
+            Some(t) => {
+                let level = Some(self.traversal.beam_level);
+                self.march_at(rel, base, d, (t.max(0.0), span), level)
+            }
+        }
     }
 }
 
@@ -407,10 +667,15 @@ pub struct FrameCount {
     pub size: [u32; 2],
     /// Pixels whose ray hit.
     pub hits: u64,
+    /// The beams (one ray per 8x8-pixel tile; empty without them).
+    pub beam: PassCount,
     /// The camera march.
     pub march: PassCount,
     /// The shadow casts of the stamped blocks (empty with shadows off).
     pub shadow: PassCount,
+    /// Iterations of the shadow blocks' beams, all blocks together (one per
+    /// block: its 64 invocations search at once).
+    pub shadow_beam_iterations: u64,
     /// The shading of the hits.
     pub shade: PassCount,
     /// Shadow blocks stamped (8x8 texels each).
@@ -428,7 +693,7 @@ pub struct FrameCount {
 impl FrameCount {
     /// Bytes read and written by the three passes together.
     pub fn bytes(&self) -> u64 {
-        [self.march, self.shadow, self.shade]
+        [self.beam, self.march, self.shadow, self.shade]
             .iter()
             .map(|p| p.bytes_read + p.bytes_written)
             .sum()
@@ -525,6 +790,67 @@ fn shadow_taps(g: &Globals, p: Vec3, c: &strata_level::model::Column, d: Vec3) -
     4
 }
 
+/// Check the beams on every pixel of a frame and every texel of the shadow
+/// blocks its hits stamp: march each ray from the near plane (altitude 255)
+/// and from its tile's (block's) beam ([`Replay::tile_beam`],
+/// [`Replay::shadow_beam`]); the rays whose hits differ (t to the bit, or
+/// the column) and those whose hit lies before their beam (both must be 0).
+pub fn beam_disagreements(replay: &mut Replay<'_>, g: &Globals) -> (u64, u64) {
+    let (w, h) = (g.screen[0] as u32, g.screen[1] as u32);
+    let (mut differ, mut early) = (0, 0);
+    let bits = |hit: Option<(f32, IVec2)>| hit.map(|(t, c)| (t.to_bits(), c));
+    let mut blocks = std::collections::BTreeSet::new();
+    for ty in 0..h.div_ceil(BEAM_TILE) {
+        for tx in 0..w.div_ceil(BEAM_TILE) {
+            let start = replay.tile_beam(g, tx, ty).t;
+            for y in ty * BEAM_TILE..((ty + 1) * BEAM_TILE).min(h) {
+                for x in tx * BEAM_TILE..((tx + 1) * BEAM_TILE).min(w) {
+                    let (px, py) = (x as f32 + 0.5, y as f32 + 0.5);
+                    let (d, old) = replay.pixel(g, px, py);
+                    let new = replay.pixel_from(g, px, py, Some(start)).1.hit;
+                    differ += u64::from(bits(old.hit) != bits(new));
+                    early += u64::from(old.hit.is_some_and(|(t, _)| t < start));
+                    if let Some((t, _)) = old.hit
+                        && g.light_dir[3] != 0.0
+                    {
+                        let p = Vec3::from_slice(&g.eye[..3]) + d * t;
+                        shadow_blocks_of(g, p, &mut |b| {
+                            blocks.insert(b);
+                        });
+                    }
+                }
+            }
+        }
+    }
+    // The shadow blocks the hits stamp, every texel.
+    let across = g.shadow_u[3] as u32 / MARK_BLOCK as u32;
+    for b in blocks {
+        let (bx, by) = (b % across * 8, b / across * 8);
+        let start = replay.shadow_beam(g, bx, by).t;
+        for j in 0..MARK_BLOCK as u32 {
+            for i in 0..MARK_BLOCK as u32 {
+                let old = replay.shadow_texel(g, bx + i, by + j).hit;
+                let new = replay.shadow_texel_from(g, bx + i, by + j, Some(start)).hit;
+                differ += u64::from(bits(old) != bits(new));
+                early += u64::from(old.is_some_and(|(t, _)| t < start));
+            }
+        }
+    }
+    (differ, early)
+}
+
+/// Warps of 8x8 workgroups over a w x h grid of invocations: 8x4 each, as
+/// indices into the grid's row-major order.
+fn warps_of(w: u32, h: u32) -> impl Iterator<Item = Vec<usize>> {
+    (0..h.div_ceil(4)).flat_map(move |wy| {
+        (0..w.div_ceil(8)).map(move |wx| {
+            (wy * 4..(wy * 4 + 4).min(h))
+                .flat_map(|y| (wx * 8..(wx * 8 + 8).min(w)).map(move |x| (y * w + x) as usize))
+                .collect()
+        })
+    })
+}
+
 /// Replay `ray-exact`'s deferred frame for globals `g` (shadows as `g` says).
 pub fn replay_frame(replay: &mut Replay<'_>, g: &Globals) -> FrameCount {
     replay.terrain_touched.clear();
@@ -536,9 +862,36 @@ pub fn replay_frame(replay: &mut Replay<'_>, g: &Globals) -> FrameCount {
     let mut hits = Vec::new();
     let mut stamped = vec![false; ((side / MARK_BLOCK as u32).pow(2)) as usize];
     let mut listed = Vec::new();
+    // The beams: one per 8x8 tile, one thread each, in 8x8 workgroups of
+    // tiles (a warp: 8x4 tiles).
+    let tiles = (w.div_ceil(BEAM_TILE), h.div_ceil(BEAM_TILE));
+    let mut beam = PassAcc::default();
+    let mut starts = vec![None; (tiles.0 * tiles.1) as usize];
+    if replay.traversal.beam {
+        for ty in 0..tiles.1 {
+            for tx in 0..tiles.0 {
+                let b = replay.tile_beam(g, tx, ty);
+                starts[(ty * tiles.0 + tx) as usize] = Some(b.t);
+                beam.add(&MarchCount {
+                    iterations: b.iterations,
+                    pyramid_reads: b.pyramid_reads,
+                    ..MarchCount::default()
+                });
+            }
+        }
+    }
+    let beam = if replay.traversal.beam {
+        let mut p = beam.finish(warps_of(tiles.0, tiles.1));
+        // One f32 per tile.
+        p.bytes_written = u64::from(tiles.0 * tiles.1) * 4;
+        p
+    } else {
+        PassCount::default()
+    };
     for y in 0..h {
         for x in 0..w {
-            let (d, m) = replay.pixel(g, x as f32 + 0.5, y as f32 + 0.5);
+            let start = starts[((y / BEAM_TILE) * tiles.0 + x / BEAM_TILE) as usize];
+            let (d, m) = replay.pixel_from(g, x as f32 + 0.5, y as f32 + 0.5, start);
             march.add(&m);
             if let Some((t, column)) = m.hit {
                 let p = Vec3::from_slice(&g.eye[..3]) + d * t;
@@ -554,28 +907,33 @@ pub fn replay_frame(replay: &mut Replay<'_>, g: &Globals) -> FrameCount {
         }
     }
     let pixels = u64::from(w) * u64::from(h);
-    // Warps of 8x8 workgroups over the image: 8x4 pixels each.
-    let warps = (0..h.div_ceil(4)).flat_map(|wy| {
-        (0..w.div_ceil(8)).map(move |wx| {
-            (wy * 4..(wy * 4 + 4).min(h))
-                .flat_map(|y| (wx * 8..(wx * 8 + 8).min(w)).map(move |x| (y * w + x) as usize))
-                .collect()
-        })
-    });
-    let mut march = march.finish(warps);
+    let mut march = march.finish(warps_of(w, h));
     // hits (4 B each pixel), depth_io (4 B per hit), stamps and list.
     march.bytes_written =
         pixels * TEXEL_BYTES + hits.len() as u64 * TEXEL_BYTES + listed.len() as u64 * 8;
+    if replay.traversal.beam {
+        // Each pixel reads its tile's start.
+        march.bytes_read += pixels * 4;
+    }
     let most_iterations = march.iterations.max;
 
     let mut shadow = PassAcc::default();
+    let mut shadow_beams = 0u64;
     if shadows {
         let across = side / MARK_BLOCK as u32;
         for &b in &listed {
             let (bx, by) = (b % across, b / across);
+            let start = replay
+                .traversal
+                .beam
+                .then(|| replay.shadow_beam(g, bx * 8, by * 8));
+            if let Some(s) = start {
+                shadow_beams += u64::from(s.iterations);
+            }
             for j in 0..MARK_BLOCK as u32 {
                 for i in 0..MARK_BLOCK as u32 {
-                    shadow.add(&replay.shadow_texel(g, bx * 8 + i, by * 8 + j));
+                    let t = start.map(|s| s.t);
+                    shadow.add(&replay.shadow_texel_from(g, bx * 8 + i, by * 8 + j, t));
                 }
             }
         }
@@ -615,8 +973,10 @@ pub fn replay_frame(replay: &mut Replay<'_>, g: &Globals) -> FrameCount {
     FrameCount {
         size: [w, h],
         hits: hits.len() as u64,
+        beam,
         march,
         shadow,
+        shadow_beam_iterations: shadow_beams,
         shade,
         shadow_blocks: listed.len() as u64,
         terrain_bytes_touched: replay.terrain_touched.count * TERRAIN_TEXEL_BYTES,

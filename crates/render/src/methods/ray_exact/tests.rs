@@ -571,6 +571,19 @@ fn first_frame_after_the_crater_matches_a_fresh_build() {
     }
 }
 
+/// The camera of `view` at `size` and its frame's globals, shadows on.
+fn view_globals(
+    level: &Level,
+    view: &strata_level::ViewSpec,
+    (width, height): (u32, u32),
+) -> (Camera, crate::frame::Globals) {
+    let camera = Camera::from_view(level, view, width, height).unwrap();
+    let shadow = crate::shadow::ShadowFrame::fit(&camera, true);
+    let globals =
+        crate::frame::Globals::new(&camera, &crate::frame::LevelShape::of(level), &shadow);
+    (camera, globals)
+}
+
 /// One frame of `m` recorded by hand (the renderer owns its methods): the
 /// globals written, the exact shadow map cast, the march.
 fn record_frame(
@@ -621,6 +634,12 @@ fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
                 depth: DepthMode::Blit,
                 ..d
             },
+            ExactOptions { beam: false, ..d },
+            ExactOptions {
+                beam: false,
+                exact_shadow: false,
+                ..d
+            },
         ];
         let mut images = Vec::new();
         for options in variants {
@@ -642,15 +661,24 @@ fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
             );
             assert!(a.1 == b.1, "view {v}: colour differs");
         }
-        // Climbing as far as a step allows, visiting every other level, or
-        // loading depth instead of clearing it changes nothing but the work.
-        for other in [3, 4, 5] {
+        // Climbing as far as a step allows, visiting every other level,
+        // loading depth instead of clearing it, or starting every ray at the
+        // near plane instead of its tile's beam changes nothing but the work.
+        for other in [3, 4, 5, 6] {
             for (v, (a, b)) in images[1].iter().zip(&images[other]).enumerate() {
                 assert!(
                     a.0 == b.0 && a.1 == b.1,
                     "view {v}: variant {other} changed the image"
                 );
             }
+        }
+        // The one-pass frame (the renderer's shadow map) with and without
+        // the beam: the same image.
+        for (v, (a, b)) in images[2].iter().zip(&images[7]).enumerate() {
+            assert!(
+                a.0 == b.0 && a.1 == b.1,
+                "view {v}: the beam changed the one-pass frame's image"
+            );
         }
         // The exact shadow map and the 128-step one shade nearly alike.
         for (v, (a, b)) in images[1].iter().zip(&images[2]).enumerate() {
@@ -683,13 +711,7 @@ fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
         assert_eq!(m.stats().unwrap(), ExactStats::default());
         let timer = crate::timing::PassTimer::new(&shared.device, &shared.queue, false);
         for (index, view) in w.views.iter().enumerate() {
-            let camera = Camera::from_view(&w.level, view, W, H).unwrap();
-            let shadow = crate::shadow::ShadowFrame::fit(&camera, true);
-            let globals = crate::frame::Globals::new(
-                &camera,
-                &crate::frame::LevelShape::of(&w.level),
-                &shadow,
-            );
+            let (camera, globals) = view_globals(&w.level, view, (W, H));
             record_frame(&shared, &mut m, &camera, &globals, &timer, index);
         }
         let stats = m.stats().unwrap();
@@ -722,9 +744,7 @@ fn the_replay_takes_the_gpu_steps() {
     let shape = crate::frame::LevelShape::of(&w.level);
     let mut frames = Vec::new();
     for view in &w.views {
-        let camera = Camera::from_view(&w.level, view, W, H).unwrap();
-        let shadow = crate::shadow::ShadowFrame::fit(&camera, true);
-        let globals = crate::frame::Globals::new(&camera, &shape, &shadow);
+        let (camera, globals) = view_globals(&w.level, view, (W, H));
         let f = replay_frame(&mut replay, &globals);
         // Hits against the CPU reference, pixel by pixel.
         let reference = render_reference(&w.level, &camera);
@@ -797,5 +817,83 @@ fn the_replay_takes_the_gpu_steps() {
             );
         }
         gpu.errors.check().unwrap();
+    }
+}
+
+/// The beam pre-pass (`ray_exact_beam.wgsl`, its replay `Replay::beam`)
+/// never starts a tile past a hit of any of its rays, and a ray marched from
+/// its tile's start finds the very hit (t and column, bit for bit) it finds
+/// from the near plane (shadow rays from their block's beam likewise, at
+/// 160x100), on every generated view at 160x100 and 640x400
+/// (every tile, every pixel); and it saves iterations.
+#[test]
+fn the_beam_never_passes_a_hit() {
+    use super::replay::{BEAM_TILE, Replay, Traversal, compute_pyramid};
+    let w = common::generated_world();
+    let pyramid = compute_pyramid(&w.level);
+    let mut replay = Replay::new(&w.level, &pyramid);
+    replay.traversal = Traversal {
+        beam: false,
+        ..Traversal::GPU
+    };
+    for (width, height) in [(W, H), (640, 400)] {
+        let (mut before, mut after, mut beams, mut tiles_hit) = (0u64, 0u64, 0u64, 0u64);
+        for view in &w.views {
+            let (_, g) = view_globals(&w.level, view, (width, height));
+            for ty in 0..height.div_ceil(BEAM_TILE) {
+                for tx in 0..width.div_ceil(BEAM_TILE) {
+                    let b = replay.tile_beam(&g, tx, ty);
+                    beams += u64::from(b.iterations);
+                    assert!(b.t.is_finite() && b.iterations <= super::replay::BEAM_CAP);
+                    let mut any = false;
+                    for y in ty * BEAM_TILE..((ty + 1) * BEAM_TILE).min(height) {
+                        for x in tx * BEAM_TILE..((tx + 1) * BEAM_TILE).min(width) {
+                            let (px, py) = (x as f32 + 0.5, y as f32 + 0.5);
+                            let (_, old) = replay.pixel(&g, px, py);
+                            let (_, new) = replay.pixel_from(&g, px, py, Some(b.t));
+                            before += u64::from(old.iterations);
+                            after += u64::from(new.iterations);
+                            if let Some((t, _)) = old.hit {
+                                any = true;
+                                assert!(
+                                    t >= b.t,
+                                    "{} {width}x{height} pixel ({x}, {y}): hit at {t}, its tile starts at {}",
+                                    view.name,
+                                    b.t
+                                );
+                            }
+                            assert!(
+                                old.hit.map(|(t, c)| (t.to_bits(), c))
+                                    == new.hit.map(|(t, c)| (t.to_bits(), c)),
+                                "{} {width}x{height} pixel ({x}, {y}): {:?} from the near plane, {:?} from the beam",
+                                view.name,
+                                old.hit,
+                                new.hit
+                            );
+                        }
+                    }
+                    tiles_hit += u64::from(any);
+                }
+            }
+            // Shadow rays too (and the pixels again): every texel of the
+            // blocks the hits stamp, from 255 and from its block's beam.
+            if width == W {
+                let (differ, early) = super::replay::beam_disagreements(&mut replay, &g);
+                assert_eq!((differ, early), (0, 0), "{}: shadow beams", view.name);
+            }
+        }
+        let pixels = u64::from(width * height) * w.views.len() as u64;
+        eprintln!(
+            "{width}x{height}: march iterations a pixel {:.2} from the near plane, {:.2} from the beam; \
+             beam {:.3} a pixel; {tiles_hit} tiles with hits",
+            before as f64 / pixels as f64,
+            after as f64 / pixels as f64,
+            beams as f64 / pixels as f64
+        );
+        assert!(tiles_hit > 0);
+        assert!(
+            after + beams < before,
+            "the beam saved nothing: {before} -> {after} + {beams}"
+        );
     }
 }

@@ -1,0 +1,219 @@
+// `ray-exact`'s beam pre-pass (issue 36, item 1): one invocation per 8x8-pixel
+// tile marches the beam that holds the tile's 64 camera rays through the
+// pyramid and writes the least t at which any of them may meet a solid point;
+// the march (`exact_pixel_hit_from`) then starts each ray of the tile there
+// instead of at the near plane. The CPU twin is `replay.rs::Replay::beam`
+// (`strata exact-counts` counts both).
+//
+// Why no ray of the tile is solid before the start (so its march, from the
+// start, finds the hit the march from the near plane finds):
+// - `camera_ray` is affine in the pixel, so every pixel's direction d is a
+//   convex combination sum l_i d_i of the four corner pixels' (l_i >= 0,
+//   sum 1), and the rays share the eye o and the parameter t (t * focal is the
+//   view depth).
+// - For s in [t, t2]: o + s d = sum l_i (o + s d_i), and o + s d_i lies on the
+//   segment from o + t d_i to o + t2 d_i: every point of every ray of the tile
+//   over [t, t2] is in the convex hull of those eight points, so in their
+//   bounding box.
+// - The box, widened by a margin for f32 rounding, spans at most 2x2 tiles
+//   of the level whose tile is at least its xy extent. Every solid point of
+//   a column lies at or below its top, and the pyramid holds the highest top
+//   of each tile: when the box's lowest altitude is above the four tiles'
+//   maxima (or above 255), no point of [t, t2] of any ray of the tile is
+//   solid.
+// - The search only moves t past such intervals, so the start is at or
+//   before every ray's first solid point; a ray's march from it skips only
+//   empty space (its first column is entered at the start instead of its
+//   side, where nothing is solid). Tested: `the_beam_never_passes_a_hit`
+//   (the replay) and `depth_and_shadow_variants_agree...` (the GPU images,
+//   beam on and off, bit for bit).
+//
+// The search: intervals [t, t + dt] double while clear and halve where not,
+// until an interval that is not clear moves the rays no further than the
+// beam is wide (plus a texel); at most `BEAM_CAP` iterations (the start
+// stays where it got: still safe).
+
+#include "frame.wgsl"
+#include "ray_exact_core.wgsl"
+
+// Where each tile's rays start (`cs_exact_beam` writes; the march reads).
+@group(1) @binding(12) var<storage, read_write> exact_beams: array<f32>;
+
+// The march starts at its tile's beam (a pipeline constant; off: every ray
+// starts at the near plane and the buffer is not read).
+override EXACT_BEAM: bool = true;
+
+// The pyramid level camera rays start at from their tile's beam (a pipeline
+// constant, `ray_exact::BEAM_LEVEL`): near the ground, where the beam
+// leaves them, small tiles (4 texels) take fewer steps than `EXACT_START_LEVEL`.
+override EXACT_BEAM_LEVEL: u32 = 2u;
+
+const BEAM_TILE: u32 = 8u;
+const BEAM_CAP: u32 = 64u;
+const BEAM_FIRST_STEP: f32 = 4.0;
+const BEAM_MARGIN: f32 = 0.0625;
+const BEAM_MARGIN_RELATIVE: f32 = 1.0e-5;
+
+fn beam_tiles_across() -> u32 {
+    return (u32(globals.screen.x) + BEAM_TILE - 1u) / BEAM_TILE;
+}
+
+// Where pixel `id`'s ray starts at the earliest: its tile's beam
+// (-EXACT_BIG without the beam).
+fn exact_tile_start(id: vec2<u32>) -> f32 {
+    if (!EXACT_BEAM) {
+        return -EXACT_BIG;
+    }
+    let tile = id / BEAM_TILE;
+    return exact_beams[tile.y * beam_tiles_across() + tile.x];
+}
+
+// The pyramid level camera rays start at.
+fn exact_tile_level() -> u32 {
+    return select(EXACT_START_LEVEL, EXACT_BEAM_LEVEL, EXACT_BEAM);
+}
+
+struct BeamBox {
+    lo: vec3<f32>,
+    hi: vec3<f32>,
+}
+
+// The box of the four corner rays' points at t.
+fn beam_box(o0: vec3<f32>, o1: vec3<f32>, o2: vec3<f32>, o3: vec3<f32>, d0: vec3<f32>, d1: vec3<f32>, d2: vec3<f32>, d3: vec3<f32>, t: f32) -> BeamBox {
+    let p0 = o0 + d0 * t;
+    let p1 = o1 + d1 * t;
+    let p2 = o2 + d2 * t;
+    let p3 = o3 + d3 * t;
+    return BeamBox(min(min(p0, p1), min(p2, p3)), max(max(p0, p1), max(p2, p3)));
+}
+
+// Whether nothing in the box (lo, hi), relative to `base` and widened by the
+// margin, is solid: its lowest altitude above 255, or above the highest top
+// of the 2x2 tiles, of the finest kept level whose tile is at least its
+// extent, that hold it.
+fn beam_clear(base: vec2<i32>, lo_in: vec3<f32>, hi_in: vec3<f32>) -> bool {
+    let big = max(abs(lo_in), abs(hi_in));
+    let m = BEAM_MARGIN + BEAM_MARGIN_RELATIVE * max(max(big.x, big.y), big.z);
+    let lo = lo_in - vec3<f32>(m);
+    let hi = hi_in + vec3<f32>(m);
+    if (lo.z > MAX_ALTITUDE) {
+        return true;
+    }
+    let top = xparams.config.x;
+    let ext = max(hi.x - lo.x, hi.y - lo.y);
+    var shift = EXACT_LOG_RATIO;
+    loop {
+        if (shift >= top || f32(1u << shift) >= ext) {
+            break;
+        }
+        shift = shift + EXACT_LOG_RATIO;
+    }
+    let size = f32(1u << shift);
+    if (size < ext) {
+        return false;
+    }
+    let inv = 1.0 / size;
+    let tiles = base >> vec2<u32>(shift);
+    let c0 = vec2<i32>(floor(lo.xy * inv)) + tiles;
+    let c1 = vec2<i32>(floor(hi.xy * inv)) + tiles;
+    let h = max(
+        max(maxmip_get(shift, c0.x, c0.y), maxmip_get(shift, c1.x, c0.y)),
+        max(maxmip_get(shift, c0.x, c1.y), maxmip_get(shift, c1.x, c1.y)),
+    );
+    return lo.z > h;
+}
+
+// The least t in [t0, t1] at which a ray o + t d, d in the convex hull of
+// d0..d3, may be solid (t1 when none may); o relative to `base`.
+fn exact_beam(o: vec3<f32>, base: vec2<i32>, d0: vec3<f32>, d1: vec3<f32>, d2: vec3<f32>, d3: vec3<f32>, t0: f32, t1: f32) -> f32 {
+    let q = max(max(abs(d0), abs(d1)), max(abs(d2), abs(d3)));
+    let reach = max(max(q.x, q.y), q.z);
+    var t = t0;
+    if (reach == 0.0) {
+        return t;
+    }
+    var dt = BEAM_FIRST_STEP / reach;
+    var a = beam_box(o, o, o, o, d0, d1, d2, d3, t);
+    var n = 0u;
+    loop {
+        if (t >= t1 || n >= BEAM_CAP) {
+            break;
+        }
+        n = n + 1u;
+        let t2 = min(t + dt, t1);
+        let b = beam_box(o, o, o, o, d0, d1, d2, d3, t2);
+        if (beam_clear(base, min(a.lo, b.lo), max(a.hi, b.hi))) {
+            t = t2;
+            a = b;
+            dt = dt * 2.0;
+        } else if (dt * reach <= max(a.hi.x - a.lo.x, a.hi.y - a.lo.y) + 1.0) {
+            break;
+        } else {
+            dt = dt * 0.5;
+        }
+    }
+    return t;
+}
+
+// The shadow block's first lane k that found its interval not clear, as
+// 64 - k (0: none).
+var<workgroup> beam_first: atomic<u32>;
+
+// Where the rays of the 8x8-texel shadow block whose first texel is `first`
+// start, searched by the block's 64 invocations at once (call it from every
+// invocation of the workgroup, `li` its index): invocation k tests the k-th
+// of 64 equal intervals of [0, span] of the box of the four corner texels'
+// rays (parallel rays whose starts at altitude 255 are affine in the texel,
+// so every ray of the block is a convex combination of theirs, as in the
+// argument at the top), and the rays start at the first interval that is
+// not clear.
+fn exact_shadow_block_start(first: vec2<u32>, li: u32) -> f32 {
+    if (!EXACT_BEAM) {
+        return 0.0;
+    }
+    let far = BEAM_TILE - 1u;
+    let r0 = exact_shadow_ray(first);
+    let r1 = exact_shadow_ray(first + vec2<u32>(far, 0u));
+    let r2 = exact_shadow_ray(first + vec2<u32>(0u, far));
+    let r3 = exact_shadow_ray(first + vec2<u32>(far, far));
+    let base = exact_base(r0.p.xy);
+    let at = vec2<f32>(base);
+    let o0 = vec3<f32>(r0.p.xy - at, r0.p.z);
+    let o1 = vec3<f32>(r1.p.xy - at, r1.p.z);
+    let o2 = vec3<f32>(r2.p.xy - at, r2.p.z);
+    let o3 = vec3<f32>(r3.p.xy - at, r3.p.z);
+    let d = globals.light_dir.xyz;
+    let lanes = f32(BEAM_TILE * BEAM_TILE);
+    let a = beam_box(o0, o1, o2, o3, d, d, d, d, r0.span * (f32(li) / lanes));
+    let b = beam_box(o0, o1, o2, o3, d, d, d, d, r0.span * (f32(li + 1u) / lanes));
+    if (!beam_clear(base, min(a.lo, b.lo), max(a.hi, b.hi))) {
+        atomicMax(&beam_first, BEAM_TILE * BEAM_TILE - li);
+    }
+    workgroupBarrier();
+    let k = BEAM_TILE * BEAM_TILE - atomicLoad(&beam_first);
+    return r0.span * (f32(k) / lanes);
+}
+
+// One invocation per 8x8-pixel tile: its rays' start, through the corner
+// pixels' centres.
+@compute @workgroup_size(8, 8, 1)
+fn cs_exact_beam(@builtin(global_invocation_id) id: vec3<u32>) {
+    let size = vec2<u32>(globals.screen.xy);
+    let across = beam_tiles_across();
+    let down = (size.y + BEAM_TILE - 1u) / BEAM_TILE;
+    if (id.x >= across || id.y >= down) {
+        return;
+    }
+    let first = id.xy * BEAM_TILE;
+    let a = vec2<f32>(first) + vec2<f32>(0.5);
+    let b = vec2<f32>(min(first + vec2<u32>(BEAM_TILE), size)) - vec2<f32>(0.5);
+    let d0 = camera_ray(a.x, a.y);
+    let d1 = camera_ray(b.x, a.y);
+    let d2 = camera_ray(a.x, b.y);
+    let d3 = camera_ray(b.x, b.y);
+    let eye = globals.eye.xyz;
+    let focal = globals.eye.w;
+    let base = exact_base(eye.xy);
+    let o = vec3<f32>(eye.xy - vec2<f32>(base), eye.z);
+    exact_beams[id.y * across + id.x] = exact_beam(o, base, d0, d1, d2, d3, globals.forward.w / focal, globals.right.w / focal);
+}
