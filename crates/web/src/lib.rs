@@ -15,7 +15,7 @@
 //!
 //! The same module also runs in the page's decoding workers
 //! (`www/decode-worker.js`), where there is no window: there it only
-//! answers [`stream::worker_read`].
+//! answers `stream::worker_read`.
 #![cfg(target_arch = "wasm32")]
 
 mod compare;
