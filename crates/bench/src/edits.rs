@@ -233,6 +233,9 @@ pub fn edit_row(
         first_gpu.extend(t.gpu_ms);
         if sample == 0 {
             pictures.after = r.read_color()?;
+            // Work an edit left in flight (`mesh`'s refits) finishes first,
+            // untimed: the check compares the settled state.
+            r.settle_edits()?;
             checks = checks_until_consistent(&mut r, cam, &target, 1)?;
         }
     }

@@ -64,30 +64,60 @@ pub fn fit_chunk_from(
     if let Some(level) = source.as_level() {
         return Ok(fitter.fit_with(level, layout, cx, cy, tol, options));
     }
-    // Samples 0..=size in each direction, plus one column so the last
-    // sample's pair (it starts on an even texel) decodes from raw bytes.
-    let (ww, wh) = (layout.size_x + 2, layout.size_y + 1);
-    let (pw, ph) = (ww.next_power_of_two(), wh.next_power_of_two());
-    let (x0, y0) = (
-        i64::from(cx) * i64::from(layout.size_x),
-        i64::from(cy) * i64::from(layout.size_y),
-    );
-    let (wh_bytes, wm_bytes) = read_window(source, x0, y0, ww, wh)?;
-    let (mut heights, mut metas) = (vec![0u8; (pw * ph) as usize], vec![0u8; (pw * ph) as usize]);
-    for j in 0..wh as usize {
-        let (src, dst) = (j * ww as usize, j * pw as usize);
-        heights[dst..dst + ww as usize].copy_from_slice(&wh_bytes[src..src + ww as usize]);
-        metas[dst..dst + ww as usize].copy_from_slice(&wm_bytes[src..src + ww as usize]);
+    Ok(Patch::read(source, layout, (cx, cy))?.fit(fitter, tol, options))
+}
+
+/// A chunk's samples in a small level of their own: the chunk's
+/// `(size + 1)²` samples and the pair partner of its last column, at the
+/// origin. Fitting its chunk 0 gives the chunk's mesh of the whole-map fit,
+/// index for index; an edit's refit can take one off the render thread
+/// without the rest of the map.
+pub struct Patch {
+    /// The samples at the origin (power-of-two sides, zero past them).
+    pub level: Level,
+    /// The map's chunk size over the patch (its chunk 0 is the chunk).
+    pub layout: ChunkLayout,
+}
+
+impl Patch {
+    /// Chunk `(cx, cy)` of `layout` over the map `source` reads (a
+    /// [`Level`] is a source too).
+    pub fn read(
+        source: &dyn ColumnSource,
+        layout: &ChunkLayout,
+        (cx, cy): (u32, u32),
+    ) -> Result<Patch, SourceError> {
+        // Samples 0..=size in each direction, plus one column so the last
+        // sample's pair (it starts on an even texel) decodes from raw bytes.
+        let (ww, wh) = (layout.size_x + 2, layout.size_y + 1);
+        let (pw, ph) = (ww.next_power_of_two(), wh.next_power_of_two());
+        let (x0, y0) = (
+            i64::from(cx) * i64::from(layout.size_x),
+            i64::from(cy) * i64::from(layout.size_y),
+        );
+        let (wh_bytes, wm_bytes) = read_window(source, x0, y0, ww, wh)?;
+        let (mut heights, mut metas) =
+            (vec![0u8; (pw * ph) as usize], vec![0u8; (pw * ph) as usize]);
+        for j in 0..wh as usize {
+            let (src, dst) = (j * ww as usize, j * pw as usize);
+            heights[dst..dst + ww as usize].copy_from_slice(&wh_bytes[src..src + ww as usize]);
+            metas[dst..dst + ww as usize].copy_from_slice(&wm_bytes[src..src + ww as usize]);
+        }
+        let level = Level::from_planes(pw, ph, heights, metas, source.mid_rule())
+            .map_err(|e| SourceError(format!("patch for chunk ({cx}, {cy}): {e}")))?;
+        let layout = ChunkLayout {
+            size_x: layout.size_x,
+            size_y: layout.size_y,
+            chunks_x: pw / layout.size_x,
+            chunks_y: ph / layout.size_y,
+        };
+        Ok(Patch { level, layout })
     }
-    let patch = Level::from_planes(pw, ph, heights, metas, source.mid_rule())
-        .map_err(|e| SourceError(format!("patch for chunk ({cx}, {cy}): {e}")))?;
-    let patch_layout = ChunkLayout {
-        size_x: layout.size_x,
-        size_y: layout.size_y,
-        chunks_x: pw / layout.size_x,
-        chunks_y: ph / layout.size_y,
-    };
-    Ok(fitter.fit_with(&patch, &patch_layout, 0, 0, tol, options))
+
+    /// Fit the patch's chunk at finest tolerance `tol` with `options`.
+    pub fn fit(&self, fitter: &mut ChunkFitter, tol: f64, options: FitOptions) -> ChunkMesh {
+        fitter.fit_with(&self.level, &self.layout, 0, 0, tol, options)
+    }
 }
 
 /// Fit the chunks `ids` (indices of `layout`) of the map `source` reads,
