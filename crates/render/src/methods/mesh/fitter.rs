@@ -180,12 +180,12 @@ impl Fitter {
     pub fn poll(&mut self, most: usize, budget_ms: f64) -> Vec<Finished> {
         if self.workers.is_empty() {
             let start = web_time::Instant::now();
-            while start.elapsed().as_secs_f64() * 1e3 < budget_ms {
-                let Some(job) = take_job(&self.shared) else {
-                    break;
-                };
+            while let Some(job) = take_job(&self.shared) {
                 let done = run_job(&self.spec, job, &mut self.cache, &mut self.chunk_fitter);
                 let _ = self.done_tx.send(done);
+                if start.elapsed().as_secs_f64() * 1e3 >= budget_ms {
+                    break;
+                }
             }
         }
         let taken: Vec<FitResult> = self.done.try_iter().take(most).collect();
@@ -438,6 +438,99 @@ mod tests {
                     super::super::z_range(&level, &layout, i, want),
                     "chunk {i}"
                 );
+            }
+        }
+    }
+
+    fn world(seed: u64) -> Level {
+        strata_level::generate::generate(&strata_level::generate::GenerateParams {
+            seed,
+            width: 512,
+            height: 512,
+        })
+        .unwrap()
+        .level
+    }
+
+    /// Every fit `fitter` finishes, polled or waited for, by chunk.
+    fn drain(fitter: &mut Fitter, wait: bool) -> Vec<Finished> {
+        let mut all = Vec::new();
+        while fitter.in_flight() > 0 {
+            all.extend(if wait {
+                fitter.wait(usize::MAX)
+            } else {
+                fitter.poll(usize::MAX, 1.0)
+            });
+        }
+        all.sort_by_key(|(c, g, _)| (*c, *g));
+        all
+    }
+
+    /// The no-thread seam (a browser page): fits run in `poll` within its
+    /// budget and come back as the worker threads' do, equal to them.
+    #[test]
+    fn fits_on_the_calling_thread_equal_the_worker_threads() {
+        let level = Arc::new(world(5));
+        let source: Arc<dyn PageSource> = Arc::new(LevelPages::new(level.clone()).unwrap());
+        let tol = strata_mesh::tolerance_for_quality(0.5).unwrap();
+        let options = FitOptions { outline: true };
+        let wanted = [0u32, 3, 5, 12, 15];
+        let mut results = Vec::new();
+        for threads in [0, 2] {
+            let mut fitter = Fitter::new(Some(source.clone()), tol, options, threads);
+            fitter.want(&wanted);
+            // No threads: a poll of a tiny budget fits at least one chunk
+            // and leaves the rest queued.
+            if threads == 0 {
+                let first = fitter.poll(usize::MAX, 1e-6);
+                assert_eq!(first.len(), 1);
+                assert_eq!(fitter.in_flight(), wanted.len() - 1);
+                let mut rest = drain(&mut fitter, false);
+                rest.extend(first);
+                rest.sort_by_key(|(c, g, _)| (*c, *g));
+                results.push(rest);
+            } else {
+                results.push(drain(&mut fitter, true));
+            }
+        }
+        let chunks: Vec<u32> = results[0].iter().map(|(c, ..)| *c).collect();
+        assert_eq!(chunks, wanted);
+        assert_eq!(results[0], results[1]);
+        let ids: Vec<usize> = wanted.iter().map(|&c| c as usize).collect();
+        let whole = fit_chunks(&level, tol, options, &ids, 1);
+        for ((c, _, fit), want) in results[0].iter().zip(&whole) {
+            assert_eq!(&fit.as_ref().unwrap().0, want, "chunk {c}");
+        }
+    }
+
+    /// An edit's refits: a patch's fit is the edited level's chunk; a chunk
+    /// pushed again before its fit started keeps only the newest job.
+    #[test]
+    fn pushed_patches_fit_the_edited_chunks_and_coalesce() {
+        let (old, new) = (world(5), world(6));
+        let layout = ChunkLayout::of(&new);
+        let tol = strata_mesh::tolerance_for_quality(0.5).unwrap();
+        for threads in [0, 1] {
+            let mut fitter = Fitter::new(None, tol, FitOptions::default(), threads);
+            let patch =
+                |level: &Level, c: usize| Patch::read(level, &layout, layout.coords(c)).unwrap();
+            if threads == 0 {
+                fitter.push(7, 1, patch(&old, 7));
+                fitter.push(2, 1, patch(&old, 2));
+                fitter.push(7, 2, patch(&new, 7));
+                assert_eq!(fitter.in_flight(), 2, "chunk 7's older job was replaced");
+            } else {
+                fitter.push(7, 2, patch(&new, 7));
+                fitter.push(2, 1, patch(&old, 2));
+            }
+            let done = drain(&mut fitter, threads > 0);
+            let got: Vec<(u32, u64)> = done.iter().map(|(c, g, _)| (*c, *g)).collect();
+            assert_eq!(got, [(2, 1), (7, 2)]);
+            for ((c, _, fit), level) in done.iter().zip([&old, &new]) {
+                let c = *c as usize;
+                let want = fit_chunks(level, tol, FitOptions::default(), &[c], 1).remove(0);
+                let z = super::super::z_range(level, &layout, c, &want);
+                assert_eq!(fit.as_ref().unwrap(), &(want, z), "chunk {c}");
             }
         }
     }
