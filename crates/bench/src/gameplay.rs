@@ -589,8 +589,7 @@ fn check(
         hold_busy_ms: 0,
         ..input.fresh
     };
-    r.settle_edits()
-        .with_context(|| format!("frame {frame}: settling the edits"))?;
+    edits::settle(r, cam).with_context(|| format!("frame {frame}: settling the edits"))?;
     let fresh = edits::build(&fresh_input, level, name, settings)
         .with_context(|| format!("frame {frame}: the fresh build"))?;
     let target = edits::distance(&fresh, cam)?;
