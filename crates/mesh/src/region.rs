@@ -95,13 +95,31 @@ impl Patch {
             i64::from(cx) * i64::from(layout.size_x),
             i64::from(cy) * i64::from(layout.size_y),
         );
-        let (wh_bytes, wm_bytes) = read_window(source, x0, y0, ww, wh)?;
         let (mut heights, mut metas) =
             (vec![0u8; (pw * ph) as usize], vec![0u8; (pw * ph) as usize]);
-        for j in 0..wh as usize {
-            let (src, dst) = (j * ww as usize, j * pw as usize);
-            heights[dst..dst + ww as usize].copy_from_slice(&wh_bytes[src..src + ww as usize]);
-            metas[dst..dst + ww as usize].copy_from_slice(&wm_bytes[src..src + ww as usize]);
+        let (ww, pw_) = (ww as usize, pw as usize);
+        if let Some(level) = source.as_level() {
+            // Row by row, in at most two runs where the map wraps (an
+            // edit's refit copies its chunks on the render thread).
+            let (w, h) = (level.width() as usize, level.height() as usize);
+            for j in 0..wh as usize {
+                let (hr, mr) = level.row(((y0 as usize) + j).rem_euclid(h) as u32);
+                let (mut x, mut i) = ((x0 as usize) % w, 0);
+                while i < ww {
+                    let run = (w - x).min(ww - i);
+                    let at = j * pw_ + i;
+                    heights[at..at + run].copy_from_slice(&hr[x..x + run]);
+                    metas[at..at + run].copy_from_slice(&mr[x..x + run]);
+                    (x, i) = (0, i + run);
+                }
+            }
+        } else {
+            let (wh_bytes, wm_bytes) = read_window(source, x0, y0, ww as u32, wh)?;
+            for j in 0..wh as usize {
+                let (src, dst) = (j * ww, j * pw_);
+                heights[dst..dst + ww].copy_from_slice(&wh_bytes[src..src + ww]);
+                metas[dst..dst + ww].copy_from_slice(&wm_bytes[src..src + ww]);
+            }
         }
         let level = Level::from_planes(pw, ph, heights, metas, source.mid_rule())
             .map_err(|e| SourceError(format!("patch for chunk ({cx}, {cy}): {e}")))?;
@@ -212,5 +230,31 @@ mod tests {
         let cells = region_cells(&layout, 500, 0, 530, 10);
         assert_eq!(cells, vec![(3, -1), (4, -1), (3, 0), (4, 0)]);
         assert_eq!(cell_chunk(&layout, 4, -1), layout.index(0, 1));
+    }
+
+    /// A level's patches (copied row by row) equal those read through
+    /// tiles, and fit to the whole fit's chunks, wrapping at the map's
+    /// edges, on a map narrower than a patch too.
+    #[test]
+    fn patches_of_a_level_equal_patches_read_through_tiles() {
+        for (w, h) in [(512, 256), (64, 128)] {
+            let level = synthetic_level(w, h, 5);
+            let layout = layout_for(w, h);
+            let whole = LevelMesh::fit(&level, 2.0);
+            let tiled = Tiled(level.clone());
+            let mut fitter = ChunkFitter::default();
+            for i in 0..layout.count() {
+                let from_level = Patch::read(&level, &layout, layout.coords(i)).unwrap();
+                let from_tiles = Patch::read(&tiled, &layout, layout.coords(i)).unwrap();
+                assert_eq!(from_level.layout, from_tiles.layout);
+                assert_eq!(
+                    from_level.level.content_hash(),
+                    from_tiles.level.content_hash(),
+                    "{w}x{h} chunk {i}"
+                );
+                let mesh = from_level.fit(&mut fitter, 2.0, FitOptions::default());
+                assert_eq!(mesh, whole.chunks[i], "{w}x{h} chunk {i}");
+            }
+        }
     }
 }

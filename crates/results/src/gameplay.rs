@@ -185,14 +185,13 @@ fn lag_line(md: &mut String, rows: &[GameplayRow]) {
     if late.is_empty() {
         let _ = writeln!(
             md,
-            "Every method draws a frame's edits in the next frame.
-"
+            "Every method draws a frame's edits in the next frame.\n"
         );
     } else {
         let _ = writeln!(
             md,
-            "Frames until a frame's edits are drawn in full (p50 / p99 / max; 0: the next frame;              the others draw them in the next frame): {}.
-",
+            "Frames until a frame's edits are drawn in full (p50 / p99 / max; 0: the next frame; \
+             the others draw them in the next frame): {}.\n",
             late.join(", ")
         );
     }
