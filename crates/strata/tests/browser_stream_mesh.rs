@@ -20,7 +20,7 @@ use browser_common::*;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 /// The canvas: 160x100 drawn 1:1, overlay off.
 const SIZE: (u32, u32) = (160, 100);
@@ -103,40 +103,26 @@ fn paged_mesh_streams_into_the_page_and_matches_the_native_mesh() {
     std::fs::create_dir_all(&dir).expect("the fixture directory");
     let (store, view, views) = fixture(&dir);
     let size = format!("{}x{}", SIZE.0, SIZE.1);
-    let (level, views_s) = (store.to_string_lossy(), views.to_string_lossy());
     let (reference, native) = (dir.join("reference"), dir.join("native"));
-    strata(
-        &[
-            "reference",
-            "--no-cache",
-            "--size",
-            &size,
-            "--level",
-            &level,
-            "--views",
-            &views_s,
-            "--out",
-            &reference.to_string_lossy(),
-        ],
-        "reference",
-    );
-    strata(
-        &[
-            "render",
-            "--method",
-            "mesh",
-            "--gpu-budget",
-            &BUDGET.to_string(),
-            "--size",
-            &size,
-            "--level",
-            &level,
-            "--views",
-            &views_s,
-            "--out",
-            &native.to_string_lossy(),
-        ],
-        "render --method mesh --gpu-budget",
+    // `strata COMMAND FLAGS` over the store's view at the canvas's size into `out`.
+    let over_view = |command: &[&str], out: &Path| {
+        let mut args: Vec<String> = command.iter().map(|a| a.to_string()).collect();
+        for (flag, value) in [
+            ("--size", size.clone()),
+            ("--level", store.to_string_lossy().into()),
+            ("--views", views.to_string_lossy().into()),
+            ("--out", out.to_string_lossy().into()),
+        ] {
+            args.extend([flag.to_string(), value]);
+        }
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        strata(&args, command[0]);
+    };
+    over_view(&["reference", "--no-cache"], &reference);
+    let budget = BUDGET.to_string();
+    over_view(
+        &["render", "--method", "mesh", "--gpu-budget", &budget],
+        &native,
     );
     let metrics = strata(
         &[
@@ -176,30 +162,8 @@ fn paged_mesh_streams_into_the_page_and_matches_the_native_mesh() {
         assert_eq!(s["adapter"]["backend"], "browserwebgpu", "{s}");
         assert_eq!(s["active"], "mesh", "the page refused paged mesh: {s}");
         run(&client, "overlay off\nframes 2", 60).await;
-        // Converged: nothing pending, no page or fit in flight, three
-        // frames in a row; each frame timed (wall clock, one at a time).
         let start = Instant::now();
-        let (mut calm, mut frames, mut slowest) = (0, 0u32, 0.0f64);
-        let s = loop {
-            let t = Instant::now();
-            let s = run(&client, "frames 1", 120).await;
-            slowest = slowest.max(t.elapsed().as_secs_f64() * 1e3);
-            frames += 1;
-            let p = &s["paging"]["stats"];
-            let settled = p["pending_pixels"] == 0
-                && p["pending_shadow_texels"] == 0
-                && p["in_flight"] == 0
-                && p["resident_pages"].as_u64().unwrap_or(0) > 0;
-            calm = if settled { calm + 1 } else { 0 };
-            if calm >= 3 {
-                break s;
-            }
-            assert!(
-                start.elapsed() < Duration::from_secs(600),
-                "no convergence in 600 s ({frames} frames): {}",
-                s["paging"]
-            );
-        };
+        let (s, frames, slowest) = converge(&client, 600).await;
         eprintln!(
             "paged mesh converged in {:.1} s, {frames} frames, the slowest {slowest:.0} ms (wall, with the script round trip); paging {}",
             start.elapsed().as_secs_f64(),
