@@ -131,12 +131,12 @@ fn paged_mesh_streams_into_the_page_and_matches_the_native_mesh() {
             "--reference",
             &reference.join(&view).to_string_lossy(),
             "--render",
-            &native.join(&view).to_string_lossy(),
+            &native.to_string_lossy(),
         ],
         "metrics",
     );
     let m: Value = serde_json::from_slice(&metrics.stdout).expect("metrics JSON");
-    let get = |k: &str| m["metrics"][k].as_f64().unwrap_or(f64::NAN);
+    let get = |k: &str| m[k].as_f64().unwrap_or(f64::NAN);
     let (see, sky, coh) = (get("see_through"), get("covers_sky"), get("coherence"));
     eprintln!(
         "native paged mesh against the CPU reference: see-through {see:.3} %, covers-sky {sky:.3} %, coherence {coh:.3} %"
@@ -146,7 +146,7 @@ fn paged_mesh_streams_into_the_page_and_matches_the_native_mesh() {
         see <= max_see && sky <= max_sky && coh <= max_coh,
         "the native paged mesh is outside mesh's limits: {m}"
     );
-    let native_color = image::open(native.join(&view).join("color.png"))
+    let native_color = image::open(native.join("color.png"))
         .expect("the native render's color.png")
         .to_rgba8();
 
