@@ -88,20 +88,8 @@ impl Fixture {
     /// The fixture over an existing `store` (its first view at `pitch`
     /// degrees, the CPU reference of it in `dir`).
     fn over(dir: PathBuf, store: PathBuf, pitch: &str) -> Self {
-        let root: Value =
-            serde_json::from_slice(&std::fs::read(store.join("zarr.json")).expect("zarr.json"))
-                .expect("JSON");
-        let views = root["attributes"]["strata"]["views"]
-            .as_str()
-            .expect("the store's views")
-            .to_string();
         // A view that looks along the world, not down: many chunks to stream.
-        let line = views
-            .lines()
-            .find(|l| l.split_whitespace().last() == Some(pitch))
-            .or_else(|| views.lines().next())
-            .expect("a view")
-            .to_string();
+        let line = store_view_line(&store, pitch);
         let view = line.split_whitespace().next().expect("a name").to_string();
         std::fs::write(dir.join("views.txt"), format!("{line}\n")).expect("views.txt");
         let reference = dir.join("reference");

@@ -74,19 +74,7 @@ fn fixture(dir: &Path) -> (PathBuf, String, PathBuf) {
         ],
         "generate --to store",
     );
-    let root: Value =
-        serde_json::from_slice(&std::fs::read(store.join("zarr.json")).expect("zarr.json"))
-            .expect("JSON");
-    let views = root["attributes"]["strata"]["views"]
-        .as_str()
-        .expect("the store's views")
-        .to_string();
-    let line = views
-        .lines()
-        .find(|l| l.split_whitespace().last() == Some("-30"))
-        .or_else(|| views.lines().next())
-        .expect("a view")
-        .to_string();
+    let line = store_view_line(&store, "-30");
     let view = line.split_whitespace().next().expect("a name").to_string();
     let file = dir.join("views.txt");
     std::fs::write(&file, format!("{line}\n")).expect("views.txt");

@@ -189,6 +189,23 @@ pub async fn open(client: &Client, url: &str) -> (Value, f64) {
     (s, start.elapsed().as_secs_f64())
 }
 
+/// The `views.txt` line of `store`'s first view at `pitch` degrees (else
+/// its first view), from the store's `zarr.json`.
+pub fn store_view_line(store: &Path, pitch: &str) -> String {
+    let root: Value =
+        serde_json::from_slice(&std::fs::read(store.join("zarr.json")).expect("zarr.json"))
+            .expect("JSON");
+    let views = root["attributes"]["strata"]["views"]
+        .as_str()
+        .expect("the store's views");
+    views
+        .lines()
+        .find(|l| l.split_whitespace().last() == Some(pitch))
+        .or_else(|| views.lines().next())
+        .expect("a view")
+        .to_string()
+}
+
 /// Draw frames one at a time until the paged terrain has converged (nothing
 /// pending, nothing in flight, pages resident, three frames in a row: the
 /// feedback comes a frame or two late in a page), failing after `secs`.
