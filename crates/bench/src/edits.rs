@@ -140,6 +140,19 @@ pub fn distance(r: &Renderer, camera: &Camera) -> anyhow::Result<Vec<f32>> {
     ))
 }
 
+/// Finish the work the edits left in flight (`mesh`'s refits), untimed, so
+/// that a check compares the settled state; where the last frame did not
+/// show every edit yet, draw it again (it then counts as the first post-edit
+/// frame). Methods whose next frame shows their edits draw nothing more.
+pub fn settle(r: &mut Renderer, cam: &Camera) -> anyhow::Result<()> {
+    let late = r.pending_edits() > 0;
+    r.settle_edits()?;
+    if late {
+        r.render_frame(cam)?;
+    }
+    Ok(())
+}
+
 /// Compare an edited renderer that has drawn `drawn` frames since its edit
 /// with `target` (a fresh build's distances) after each of
 /// [`EDIT_CHECK_FRAMES`] post-edit frames, drawing the frames between, up
@@ -233,6 +246,7 @@ pub fn edit_row(
         first_gpu.extend(t.gpu_ms);
         if sample == 0 {
             pictures.after = r.read_color()?;
+            settle(&mut r, cam)?;
             checks = checks_until_consistent(&mut r, cam, &target, 1)?;
         }
     }

@@ -477,6 +477,7 @@ pub fn method_row(
     let (mut with_cpu, mut with_gpu) = (Vec::with_capacity(n), Vec::with_capacity(n));
     let (mut alone_cpu, mut alone_gpu) = (Vec::with_capacity(n), Vec::with_capacity(n));
     let mut checks = Vec::new();
+    let mut lag = EditLag::default();
     for f in 0..spec.frames {
         let rects = replay.apply(f, &workload.edits(f));
         let cam = workload.camera(replay.level(), f, w, h)?;
@@ -484,13 +485,16 @@ pub fn method_row(
         r.apply_edit(replay.level(), &rects)
             .with_context(|| format!("frame {f}: applying the edits"))?;
         edit_cpu.push(ms(start));
+        lag.applied();
         let t = r.render_frame(&cam)?;
         with_cpu.push(ms(start));
+        lag.drawn(&r);
         if let Some(g) = t.gpu_ms {
             with_gpu.push(g);
             edit_gpu.push(update_ms(&t));
         }
         if spec.checks_after(f) {
+            lag.settling();
             checks.push(check(
                 input,
                 &mut r,
@@ -504,6 +508,7 @@ pub fn method_row(
         let start = Instant::now();
         let t = r.render_frame(&cam)?;
         alone_cpu.push(ms(start));
+        lag.drawn(&r);
         alone_gpu.extend(t.gpu_ms);
     }
     let timed = |g: &[f64]| {
@@ -521,6 +526,7 @@ pub fn method_row(
         alone_cpu_ms: spread(&alone_cpu)?,
         alone_gpu_ms: timed(&alone_gpu),
         consistent: checks.iter().all(|c| c.consistent_after_frames.is_some()),
+        edit_lag_frames: Spread::of(&lag.frames),
         checks,
         edit_cpu_samples: edit_cpu,
         with_edits_cpu_samples: with_cpu,
@@ -528,7 +534,47 @@ pub fn method_row(
     })
 }
 
-/// The edited renderer against one built fresh from the edited level.
+/// How many frames each frame's edits take to be drawn in full
+/// ([`Renderer::pending_edits`]): 0 when the first frame drawn after
+/// `apply_edit` shows them (every method but `mesh`, whose refits run off
+/// the frame). Every frame drawn counts (the workload draws each camera
+/// twice: with its edits, then alone); batches a check settles are left out.
+#[derive(Default)]
+struct EditLag {
+    /// Frames drawn so far.
+    drawn: u64,
+    /// Per batch handed over: frames drawn before it.
+    applied_at: Vec<u64>,
+    /// Batches shown (or left out) so far.
+    shown: usize,
+    /// Per batch shown: its lag in frames.
+    frames: Vec<f64>,
+}
+
+impl EditLag {
+    fn applied(&mut self) {
+        self.applied_at.push(self.drawn);
+    }
+
+    fn drawn(&mut self, r: &Renderer) {
+        self.drawn += 1;
+        let pending = usize::try_from(r.pending_edits()).unwrap_or(usize::MAX);
+        let shown = self.applied_at.len().saturating_sub(pending);
+        for &at in &self.applied_at[self.shown.min(shown)..shown] {
+            self.frames.push((self.drawn - at - 1) as f64);
+        }
+        self.shown = self.shown.max(shown);
+    }
+
+    /// A check settles every batch handed over: leave those not yet shown out.
+    fn settling(&mut self) {
+        self.shown = self.applied_at.len();
+    }
+}
+
+/// The edited renderer against one built fresh from the edited level,
+/// once the work its edits left in flight is done (`mesh`'s refits;
+/// untimed).
 fn check(
     input: &GameplayInput<'_>,
     r: &mut Renderer,
@@ -543,6 +589,7 @@ fn check(
         hold_busy_ms: 0,
         ..input.fresh
     };
+    edits::settle(r, cam).with_context(|| format!("frame {frame}: settling the edits"))?;
     let fresh = edits::build(&fresh_input, level, name, settings)
         .with_context(|| format!("frame {frame}: the fresh build"))?;
     let target = edits::distance(&fresh, cam)?;

@@ -236,6 +236,8 @@ fn run_sequence(fx: &Fixture, steps: &[Step]) -> Result<(u32, u32), TestCaseErro
         let before = distances(&renderers[0], &camera).map_err(err)?;
         for (r, &m) in renderers.iter_mut().zip(&fx.methods) {
             r.apply_edit(&level, &dirty).map_err(err)?;
+            // `mesh` refits off the frame: compare the settled state.
+            r.settle_edits().map_err(err)?;
             let mut fresh =
                 Renderer::new(&fx.gpu, &level, &fx.colors, m, &settings, SIZE.0, SIZE.1)
                     .map_err(err)?;

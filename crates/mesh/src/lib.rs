@@ -108,4 +108,5 @@ pub use level_mesh::{
     ChunkRange, FitInSteps, FitTiming, LevelMesh, MeshStats, dirty_chunks, fit_chunks,
     fit_on_threads, fit_on_threads_with, timed_fit, timed_fit_with, tolerance_for_quality,
 };
+pub use region::Patch;
 pub use samples::{CHUNK, ChunkLayout};

@@ -64,30 +64,78 @@ pub fn fit_chunk_from(
     if let Some(level) = source.as_level() {
         return Ok(fitter.fit_with(level, layout, cx, cy, tol, options));
     }
-    // Samples 0..=size in each direction, plus one column so the last
-    // sample's pair (it starts on an even texel) decodes from raw bytes.
-    let (ww, wh) = (layout.size_x + 2, layout.size_y + 1);
-    let (pw, ph) = (ww.next_power_of_two(), wh.next_power_of_two());
-    let (x0, y0) = (
-        i64::from(cx) * i64::from(layout.size_x),
-        i64::from(cy) * i64::from(layout.size_y),
-    );
-    let (wh_bytes, wm_bytes) = read_window(source, x0, y0, ww, wh)?;
-    let (mut heights, mut metas) = (vec![0u8; (pw * ph) as usize], vec![0u8; (pw * ph) as usize]);
-    for j in 0..wh as usize {
-        let (src, dst) = (j * ww as usize, j * pw as usize);
-        heights[dst..dst + ww as usize].copy_from_slice(&wh_bytes[src..src + ww as usize]);
-        metas[dst..dst + ww as usize].copy_from_slice(&wm_bytes[src..src + ww as usize]);
+    Ok(Patch::read(source, layout, (cx, cy))?.fit(fitter, tol, options))
+}
+
+/// A chunk's samples in a small level of their own: the chunk's
+/// `(size + 1)²` samples and the pair partner of its last column, at the
+/// origin. Fitting its chunk 0 gives the chunk's mesh of the whole-map fit,
+/// index for index; an edit's refit can take one off the render thread
+/// without the rest of the map.
+pub struct Patch {
+    /// The samples at the origin (power-of-two sides, zero past them).
+    pub level: Level,
+    /// The map's chunk size over the patch (its chunk 0 is the chunk).
+    pub layout: ChunkLayout,
+}
+
+impl Patch {
+    /// Chunk `(cx, cy)` of `layout` over the map `source` reads (a
+    /// [`Level`] is a source too).
+    pub fn read(
+        source: &dyn ColumnSource,
+        layout: &ChunkLayout,
+        (cx, cy): (u32, u32),
+    ) -> Result<Patch, SourceError> {
+        // Samples 0..=size in each direction, plus one column so the last
+        // sample's pair (it starts on an even texel) decodes from raw bytes.
+        let (ww, wh) = (layout.size_x + 2, layout.size_y + 1);
+        let (pw, ph) = (ww.next_power_of_two(), wh.next_power_of_two());
+        let (x0, y0) = (
+            i64::from(cx) * i64::from(layout.size_x),
+            i64::from(cy) * i64::from(layout.size_y),
+        );
+        let (mut heights, mut metas) =
+            (vec![0u8; (pw * ph) as usize], vec![0u8; (pw * ph) as usize]);
+        let (ww, pw_) = (ww as usize, pw as usize);
+        if let Some(level) = source.as_level() {
+            // Row by row, in at most two runs where the map wraps (an
+            // edit's refit copies its chunks on the render thread).
+            let (w, h) = (level.width() as usize, level.height() as usize);
+            for j in 0..wh as usize {
+                let (hr, mr) = level.row(((y0 as usize) + j).rem_euclid(h) as u32);
+                let (mut x, mut i) = ((x0 as usize) % w, 0);
+                while i < ww {
+                    let run = (w - x).min(ww - i);
+                    let at = j * pw_ + i;
+                    heights[at..at + run].copy_from_slice(&hr[x..x + run]);
+                    metas[at..at + run].copy_from_slice(&mr[x..x + run]);
+                    (x, i) = (0, i + run);
+                }
+            }
+        } else {
+            let (wh_bytes, wm_bytes) = read_window(source, x0, y0, ww as u32, wh)?;
+            for j in 0..wh as usize {
+                let (src, dst) = (j * ww, j * pw_);
+                heights[dst..dst + ww].copy_from_slice(&wh_bytes[src..src + ww]);
+                metas[dst..dst + ww].copy_from_slice(&wm_bytes[src..src + ww]);
+            }
+        }
+        let level = Level::from_planes(pw, ph, heights, metas, source.mid_rule())
+            .map_err(|e| SourceError(format!("patch for chunk ({cx}, {cy}): {e}")))?;
+        let layout = ChunkLayout {
+            size_x: layout.size_x,
+            size_y: layout.size_y,
+            chunks_x: pw / layout.size_x,
+            chunks_y: ph / layout.size_y,
+        };
+        Ok(Patch { level, layout })
     }
-    let patch = Level::from_planes(pw, ph, heights, metas, source.mid_rule())
-        .map_err(|e| SourceError(format!("patch for chunk ({cx}, {cy}): {e}")))?;
-    let patch_layout = ChunkLayout {
-        size_x: layout.size_x,
-        size_y: layout.size_y,
-        chunks_x: pw / layout.size_x,
-        chunks_y: ph / layout.size_y,
-    };
-    Ok(fitter.fit_with(&patch, &patch_layout, 0, 0, tol, options))
+
+    /// Fit the patch's chunk at finest tolerance `tol` with `options`.
+    pub fn fit(&self, fitter: &mut ChunkFitter, tol: f64, options: FitOptions) -> ChunkMesh {
+        fitter.fit_with(&self.level, &self.layout, 0, 0, tol, options)
+    }
 }
 
 /// Fit the chunks `ids` (indices of `layout`) of the map `source` reads,
@@ -182,5 +230,31 @@ mod tests {
         let cells = region_cells(&layout, 500, 0, 530, 10);
         assert_eq!(cells, vec![(3, -1), (4, -1), (3, 0), (4, 0)]);
         assert_eq!(cell_chunk(&layout, 4, -1), layout.index(0, 1));
+    }
+
+    /// A level's patches (copied row by row) equal those read through
+    /// tiles, and fit to the whole fit's chunks, wrapping at the map's
+    /// edges, on a map narrower than a patch too.
+    #[test]
+    fn patches_of_a_level_equal_patches_read_through_tiles() {
+        for (w, h) in [(512, 256), (64, 128)] {
+            let level = synthetic_level(w, h, 5);
+            let layout = layout_for(w, h);
+            let whole = LevelMesh::fit(&level, 2.0);
+            let tiled = Tiled(level.clone());
+            let mut fitter = ChunkFitter::default();
+            for i in 0..layout.count() {
+                let from_level = Patch::read(&level, &layout, layout.coords(i)).unwrap();
+                let from_tiles = Patch::read(&tiled, &layout, layout.coords(i)).unwrap();
+                assert_eq!(from_level.layout, from_tiles.layout);
+                assert_eq!(
+                    from_level.level.content_hash(),
+                    from_tiles.level.content_hash(),
+                    "{w}x{h} chunk {i}"
+                );
+                let mesh = from_level.fit(&mut fitter, 2.0, FitOptions::default());
+                assert_eq!(mesh, whole.chunks[i], "{w}x{h} chunk {i}");
+            }
+        }
     }
 }

@@ -676,6 +676,25 @@ impl Renderer {
         Ok(())
     }
 
+    /// Wait until every method has finished the derived data of every edit
+    /// applied so far (`mesh`'s refits run off the frame), so that the next
+    /// frame shows them all: for comparing against a fresh build. A game
+    /// never needs it; the frame does not wait.
+    pub fn settle_edits(&mut self) -> anyhow::Result<()> {
+        let shared = Arc::clone(&self.shared);
+        for built in &mut self.methods {
+            built.method.settle_edits(&shared)?;
+        }
+        Ok(())
+    }
+
+    /// How many of the latest [`apply_edit`](Self::apply_edit) calls the
+    /// last frame of the active method did not yet show in full (0 for
+    /// methods whose edits are drawn by the next frame).
+    pub fn pending_edits(&self) -> u64 {
+        self.methods[self.active].method.pending_edits()
+    }
+
     /// Follow every later [`apply_edit`](Self::apply_edit) on the CPU too
     /// (replaces any earlier listener; `None` removes it).
     ///

@@ -62,6 +62,8 @@ fn an_edit_shows_in_the_next_frame() {
             let mut edited = level.clone();
             dig(&mut edited, rect);
             r.apply_edit(&edited, &[rect]).unwrap();
+            // `mesh` refits off the frame: compare the settled state.
+            r.settle_edits().unwrap();
             r.render_frame(&camera).unwrap();
             let after = r.read_depth().unwrap();
             let mut fresh = renderer(&gpu, &edited, method);

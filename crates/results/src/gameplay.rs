@@ -108,6 +108,12 @@ pub struct GameplayRow {
     pub checks: Vec<GameplayCheck>,
     /// Every check agreed within 16 frames.
     pub consistent: bool,
+    /// Frames until a frame's edits are drawn in full, p50 / p99 / max: 0
+    /// when the first frame after `apply_edit` shows them (`mesh` refits off
+    /// the frame). Every frame drawn counts; batches a check settles are left
+    /// out. `None` in results from before it was measured.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub edit_lag_frames: Option<Spread>,
     /// Per-frame samples (ms), frame order: `apply_edit` CPU, the frame
     /// with edits (CPU wall; GPU where timed).
     pub edit_cpu_samples: Vec<f64>,
@@ -159,6 +165,35 @@ fn checks_label(r: &GameplayRow) -> String {
                 .unwrap_or_default();
             format!("**no** ({worst})")
         }
+    }
+}
+
+/// Which methods draw a frame's edits late, and by how many frames.
+fn lag_line(md: &mut String, rows: &[GameplayRow]) {
+    let measured: Vec<(&str, &Spread)> = rows
+        .iter()
+        .filter_map(|r| Some((r.method.as_str(), r.edit_lag_frames.as_ref()?)))
+        .collect();
+    if measured.is_empty() {
+        return;
+    }
+    let late: Vec<String> = measured
+        .iter()
+        .filter(|(_, s)| s.max > 0.0)
+        .map(|(m, s)| format!("{m} {:.0} / {:.0} / {:.0}", s.p50, s.p99, s.max))
+        .collect();
+    if late.is_empty() {
+        let _ = writeln!(
+            md,
+            "Every method draws a frame's edits in the next frame.\n"
+        );
+    } else {
+        let _ = writeln!(
+            md,
+            "Frames until a frame's edits are drawn in full (p50 / p99 / max; 0: the next frame; \
+             the others draw them in the next frame): {}.\n",
+            late.join(", ")
+        );
     }
 }
 
@@ -218,6 +253,7 @@ pub(crate) fn section(md: &mut String, runs: &[crate::RunResults]) {
         }
         t.write_to(md);
         md.push('\n');
+        lag_line(md, &g.rows);
         if let Some(c) = &g.collider {
             let _ = writeln!(
                 md,
@@ -265,6 +301,7 @@ mod tests {
                 differing_pixels: 0.0,
             }],
             consistent: true,
+            edit_lag_frames: None,
             edit_cpu_samples: vec![],
             with_edits_cpu_samples: vec![],
             with_edits_gpu_samples: vec![],

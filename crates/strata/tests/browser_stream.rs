@@ -130,14 +130,8 @@ impl Fixture {
     /// The fixture over an existing `store` (its first view at `pitch`
     /// degrees, the CPU reference of it in `dir`).
     fn over(dir: PathBuf, store: PathBuf, pitch: &str) -> Self {
-        let views = store_views(&store);
         // A view that looks along the world, not down: many chunks to stream.
-        let line = views
-            .lines()
-            .find(|l| l.split_whitespace().last() == Some(pitch))
-            .or_else(|| views.lines().next())
-            .expect("a view")
-            .to_string();
+        let line = store_view_line(&store, pitch);
         let view = line.split_whitespace().next().expect("a name").to_string();
         std::fs::write(dir.join("views.txt"), format!("{line}\n")).expect("views.txt");
         let reference = dir.join("reference");
@@ -258,27 +252,8 @@ async fn stream_and_compare(client: &Client, url: &str, fixture: &Fixture, query
         "first frame {first_ms} ms after navigation, bound {FIRST_FRAME_BOUND_MS}"
     );
     run(client, "overlay off\nframes 2", 60).await;
-    // Converged: nothing pending, nothing in flight, twice in a row (the
-    // feedback comes a frame or two late in a page).
     let start = Instant::now();
-    let mut calm = 0;
-    let s = loop {
-        let s = run(client, "frames 1", 120).await;
-        let (p, _) = paging(&s);
-        let settled = p["pending_pixels"] == 0
-            && p["pending_shadow_texels"] == 0
-            && p["in_flight"] == 0
-            && p["resident_pages"].as_u64().unwrap_or(0) > 0;
-        calm = if settled { calm + 1 } else { 0 };
-        if calm >= 3 {
-            break s;
-        }
-        assert!(
-            start.elapsed() < Duration::from_secs(300),
-            "no convergence in 300 s: {}",
-            s["paging"]
-        );
-    };
+    let (s, _, _) = converge(client, 300).await;
     let (p, stream) = paging(&s);
     eprintln!(
         "converged in {:.1} s: {} pages resident ({} bytes), {} of {} GPU bytes; stream {stream}",

@@ -21,12 +21,9 @@ use strata_render::paged::{
 
 /// Why `method` cannot draw a paged world (`None`: it can).
 pub fn refusal(method: &str) -> Option<String> {
-    // A browser page has no threads to fit the paged mesh's chunks on.
-    if cfg!(target_arch = "wasm32") && method == "mesh" {
-        return Some(
-            "`mesh` over paged terrain fits its chunks on worker threads, which the page does not have; in the page paged worlds are drawn by ray-exact, ray-exact-fragment".into(),
-        );
-    }
+    // `mesh` fits its chunks on worker threads natively and, in a browser
+    // page (no threads: `PagedOptions::threads` 0), between frames within a
+    // few milliseconds each (`methods/mesh/fitter.rs`).
     (!strata_render::paged::PAGED_METHODS.contains(&method)).then(|| {
         format!(
             "`{method}` draws whole worlds only; paged worlds are drawn by {}",

@@ -68,6 +68,8 @@ fn a_dig_during_a_background_build_reaches_the_built_method() {
         Finished::Failed { error, .. } => panic!("{error:#}"),
     }
     renderer.activate("mesh").unwrap();
+    // The build's recorded edit is refitted off the frame: settle it first.
+    renderer.settle_edits().unwrap();
     renderer.render_frame(&camera).unwrap();
     let got = renderer.read_depth().unwrap();
 

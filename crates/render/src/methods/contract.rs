@@ -110,6 +110,22 @@ pub trait Method: Send {
         Ok(())
     }
 
+    /// Finish the derived data of every edit handed to
+    /// [`apply_edit`](Method::apply_edit) so far (waiting for work it left in
+    /// flight), so that the next frame shows them all. For checks against a
+    /// fresh build; a game's frame never calls it. Default: nothing is left
+    /// in flight.
+    fn settle_edits(&mut self, _shared: &Shared) -> anyhow::Result<()> {
+        Ok(())
+    }
+
+    /// How many of the latest [`apply_edit`](Method::apply_edit) calls the
+    /// frame prepared last did not yet show in full (work still in flight).
+    /// Default 0: an edit is drawn by the next frame.
+    fn pending_edits(&self) -> u64 {
+        0
+    }
+
     /// The shared targets were recreated at `shared.width` x `shared.height`:
     /// rebuild what was sized for or bound to the old ones (methods that only
     /// attach the targets when recording need nothing).

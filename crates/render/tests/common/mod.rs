@@ -294,6 +294,8 @@ pub fn crater_against_fresh(gpu: &Gpu, method: &str) -> (f64, f32, usize) {
     let before = r.read_depth().unwrap();
     let rects = strata_level::edit::crater(&mut level, &site);
     r.apply_edit(&level, &rects).unwrap();
+    // `mesh` refits off the frame: compare the settled state.
+    r.settle_edits().unwrap();
     r.render_frame(&camera).unwrap();
     let after = metrics::distance_from_depth(&camera, &r.read_depth().unwrap());
     let mut fresh = Renderer::new(gpu, &level, &colors, method, &settings, w_px, h_px).unwrap();

@@ -189,6 +189,53 @@ pub async fn open(client: &Client, url: &str) -> (Value, f64) {
     (s, start.elapsed().as_secs_f64())
 }
 
+/// The `views.txt` line of `store`'s first view at `pitch` degrees (else
+/// its first view), from the store's `zarr.json`.
+pub fn store_view_line(store: &Path, pitch: &str) -> String {
+    let root: Value =
+        serde_json::from_slice(&std::fs::read(store.join("zarr.json")).expect("zarr.json"))
+            .expect("JSON");
+    let views = root["attributes"]["strata"]["views"]
+        .as_str()
+        .expect("the store's views");
+    views
+        .lines()
+        .find(|l| l.split_whitespace().last() == Some(pitch))
+        .or_else(|| views.lines().next())
+        .expect("a view")
+        .to_string()
+}
+
+/// Draw frames one at a time until the paged terrain has converged (nothing
+/// pending, nothing in flight, pages resident, three frames in a row: the
+/// feedback comes a frame or two late in a page), failing after `secs`.
+/// The state then, the frames drawn, and the slowest frame's wall ms (with
+/// the script's round trip).
+pub async fn converge(client: &Client, secs: u64) -> (Value, u32, f64) {
+    let start = Instant::now();
+    let (mut calm, mut frames, mut slowest) = (0, 0u32, 0.0f64);
+    loop {
+        let t = Instant::now();
+        let s = run(client, "frames 1", 120).await;
+        slowest = slowest.max(t.elapsed().as_secs_f64() * 1e3);
+        frames += 1;
+        let p = &s["paging"]["stats"];
+        let settled = p["pending_pixels"] == 0
+            && p["pending_shadow_texels"] == 0
+            && p["in_flight"] == 0
+            && p["resident_pages"].as_u64().unwrap_or(0) > 0;
+        calm = if settled { calm + 1 } else { 0 };
+        if calm >= 3 {
+            return (s, frames, slowest);
+        }
+        assert!(
+            start.elapsed() < Duration::from_secs(secs),
+            "no convergence in {secs} s ({frames} frames): {}",
+            s["paging"]
+        );
+    }
+}
+
 /// The canvas's pixels in a WebDriver screenshot (what the page shows).
 pub async fn canvas_pixels(client: &Client) -> image::RgbaImage {
     let rect = client

@@ -20,7 +20,10 @@
 //! (default 1): resolution and field of view decide, not fixed distances.
 //!
 //! Edits refit the dirty chunks from scratch (equal to a fresh fit of the
-//! edited level) and rewrite only their slots.
+//! edited level) and rewrite only their slots, off the frame (`refits.rs`,
+//! issue 35): `apply_edit` copies the dirty chunks' samples and queues
+//! their fits on worker threads; each `prepare` uploads the fits finished
+//! by then without waiting; [`Method::settle_edits`] waits for all of them.
 
 use super::common::{begin_pass, forward_pipeline};
 mod fitter;
@@ -28,6 +31,7 @@ mod knobs;
 pub mod paged;
 mod paged_pool;
 mod pool;
+mod refits;
 use super::contract::{Frame, Method, MethodSettings, RetainedBytes};
 use crate::frame::{Shared, uniform_layout_entry};
 use glam::{Vec3, Vec4};
@@ -37,7 +41,7 @@ use strata_camera::Camera;
 use strata_level::model::decode_column;
 use strata_level::{DirtyRect, Level};
 use strata_mesh::{
-    ChunkLayout, ChunkMesh, FitInSteps, FitOptions, LODS, LevelMesh, dirty_chunks, fit_chunks,
+    ChunkLayout, ChunkMesh, FitInSteps, FitOptions, LODS, LevelMesh, dirty_chunks,
     tolerance_for_quality,
 };
 
@@ -95,6 +99,8 @@ pub struct Mesh {
     gradient_normal: bool,
     /// This frame's visible copies, front to back (written by `prepare`).
     draws: Vec<Draw>,
+    /// Edits' refits in flight (made at the first edit).
+    refits: Option<refits::Refits>,
 }
 
 /// Altitude range of the vertices a chunk's indices name.
@@ -333,6 +339,7 @@ fn from_fit(
         lod_pixels,
         gradient_normal,
         draws: Vec::new(),
+        refits: None,
     }))
 }
 
@@ -341,26 +348,6 @@ fn from_fit(
 fn pool_headroom(chunks: &[Fitted]) -> u32 {
     let total: usize = chunks.iter().map(|(m, _)| m.indices.len()).sum();
     (total / 16).max(1 << 15) as u32
-}
-
-/// Fit `ids` of `level` at `tol`, split over the available cores (the
-/// outline fit's two triangulations of a chunk as two jobs).
-fn refit_chunks(
-    level: &Level,
-    layout: &ChunkLayout,
-    tol: f64,
-    options: FitOptions,
-    ids: &[usize],
-) -> Vec<Fitted> {
-    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
-    fit_chunks(level, tol, options, ids, threads)
-        .into_iter()
-        .zip(ids)
-        .map(|(m, &i)| {
-            let z = z_range(level, layout, i, &m);
-            (m, z)
-        })
-        .collect()
 }
 
 /// Whether the box `[lo, hi]` lies entirely outside one clip plane of `m`.
@@ -503,6 +490,8 @@ impl Method for Mesh {
             let headroom = pool_headroom(&chunks);
             let (pool, slots) = IndexPool::build(&shared.device, &shared.queue, &chunks, headroom)?;
             (self.layout, self.pool, self.slots) = (layout, pool, slots);
+            // Refits in flight were of the old map.
+            self.refits = None;
             let grid = mesh_params(&layout, self.gradient_normal);
             shared
                 .queue
@@ -510,15 +499,27 @@ impl Method for Mesh {
             return Ok(());
         }
         let ids = dirty_chunks(&layout, level.width(), level.height(), rects);
-        let fresh = refit_chunks(level, &layout, self.tolerance, self.options, &ids);
-        for (&i, (mesh, z)) in ids.iter().zip(&fresh) {
-            self.pool
-                .replace(&shared.device, &shared.queue, &mut self.slots[i], mesh, *z);
+        let (tolerance, options) = (self.tolerance, self.options);
+        self.refits
+            .get_or_insert_with(|| refits::Refits::new(tolerance, options))
+            .push(level, &layout, &ids)
+    }
+
+    fn settle_edits(&mut self, shared: &Shared) -> anyhow::Result<()> {
+        match &mut self.refits {
+            Some(r) => r.upload(shared, (&mut self.pool, &mut self.slots), true),
+            None => Ok(()),
         }
-        Ok(())
+    }
+
+    fn pending_edits(&self) -> u64 {
+        self.refits.as_ref().map_or(0, refits::Refits::pending)
     }
 
     fn prepare(&mut self, shared: &Shared, camera: &Camera) -> anyhow::Result<()> {
+        if let Some(r) = &mut self.refits {
+            r.upload(shared, (&mut self.pool, &mut self.slots), false)?;
+        }
         let slots = &self.slots;
         visible_copies(
             &self.layout,

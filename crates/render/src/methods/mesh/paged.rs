@@ -10,6 +10,9 @@
 //!   window, merged with what the shadow pass's feedback asks for.
 //! - **Fits** run on worker threads (`Fitter`), nearest chunk copy first,
 //!   each reading only the pages its samples lie in; no frame waits on one.
+//!   Without threads (a browser page: `PagedOptions::threads` 0) `prepare`
+//!   fits queued chunks itself for [`FIT_BUDGET_MS`] (at least one chunk),
+//!   the results handed back the same way.
 //!   Fitted chunks go into an index pool of a fixed size (`PagedPool`),
 //!   least recently drawn evicted first.
 //! - **Budget**: the pool takes [`POOL_SHARE`] of `--gpu-budget` (after the
@@ -62,7 +65,12 @@ pub const COLOUR_MARGIN: u32 = 16;
 const BOX_VERTICES: u32 = 36;
 
 /// Fitted chunks placed in the pool per frame, at most.
-const FITS_PER_FRAME: usize = 32;
+pub(super) const FITS_PER_FRAME: usize = 32;
+
+/// Milliseconds a frame fits chunks on the calling thread where there are no
+/// fit threads (a browser page): checked between chunks, so a frame takes at
+/// least one queued chunk's fit.
+pub(super) const FIT_BUDGET_MS: f64 = 4.0;
 
 /// The smallest pool: room for a few dense chunks.
 const MIN_POOL_BYTES: u64 = 1 << 20;
@@ -255,7 +263,7 @@ pub fn build(
     );
     let mut mesh = PagedMesh {
         pool: PagedPool::new(device, pool_bytes),
-        fitter: Fitter::new(source, tolerance, options, fit_threads(threads)),
+        fitter: Fitter::new(Some(source), tolerance, options, fit_threads(threads)),
         paged,
         budget,
         pipeline,
@@ -293,6 +301,17 @@ fn fit_threads(readers: usize) -> usize {
     }
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     (cores / 2).max(readers).min(MAX_FIT_THREADS)
+}
+
+/// Fit threads for an edit's refits of the whole-world mesh: every core but
+/// the render thread's (at least one, at most [`MAX_FIT_THREADS`]); none in
+/// a browser page (refits run in `prepare`, within [`FIT_BUDGET_MS`]).
+pub(super) fn refit_threads() -> usize {
+    if cfg!(target_arch = "wasm32") {
+        return 0;
+    }
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    cores.saturating_sub(1).clamp(1, MAX_FIT_THREADS)
 }
 
 /// Most fit threads.
@@ -447,7 +466,7 @@ impl PagedMesh {
 
     /// Place finished fits in the pool.
     fn take_fits(&mut self, queue: &wgpu::Queue) {
-        for (chunk, fit) in self.fitter.poll(FITS_PER_FRAME, 4.0) {
+        for (chunk, _, fit) in self.fitter.poll(FITS_PER_FRAME, FIT_BUDGET_MS) {
             match fit {
                 Ok((mesh, z)) => {
                     self.pool.insert(queue, chunk, &mesh, z, self.stamp);
