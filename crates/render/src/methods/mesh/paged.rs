@@ -11,7 +11,7 @@
 //! - **Fits** run on worker threads (`Fitter`), nearest chunk copy first,
 //!   each reading only the pages its samples lie in; no frame waits on one.
 //!   Without threads (a browser page: `PagedOptions::threads` 0) `prepare`
-//!   fits queued chunks itself for [`FIT_BUDGET_MS`] (at least one chunk),
+//!   fits queued chunks itself for `FIT_BUDGET_MS` (at least one chunk),
 //!   the results handed back the same way.
 //!   Fitted chunks go into an index pool of a fixed size (`PagedPool`),
 //!   least recently drawn evicted first.
