@@ -49,7 +49,7 @@ override EXACT_BEAM: bool = true;
 override EXACT_BEAM_LEVEL: u32 = 2u;
 
 const BEAM_TILE: u32 = 8u;
-const BEAM_CAP: u32 = 64u;
+const BEAM_CAP: u32 = 24u;
 const BEAM_FIRST_STEP: f32 = 4.0;
 const BEAM_MARGIN: f32 = 0.0625;
 const BEAM_MARGIN_RELATIVE: f32 = 1.0e-5;

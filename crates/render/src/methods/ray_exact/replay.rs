@@ -62,10 +62,12 @@ pub const BEAM_TILE: u32 = 8;
 /// Intervals a shadow block's beam tests at once, one per invocation.
 pub const SHADOW_BEAM_LANES: u32 = 64;
 /// Most iterations of one beam (`BEAM_CAP`): the beam pass is a chain of
-/// dependent fetches per tile, and its slowest warp sets its time; on the
-/// default views a cap of 64 costs 0.03 march iterations a pixel against
-/// 128 (10.10 against 10.07) and halves the longest chain.
-pub const BEAM_CAP: u32 = 64;
+/// dependent fetches per tile, and its slowest warp sets its time. On the
+/// H100 (the protocol's views, one binary, the cap swept): cap 64 gave a
+/// 0.0305 ms pass and a 0.1106 ms march, 24 gives 0.0163 and 0.1150, the
+/// least frame (0.1896 ms against 0.1972 without the beam; 16: 0.1919,
+/// 32: 0.1911; `bench/issue36-beam/`).
+pub const BEAM_CAP: u32 = 24;
 /// A beam's first interval moves its rays this far (`BEAM_FIRST_STEP`).
 const BEAM_FIRST_STEP: f32 = 4.0;
 /// The beam box's margin for f32 rounding, absolute and relative to its
