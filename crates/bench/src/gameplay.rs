@@ -504,6 +504,14 @@ pub fn method_row(
                 name,
                 settings,
             )?);
+            // The check's fresh build keeps the CPU busy for up to seconds
+            // (`mesh` fits the whole level) while the GPU idles and drops
+            // its clock: bring it back to its busy clock, untimed, so the
+            // frames after a check are timed as the others are.
+            let hold = input.fresh.hold_busy_ms;
+            if hold > 0 {
+                r.hold_busy(&cam, std::time::Duration::from_millis(u64::from(hold)))?;
+            }
         }
         let start = Instant::now();
         let t = r.render_frame(&cam)?;
