@@ -60,6 +60,23 @@ pub struct ExactOptions {
     /// tile's beam may first meet the ground (the same image in fewer
     /// iterations). Off: they start at the near plane.
     pub beam: bool,
+    /// How the beam is searched (with `beam` on).
+    pub beam_search: BeamSearch,
+}
+
+/// How `ray-exact`'s beam finds where a tile's rays start
+/// (`ray_exact_beam.wgsl`; the same image either way).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BeamSearch {
+    /// A pre-pass of its own, one invocation per 8x8-pixel tile walking the
+    /// beam (intervals doubling while clear, halving where not); shadow
+    /// blocks test 64 intervals of the light's path at once, one round.
+    Serial,
+    /// In the march itself: the tile's 64 invocations test 64 slices of the
+    /// beam's depth range at once, then 64 sub-slices of the first slice
+    /// that may hold ground (a few rounds, no pre-pass); shadow blocks
+    /// likewise.
+    Wide,
 }
 
 /// How the compute variant moves its depth image into the shared depth target.
@@ -86,6 +103,7 @@ impl ExactOptions {
         // frame: 0.198 ms mean against 0.202 visiting every level.
         log_ratio: 2,
         beam: true,
+        beam_search: BeamSearch::Wide,
     };
 
     /// Which pyramid levels to keep: only those the traversals visit. The

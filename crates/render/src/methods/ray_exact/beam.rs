@@ -13,14 +13,15 @@ use super::bindings::{
 };
 use crate::frame::Shared;
 use crate::methods::contract::Frame;
-use crate::options::ExactOptions;
+use crate::options::{BeamSearch, ExactOptions};
 
 /// Side of a tile in pixels (`BEAM_TILE`).
 const TILE: u32 = super::replay::BEAM_TILE;
 
 /// The pass and the tiles' starts it writes.
 pub(super) struct Beam {
-    /// `None` with the beam off: the buffer is bound, never written or read.
+    /// `None` with the beam off or searched wide: the buffer is bound, never
+    /// written or read.
     pipeline: Option<wgpu::ComputePipeline>,
     layout: wgpu::BindGroupLayout,
     group: wgpu::BindGroup,
@@ -53,7 +54,8 @@ impl Beam {
                 label: Some("ray-exact beam"),
                 entries: &entries,
             });
-        let pipeline = if options.beam {
+        // The wide search runs in the march's workgroups: no pre-pass.
+        let pipeline = if options.beam && options.beam_search == BeamSearch::Serial {
             Some(exact_pipeline(
                 shared,
                 "ray-exact beam",

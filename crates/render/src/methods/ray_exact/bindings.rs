@@ -5,7 +5,7 @@
 use super::pyramid::GpuMaxMip;
 use crate::frame::Shared;
 use crate::methods::common::DepthCopy;
-use crate::options::ExactOptions;
+use crate::options::{BeamSearch, ExactOptions};
 use crate::paged::PagedTerrain;
 
 pub(super) fn buffer_entry(
@@ -173,6 +173,11 @@ pub(super) fn exact_pipeline(
     ];
     if reads_beam(levels, shader) {
         constants.push(("EXACT_BEAM", f64::from(u8::from(options.beam))));
+        let search = match options.beam_search {
+            BeamSearch::Serial => 0u8,
+            BeamSearch::Wide => 1,
+        };
+        constants.push(("EXACT_BEAM_SEARCH", f64::from(search)));
         constants.push(("EXACT_BEAM_LEVEL", f64::from(super::BEAM_LEVEL)));
     }
     super::super::common::compute_pipeline_with_constants(

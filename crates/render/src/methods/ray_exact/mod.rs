@@ -162,7 +162,7 @@ pub struct RayExact {
     update_ms: Vec<f64>,
 }
 
-pub use crate::options::{DepthMode, ExactOptions};
+pub use crate::options::{BeamSearch, DepthMode, ExactOptions};
 
 pub fn create(
     shared: &Shared,
