@@ -54,12 +54,16 @@
 override EXACT_BEAM: bool = true;
 
 // How the beam is searched (a pipeline constant, `ExactOptions::beam_search`):
-// `BEAM_SERIAL` (the pre-pass `cs_exact_beam` writes `exact_beams`) or
+// `BEAM_SERIAL` (the pre-pass `cs_exact_beam` writes `exact_beams`),
 // `BEAM_WIDE` (`exact_group_start` searches in the march's workgroup; the
-// buffer is bound but neither written nor read).
-override EXACT_BEAM_SEARCH: u32 = 1u;
+// buffer is bound but neither written nor read) or `BEAM_WIDE_PASS` (the
+// same search in a pre-pass, `cs_exact_beam_wide`, so the march keeps no
+// barrier).
+override EXACT_BEAM_SEARCH: u32 = 2u;
 const BEAM_SERIAL: u32 = 0u;
 const BEAM_WIDE: u32 = 1u;
+// The wide search in a pre-pass (`cs_exact_beam_wide` writes `exact_beams`).
+const BEAM_WIDE_PASS: u32 = 2u;
 
 // The pyramid level camera rays start at from their tile's beam (a pipeline
 // constant, `ray_exact::BEAM_LEVEL`): near the ground, where the beam
@@ -339,7 +343,7 @@ fn exact_shadow_block_start(first: vec2<u32>, li: u32) -> f32 {
     let o2 = vec3<f32>(r2.p.xy - at, r2.p.z);
     let o3 = vec3<f32>(r3.p.xy - at, r3.p.z);
     let d = globals.light_dir.xyz;
-    if (EXACT_BEAM_SEARCH == BEAM_WIDE) {
+    if (EXACT_BEAM_SEARCH != BEAM_SERIAL) {
         let o_lo = min(min(o0, o1), min(o2, o3));
         let o_hi = max(max(o0, o1), max(o2, o3));
         return wide_search(base, o_lo, o_hi, d, d, 0.0, r0.span, li);
@@ -377,4 +381,17 @@ fn cs_exact_beam(@builtin(global_invocation_id) id: vec3<u32>) {
     let base = exact_base(eye.xy);
     let o = vec3<f32>(eye.xy - vec2<f32>(base), eye.z);
     exact_beams[id.y * across + id.x] = exact_beam(o, base, d0, d1, d2, d3, globals.forward.w / focal, globals.right.w / focal);
+}
+
+// The wide search as a pre-pass (`BEAM_WIDE_PASS`): one 8x8 workgroup per
+// tile, dispatched tiles across by tiles down.
+@compute @workgroup_size(8, 8, 1)
+fn cs_exact_beam_wide(
+    @builtin(workgroup_id) group: vec3<u32>,
+    @builtin(local_invocation_index) li: u32,
+) {
+    let t = exact_wide_tile_start(group.xy, li);
+    if (li == 0u) {
+        exact_beams[group.y * beam_tiles_across() + group.x] = t;
+    }
 }

@@ -77,6 +77,18 @@ pub enum BeamSearch {
     /// that may hold ground (a few rounds, no pre-pass); shadow blocks
     /// likewise.
     Wide,
+    /// The wide search in a pre-pass of its own (one 8x8 workgroup per tile
+    /// writes the tile's start, which the march reads): the march keeps no
+    /// barrier, which some compilers (llvmpipe's) pay for over the whole
+    /// march. Shadow blocks as `Wide`.
+    WidePass,
+}
+
+impl BeamSearch {
+    /// Whether the search is the wide one (in the march or a pre-pass).
+    pub fn is_wide(self) -> bool {
+        matches!(self, BeamSearch::Wide | BeamSearch::WidePass)
+    }
 }
 
 /// How the compute variant moves its depth image into the shared depth target.
@@ -103,7 +115,10 @@ impl ExactOptions {
         // frame: 0.198 ms mean against 0.202 visiting every level.
         log_ratio: 2,
         beam: true,
-        beam_search: BeamSearch::Wide,
+        // Wide in a pre-pass: the same starts as in the march, and on
+        // lavapipe the march with the search's barriers in it was 1.4x
+        // slower (`bench/issue36-beam/`); the H100 A/B is to come.
+        beam_search: BeamSearch::WidePass,
     };
 
     /// Which pyramid levels to keep: only those the traversals visit. The

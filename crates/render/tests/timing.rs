@@ -29,15 +29,24 @@ fn every_pass_is_timed() {
             vec!["shadow", "ray-compute march", "ray-compute depth copy"],
         ),
         // The exact march casts the shadow blocks its hits read between
-        // marching and shading; its beam is searched in the march's own
-        // workgroups (no pre-pass but with `STRATA_EXACT_BEAM=serial`).
+        // marching and shading; its beam pre-pass goes first.
         (
             "ray-exact",
             true,
             false,
-            vec!["ray-exact march", "shadow", "ray-exact shade"],
+            vec![
+                "ray-exact beam",
+                "ray-exact march",
+                "shadow",
+                "ray-exact shade",
+            ],
         ),
-        ("ray-exact", false, false, vec!["ray-exact march"]),
+        (
+            "ray-exact",
+            false,
+            false,
+            vec!["ray-exact beam", "ray-exact march"],
+        ),
     ] {
         let settings = MethodSettings {
             shadows,

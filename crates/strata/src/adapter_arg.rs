@@ -44,8 +44,8 @@ pub fn parse_backend(s: &str) -> anyhow::Result<BackendChoice> {
 /// copies depth into the shared target every frame;
 /// `STRATA_EXACT_SHADOW=shared|exact`, `STRATA_EXACT_DEPTH=blit|points|load`,
 /// `STRATA_EXACT_CLIMB=all`, `STRATA_EXACT_RATIO=2|4`,
-/// `STRATA_EXACT_BEAM=off|serial|wide` (no beam, the serial pre-pass, or the
-/// wide search in the march; default wide) configure `ray-exact`; `STRATA_EXACT_STATS=1` prints its statistics;
+/// `STRATA_EXACT_BEAM=off|serial|wide|wide-pass` (no beam, the serial
+/// pre-pass, the wide search in the march or in a pre-pass; default wide) configure `ray-exact`; `STRATA_EXACT_STATS=1` prints its statistics;
 /// `STRATA_TEST_OVERSIZE_BUILD=METHOD` makes that method's build ask for a
 /// buffer over the device's limit (the README's way to see a refused build).
 pub fn render_options() -> RenderOptions {
@@ -85,6 +85,7 @@ fn render_options_from(var: impl Fn(&str) -> Option<String>) -> RenderOptions {
             beam_search: match var("STRATA_EXACT_BEAM").as_deref() {
                 Some("serial") => BeamSearch::Serial,
                 Some("wide") => BeamSearch::Wide,
+                Some("wide-pass") => BeamSearch::WidePass,
                 _ => e.beam_search,
             },
             ..e
@@ -111,7 +112,11 @@ mod tests {
         });
         assert!(!o.shadow_cull && !o.shadow_reuse && !o.exact.beam);
         assert!(render_options_from(|_| None).exact.beam);
-        for (value, search) in [("serial", BeamSearch::Serial), ("wide", BeamSearch::Wide)] {
+        for (value, search) in [
+            ("serial", BeamSearch::Serial),
+            ("wide", BeamSearch::Wide),
+            ("wide-pass", BeamSearch::WidePass),
+        ] {
             let o = render_options_from(|n| (n == "STRATA_EXACT_BEAM").then(|| value.into()));
             assert!(o.exact.beam && o.exact.beam_search == search, "{value}");
         }

@@ -22,7 +22,10 @@ fn parse_search(s: &str) -> Result<BeamSearch, String> {
     match s {
         "serial" => Ok(BeamSearch::Serial),
         "wide" => Ok(BeamSearch::Wide),
-        _ => Err(format!("`{s}`: the beam search is `serial` or `wide`")),
+        "wide-pass" => Ok(BeamSearch::WidePass),
+        _ => Err(format!(
+            "`{s}`: the beam search is `serial`, `wide` or `wide-pass`"
+        )),
     }
 }
 
@@ -56,7 +59,8 @@ pub struct Args {
     #[arg(long)]
     no_beam: bool,
     /// How the beams are searched: `serial` (a pre-pass, one invocation per
-    /// tile) or `wide` (the tile's 64 invocations at once, in the march);
+    /// tile) or `wide` (the tile's 64 invocations at once, in the march;
+    /// `wide-pass`: the same in a pre-pass, the same counts);
     /// the GPU's default is `wide` (`STRATA_EXACT_BEAM` picks it there).
     #[arg(long, value_parser = parse_search)]
     search: Option<BeamSearch>,

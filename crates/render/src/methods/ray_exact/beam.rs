@@ -23,6 +23,8 @@ pub(super) struct Beam {
     /// `None` with the beam off or searched wide: the buffer is bound, never
     /// written or read.
     pipeline: Option<wgpu::ComputePipeline>,
+    /// The wide pre-pass (a workgroup per tile), else the serial one.
+    wide: bool,
     layout: wgpu::BindGroupLayout,
     group: wgpu::BindGroup,
     /// One f32 per tile of the targets.
@@ -54,24 +56,29 @@ impl Beam {
                 label: Some("ray-exact beam"),
                 entries: &entries,
             });
-        // The wide search runs in the march's workgroups: no pre-pass.
-        let pipeline = if options.beam && options.beam_search == BeamSearch::Serial {
-            Some(exact_pipeline(
+        // The wide search in the march's workgroups has no pre-pass.
+        let entry = match options.beam_search {
+            BeamSearch::Serial => Some("cs_exact_beam"),
+            BeamSearch::WidePass => Some("cs_exact_beam_wide"),
+            BeamSearch::Wide => None,
+        };
+        let pipeline = match entry {
+            Some(entry) if options.beam => Some(exact_pipeline(
                 shared,
                 "ray-exact beam",
                 levels,
                 "ray_exact.wgsl",
                 &shared.pipeline_layout("ray-exact beam", &[&layout]),
-                "cs_exact_beam",
+                entry,
                 options,
-            )?)
-        } else {
-            None
+            )?),
+            _ => None,
         };
         let buffer = starts_buffer(shared);
         let group = Self::group(shared, &layout, (params, levels, stats), &buffer);
         Ok(Beam {
             pipeline,
+            wide: options.beam_search.is_wide(),
             layout,
             group,
             buffer,
@@ -122,7 +129,13 @@ impl Beam {
         pass.set_bind_group(0, &shared.frame_group, &[]);
         pass.set_bind_group(1, &self.group, &[]);
         let tiles = (shared.width.div_ceil(TILE), shared.height.div_ceil(TILE));
-        pass.dispatch_workgroups(tiles.0.div_ceil(8), tiles.1.div_ceil(8), 1);
+        if self.wide {
+            // A workgroup per tile.
+            pass.dispatch_workgroups(tiles.0, tiles.1, 1);
+        } else {
+            // An invocation per tile.
+            pass.dispatch_workgroups(tiles.0.div_ceil(8), tiles.1.div_ceil(8), 1);
+        }
     }
 
     pub(super) fn bytes(&self) -> u64 {

@@ -176,6 +176,7 @@ pub(super) fn exact_pipeline(
         let search = match options.beam_search {
             BeamSearch::Serial => 0u8,
             BeamSearch::Wide => 1,
+            BeamSearch::WidePass => 2,
         };
         constants.push(("EXACT_BEAM_SEARCH", f64::from(search)));
         constants.push(("EXACT_BEAM_LEVEL", f64::from(super::BEAM_LEVEL)));

@@ -701,6 +701,7 @@ pub fn replay_frame(replay: &mut Replay<'_>, g: &Globals) -> FrameCount {
             }
         }
     }
+    // The wide search in the march writes and reads no starts.
     let wide = replay.traversal.search == BeamSearch::Wide;
     let beam = if replay.traversal.beam {
         let mut p = beam.finish(warps_of(tiles.0, tiles.1));
@@ -801,7 +802,11 @@ pub fn replay_frame(replay: &mut Replay<'_>, g: &Globals) -> FrameCount {
         size: [w, h],
         hits: hits.len() as u64,
         beam,
-        beam_lanes: if wide { WIDE_LANES } else { 1 },
+        beam_lanes: if replay.traversal.search.is_wide() {
+            WIDE_LANES
+        } else {
+            1
+        },
         march,
         shadow,
         shadow_beam_iterations: shadow_beams,

@@ -649,8 +649,17 @@ fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
                 exact_shadow: false,
                 ..d
             },
+            ExactOptions {
+                beam_search: BeamSearch::Wide,
+                ..d
+            },
+            ExactOptions {
+                beam_search: BeamSearch::Wide,
+                exact_shadow: false,
+                ..d
+            },
         ];
-        assert_eq!(d.beam_search, BeamSearch::Wide);
+        assert_eq!(d.beam_search, BeamSearch::WidePass);
         let mut images = Vec::new();
         for options in variants {
             let m = build(&r.shared_handle(), &w.level, options).unwrap();
@@ -674,9 +683,9 @@ fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
         // Climbing as far as a step allows, visiting every other level,
         // loading depth instead of clearing it, or starting every ray at the
         // near plane instead of its tile's beam, or searching the beam
-        // serially in a pre-pass instead of wide in the march, changes
-        // nothing but the work.
-        for other in [3, 4, 5, 6, 8] {
+        // serially or wide in the march instead of wide in a pre-pass,
+        // changes nothing but the work.
+        for other in [3, 4, 5, 6, 8, 10] {
             for (v, (a, b)) in images[1].iter().zip(&images[other]).enumerate() {
                 assert!(
                     a.0 == b.0 && a.1 == b.1,
@@ -685,8 +694,9 @@ fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
             }
         }
         // The one-pass frame (the renderer's shadow map) with the wide
-        // beam, without a beam and with the serial one: the same image.
-        for other in [7, 9] {
+        // beam in a pre-pass, without a beam, with the serial one and with
+        // the wide one in the march: the same image.
+        for other in [7, 9, 11] {
             for (v, (a, b)) in images[2].iter().zip(&images[other]).enumerate() {
                 assert!(
                     a.0 == b.0 && a.1 == b.1,
@@ -751,7 +761,7 @@ fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
 /// rounding differs on a grazed boundary.
 #[test]
 fn the_replay_takes_the_gpu_steps() {
-    for search in [BeamSearch::Wide, BeamSearch::Serial] {
+    for search in [BeamSearch::Wide, BeamSearch::Serial, BeamSearch::WidePass] {
         replay_takes_the_gpu_steps(search);
     }
 }
@@ -875,7 +885,9 @@ fn beam_never_passes_a_hit(search: BeamSearch) {
     // the wide search's rounds are an interval test by every pixel.
     let (cap, lanes) = match search {
         BeamSearch::Serial => (BEAM_CAP, 1),
-        BeamSearch::Wide => (WIDE_ROUNDS, u64::from(super::replay::WIDE_LANES)),
+        BeamSearch::Wide | BeamSearch::WidePass => {
+            (WIDE_ROUNDS, u64::from(super::replay::WIDE_LANES))
+        }
     };
     for (width, height) in [(W, H), (640, 400)] {
         let (mut before, mut after, mut beams, mut tiles_hit) = (0u64, 0u64, 0u64, 0u64);

@@ -235,7 +235,7 @@ impl Replay<'_> {
     pub fn tile_start(&mut self, g: &Globals, tx: u32, ty: u32) -> BeamCount {
         match self.traversal.search {
             BeamSearch::Serial => self.tile_beam(g, tx, ty),
-            BeamSearch::Wide => self.tile_beam_wide(g, tx, ty),
+            BeamSearch::Wide | BeamSearch::WidePass => self.tile_beam_wide(g, tx, ty),
         }
     }
 
@@ -243,7 +243,7 @@ impl Replay<'_> {
     pub fn shadow_block_start(&mut self, g: &Globals, i: u32, j: u32) -> BeamCount {
         match self.traversal.search {
             BeamSearch::Serial => self.shadow_beam(g, i, j),
-            BeamSearch::Wide => self.shadow_beam_wide(g, i, j),
+            BeamSearch::Wide | BeamSearch::WidePass => self.shadow_beam_wide(g, i, j),
         }
     }
 
