@@ -190,7 +190,7 @@ fn exact_beam(o: vec3<f32>, base: vec2<i32>, d0: vec3<f32>, d1: vec3<f32>, d2: v
 
 // The wide search (`EXACT_BEAM_SEARCH` = `BEAM_WIDE`).
 const WIDE_LANES: u32 = 64u;
-const WIDE_ROUNDS: u32 = 4u;
+const WIDE_ROUNDS: u32 = 8u;
 const WIDE_RANGE_MARGIN: f32 = 1.0e-4;
 
 // Round 1's slices that are not clear (bit k of the 64: slice k).

@@ -32,7 +32,7 @@ pub const WIDE_LANES: u32 = 64;
 /// Most rounds of a wide search (`WIDE_ROUNDS`): the first tests 64 slices
 /// of the beam's depth range, each later one 64 sub-slices of the first
 /// slice that may hold ground and has not been found clear.
-pub const WIDE_ROUNDS: u32 = 4;
+pub const WIDE_ROUNDS: u32 = 8;
 
 /// What one beam did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
