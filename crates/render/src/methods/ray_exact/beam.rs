@@ -1,12 +1,15 @@
 //! `ray-exact`'s beam pre-pass over the whole map (`ray_exact_beam.wgsl`,
-//! issue 36 item 1): one invocation per 8x8-pixel tile searches the least
-//! `t` at which any of the tile's camera rays may meet a solid point (the
-//! argument that it never passes a hit is in the shader), and the march
-//! starts each ray there. Same image, fewer iterations: the counts
-//! (`strata exact-counts`, [`super::replay`]) are in `bench/issue36-beam/`.
-//! [`crate::options::ExactOptions::beam`] off (`STRATA_EXACT_BEAM=off`)
-//! skips the pass and the march does not read its buffer. Paged terrain has
-//! none (its finer levels live per page).
+//! issue 36 item 1): the least `t` at which any of an 8x8-pixel tile's
+//! camera rays may meet a solid point (the argument that it never passes a
+//! hit is in the shader), searched by one workgroup per tile, 64 slices at
+//! a time (`BeamSearch::WidePass`, `cs_exact_beam_wide`), or by one
+//! invocation per tile walking it (`BeamSearch::Serial`, `cs_exact_beam`);
+//! the march starts each ray there. `BeamSearch::Wide` searches in the
+//! march's own workgroup instead: no pass here. Same image, fewer
+//! iterations: the counts (`strata exact-counts`, [`super::replay`]) are in
+//! `bench/issue36-beam/`. [`crate::options::ExactOptions::beam`] off
+//! (`STRATA_EXACT_BEAM=off`) skips the pass and the march does not read its
+//! buffer. Paged terrain has none (its finer levels live per page).
 
 use super::bindings::{
     Levels, beam_binding, beam_layout_entry, core_bindings, core_entries, exact_pipeline,
