@@ -106,6 +106,15 @@ fn exact_tile_level() -> u32 {
     return select(EXACT_START_LEVEL, EXACT_BEAM_LEVEL, EXACT_BEAM);
 }
 
+// The rays through the corner pixels' centres of tile `tile`.
+fn beam_corner_rays(tile: vec2<u32>) -> array<vec3<f32>, 4> {
+    let size = vec2<u32>(globals.screen.xy);
+    let first = tile * BEAM_TILE;
+    let a = vec2<f32>(first) + vec2<f32>(0.5);
+    let b = vec2<f32>(min(first + vec2<u32>(BEAM_TILE), size)) - vec2<f32>(0.5);
+    return array<vec3<f32>, 4>(camera_ray(a.x, a.y), camera_ray(b.x, a.y), camera_ray(a.x, b.y), camera_ray(b.x, b.y));
+}
+
 struct BeamBox {
     lo: vec3<f32>,
     hi: vec3<f32>,
@@ -296,16 +305,9 @@ fn wide_search(base: vec2<i32>, o_lo: vec3<f32>, o_hi: vec3<f32>, d_lo: vec3<f32
 // the corner pixels' ray directions boxed (every pixel's is a convex
 // combination of theirs, as at the top), from the eye.
 fn exact_wide_tile_start(group: vec2<u32>, li: u32) -> f32 {
-    let size = vec2<u32>(globals.screen.xy);
-    let first = group * BEAM_TILE;
-    let a = vec2<f32>(first) + vec2<f32>(0.5);
-    let b = vec2<f32>(min(first + vec2<u32>(BEAM_TILE), size)) - vec2<f32>(0.5);
-    let d0 = camera_ray(a.x, a.y);
-    let d1 = camera_ray(b.x, a.y);
-    let d2 = camera_ray(a.x, b.y);
-    let d3 = camera_ray(b.x, b.y);
-    let d_lo = min(min(d0, d1), min(d2, d3));
-    let d_hi = max(max(d0, d1), max(d2, d3));
+    let d = beam_corner_rays(group);
+    let d_lo = min(min(d[0], d[1]), min(d[2], d[3]));
+    let d_hi = max(max(d[0], d[1]), max(d[2], d[3]));
     let eye = globals.eye.xyz;
     let focal = globals.eye.w;
     let base = exact_base(eye.xy);
@@ -369,18 +371,12 @@ fn cs_exact_beam(@builtin(global_invocation_id) id: vec3<u32>) {
     if (id.x >= across || id.y >= down) {
         return;
     }
-    let first = id.xy * BEAM_TILE;
-    let a = vec2<f32>(first) + vec2<f32>(0.5);
-    let b = vec2<f32>(min(first + vec2<u32>(BEAM_TILE), size)) - vec2<f32>(0.5);
-    let d0 = camera_ray(a.x, a.y);
-    let d1 = camera_ray(b.x, a.y);
-    let d2 = camera_ray(a.x, b.y);
-    let d3 = camera_ray(b.x, b.y);
+    let d = beam_corner_rays(id.xy);
     let eye = globals.eye.xyz;
     let focal = globals.eye.w;
     let base = exact_base(eye.xy);
     let o = vec3<f32>(eye.xy - vec2<f32>(base), eye.z);
-    exact_beams[id.y * across + id.x] = exact_beam(o, base, d0, d1, d2, d3, globals.forward.w / focal, globals.right.w / focal);
+    exact_beams[id.y * across + id.x] = exact_beam(o, base, d[0], d[1], d[2], d[3], globals.forward.w / focal, globals.right.w / focal);
 }
 
 // The wide search as a pre-pass (`BEAM_WIDE_PASS`): one 8x8 workgroup per

@@ -766,15 +766,27 @@ fn the_replay_takes_the_gpu_steps() {
     }
 }
 
-fn replay_takes_the_gpu_steps(search: BeamSearch) {
-    use super::replay::{Replay, Traversal, compute_pyramid, replay_frame};
+/// The generated world and its compute pyramid, for a replay.
+fn replay_world() -> (World, strata_maxmip::Pyramid) {
     let w = common::generated_world();
-    let pyramid = compute_pyramid(&w.level);
-    let mut replay = Replay::new(&w.level, &pyramid);
-    replay.traversal = Traversal {
+    let pyramid = super::replay::compute_pyramid(&w.level);
+    (w, pyramid)
+}
+
+/// `Traversal::GPU` with the beam searched by `search` (`beam` on or off).
+fn replay_traversal(search: BeamSearch, beam: bool) -> super::replay::Traversal {
+    super::replay::Traversal {
+        beam,
         search,
-        ..Traversal::GPU
-    };
+        ..super::replay::Traversal::GPU
+    }
+}
+
+fn replay_takes_the_gpu_steps(search: BeamSearch) {
+    use super::replay::{Replay, replay_frame};
+    let (w, pyramid) = replay_world();
+    let mut replay = Replay::new(&w.level, &pyramid);
+    replay.traversal = replay_traversal(search, true);
     let options = ExactOptions {
         beam_search: search,
         ..ExactOptions::DEFAULT
@@ -872,15 +884,10 @@ fn the_beam_never_passes_a_hit() {
 }
 
 fn beam_never_passes_a_hit(search: BeamSearch) {
-    use super::replay::{BEAM_CAP, BEAM_TILE, Replay, Traversal, WIDE_ROUNDS, compute_pyramid};
-    let w = common::generated_world();
-    let pyramid = compute_pyramid(&w.level);
+    use super::replay::{BEAM_CAP, BEAM_TILE, Replay, WIDE_ROUNDS};
+    let (w, pyramid) = replay_world();
     let mut replay = Replay::new(&w.level, &pyramid);
-    replay.traversal = Traversal {
-        beam: false,
-        search,
-        ..Traversal::GPU
-    };
+    replay.traversal = replay_traversal(search, false);
     // Most iterations (rounds) of a beam, and the invocations each takes:
     // the wide search's rounds are an interval test by every pixel.
     let (cap, lanes) = match search {
