@@ -35,11 +35,12 @@
 //   a texel); at most `BEAM_CAP` iterations (the start stays where it got:
 //   still safe). A chain of dependent fetches per tile: the pass is
 //   latency-bound.
-// - wide (`wide_search`, in the march's own 8x8 workgroup, no pre-pass):
-//   the 64 invocations test 64 slices of the depth range at once, then 64
-//   sub-slices of the first slice that is not clear, and so on for at most
-//   `WIDE_ROUNDS` rounds: a few fetch latencies instead of ~20. Why that
-//   start is safe too is at `wide_search`.
+// - wide (`wide_search`, by an 8x8 workgroup per tile: the march's own, or
+//   a pre-pass's, `cs_exact_beam_wide`): the 64 invocations test 64 slices
+//   of the depth range at once, then 64 sub-slices of the first slice that
+//   is not clear, and so on for at most `WIDE_ROUNDS` rounds: a few fetch
+//   latencies instead of ~20. Why that start is safe too is at
+//   `wide_search`.
 // The shadow blocks search likewise, by their 64 invocations
 // (`exact_shadow_block_start`): one round serially, `wide_search` wide.
 
@@ -197,7 +198,7 @@ fn exact_beam(o: vec3<f32>, base: vec2<i32>, d0: vec3<f32>, d1: vec3<f32>, d2: v
     return t;
 }
 
-// The wide search (`EXACT_BEAM_SEARCH` = `BEAM_WIDE`).
+// The wide search (`EXACT_BEAM_SEARCH` = `BEAM_WIDE` or `BEAM_WIDE_PASS`).
 const WIDE_LANES: u32 = 64u;
 const WIDE_ROUNDS: u32 = 8u;
 const WIDE_RANGE_MARGIN: f32 = 1.0e-4;
