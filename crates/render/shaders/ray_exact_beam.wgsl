@@ -203,6 +203,13 @@ const WIDE_LANES: u32 = 64u;
 const WIDE_ROUNDS: u32 = 8u;
 const WIDE_RANGE_MARGIN: f32 = 1.0e-4;
 
+// Most rounds of the shadow blocks' wide search (a pipeline constant,
+// `ExactOptions::shadow_rounds`, 1 to `WIDE_ROUNDS`): the shadow pass is a
+// single wave whose time is its longest chain of dependent steps, and each
+// round is one more link (1: the first slice not clear, as the serial
+// search's one round).
+override EXACT_SHADOW_ROUNDS: u32 = 8u;
+
 // Round 1's slices that are not clear (bit k of the 64: slice k).
 var<workgroup> wide_mask: array<atomic<u32>, 2>;
 // Round r's first sub-slice j that is not clear, as 64 - j (0: none).
@@ -251,7 +258,8 @@ fn wide_clear(base: vec2<i32>, o_lo: vec3<f32>, o_hi: vec3<f32>, d_lo: vec3<f32>
 // The least t in [ta, tb] at which a ray o + t d, o in the box (o_lo, o_hi)
 // and d in (d_lo, d_hi), may be solid (tb when none may), searched by the
 // workgroup's 64 invocations at once (call it from every invocation, `li`
-// its index, in uniform control flow). Twin: `Replay::wide_beam`.
+// its index, in uniform control flow) in at most `rounds` rounds (and
+// `WIDE_ROUNDS`). Twin: `Replay::wide_beam`.
 //
 // Why no such ray is solid before the start: for t >= 0 each coordinate of
 // o + t d lies between o_lo + t d_lo and o_hi + t d_hi, which are affine in
@@ -268,7 +276,7 @@ fn wide_clear(base: vec2<i32>, o_lo: vec3<f32>, o_hi: vec3<f32>, d_lo: vec3<f32>
 // Before ta nothing is solid (`wide_range`). Every value the rounds branch on
 // is read with `workgroupUniformLoad`, so the loop and its barriers are
 // uniform.
-fn wide_search(base: vec2<i32>, o_lo: vec3<f32>, o_hi: vec3<f32>, d_lo: vec3<f32>, d_hi: vec3<f32>, ta: f32, tb: f32, li: u32) -> f32 {
+fn wide_search(base: vec2<i32>, o_lo: vec3<f32>, o_hi: vec3<f32>, d_lo: vec3<f32>, d_hi: vec3<f32>, ta: f32, tb: f32, li: u32, rounds: u32) -> f32 {
     if (!wide_clear(base, o_lo, o_hi, d_lo, d_hi, wide_bound(ta, tb, li), wide_bound(ta, tb, li + 1u))) {
         atomicOr(&wide_mask[li >> 5u], 1u << (li & 31u));
     }
@@ -281,7 +289,7 @@ fn wide_search(base: vec2<i32>, o_lo: vec3<f32>, o_hi: vec3<f32>, d_lo: vec3<f32
         let c = select(32u + firstTrailingBit(mask.y), firstTrailingBit(mask.x), mask.x != 0u);
         let lo = wide_bound(ta, tb, c);
         let hi = wide_bound(ta, tb, c + 1u);
-        if (round >= WIDE_ROUNDS) {
+        if (round >= min(rounds, WIDE_ROUNDS)) {
             return lo;
         }
         if (!wide_clear(base, o_lo, o_hi, d_lo, d_hi, wide_bound(lo, hi, li), wide_bound(lo, hi, li + 1u))) {
@@ -314,7 +322,7 @@ fn exact_wide_tile_start(group: vec2<u32>, li: u32) -> f32 {
     let base = exact_base(eye.xy);
     let o = vec3<f32>(eye.xy - vec2<f32>(base), eye.z);
     let range = wide_range(o.z, o.z, d_lo.z, d_hi.z, globals.forward.w / focal, globals.right.w / focal);
-    return wide_search(base, o, o, d_lo, d_hi, range.x, range.y, li);
+    return wide_search(base, o, o, d_lo, d_hi, range.x, range.y, li, WIDE_ROUNDS);
 }
 
 // The shadow block's first lane k that found its interval not clear, as
@@ -349,7 +357,7 @@ fn exact_shadow_block_start(first: vec2<u32>, li: u32) -> f32 {
     if (EXACT_BEAM_SEARCH != BEAM_SERIAL) {
         let o_lo = min(min(o0, o1), min(o2, o3));
         let o_hi = max(max(o0, o1), max(o2, o3));
-        return wide_search(base, o_lo, o_hi, d, d, 0.0, r0.span, li);
+        return wide_search(base, o_lo, o_hi, d, d, 0.0, r0.span, li, EXACT_SHADOW_ROUNDS);
     }
     let lanes = f32(BEAM_TILE * BEAM_TILE);
     let a = beam_box(o0, o1, o2, o3, d, d, d, d, r0.span * (f32(li) / lanes));

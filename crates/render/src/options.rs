@@ -62,6 +62,9 @@ pub struct ExactOptions {
     pub beam: bool,
     /// How the beam is searched (with `beam` on).
     pub beam_search: BeamSearch,
+    /// Most rounds of the shadow blocks' wide search, 1 to 8
+    /// (`EXACT_SHADOW_ROUNDS`; the camera tiles' search takes up to 8).
+    pub shadow_rounds: u32,
 }
 
 /// How `ray-exact`'s beam finds where a tile's rays start
@@ -119,6 +122,7 @@ impl ExactOptions {
         // lavapipe the march with the search's barriers in it was 1.4x
         // slower (`bench/issue36-beam/`); the H100 A/B is to come.
         beam_search: BeamSearch::WidePass,
+        shadow_rounds: 8,
     };
 
     /// Which pyramid levels to keep: only those the traversals visit. The

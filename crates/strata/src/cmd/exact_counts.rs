@@ -64,6 +64,10 @@ pub struct Args {
     /// the GPU's default is `wide` (`STRATA_EXACT_BEAM` picks it there).
     #[arg(long, value_parser = parse_search)]
     search: Option<BeamSearch>,
+    /// Most rounds of the shadow blocks' wide search (1 to 8; the GPU's
+    /// default 8, `STRATA_EXACT_SHADOW_ROUNDS` there).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=8))]
+    shadow_rounds: Option<u32>,
     /// Try another traversal on paper: the visited level camera rays start
     /// at from their tile's beam (the GPU's: 1, tiles of 4 texels).
     #[arg(long, value_parser = clap::value_parser!(u32).range(0..=4))]
@@ -160,6 +164,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         start: args.start_level.or(Traversal::GPU.start),
         beam: !args.no_beam,
         search: args.search.unwrap_or(Traversal::GPU.search),
+        shadow_rounds: args.shadow_rounds.unwrap_or(Traversal::GPU.shadow_rounds),
         beam_level: args.beam_level.unwrap_or(Traversal::GPU.beam_level),
     };
     let shape = LevelShape::of(&world.level);

@@ -179,6 +179,8 @@ pub(super) fn exact_pipeline(
             BeamSearch::WidePass => 2,
         };
         constants.push(("EXACT_BEAM_SEARCH", f64::from(search)));
+        let rounds = options.shadow_rounds.clamp(1, super::replay::WIDE_ROUNDS);
+        constants.push(("EXACT_SHADOW_ROUNDS", f64::from(rounds)));
         constants.push(("EXACT_BEAM_LEVEL", f64::from(super::BEAM_LEVEL)));
     }
     super::super::common::compute_pipeline_with_constants(

@@ -77,6 +77,8 @@ pub struct Traversal {
     pub beam: bool,
     /// How the beams are searched (`EXACT_BEAM_SEARCH`).
     pub search: BeamSearch,
+    /// Most rounds of a shadow block's wide search (`EXACT_SHADOW_ROUNDS`).
+    pub shadow_rounds: u32,
     /// The visited level camera and shadow rays start at from their beam
     /// (`EXACT_BEAM_LEVEL`).
     pub beam_level: u32,
@@ -89,6 +91,7 @@ impl Traversal {
         start: Some(super::START_LEVEL / LOG_RATIO),
         beam: true,
         search: crate::options::ExactOptions::DEFAULT.beam_search,
+        shadow_rounds: crate::options::ExactOptions::DEFAULT.shadow_rounds,
         beam_level: super::BEAM_LEVEL / LOG_RATIO,
     };
 
@@ -98,6 +101,7 @@ impl Traversal {
         start: None,
         beam: false,
         search: BeamSearch::Serial,
+        shadow_rounds: WIDE_ROUNDS,
         beam_level: super::BEAM_LEVEL / LOG_RATIO,
     };
 }

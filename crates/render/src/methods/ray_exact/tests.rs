@@ -658,6 +658,10 @@ fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
                 exact_shadow: false,
                 ..d
             },
+            ExactOptions {
+                shadow_rounds: 1,
+                ..d
+            },
         ];
         assert_eq!(d.beam_search, BeamSearch::WidePass);
         let mut images = Vec::new();
@@ -685,7 +689,7 @@ fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
         // near plane instead of its tile's beam, or searching the beam
         // serially or wide in the march instead of wide in a pre-pass,
         // changes nothing but the work.
-        for other in [3, 4, 5, 6, 8, 10] {
+        for other in [3, 4, 5, 6, 8, 10, 12] {
             for (v, (a, b)) in images[1].iter().zip(&images[other]).enumerate() {
                 assert!(
                     a.0 == b.0 && a.1 == b.1,
@@ -761,8 +765,13 @@ fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
 /// rounding differs on a grazed boundary.
 #[test]
 fn the_replay_takes_the_gpu_steps() {
-    for search in [BeamSearch::Wide, BeamSearch::Serial, BeamSearch::WidePass] {
-        replay_takes_the_gpu_steps(search);
+    for (search, shadow_rounds) in [
+        (BeamSearch::Wide, 8),
+        (BeamSearch::Serial, 8),
+        (BeamSearch::WidePass, 8),
+        (BeamSearch::WidePass, 1),
+    ] {
+        replay_takes_the_gpu_steps(search, shadow_rounds);
     }
 }
 
@@ -782,13 +791,17 @@ fn replay_traversal(search: BeamSearch, beam: bool) -> super::replay::Traversal 
     }
 }
 
-fn replay_takes_the_gpu_steps(search: BeamSearch) {
+fn replay_takes_the_gpu_steps(search: BeamSearch, shadow_rounds: u32) {
     use super::replay::{Replay, replay_frame};
     let (w, pyramid) = replay_world();
     let mut replay = Replay::new(&w.level, &pyramid);
-    replay.traversal = replay_traversal(search, true);
+    replay.traversal = super::replay::Traversal {
+        shadow_rounds,
+        ..replay_traversal(search, true)
+    };
     let options = ExactOptions {
         beam_search: search,
+        shadow_rounds,
         ..ExactOptions::DEFAULT
     };
     let shape = crate::frame::LevelShape::of(&w.level);
@@ -854,7 +867,7 @@ fn replay_takes_the_gpu_steps(search: BeamSearch) {
             record_frame(&shared, &mut m, camera, &globals, &timer, index);
             let s = m.stats().unwrap();
             eprintln!(
-                "{search:?} view {index}: most iterations GPU {} / {} (shadow), replay {} / {}",
+                "{search:?} {shadow_rounds} view {index}: most iterations GPU {} / {} (shadow), replay {} / {}",
                 s.most_iterations,
                 s.shadow_most_iterations,
                 f.most_iterations,

@@ -148,7 +148,8 @@ impl Replay<'_> {
     /// `wide_search` of `ray_exact_beam.wgsl`: the least t in [ta, tb] at
     /// which a ray o + t d with o in the box (o_lo, o_hi) and d in the box
     /// (d_lo, d_hi) may be solid (tb when none may), searched by
-    /// [`WIDE_LANES`] invocations at once. Such a ray's point at t >= 0 lies
+    /// [`WIDE_LANES`] invocations at once in at most `rounds` rounds (1 to
+    /// [`WIDE_ROUNDS`]). Such a ray's point at t >= 0 lies
     /// in the box (o_lo + t d_lo, o_hi + t d_hi), whose corners are affine in
     /// t, so over [a, b] (0 <= a <= b) in the union of the boxes at a and b.
     /// Round 1: invocation k tests slice k of 64 equal slices of [ta, tb];
@@ -162,10 +163,11 @@ impl Replay<'_> {
         base: IVec2,
         (o_lo, o_hi): (Vec3, Vec3),
         (d_lo, d_hi): (Vec3, Vec3),
-        ta: f32,
-        tb: f32,
+        (ta, tb): (f32, f32),
+        rounds: u32,
     ) -> BeamCount {
         let lanes = WIDE_LANES;
+        let rounds = rounds.clamp(1, WIDE_ROUNDS);
         let mut r = BeamCount {
             t: tb,
             ..BeamCount::default()
@@ -194,7 +196,7 @@ impl Replay<'_> {
         while mask != 0 {
             let c = mask.trailing_zeros();
             let (lo, hi) = (wide_bound(ta, tb, c), wide_bound(ta, tb, c + 1));
-            if r.iterations >= WIDE_ROUNDS {
+            if r.iterations >= rounds {
                 r.t = lo;
                 return r;
             }
@@ -218,7 +220,7 @@ impl Replay<'_> {
         let d_lo = d[0].min(d[1]).min(d[2].min(d[3]));
         let d_hi = d[0].max(d[1]).max(d[2].max(d[3]));
         let (ta, tb) = wide_range(o.z, o.z, d_lo.z, d_hi.z, t0, t1);
-        self.wide_beam(base, (o, o), (d_lo, d_hi), ta, tb)
+        self.wide_beam(base, (o, o), (d_lo, d_hi), (ta, tb), WIDE_ROUNDS)
     }
 
     /// The wide search of the shadow block whose first texel is (i, j)
@@ -228,7 +230,8 @@ impl Replay<'_> {
         let (o, base, d, span) = self.shadow_corners(g, i, j);
         let o_lo = o[0].min(o[1]).min(o[2].min(o[3]));
         let o_hi = o[0].max(o[1]).max(o[2].max(o[3]));
-        self.wide_beam(base, (o_lo, o_hi), (d, d), 0.0, span)
+        let rounds = self.traversal.shadow_rounds;
+        self.wide_beam(base, (o_lo, o_hi), (d, d), (0.0, span), rounds)
     }
 
     /// The tile's beam by the traversal's search.
