@@ -7,6 +7,10 @@ fn exact_tile_start(id: vec2<u32>) -> f32 {
     return -EXACT_BIG;
 }
 
+fn exact_group_start(group: vec2<u32>, li: u32) -> f32 {
+    return -EXACT_BIG;
+}
+
 fn exact_tile_level() -> u32 {
     return EXACT_START_LEVEL;
 }

@@ -18,11 +18,14 @@ var<workgroup> group_most: atomic<u32>;
 fn cs_ray_exact(
     @builtin(global_invocation_id) id: vec3<u32>,
     @builtin(local_invocation_index) li: u32,
+    @builtin(workgroup_id) group: vec3<u32>,
 ) {
     let size = vec2<u32>(globals.screen.xy);
+    // The tile's beam (every invocation: the wide search is the workgroup's).
+    let start = exact_group_start(group.xy, li);
     if (all(id.xy < size)) {
         page_pixel_begin();
-        let s = exact_pixel_from(f32(id.x) + 0.5, f32(id.y) + 0.5, exact_tile_start(id.xy), exact_tile_level());
+        let s = exact_pixel_from(f32(id.x) + 0.5, f32(id.y) + 0.5, start, exact_tile_level());
         page_pixel_end(page_pixel_missed());
         textureStore(color_out, id.xy, s.color);
         textureStore(depth_out, id.xy, vec4<f32>(s.depth, 0.0, 0.0, 0.0));

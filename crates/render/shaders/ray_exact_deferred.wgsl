@@ -89,11 +89,14 @@ fn list_every_block(flat: u32, pixels: u32) {
 fn cs_exact_march_hits(
     @builtin(global_invocation_id) id: vec3<u32>,
     @builtin(local_invocation_index) li: u32,
+    @builtin(workgroup_id) group: vec3<u32>,
 ) {
     let size = vec2<u32>(globals.screen.xy);
+    // The tile's beam (every invocation: the wide search is the workgroup's).
+    let start = exact_group_start(group.xy, li);
     if (all(id.xy < size)) {
         page_pixel_begin();
-        let h = exact_pixel_hit_from(f32(id.x) + 0.5, f32(id.y) + 0.5, exact_tile_start(id.xy), exact_tile_level());
+        let h = exact_pixel_hit_from(f32(id.x) + 0.5, f32(id.y) + 0.5, start, exact_tile_level());
         var packed = HIT_NONE;
         if (h.hit) {
             let rel = h.column - exact_base(globals.eye.xy) + vec2<i32>(32768);

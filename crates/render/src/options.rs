@@ -60,6 +60,38 @@ pub struct ExactOptions {
     /// tile's beam may first meet the ground (the same image in fewer
     /// iterations). Off: they start at the near plane.
     pub beam: bool,
+    /// How the beam is searched (with `beam` on).
+    pub beam_search: BeamSearch,
+    /// Most rounds of the shadow blocks' wide search, 1 to 8
+    /// (`EXACT_SHADOW_ROUNDS`; the camera tiles' search takes up to 8).
+    pub shadow_rounds: u32,
+}
+
+/// How `ray-exact`'s beam finds where a tile's rays start
+/// (`ray_exact_beam.wgsl`; the same image either way).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BeamSearch {
+    /// A pre-pass of its own, one invocation per 8x8-pixel tile walking the
+    /// beam (intervals doubling while clear, halving where not); shadow
+    /// blocks test 64 intervals of the light's path at once, one round.
+    Serial,
+    /// In the march itself: the tile's 64 invocations test 64 slices of the
+    /// beam's depth range at once, then 64 sub-slices of the first slice
+    /// that may hold ground (a few rounds, no pre-pass); shadow blocks
+    /// likewise.
+    Wide,
+    /// The wide search in a pre-pass of its own (one 8x8 workgroup per tile
+    /// writes the tile's start, which the march reads): the march keeps no
+    /// barrier, which some compilers (llvmpipe's) pay for over the whole
+    /// march. Shadow blocks as `Wide`.
+    WidePass,
+}
+
+impl BeamSearch {
+    /// Whether the search is the wide one (in the march or a pre-pass).
+    pub fn is_wide(self) -> bool {
+        matches!(self, BeamSearch::Wide | BeamSearch::WidePass)
+    }
 }
 
 /// How the compute variant moves its depth image into the shared depth target.
@@ -86,6 +118,11 @@ impl ExactOptions {
         // frame: 0.198 ms mean against 0.202 visiting every level.
         log_ratio: 2,
         beam: true,
+        // Wide in a pre-pass: the same starts as in the march, and on
+        // lavapipe the march with the search's barriers in it was 1.4x
+        // slower (`bench/issue36-beam/`); the H100 A/B is to come.
+        beam_search: BeamSearch::WidePass,
+        shadow_rounds: 8,
     };
 
     /// Which pyramid levels to keep: only those the traversals visit. The

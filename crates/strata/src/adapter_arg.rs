@@ -2,7 +2,7 @@
 //! renderer's measuring switches, which the binary (never the library) reads
 //! from the environment.
 
-use strata_render::options::{DepthMode, ExactOptions, RenderOptions};
+use strata_render::options::{BeamSearch, DepthMode, ExactOptions, RenderOptions};
 use strata_render::{AdapterChoice, BackendChoice, Gpu};
 
 #[derive(clap::Args, Clone, Debug, Default)]
@@ -44,7 +44,10 @@ pub fn parse_backend(s: &str) -> anyhow::Result<BackendChoice> {
 /// copies depth into the shared target every frame;
 /// `STRATA_EXACT_SHADOW=shared|exact`, `STRATA_EXACT_DEPTH=blit|points|load`,
 /// `STRATA_EXACT_CLIMB=all`, `STRATA_EXACT_RATIO=2|4`,
-/// `STRATA_EXACT_BEAM=off` (no beam pre-pass) configure `ray-exact`; `STRATA_EXACT_STATS=1` prints its statistics;
+/// `STRATA_EXACT_BEAM=off|serial|wide|wide-pass` (no beam, the serial
+/// pre-pass, the wide search in the march or in a pre-pass; default
+/// wide-pass), `STRATA_EXACT_SHADOW_ROUNDS=1..8` (the shadow blocks' wide
+/// search's most rounds) configure `ray-exact`; `STRATA_EXACT_STATS=1` prints its statistics;
 /// `STRATA_TEST_OVERSIZE_BUILD=METHOD` makes that method's build ask for a
 /// buffer over the device's limit (the README's way to see a refused build).
 pub fn render_options() -> RenderOptions {
@@ -81,6 +84,16 @@ fn render_options_from(var: impl Fn(&str) -> Option<String>) -> RenderOptions {
                 _ => e.log_ratio,
             },
             beam: !is("STRATA_EXACT_BEAM", "off"),
+            beam_search: match var("STRATA_EXACT_BEAM").as_deref() {
+                Some("serial") => BeamSearch::Serial,
+                Some("wide") => BeamSearch::Wide,
+                Some("wide-pass") => BeamSearch::WidePass,
+                _ => e.beam_search,
+            },
+            shadow_rounds: var("STRATA_EXACT_SHADOW_ROUNDS")
+                .and_then(|v| v.parse().ok())
+                .filter(|n| (1..=8).contains(n))
+                .unwrap_or(e.shadow_rounds),
             ..e
         },
         exact_stats: is("STRATA_EXACT_STATS", "1"),
@@ -100,11 +113,21 @@ mod tests {
             "STRATA_EXACT_DEPTH" => Some("points".into()),
             "STRATA_EXACT_RATIO" => Some("2".into()),
             "STRATA_EXACT_BEAM" => Some("off".into()),
+            "STRATA_EXACT_SHADOW_ROUNDS" => Some("1".into()),
             "STRATA_TEST_OVERSIZE_BUILD" => Some("voxel".into()),
             _ => None,
         });
         assert!(!o.shadow_cull && !o.shadow_reuse && !o.exact.beam);
+        assert_eq!(o.exact.shadow_rounds, 1);
         assert!(render_options_from(|_| None).exact.beam);
+        for (value, search) in [
+            ("serial", BeamSearch::Serial),
+            ("wide", BeamSearch::Wide),
+            ("wide-pass", BeamSearch::WidePass),
+        ] {
+            let o = render_options_from(|n| (n == "STRATA_EXACT_BEAM").then(|| value.into()));
+            assert!(o.exact.beam && o.exact.beam_search == search, "{value}");
+        }
         assert_eq!((o.exact.depth, o.exact.log_ratio), (DepthMode::Points, 1));
         assert_eq!(o.oversize_build.as_deref(), Some("voxel"));
     }

@@ -14,8 +14,20 @@ use std::path::PathBuf;
 use strata_level::{ViewSpec, views::parse_views};
 use strata_render::frame::{Globals, LevelShape};
 use strata_render::methods::ray_exact::replay::{
-    FrameCount, PassCount, Replay, Traversal, beam_disagreements, compute_pyramid, replay_frame,
+    BeamSearch, FrameCount, PassCount, Replay, Traversal, beam_disagreements, compute_pyramid,
+    replay_frame,
 };
+
+fn parse_search(s: &str) -> Result<BeamSearch, String> {
+    match s {
+        "serial" => Ok(BeamSearch::Serial),
+        "wide" => Ok(BeamSearch::Wide),
+        "wide-pass" => Ok(BeamSearch::WidePass),
+        _ => Err(format!(
+            "`{s}`: the beam search is `serial`, `wide` or `wide-pass`"
+        )),
+    }
+}
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -46,6 +58,16 @@ pub struct Args {
     /// at the near plane, as `ray-exact` with `STRATA_EXACT_BEAM=off`).
     #[arg(long)]
     no_beam: bool,
+    /// How the beams are searched: `serial` (a pre-pass, one invocation per
+    /// tile) or `wide` (the tile's 64 invocations at once, in the march;
+    /// `wide-pass`: the same in a pre-pass, the same counts);
+    /// the GPU's default is `wide` (`STRATA_EXACT_BEAM` picks it there).
+    #[arg(long, value_parser = parse_search)]
+    search: Option<BeamSearch>,
+    /// Most rounds of the shadow blocks' wide search (1 to 8; the GPU's
+    /// default 8, `STRATA_EXACT_SHADOW_ROUNDS` there).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=8))]
+    shadow_rounds: Option<u32>,
     /// Try another traversal on paper: the visited level camera rays start
     /// at from their tile's beam (the GPU's: 1, tiles of 4 texels).
     #[arg(long, value_parser = clap::value_parser!(u32).range(0..=4))]
@@ -75,14 +97,20 @@ struct Report {
     /// Means over the views.
     mean_bytes: f64,
     mean_march_iterations: f64,
-    /// The beams' iterations over the pixels (each tile's beam shared by its
-    /// 64 pixels).
+    /// The beams' iterations over the pixels: a serial beam's iterations
+    /// are shared by its tile's 64 pixels, the wide search's rounds are each
+    /// one interval test for every pixel of the tile.
     mean_beam_iterations_per_pixel: f64,
+    /// The beams' iterations (serial) or rounds (wide) a tile.
+    mean_beam_iterations_per_tile: f64,
     mean_march_warp_iterations: f64,
     mean_shadow_iterations: f64,
     mean_shadow_warp_iterations: f64,
     /// The shadow blocks' beams' iterations over the shadow rays.
     mean_shadow_beam_iterations_per_ray: f64,
+    /// The shadow blocks' beams' rounds a block (each round one interval
+    /// test for every ray of the block).
+    mean_shadow_beam_rounds_per_block: f64,
     mean_shadow_rays: f64,
 }
 
@@ -135,6 +163,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         climb: args.climb,
         start: args.start_level.or(Traversal::GPU.start),
         beam: !args.no_beam,
+        search: args.search.unwrap_or(Traversal::GPU.search),
+        shadow_rounds: args.shadow_rounds.unwrap_or(Traversal::GPU.shadow_rounds),
         beam_level: args.beam_level.unwrap_or(Traversal::GPU.beam_level),
     };
     let shape = LevelShape::of(&world.level);
@@ -196,13 +226,18 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         mean_bytes: mean(&|c| c.bytes as f64),
         mean_march_iterations: mean(&|c| c.frame.march.iterations.mean),
         mean_beam_iterations_per_pixel: mean(&|c| {
-            c.frame.beam.iterations.total as f64 / c.frame.march.rays.max(1) as f64
+            (c.frame.beam.iterations.total * u64::from(c.frame.beam_lanes)) as f64
+                / c.frame.march.rays.max(1) as f64
         }),
+        mean_beam_iterations_per_tile: mean(&|c| c.frame.beam.iterations.mean),
         mean_march_warp_iterations: mean(&|c| c.frame.march.warp_iterations),
         mean_shadow_iterations: mean(&|c| c.frame.shadow.iterations.mean),
         mean_shadow_warp_iterations: mean(&|c| c.frame.shadow.warp_iterations),
         mean_shadow_beam_iterations_per_ray: mean(&|c| {
             c.frame.shadow_beam_iterations as f64 / c.frame.shadow.rays.max(1) as f64
+        }),
+        mean_shadow_beam_rounds_per_block: mean(&|c| {
+            c.frame.shadow_beam_iterations as f64 / c.frame.shadow_blocks.max(1) as f64
         }),
         mean_shadow_rays: mean(&|c| c.frame.shadow.rays as f64),
         views: counts,
@@ -214,17 +249,18 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         writeln!(
             out,
             "mean over {} views: {:.2} MB a frame, {:.2} march iterations a pixel ({:.2} a warp) \
-             + {:.3} beam iterations a pixel, {:.0} shadow rays of {:.2} iterations ({:.2} a warp) \
-             + {:.3} beam iterations a ray",
+             + {:.3} beam iterations a pixel ({:.2} a tile), {:.0} shadow rays of {:.2} iterations ({:.2} a warp) \
+             + {:.2} beam rounds a block",
             report.views.len(),
             report.mean_bytes / 1e6,
             report.mean_march_iterations,
             report.mean_march_warp_iterations,
             report.mean_beam_iterations_per_pixel,
+            report.mean_beam_iterations_per_tile,
             report.mean_shadow_rays,
             report.mean_shadow_iterations,
             report.mean_shadow_warp_iterations,
-            report.mean_shadow_beam_iterations_per_ray,
+            report.mean_shadow_beam_rounds_per_block,
         )?;
     }
     Ok(())

@@ -1,27 +1,33 @@
 //! `ray-exact`'s beam pre-pass over the whole map (`ray_exact_beam.wgsl`,
-//! issue 36 item 1): one invocation per 8x8-pixel tile searches the least
-//! `t` at which any of the tile's camera rays may meet a solid point (the
-//! argument that it never passes a hit is in the shader), and the march
-//! starts each ray there. Same image, fewer iterations: the counts
-//! (`strata exact-counts`, [`super::replay`]) are in `bench/issue36-beam/`.
-//! [`crate::options::ExactOptions::beam`] off (`STRATA_EXACT_BEAM=off`)
-//! skips the pass and the march does not read its buffer. Paged terrain has
-//! none (its finer levels live per page).
+//! issue 36 item 1): the least `t` at which any of an 8x8-pixel tile's
+//! camera rays may meet a solid point (the argument that it never passes a
+//! hit is in the shader), searched by one workgroup per tile, 64 slices at
+//! a time (`BeamSearch::WidePass`, `cs_exact_beam_wide`), or by one
+//! invocation per tile walking it (`BeamSearch::Serial`, `cs_exact_beam`);
+//! the march starts each ray there. `BeamSearch::Wide` searches in the
+//! march's own workgroup instead: no pass here. Same image, fewer
+//! iterations: the counts (`strata exact-counts`, [`super::replay`]) are in
+//! `bench/issue36-beam/`. [`crate::options::ExactOptions::beam`] off
+//! (`STRATA_EXACT_BEAM=off`) skips the pass and the march does not read its
+//! buffer. Paged terrain has none (its finer levels live per page).
 
 use super::bindings::{
     Levels, beam_binding, beam_layout_entry, core_bindings, core_entries, exact_pipeline,
 };
 use crate::frame::Shared;
 use crate::methods::contract::Frame;
-use crate::options::ExactOptions;
+use crate::options::{BeamSearch, ExactOptions};
 
 /// Side of a tile in pixels (`BEAM_TILE`).
 const TILE: u32 = super::replay::BEAM_TILE;
 
 /// The pass and the tiles' starts it writes.
 pub(super) struct Beam {
-    /// `None` with the beam off: the buffer is bound, never written or read.
+    /// `None` with the beam off or searched wide: the buffer is bound, never
+    /// written or read.
     pipeline: Option<wgpu::ComputePipeline>,
+    /// The wide pre-pass (a workgroup per tile), else the serial one.
+    wide: bool,
     layout: wgpu::BindGroupLayout,
     group: wgpu::BindGroup,
     /// One f32 per tile of the targets.
@@ -53,23 +59,29 @@ impl Beam {
                 label: Some("ray-exact beam"),
                 entries: &entries,
             });
-        let pipeline = if options.beam {
-            Some(exact_pipeline(
+        // The wide search in the march's workgroups has no pre-pass.
+        let entry = match options.beam_search {
+            BeamSearch::Serial => Some("cs_exact_beam"),
+            BeamSearch::WidePass => Some("cs_exact_beam_wide"),
+            BeamSearch::Wide => None,
+        };
+        let pipeline = match entry {
+            Some(entry) if options.beam => Some(exact_pipeline(
                 shared,
                 "ray-exact beam",
                 levels,
                 "ray_exact.wgsl",
                 &shared.pipeline_layout("ray-exact beam", &[&layout]),
-                "cs_exact_beam",
+                entry,
                 options,
-            )?)
-        } else {
-            None
+            )?),
+            _ => None,
         };
         let buffer = starts_buffer(shared);
         let group = Self::group(shared, &layout, (params, levels, stats), &buffer);
         Ok(Beam {
             pipeline,
+            wide: options.beam_search.is_wide(),
             layout,
             group,
             buffer,
@@ -120,7 +132,13 @@ impl Beam {
         pass.set_bind_group(0, &shared.frame_group, &[]);
         pass.set_bind_group(1, &self.group, &[]);
         let tiles = (shared.width.div_ceil(TILE), shared.height.div_ceil(TILE));
-        pass.dispatch_workgroups(tiles.0.div_ceil(8), tiles.1.div_ceil(8), 1);
+        if self.wide {
+            // A workgroup per tile.
+            pass.dispatch_workgroups(tiles.0, tiles.1, 1);
+        } else {
+            // An invocation per tile.
+            pass.dispatch_workgroups(tiles.0.div_ceil(8), tiles.1.div_ceil(8), 1);
+        }
     }
 
     pub(super) fn bytes(&self) -> u64 {

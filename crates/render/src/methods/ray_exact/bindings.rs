@@ -5,7 +5,7 @@
 use super::pyramid::GpuMaxMip;
 use crate::frame::Shared;
 use crate::methods::common::DepthCopy;
-use crate::options::ExactOptions;
+use crate::options::{BeamSearch, ExactOptions};
 use crate::paged::PagedTerrain;
 
 pub(super) fn buffer_entry(
@@ -173,6 +173,14 @@ pub(super) fn exact_pipeline(
     ];
     if reads_beam(levels, shader) {
         constants.push(("EXACT_BEAM", f64::from(u8::from(options.beam))));
+        let search = match options.beam_search {
+            BeamSearch::Serial => 0u8,
+            BeamSearch::Wide => 1,
+            BeamSearch::WidePass => 2,
+        };
+        constants.push(("EXACT_BEAM_SEARCH", f64::from(search)));
+        let rounds = options.shadow_rounds.clamp(1, super::replay::WIDE_ROUNDS);
+        constants.push(("EXACT_SHADOW_ROUNDS", f64::from(rounds)));
         constants.push(("EXACT_BEAM_LEVEL", f64::from(super::BEAM_LEVEL)));
     }
     super::super::common::compute_pipeline_with_constants(

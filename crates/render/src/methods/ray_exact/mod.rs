@@ -37,15 +37,19 @@
 //! no other method reuses it. Frames that reuse a map, or have shadows off,
 //! march and shade in one pass.
 //!
-//! The compute variant over the whole map first runs a beam pre-pass
-//! (`beam.rs`, `ray_exact_beam.wgsl`, issue 36): one invocation per 8x8-pixel
-//! tile finds the least `t` at which any ray of the tile may meet a solid
-//! point, and the march starts each of its rays there, at the 4-texel tiles
-//! ([`BEAM_LEVEL`]); the deferred frame's shadow blocks do the same along
-//! the light, the 64 invocations of a block testing 64 intervals at once.
-//! Same hits, bit for bit; on the default views at 1280x800
-//! (`strata exact-counts`) 10.1 march iterations a pixel instead of 18.6
-//! and 10.6 a shadow ray instead of 17.0 (`bench/issue36-beam/`).
+//! The compute variant over the whole map first searches a beam per 8x8-pixel
+//! tile (`beam.rs`, `ray_exact_beam.wgsl`, issue 36): the least `t` at which
+//! any ray of the tile may meet a solid point, and the march starts each of
+//! its rays there, at the 4-texel tiles ([`BEAM_LEVEL`]); the deferred
+//! frame's shadow blocks do the same along the light. The search
+//! ([`ExactOptions::beam_search`], [`BeamSearch`]) is wide by default: the
+//! tile's 64 invocations test 64 slices of its depth range at once, then 64
+//! sub-slices of the first slice that may hold ground (a pre-pass of one
+//! workgroup per tile, or in the march's own workgroup), where the first
+//! pre-pass walked it serially, one invocation per tile. Same hits, bit for
+//! bit; on the default views at 1280x800 (`strata exact-counts`) 9.05 march
+//! iterations a pixel instead of 18.6 without a beam (11.1 serially) and
+//! 9.4 a shadow ray instead of 17.0 (10.6): `bench/issue36-beam/wide/`.
 //! `STRATA_EXACT_BEAM=off` ([`ExactOptions::beam`]) turns it off.
 //!
 //! Measuring switches ([`ExactOptions`] and `exact_stats` in
@@ -162,7 +166,7 @@ pub struct RayExact {
     update_ms: Vec<f64>,
 }
 
-pub use crate::options::{DepthMode, ExactOptions};
+pub use crate::options::{BeamSearch, DepthMode, ExactOptions};
 
 pub fn create(
     shared: &Shared,

@@ -27,7 +27,8 @@ use strata_level::Level;
 use strata_maxmip::Pyramid;
 
 mod beam;
-pub use beam::{BEAM_CAP, BEAM_TILE, BeamCount, SHADOW_BEAM_LANES};
+pub use crate::options::BeamSearch;
+pub use beam::{BEAM_CAP, BEAM_TILE, BeamCount, SHADOW_BEAM_LANES, WIDE_LANES, WIDE_ROUNDS};
 
 /// `EXACT_LOG_RATIO` of the compute pipelines ([`crate::options::ExactOptions`]).
 pub const LOG_RATIO: u32 = 2;
@@ -74,6 +75,10 @@ pub struct Traversal {
     /// plane; shadow rays where their 8x8-texel block's does
     /// ([`Replay::shadow_beam`]), else at altitude 255.
     pub beam: bool,
+    /// How the beams are searched (`EXACT_BEAM_SEARCH`).
+    pub search: BeamSearch,
+    /// Most rounds of a shadow block's wide search (`EXACT_SHADOW_ROUNDS`).
+    pub shadow_rounds: u32,
     /// The visited level camera and shadow rays start at from their beam
     /// (`EXACT_BEAM_LEVEL`).
     pub beam_level: u32,
@@ -85,6 +90,8 @@ impl Traversal {
         climb: 1,
         start: Some(super::START_LEVEL / LOG_RATIO),
         beam: true,
+        search: crate::options::ExactOptions::DEFAULT.beam_search,
+        shadow_rounds: crate::options::ExactOptions::DEFAULT.shadow_rounds,
         beam_level: super::BEAM_LEVEL / LOG_RATIO,
     };
 
@@ -93,6 +100,8 @@ impl Traversal {
         climb: 1,
         start: None,
         beam: false,
+        search: BeamSearch::Serial,
+        shadow_rounds: WIDE_ROUNDS,
         beam_level: super::BEAM_LEVEL / LOG_RATIO,
     };
 }
@@ -479,8 +488,12 @@ pub struct FrameCount {
     pub size: [u32; 2],
     /// Pixels whose ray hit.
     pub hits: u64,
-    /// The beams (one ray per 8x8-pixel tile; empty without them).
+    /// The beams (one per 8x8-pixel tile; empty without them): per tile,
+    /// the serial search's iterations or the wide search's rounds.
     pub beam: PassCount,
+    /// Invocations per beam: 1 (serial) or [`WIDE_LANES`] (wide, every
+    /// invocation of the tile's workgroup tests an interval each round).
+    pub beam_lanes: u32,
     /// The camera march.
     pub march: PassCount,
     /// The shadow casts of the stamped blocks (empty with shadows off).
@@ -614,7 +627,7 @@ pub fn beam_disagreements(replay: &mut Replay<'_>, g: &Globals) -> (u64, u64) {
     let mut blocks = std::collections::BTreeSet::new();
     for ty in 0..h.div_ceil(BEAM_TILE) {
         for tx in 0..w.div_ceil(BEAM_TILE) {
-            let start = replay.tile_beam(g, tx, ty).t;
+            let start = replay.tile_start(g, tx, ty).t;
             for y in ty * BEAM_TILE..((ty + 1) * BEAM_TILE).min(h) {
                 for x in tx * BEAM_TILE..((tx + 1) * BEAM_TILE).min(w) {
                     let (px, py) = (x as f32 + 0.5, y as f32 + 0.5);
@@ -638,7 +651,7 @@ pub fn beam_disagreements(replay: &mut Replay<'_>, g: &Globals) -> (u64, u64) {
     let across = g.shadow_u[3] as u32 / MARK_BLOCK as u32;
     for b in blocks {
         let (bx, by) = (b % across * 8, b / across * 8);
-        let start = replay.shadow_beam(g, bx, by).t;
+        let start = replay.shadow_block_start(g, bx, by).t;
         for j in 0..MARK_BLOCK as u32 {
             for i in 0..MARK_BLOCK as u32 {
                 let old = replay.shadow_texel(g, bx + i, by + j).hit;
@@ -682,7 +695,7 @@ pub fn replay_frame(replay: &mut Replay<'_>, g: &Globals) -> FrameCount {
     if replay.traversal.beam {
         for ty in 0..tiles.1 {
             for tx in 0..tiles.0 {
-                let b = replay.tile_beam(g, tx, ty);
+                let b = replay.tile_start(g, tx, ty);
                 starts[(ty * tiles.0 + tx) as usize] = Some(b.t);
                 beam.add(&MarchCount {
                     iterations: b.iterations,
@@ -692,10 +705,17 @@ pub fn replay_frame(replay: &mut Replay<'_>, g: &Globals) -> FrameCount {
             }
         }
     }
+    // The wide search in the march writes and reads no starts.
+    let wide = replay.traversal.search == BeamSearch::Wide;
     let beam = if replay.traversal.beam {
         let mut p = beam.finish(warps_of(tiles.0, tiles.1));
-        // One f32 per tile.
-        p.bytes_written = u64::from(tiles.0 * tiles.1) * 4;
+        // The serial pre-pass writes one f32 per tile; the wide search
+        // happens in the march's workgroup and writes nothing.
+        p.bytes_written = if wide {
+            0
+        } else {
+            u64::from(tiles.0 * tiles.1) * 4
+        };
         p
     } else {
         PassCount::default()
@@ -723,7 +743,7 @@ pub fn replay_frame(replay: &mut Replay<'_>, g: &Globals) -> FrameCount {
     // hits (4 B each pixel), depth_io (4 B per hit), stamps and list.
     march.bytes_written =
         pixels * TEXEL_BYTES + hits.len() as u64 * TEXEL_BYTES + listed.len() as u64 * 8;
-    if replay.traversal.beam {
+    if replay.traversal.beam && !wide {
         // Each pixel reads its tile's start.
         march.bytes_read += pixels * 4;
     }
@@ -738,7 +758,7 @@ pub fn replay_frame(replay: &mut Replay<'_>, g: &Globals) -> FrameCount {
             let start = replay
                 .traversal
                 .beam
-                .then(|| replay.shadow_beam(g, bx * 8, by * 8));
+                .then(|| replay.shadow_block_start(g, bx * 8, by * 8));
             if let Some(s) = start {
                 shadow_beams += u64::from(s.iterations);
             }
@@ -786,6 +806,11 @@ pub fn replay_frame(replay: &mut Replay<'_>, g: &Globals) -> FrameCount {
         size: [w, h],
         hits: hits.len() as u64,
         beam,
+        beam_lanes: if replay.traversal.search.is_wide() {
+            WIDE_LANES
+        } else {
+            1
+        },
         march,
         shadow,
         shadow_beam_iterations: shadow_beams,

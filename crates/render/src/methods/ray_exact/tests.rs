@@ -640,7 +640,30 @@ fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
                 exact_shadow: false,
                 ..d
             },
+            ExactOptions {
+                beam_search: BeamSearch::Serial,
+                ..d
+            },
+            ExactOptions {
+                beam_search: BeamSearch::Serial,
+                exact_shadow: false,
+                ..d
+            },
+            ExactOptions {
+                beam_search: BeamSearch::Wide,
+                ..d
+            },
+            ExactOptions {
+                beam_search: BeamSearch::Wide,
+                exact_shadow: false,
+                ..d
+            },
+            ExactOptions {
+                shadow_rounds: 1,
+                ..d
+            },
         ];
+        assert_eq!(d.beam_search, BeamSearch::WidePass);
         let mut images = Vec::new();
         for options in variants {
             let m = build(&r.shared_handle(), &w.level, options).unwrap();
@@ -663,8 +686,10 @@ fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
         }
         // Climbing as far as a step allows, visiting every other level,
         // loading depth instead of clearing it, or starting every ray at the
-        // near plane instead of its tile's beam changes nothing but the work.
-        for other in [3, 4, 5, 6] {
+        // near plane instead of its tile's beam, or searching the beam
+        // serially or wide in the march instead of wide in a pre-pass,
+        // changes nothing but the work.
+        for other in [3, 4, 5, 6, 8, 10, 12] {
             for (v, (a, b)) in images[1].iter().zip(&images[other]).enumerate() {
                 assert!(
                     a.0 == b.0 && a.1 == b.1,
@@ -672,13 +697,16 @@ fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
                 );
             }
         }
-        // The one-pass frame (the renderer's shadow map) with and without
-        // the beam: the same image.
-        for (v, (a, b)) in images[2].iter().zip(&images[7]).enumerate() {
-            assert!(
-                a.0 == b.0 && a.1 == b.1,
-                "view {v}: the beam changed the one-pass frame's image"
-            );
+        // The one-pass frame (the renderer's shadow map) with the wide
+        // beam in a pre-pass, without a beam, with the serial one and with
+        // the wide one in the march: the same image.
+        for other in [7, 9, 11] {
+            for (v, (a, b)) in images[2].iter().zip(&images[other]).enumerate() {
+                assert!(
+                    a.0 == b.0 && a.1 == b.1,
+                    "view {v}: variant {other} changed the one-pass frame's image"
+                );
+            }
         }
         // The exact shadow map and the 128-step one shade nearly alike.
         for (v, (a, b)) in images[1].iter().zip(&images[2]).enumerate() {
@@ -737,10 +765,45 @@ fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
 /// rounding differs on a grazed boundary.
 #[test]
 fn the_replay_takes_the_gpu_steps() {
-    use super::replay::{Replay, compute_pyramid, replay_frame};
+    for (search, shadow_rounds) in [
+        (BeamSearch::Wide, 8),
+        (BeamSearch::Serial, 8),
+        (BeamSearch::WidePass, 8),
+        (BeamSearch::WidePass, 1),
+    ] {
+        replay_takes_the_gpu_steps(search, shadow_rounds);
+    }
+}
+
+/// The generated world and its compute pyramid, for a replay.
+fn replay_world() -> (World, strata_maxmip::Pyramid) {
     let w = common::generated_world();
-    let pyramid = compute_pyramid(&w.level);
+    let pyramid = super::replay::compute_pyramid(&w.level);
+    (w, pyramid)
+}
+
+/// `Traversal::GPU` with the beam searched by `search` (`beam` on or off).
+fn replay_traversal(search: BeamSearch, beam: bool) -> super::replay::Traversal {
+    super::replay::Traversal {
+        beam,
+        search,
+        ..super::replay::Traversal::GPU
+    }
+}
+
+fn replay_takes_the_gpu_steps(search: BeamSearch, shadow_rounds: u32) {
+    use super::replay::{Replay, replay_frame};
+    let (w, pyramid) = replay_world();
     let mut replay = Replay::new(&w.level, &pyramid);
+    replay.traversal = super::replay::Traversal {
+        shadow_rounds,
+        ..replay_traversal(search, true)
+    };
+    let options = ExactOptions {
+        beam_search: search,
+        shadow_rounds,
+        ..ExactOptions::DEFAULT
+    };
     let shape = crate::frame::LevelShape::of(&w.level);
     let mut frames = Vec::new();
     for view in &w.views {
@@ -763,7 +826,7 @@ fn the_replay_takes_the_gpu_steps() {
             }
         }
         eprintln!(
-            "{:10} replay: {} hits, march {:.1} iterations/ray (p99 {}, most {}), shadow {} rays \
+            "{search:?} {:10} replay: {} hits, march {:.1} iterations/ray (p99 {}, most {}), shadow {} rays \
              {:.1} (most {}), {} bytes; vs reference: {disagree} pixels disagree, worst relative \
              distance {worst:.2e}",
             view.name,
@@ -798,13 +861,13 @@ fn the_replay_takes_the_gpu_steps() {
         let shared = r.shared_handle();
         let timer = crate::timing::PassTimer::new(&shared.device, &shared.queue, false);
         for (index, (camera, f)) in frames.iter().enumerate() {
-            let mut m = build(&shared, &w.level, ExactOptions::DEFAULT).unwrap();
+            let mut m = build(&shared, &w.level, options).unwrap();
             let shadow = crate::shadow::ShadowFrame::fit(camera, true);
             let globals = crate::frame::Globals::new(camera, &shape, &shadow);
             record_frame(&shared, &mut m, camera, &globals, &timer, index);
             let s = m.stats().unwrap();
             eprintln!(
-                "view {index}: most iterations GPU {} / {} (shadow), replay {} / {}",
+                "{search:?} {shadow_rounds} view {index}: most iterations GPU {} / {} (shadow), replay {} / {}",
                 s.most_iterations,
                 s.shadow_most_iterations,
                 f.most_iterations,
@@ -813,7 +876,7 @@ fn the_replay_takes_the_gpu_steps() {
             assert!(
                 s.most_iterations.abs_diff(f.most_iterations) <= 2
                     && s.shadow_most_iterations.abs_diff(f.shadow_most_iterations) <= 2,
-                "view {index}: GPU {s:?}, replay {f:?}"
+                "{search:?} view {index}: GPU {s:?}, replay {f:?}"
             );
         }
         gpu.errors.check().unwrap();
@@ -828,13 +891,23 @@ fn the_replay_takes_the_gpu_steps() {
 /// (every tile, every pixel); and it saves iterations.
 #[test]
 fn the_beam_never_passes_a_hit() {
-    use super::replay::{BEAM_TILE, Replay, Traversal, compute_pyramid};
-    let w = common::generated_world();
-    let pyramid = compute_pyramid(&w.level);
+    for search in [BeamSearch::Wide, BeamSearch::Serial] {
+        beam_never_passes_a_hit(search);
+    }
+}
+
+fn beam_never_passes_a_hit(search: BeamSearch) {
+    use super::replay::{BEAM_CAP, BEAM_TILE, Replay, WIDE_ROUNDS};
+    let (w, pyramid) = replay_world();
     let mut replay = Replay::new(&w.level, &pyramid);
-    replay.traversal = Traversal {
-        beam: false,
-        ..Traversal::GPU
+    replay.traversal = replay_traversal(search, false);
+    // Most iterations (rounds) of a beam, and the invocations each takes:
+    // the wide search's rounds are an interval test by every pixel.
+    let (cap, lanes) = match search {
+        BeamSearch::Serial => (BEAM_CAP, 1),
+        BeamSearch::Wide | BeamSearch::WidePass => {
+            (WIDE_ROUNDS, u64::from(super::replay::WIDE_LANES))
+        }
     };
     for (width, height) in [(W, H), (640, 400)] {
         let (mut before, mut after, mut beams, mut tiles_hit) = (0u64, 0u64, 0u64, 0u64);
@@ -842,9 +915,9 @@ fn the_beam_never_passes_a_hit() {
             let (_, g) = view_globals(&w.level, view, (width, height));
             for ty in 0..height.div_ceil(BEAM_TILE) {
                 for tx in 0..width.div_ceil(BEAM_TILE) {
-                    let b = replay.tile_beam(&g, tx, ty);
-                    beams += u64::from(b.iterations);
-                    assert!(b.t.is_finite() && b.iterations <= super::replay::BEAM_CAP);
+                    let b = replay.tile_start(&g, tx, ty);
+                    beams += u64::from(b.iterations) * lanes;
+                    assert!(b.t.is_finite() && b.iterations <= cap);
                     let mut any = false;
                     for y in ty * BEAM_TILE..((ty + 1) * BEAM_TILE).min(height) {
                         for x in tx * BEAM_TILE..((tx + 1) * BEAM_TILE).min(width) {
@@ -857,7 +930,7 @@ fn the_beam_never_passes_a_hit() {
                                 any = true;
                                 assert!(
                                     t >= b.t,
-                                    "{} {width}x{height} pixel ({x}, {y}): hit at {t}, its tile starts at {}",
+                                    "{search:?} {} {width}x{height} pixel ({x}, {y}): hit at {t}, its tile starts at {}",
                                     view.name,
                                     b.t
                                 );
@@ -865,7 +938,7 @@ fn the_beam_never_passes_a_hit() {
                             assert!(
                                 old.hit.map(|(t, c)| (t.to_bits(), c))
                                     == new.hit.map(|(t, c)| (t.to_bits(), c)),
-                                "{} {width}x{height} pixel ({x}, {y}): {:?} from the near plane, {:?} from the beam",
+                                "{search:?} {} {width}x{height} pixel ({x}, {y}): {:?} from the near plane, {:?} from the beam",
                                 view.name,
                                 old.hit,
                                 new.hit
@@ -879,12 +952,17 @@ fn the_beam_never_passes_a_hit() {
             // blocks the hits stamp, from 255 and from its block's beam.
             if width == W {
                 let (differ, early) = super::replay::beam_disagreements(&mut replay, &g);
-                assert_eq!((differ, early), (0, 0), "{}: shadow beams", view.name);
+                assert_eq!(
+                    (differ, early),
+                    (0, 0),
+                    "{search:?} {}: shadow beams",
+                    view.name
+                );
             }
         }
         let pixels = u64::from(width * height) * w.views.len() as u64;
         eprintln!(
-            "{width}x{height}: march iterations a pixel {:.2} from the near plane, {:.2} from the beam; \
+            "{search:?} {width}x{height}: march iterations a pixel {:.2} from the near plane, {:.2} from the beam; \
              beam {:.3} a pixel; {tiles_hit} tiles with hits",
             before as f64 / pixels as f64,
             after as f64 / pixels as f64,
