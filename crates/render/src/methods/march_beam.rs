@@ -255,3 +255,53 @@ pub(crate) fn split_nobeam(text: &str) -> (&str, bool) {
         None => (text, true),
     }
 }
+
+/// What a method's settings record says after its knobs when the beam is off.
+pub(crate) fn nobeam_tag(s: &super::contract::MethodSettings) -> &'static str {
+    if s.march_beam { "" } else { " nobeam" }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::contract::MethodSettings;
+    use super::super::{ray, voxel};
+
+    fn parsed(knobs: &super::super::Knobs, text: &str) -> anyhow::Result<MethodSettings> {
+        let mut s = MethodSettings::default();
+        (knobs.parse)(text, &mut s)?;
+        Ok(s)
+    }
+
+    #[test]
+    fn nobeam_is_a_setting_of_ray_and_voxel() {
+        let s = parsed(&ray::KNOBS, "128/nobeam").unwrap();
+        assert_eq!((s.ray_steps, s.march_beam), (128, false));
+        assert_eq!((ray::KNOBS.describe)(&s), "steps=128 nobeam");
+        let s = parsed(&ray::KNOBS, "64").unwrap();
+        assert_eq!((s.ray_steps, s.march_beam), (64, true));
+        assert_eq!((ray::KNOBS.describe)(&s), "steps=64");
+        assert!(parsed(&ray::KNOBS, "128/beam").is_err());
+        assert!(parsed(&ray::KNOBS, "nobeam").is_err());
+
+        let s = parsed(&voxel::KNOBS, "4,8,2/100/nobeam").unwrap();
+        assert_eq!(
+            (s.voxel_size, s.voxel_steps, s.march_beam),
+            ([4, 8, 2], 100, false)
+        );
+        assert_eq!((voxel::KNOBS.describe)(&s), "grid=(4,8,2) steps=100 nobeam");
+        let s = parsed(&voxel::KNOBS, "/nobeam").unwrap();
+        assert_eq!(
+            s,
+            MethodSettings {
+                march_beam: false,
+                ..MethodSettings::default()
+            }
+        );
+        let s = parsed(&voxel::KNOBS, "2,4,1/50").unwrap();
+        assert!(s.march_beam);
+        // The beam is one of the settings two runs must share.
+        let mut kept = MethodSettings::default();
+        (voxel::KNOBS.keep)(&parsed(&voxel::KNOBS, "/nobeam").unwrap(), &mut kept);
+        assert!(!kept.march_beam);
+    }
+}

@@ -14,7 +14,9 @@
 use super::common::{draw_fullscreen, fullscreen_pipeline};
 use super::contract::{Frame, Method, MethodSettings, RetainedBytes};
 use super::knobs::{Flag, Knobs, Slider, Sweep, count, plain};
-use super::march_beam::{MarchBeam, NO_BEAM_FLAG, highest_top, highest_top_in, split_nobeam};
+use super::march_beam::{
+    MarchBeam, NO_BEAM_FLAG, highest_top, highest_top_in, nobeam_tag, split_nobeam,
+};
 use crate::frame::{Shared, uniform_layout_entry};
 use strata_camera::Camera;
 use strata_level::{DirtyRect, Level};
@@ -223,13 +225,7 @@ pub static KNOBS: Knobs = Knobs {
         s.march_beam = beam;
         Ok(())
     },
-    describe: |s| {
-        if s.march_beam {
-            format!("steps={}", s.ray_steps)
-        } else {
-            format!("steps={} nobeam", s.ray_steps)
-        }
-    },
+    describe: |s| format!("steps={}{}", s.ray_steps, nobeam_tag(s)),
     keep: |from, to| {
         to.ray_steps = from.ray_steps;
         to.march_beam = from.march_beam;

@@ -3,7 +3,7 @@
 
 use super::super::contract::MethodSettings;
 use super::super::knobs::{Flag, Knobs, Slider, Sweep, count, count_triple, plain, show_triple};
-use super::super::march_beam::{NO_BEAM_FLAG, split_nobeam};
+use super::super::march_beam::{NO_BEAM_FLAG, nobeam_tag, split_nobeam};
 use anyhow::bail;
 
 pub static KNOBS: Knobs = Knobs {
@@ -12,8 +12,11 @@ pub static KNOBS: Knobs = Knobs {
     parse,
     describe: |s| {
         let [x, y, z] = s.voxel_size;
-        let nobeam = if s.march_beam { "" } else { " nobeam" };
-        format!("grid=({x},{y},{z}) steps={}{nobeam}", s.voxel_steps)
+        format!(
+            "grid=({x},{y},{z}) steps={}{}",
+            s.voxel_steps,
+            nobeam_tag(s)
+        )
     },
     keep: |from, to| {
         to.voxel_size = from.voxel_size;
