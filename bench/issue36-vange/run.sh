@@ -6,7 +6,8 @@
 # call's `carry`:
 #   devbin/strata          Strata (release), the lead's
 #   devbin-vange/level     vange-rs's `level` (release, stripped; built from
-#                          kvark/vange-rs, commit in devbin-vange/COMMIT)
+#                          kvark/vange-rs, commit in devbin-vange/COMMIT),
+#                          with its shaders in devbin-vange/res/shader
 #   .gl/*.deb              the GL/Vulkan loaders (unpacked below)
 # Both draw the same generated world (`strata generate`, the built-in
 # world's seed and size) over its twelve views at 1280x800 with shadows, 20
@@ -23,6 +24,7 @@
 #   VANGE_SHADOW        vange-rs's shadow flag (default --shadow-ray: a
 #                       1024² height-field ray-traced shadow map, as Strata's)
 #   FRAMES, SIZE        default 20, 1280x800
+#   VANGE_WARMUP        vange-rs's untimed frames before the timed ones (default 30)
 #
 # Writes $OUT/vange-<terrain>.json (per-view bench JSONs merged),
 # $OUT/strata/results-*.json + report.md, $OUT/table.md, and prints the table.
@@ -47,7 +49,12 @@ H=${SIZE#*x}
 STRATA_METHODS=${STRATA_METHODS:-ray:128,ray:128/nobeam,voxel,voxel:/nobeam}
 VANGE_TERRAINS=${VANGE_TERRAINS:-"ray:128=RayTraced,--ray-steps,128 voxel=RayVoxelTraced,--voxel-size,4,8,2,--voxel-steps,100"}
 VANGE_SHADOW=${VANGE_SHADOW:---shadow-ray}
+VANGE_WARMUP=${VANGE_WARMUP:-30}
+VANGE_DIR=$(cd "$(dirname "$VANGE")" && pwd)
+VANGE_BIN=$(basename "$VANGE")
+STRATA=$(cd "$(dirname "$STRATA")" && pwd)/$(basename "$STRATA")
 mkdir -p "$OUT"
+OUT=$(cd "$OUT" && pwd)
 WORK=$(mktemp -d)
 export STRATA_CACHE_DIR="$WORK/cache"
 
@@ -59,7 +66,7 @@ grep -v '^\s*#' "$VIEWS" | grep -v '^\s*$' > "$WORK/views"
 cat "$WORK/views"
 
 echo "== vange-rs"
-cat devbin-vange/COMMIT 2>/dev/null || true
+cat "$VANGE_DIR/COMMIT" 2>/dev/null || true
 for pair in $VANGE_TERRAINS; do
     method=${pair%%=*}
     args=${pair#*=}
@@ -79,11 +86,13 @@ for pair in $VANGE_TERRAINS; do
         eye=${rest_spec%%:*}
         under=()
         case "$spec" in *:under) under=(--fp-under) ;; esac
-        "$VANGE" "$WORK/world/world.ini" --snapshot "$WORK/vange-$tag/$name.png" \
+        # vange-rs reads its shaders from res/shader under the working
+        # directory (devbin-vange/res/shader); `=` keeps negative numbers values.
+        (cd "$VANGE_DIR" && "./$VANGE_BIN" "$WORK/world/world.ini" --snapshot "$WORK/vange-$tag/$name.png" \
             --terrain "$terrain" "${extra[@]}" --width "$W" --height "$H" \
-            --fp "$pos" --fp-yaw "$yaw" --fp-pitch "$pitch" --fp-height "$eye" "${under[@]}" \
-            --near 1 --far 600 $VANGE_SHADOW --warmup 30 --frames "$FRAMES" \
-            --bench-out "$WORK/vange-$tag/$name.json" > "$WORK/vange-$tag/$name.log" 2>&1 \
+            --fp "$pos" --fp-yaw="$yaw" --fp-pitch="$pitch" --fp-height "$eye" "${under[@]}" \
+            --near 1 --far 600 $VANGE_SHADOW --warmup "$VANGE_WARMUP" --frames "$FRAMES" \
+            --bench-out "$WORK/vange-$tag/$name.json") > "$WORK/vange-$tag/$name.log" 2>&1 \
             || { echo "vange-rs $method $name failed:"; tail -5 "$WORK/vange-$tag/$name.log"; }
         printf '%s %s: %s\n' "$method" "$name" "$(grep -o '"gpu_avg_ms": [^,]*' "$WORK/vange-$tag/$name.json" 2>/dev/null || echo missing)"
     done < "$WORK/views"

@@ -9,6 +9,9 @@
 #include "march_beam.wgsl"
 #include "fullscreen.wgsl"
 
+// The leaf sampling decodes a column per texel, not per point (`voxel_leaf`).
+const VOXEL_LEAF_CACHE: bool = true;
+
 struct FragOut {
     @location(0) color: vec4<f32>,
     @builtin(frag_depth) depth: f32,
