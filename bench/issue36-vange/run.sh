@@ -26,7 +26,7 @@
 #   FRAMES, SIZE        default 20, 1280x800
 #   VANGE_WARMUP        vange-rs's untimed frames before the timed ones (default 30)
 #
-# Writes $OUT/vange-<terrain>.json (per-view bench JSONs merged),
+# Writes $OUT/vange.json (vange-rs's bench JSON per terrain and view),
 # $OUT/strata/results-*.json + report.md, $OUT/table.md, and prints the table.
 set -euo pipefail
 
@@ -55,6 +55,7 @@ VANGE_BIN=$(basename "$VANGE")
 STRATA=$(cd "$(dirname "$STRATA")" && pwd)/$(basename "$STRATA")
 mkdir -p "$OUT"
 OUT=$(cd "$OUT" && pwd)
+rm -f "$OUT/vange.json"
 WORK=$(mktemp -d)
 export STRATA_CACHE_DIR="$WORK/cache"
 
@@ -96,14 +97,17 @@ for pair in $VANGE_TERRAINS; do
             || { echo "vange-rs $method $name failed:"; tail -5 "$WORK/vange-$tag/$name.log"; }
         printf '%s %s: %s\n' "$method" "$name" "$(grep -o '"gpu_avg_ms": [^,]*' "$WORK/vange-$tag/$name.json" 2>/dev/null || echo missing)"
     done < "$WORK/views"
-    python3 - "$WORK/vange-$tag" "$OUT/vange-$tag.json" <<'PY'
+    # One file for every terrain (a call brings back at most 8 files).
+    python3 - "$WORK/vange-$tag" "$OUT/vange.json" "$method" <<'PY'
 import json, os, sys
-src, dst = sys.argv[1], sys.argv[2]
+src, dst, method = sys.argv[1], sys.argv[2], sys.argv[3]
 views = {}
 for f in sorted(os.listdir(src)):
     if f.endswith('.json'):
         views[f[:-5]] = json.load(open(os.path.join(src, f)))
-json.dump(views, open(dst, 'w'), indent=1)
+all_ = json.load(open(dst)) if os.path.exists(dst) else {}
+all_[method] = views
+json.dump(all_, open(dst, 'w'), indent=1)
 PY
 done
 
@@ -126,10 +130,10 @@ def mean(xs):
     xs = [x for x in xs if x is not None]
     return sum(xs) / len(xs) if xs else None
 vange = {}
+runs = json.load(open(os.path.join(out, 'vange.json')))
 for pair in terrains:
     method = pair.split('=')[0]
-    tag = method.replace(':', '-').replace('/', '-')
-    data = json.load(open(os.path.join(out, f'vange-{tag}.json')))
+    data = runs.get(method, {})
     vange[method] = mean([data.get(v, {}).get('gpu_avg_ms') for v in views])
 print(f"Mean GPU ms over {len(views)} views ({res['adapter']['name'] if isinstance(res.get('adapter'), dict) else res.get('adapter')}); Strata revision {res.get('source_revision')}\n")
 print('| Strata method | vange-rs | Strata frame | method passes | ꟻLIP | ratio |')
