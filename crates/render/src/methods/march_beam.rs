@@ -69,9 +69,27 @@ fn starts_buffer(shared: &Shared) -> wgpu::Buffer {
 }
 
 impl MarchBeam {
-    /// Whether this adapter runs the pass and lets the fragment read its starts.
-    pub(crate) fn available(shared: &Shared) -> bool {
-        shared.caps.compute && shared.caps.fragment_storage
+    /// Whether this adapter runs the pass, lets the fragment read its
+    /// starts and binds the pyramid of `level` (a map too large for it is
+    /// drawn without the beam, as before, rather than refused).
+    pub(crate) fn available(shared: &Shared, level: &Level) -> bool {
+        let step = ExactOptions {
+            compute: true,
+            ..ExactOptions::DEFAULT
+        }
+        .pyramid_step();
+        let bytes = u64::from(
+            strata_maxmip::Layout::with_step(level.width(), level.height(), step)
+                .bytes
+                .max(4),
+        );
+        let limits = shared.device.limits();
+        shared.caps.compute
+            && shared.caps.fragment_storage
+            && bytes
+                <= limits
+                    .max_storage_buffer_binding_size
+                    .min(limits.max_buffer_size)
     }
 
     /// Build the pyramid (one submission, waited for) and the pass.

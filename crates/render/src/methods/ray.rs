@@ -103,7 +103,7 @@ pub fn create(
         255
     };
     let params = shared.uniform_buffer("ray params", bytemuck::cast_slice(&data));
-    let beam = if settings.march_beam && MarchBeam::available(shared) {
+    let beam = if settings.march_beam && MarchBeam::available(shared, level) {
         Some(MarchBeam::new(shared, level, "ray beam")?)
     } else {
         None

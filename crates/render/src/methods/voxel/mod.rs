@@ -175,7 +175,7 @@ pub fn build(
     if compute {
         entries.extend(DepthCopy::layout_entries(2));
     }
-    let beam = if !compute && settings.march_beam && MarchBeam::available(shared) {
+    let beam = if !compute && settings.march_beam && MarchBeam::available(shared, level) {
         entries.push(MarchBeam::layout_entry());
         Some(MarchBeam::new(shared, level, "voxel beam")?)
     } else {
