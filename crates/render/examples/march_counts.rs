@@ -309,6 +309,7 @@ fn main() -> anyhow::Result<()> {
     println!("| view | pitch | {} |", COLUMNS.join(" | "));
     println!("|---|---:|{}", "---:|".repeat(COLUMNS.len()));
     let mut sums = [[0f64; 2]; 6];
+    let mut exhausted = 0u64;
     for view in &world.views {
         let camera = Camera::from_view(&world.level, view, w, h)?;
         r.render_frame(&camera)?;
@@ -334,6 +335,9 @@ fn main() -> anyhow::Result<()> {
                 let (vi0, vd0) = before.count(eye, d, seg, seg.0);
                 let (vi1, vd1) = now.count(eye, d, seg, start);
                 per_pixel[(y * w + x) as usize] = [a, b, vi0, vi1, vd0, vd1];
+                // Rays whose old traversal spent its whole budget: where the
+                // beam may let them go further (a different image).
+                exhausted += u64::from(vi0 >= settings.voxel_steps);
             }
         }
         let n = per_pixel.len() as f64;
@@ -366,5 +370,9 @@ fn main() -> anyhow::Result<()> {
         .map(|s| format!("{:.1} ({:.1})", s[0] / k, s[1] / k))
         .collect();
     println!("| **mean** | | {} |", means.join(" | "));
+    println!(
+        "\nvoxel rays that spent the whole budget of {} steps before the beam (over all views): {exhausted}",
+        settings.voxel_steps
+    );
     Ok(())
 }
