@@ -43,3 +43,13 @@ fn ray_pixel(px: f32, py: f32, steps: u32) -> PixelSample {
     let seg = camera_segment(o, d);
     return shade_hit(o, d, march(o, d, seg.x, seg.y, steps, SEGMENT_STEP_TEST));
 }
+
+// `ray_pixel` told where its ray may first be solid (`start`, its tile's
+// beam) and the map's highest top (`top`): the same samples, fewer of them
+// (`march_from`).
+fn ray_pixel_from(px: f32, py: f32, steps: u32, start: f32, top: f32) -> PixelSample {
+    let o = globals.eye.xyz;
+    let d = camera_ray(px, py);
+    let seg = camera_segment(o, d);
+    return shade_hit(o, d, march_from(o, d, seg.x, seg.y, steps, start, top));
+}

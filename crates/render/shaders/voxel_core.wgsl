@@ -14,7 +14,10 @@ const VOXEL_BISECTIONS: u32 = 5u;
 const VOXEL_SAMPLE_SPACING: f32 = 0.5;
 
 // Sample the leaf segment [ta, tb] (ta is known empty); on a solid sample,
-// bisect between it and the last empty one.
+// bisect between it and the last empty one. With VOXEL_LEAF_CACHE (a
+// constant of the entry shader: on for `voxel` with its beam and for
+// `voxel-compute`, off for `voxel:…/nobeam`, the traversal as before) the
+// same points through `voxel_leaf_cached`.
 fn voxel_leaf(o: vec3<f32>, d: vec3<f32>, ta: f32, tb: f32) -> MarchHit {
     var r: MarchHit;
     r.hit = false;
@@ -24,32 +27,113 @@ fn voxel_leaf(o: vec3<f32>, d: vec3<f32>, ta: f32, tb: f32) -> MarchHit {
     }
     let len = (tb - ta) * length(d);
     let n = clamp(u32(ceil(len / VOXEL_SAMPLE_SPACING)), 1u, vparams.config.z);
+    if (VOXEL_LEAF_CACHE) {
+        return voxel_leaf_cached(o, d, ta, tb, n);
+    }
     return sample_and_bisect(o, d, ta, tb, n, VOXEL_BISECTIONS);
+}
+
+// `sample_and_bisect`'s n samples of (ta, tb] and its bisections, point for
+// point, with one column decode per texel they visit in a row rather than
+// per point (consecutive samples 0.5 apart mostly share their column: a
+// pixel's decodes go 15.8 -> 7.2 on the default views with the beam,
+// `examples/march_counts.rs`; the same hits).
+fn voxel_leaf_cached(o: vec3<f32>, d: vec3<f32>, ta: f32, tb: f32, n: u32) -> MarchHit {
+    var r: MarchHit;
+    r.hit = false;
+    r.t = tb;
+    let dt = (tb - ta) / f32(n);
+    var texel = vec2<i32>(0);
+    var c: Column;
+    var known = false;
+    var a = ta;
+    var b = tb;
+    for (var i = 1u; i <= n; i = i + 1u) {
+        let t = ta + dt * f32(i);
+        let p = o + d * t;
+        let here = vec2<i32>(i32(floor(p.x)), i32(floor(p.y)));
+        if (!known || any(here != texel)) {
+            c = decode_column(here.x, here.y);
+            texel = here;
+            known = true;
+        }
+        if (column_is_solid(c, p.z)) {
+            r.hit = true;
+            b = t;
+            break;
+        }
+        a = t;
+    }
+    if (!r.hit) {
+        return r;
+    }
+    for (var k = 0u; k < VOXEL_BISECTIONS; k = k + 1u) {
+        let m = 0.5 * (a + b);
+        let p = o + d * m;
+        let here = vec2<i32>(i32(floor(p.x)), i32(floor(p.y)));
+        if (any(here != texel)) {
+            c = decode_column(here.x, here.y);
+            texel = here;
+        }
+        if (column_is_solid(c, p.z)) {
+            b = m;
+        } else {
+            a = m;
+        }
+    }
+    r.t = b;
+    return r;
 }
 
 // The first solid point of o + t d in [t0, t1] (already clipped to the
 // altitude slab), or a miss when none is found within `steps` DDA steps.
 fn voxel_march(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, steps: u32) -> MarchHit {
+    return voxel_march_from(o, d, t0, t1, steps, t0);
+}
+
+// `voxel_march` told that no point of the ray before `start` is solid (its
+// 8x8-pixel tile's beam, `march_beam.wgsl`; at or below t0: nothing known;
+// issue 36 item 2). The traversal begins at the entry of the leaf voxel
+// that holds the start's point, where the march from t0 samples that leaf
+// from (a cell's entry is the exit plane of the cell before it, the same
+// float): every leaf it samples, it samples over the same interval, so it
+// finds the same hit in fewer steps of its budget.
+fn voxel_march_from(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, steps: u32, start: f32) -> MarchHit {
     var result: MarchHit;
     result.hit = false;
     result.t = t1;
-    if (t1 <= t0) {
-        return result;
-    }
-    if (is_solid(o + d * t0)) {
-        result.hit = true;
-        result.t = t0;
+    if (t1 <= t0 || start >= t1) {
         return result;
     }
     let top = vparams.config.y - 1u;
     let dir_pos = d > vec3<f32>(0.0);
     let step = select(vec3<i32>(-1), vec3<i32>(1), dir_pos);
     // An axis the ray does not move along never gives the exit.
-    let inv = select(1.0 / d, vec3<f32>(3.0e38), abs(d) < vec3<f32>(1e-12));
-    var lod = top;
-    var size = voxel_cell_size(lod);
+    let still = abs(d) < vec3<f32>(1e-12);
+    let inv = select(1.0 / d, vec3<f32>(3.0e38), still);
     var t = t0;
-    var cell = vec3<i32>(floor((o + d * t0) / size));
+    if (start > t0) {
+        let leaf_size = voxel_cell_size(0u);
+        let leaf = floor((o + d * start) / leaf_size);
+        let near_face = (leaf + select(vec3<f32>(1.0), vec3<f32>(0.0), dir_pos)) * leaf_size;
+        let tn = select((near_face - o) * inv, vec3<f32>(-3.0e38), still);
+        t = max(t0, min(start, max(tn.x, max(tn.y, tn.z))));
+    }
+    if (t == t0 && is_solid(o + d * t0)) {
+        result.hit = true;
+        result.t = t0;
+        return result;
+    }
+    // A started ray begins at its leaf (near the ground, where the beam
+    // leaves it, a descent from the top costs a step a level; the steps
+    // after climb as before): 12.3 steps a pixel from there against 17.7
+    // from the top (`examples/march_counts.rs`).
+    var lod = top;
+    if (t > t0) {
+        lod = 0u;
+    }
+    var size = voxel_cell_size(lod);
+    var cell = vec3<i32>(floor((o + d * t) / size));
     cell.z = max(cell.z, 0);
     for (var i = 0u; i < steps; i = i + 1u) {
         if (t > t1) {
@@ -103,5 +187,14 @@ fn voxel_pixel(px: f32, py: f32) -> PixelSample {
     let d = camera_ray(px, py);
     let seg = camera_segment(o, d);
     let h = voxel_march(o, d, seg.x, seg.y, vparams.config.x);
+    return shade_hit(o, d, h);
+}
+
+// `voxel_pixel` whose ray is empty before `start` (`voxel_march_from`).
+fn voxel_pixel_from(px: f32, py: f32, start: f32) -> PixelSample {
+    let o = globals.eye.xyz;
+    let d = camera_ray(px, py);
+    let seg = camera_segment(o, d);
+    let h = voxel_march_from(o, d, seg.x, seg.y, vparams.config.x, start);
     return shade_hit(o, d, h);
 }

@@ -57,7 +57,13 @@ pub const SOURCES: &[(&str, &str)] = &[
         "fullscreen.wgsl",
         include_str!("../shaders/fullscreen.wgsl"),
     ),
+    ("ray_frag.wgsl", include_str!("../shaders/ray_frag.wgsl")),
     ("ray.wgsl", include_str!("../shaders/ray.wgsl")),
+    (
+        "march_beam.wgsl",
+        include_str!("../shaders/march_beam.wgsl"),
+    ),
+    ("ray_beam.wgsl", include_str!("../shaders/ray_beam.wgsl")),
     (
         "ray_compute.wgsl",
         include_str!("../shaders/ray_compute.wgsl"),
@@ -89,6 +95,10 @@ pub const SOURCES: &[(&str, &str)] = &[
         include_str!("../shaders/voxel_core.wgsl"),
     ),
     ("voxel.wgsl", include_str!("../shaders/voxel.wgsl")),
+    (
+        "voxel_beam.wgsl",
+        include_str!("../shaders/voxel_beam.wgsl"),
+    ),
     (
         "voxel_compute.wgsl",
         include_str!("../shaders/voxel_compute.wgsl"),
@@ -160,6 +170,7 @@ pub const SOURCES: &[(&str, &str)] = &[
 /// Shaders with entry points (the rest are modules); the naga test validates these.
 pub const ENTRY_SHADERS: &[&str] = &[
     "ray.wgsl",
+    "ray_beam.wgsl",
     "ray_compute.wgsl",
     "depth_blit.wgsl",
     "depth_read.wgsl",
@@ -168,6 +179,7 @@ pub const ENTRY_SHADERS: &[&str] = &[
     "shadow.wgsl",
     "decode_test.wgsl",
     "voxel.wgsl",
+    "voxel_beam.wgsl",
     "voxel_compute.wgsl",
     "voxel_build.wgsl",
     "painted.wgsl",

@@ -12,8 +12,9 @@ fn every_pass_is_timed() {
     let view = strata_level::ViewSpec::parse("v", "128,100:10:60", -30.0).unwrap();
     let camera = Camera::from_view(&level, &view, 160, 100).unwrap();
     for (method, shadows, depth_attachment, want) in [
-        ("ray", true, false, vec!["shadow", "ray"]),
-        ("ray", false, false, vec!["ray"]),
+        // `ray`'s beam pre-pass (its tiles' starts) goes before its march.
+        ("ray", true, false, vec!["shadow", "ray beam", "ray"]),
+        ("ray", false, false, vec!["ray beam", "ray"]),
         // The compute march copies its depth image into the shared depth
         // target only when asked.
         (

@@ -44,6 +44,13 @@ pub struct MethodSettings {
     pub mesh_gradient_normal: bool,
     /// The shared shadow map (`--no-shadows` turns it off).
     pub shadows: bool,
+    /// `ray`, `voxel`: each camera ray's march begins where its 8x8-pixel
+    /// tile's beam may first meet the ground (a compute pre-pass over a
+    /// max-height pyramid; `ray` also ends a rising ray above the map's
+    /// highest top): the same image in fewer steps. Off (`ray:128/nobeam`,
+    /// `voxel:4,8,2/100/nobeam`): the march as before, for A/B timing.
+    #[serde(default = "default_march_beam")]
+    pub march_beam: bool,
 }
 
 impl Default for MethodSettings {
@@ -60,8 +67,13 @@ impl Default for MethodSettings {
             mesh_lod_pixels: default_lod_pixels(),
             mesh_gradient_normal: false,
             shadows: true,
+            march_beam: true,
         }
     }
+}
+
+fn default_march_beam() -> bool {
+    true
 }
 
 /// The mesh's LOD tolerance in pixels (issue 17: at most 1).

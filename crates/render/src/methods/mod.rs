@@ -54,6 +54,7 @@ pub mod contract;
 #[doc(hidden)]
 pub mod forward;
 pub mod knobs;
+mod march_beam;
 #[doc(hidden)]
 pub mod mesh;
 #[doc(hidden)]

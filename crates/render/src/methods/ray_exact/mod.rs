@@ -95,7 +95,7 @@ pub const ITERATION_CAP: u32 = 4096;
 /// Twin of `ExactParams` in `ray_exact_core.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct ExactParams {
+pub(crate) struct ExactParams {
     config: [u32; 4],
     levels: [[u32; 4]; 9],
 }
@@ -193,7 +193,7 @@ pub fn create_fragment(
 }
 
 /// The traversal's level table for `layout`.
-fn exact_params(layout: &strata_maxmip::Layout) -> ExactParams {
+pub(crate) fn exact_params(layout: &strata_maxmip::Layout) -> ExactParams {
     let mut table = ExactParams {
         config: [layout.top(), ITERATION_CAP, 0, 0],
         levels: [[0; 4]; 9],

@@ -3,19 +3,25 @@
 
 use super::super::contract::MethodSettings;
 use super::super::knobs::{Flag, Knobs, Slider, Sweep, count, count_triple, plain, show_triple};
+use super::super::march_beam::{NO_BEAM_FLAG, nobeam_tag, split_nobeam};
 use anyhow::bail;
 
 pub static KNOBS: Knobs = Knobs {
-    grammar: "X,Y,Z/STEPS, (X,Y,Z)/STEPS, X,Y,Z or /STEPS",
+    grammar: "X,Y,Z/STEPS, (X,Y,Z)/STEPS, X,Y,Z or /STEPS, each optionally followed by /nobeam",
     default: Some("4,8,2/100"),
     parse,
     describe: |s| {
         let [x, y, z] = s.voxel_size;
-        format!("grid=({x},{y},{z}) steps={}", s.voxel_steps)
+        format!(
+            "grid=({x},{y},{z}) steps={}{}",
+            s.voxel_steps,
+            nobeam_tag(s)
+        )
     },
     keep: |from, to| {
         to.voxel_size = from.voxel_size;
         to.voxel_steps = from.voxel_steps;
+        to.march_beam = from.march_beam;
     },
     sliders: &[Slider::count(
         "voxel-steps",
@@ -45,11 +51,14 @@ pub static KNOBS: Knobs = Knobs {
                 Ok(())
             },
         },
+        NO_BEAM_FLAG,
     ],
 };
 
-/// `X,Y,Z/STEPS`, `(X,Y,Z)/STEPS`, `X,Y,Z` or `/STEPS`.
+/// `X,Y,Z/STEPS`, `(X,Y,Z)/STEPS`, `X,Y,Z` or `/STEPS`, then `/nobeam` or not.
 fn parse(text: &str, s: &mut MethodSettings) -> anyhow::Result<()> {
+    let (text, beam) = split_nobeam(text);
+    s.march_beam = beam;
     let (grid, steps) = match text.split_once('/') {
         Some((g, st)) => (g, Some(st)),
         None => (text, None),

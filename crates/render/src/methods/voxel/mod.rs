@@ -5,6 +5,12 @@
 //! invocation per pixel plus the core's depth copy; both shade with the
 //! shared `shade` and write the same depth as `ray`.
 //!
+//! `voxel` (the fragment pass) begins each ray's traversal at the leaf that
+//! holds its 8x8-pixel tile's beam start ([`super::march_beam`]) where the
+//! adapter runs compute and lets fragments read storage: the same leaves
+//! sampled over the same intervals, in fewer steps (issue 36 item 2;
+//! `voxel:…/nobeam` traverses as before).
+//!
 //! [`pyramid`]: pyramid
 
 use super::common::{
@@ -13,6 +19,7 @@ use super::common::{
 mod knobs;
 pub mod pyramid;
 use super::contract::{Frame, Method, MethodSettings, RetainedBytes};
+use super::march_beam::MarchBeam;
 use crate::frame::Shared;
 pub use knobs::{KNOBS, SWEEP};
 use pyramid::{DEFAULT_BUDGET_TEXELS, GpuPyramid};
@@ -50,6 +57,11 @@ pub struct Voxel {
     group: wgpu::BindGroup,
     fragment: Option<wgpu::RenderPipeline>,
     compute: Option<ComputeParts>,
+    /// The fragment pass's tile starts (none: `/nobeam`, the compute
+    /// variant, or no compute / fragment storage).
+    beam: Option<MarchBeam>,
+    /// `settings.march_beam` at creation (a change rebuilds `voxel`).
+    march_beam: bool,
 }
 
 impl Voxel {
@@ -163,17 +175,33 @@ pub fn build(
     if compute {
         entries.extend(DepthCopy::layout_entries(2));
     }
+    let beam = if !compute && settings.march_beam && MarchBeam::available(shared, level) {
+        entries.push(MarchBeam::layout_entry());
+        Some(MarchBeam::new(shared, level, "voxel beam")?)
+    } else {
+        None
+    };
     let group_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("voxel"),
         entries: &entries,
     });
-    let group = voxel_group(shared, &group_layout, &params, &pyramid, depth.as_ref());
+    let group = voxel_group(
+        shared,
+        &group_layout,
+        (&params, &pyramid),
+        depth.as_ref(),
+        beam.as_ref(),
+    );
     let pipeline_layout = shared.pipeline_layout("voxel", &[&group_layout]);
 
     let (fragment, compute_parts, name) = match depth {
         None => {
-            let pipeline =
-                fullscreen_pipeline(shared, "voxel", "voxel.wgsl", &pipeline_layout, "fs_voxel")?;
+            let (shader, entry) = if beam.is_some() {
+                ("voxel_beam.wgsl", "fs_voxel_beam")
+            } else {
+                ("voxel.wgsl", "fs_voxel")
+            };
+            let pipeline = fullscreen_pipeline(shared, "voxel", shader, &pipeline_layout, entry)?;
             (Some(pipeline), None, "voxel")
         }
         Some(depth) => {
@@ -196,16 +224,19 @@ pub fn build(
         group,
         fragment,
         compute: compute_parts,
+        beam,
+        march_beam: settings.march_beam,
     })
 }
 
-/// Parameters, the pyramid and, for the compute variant, its outputs.
+/// Parameters, the pyramid and, for the compute variant, its outputs; for
+/// the fragment pass with the beam, its starts.
 fn voxel_group(
     shared: &Shared,
     layout: &wgpu::BindGroupLayout,
-    params: &wgpu::Buffer,
-    pyramid: &GpuPyramid,
+    (params, pyramid): (&wgpu::Buffer, &GpuPyramid),
     depth: Option<&DepthCopy>,
+    beam: Option<&MarchBeam>,
 ) -> wgpu::BindGroup {
     let mut bindings = vec![
         wgpu::BindGroupEntry {
@@ -220,6 +251,7 @@ fn voxel_group(
     if let Some(depth) = depth {
         bindings.extend(depth.bindings(shared, 2));
     }
+    bindings.extend(beam.map(MarchBeam::binding));
     shared.device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("voxel"),
         layout,
@@ -238,6 +270,9 @@ impl Method for Voxel {
         _level: &Level,
         rects: &[DirtyRect],
     ) -> anyhow::Result<()> {
+        if let Some(beam) = &mut self.beam {
+            beam.enqueue(rects);
+        }
         self.pyramid.enqueue(rects)
     }
 
@@ -247,7 +282,8 @@ impl Method for Voxel {
         settings: &MethodSettings,
     ) -> anyhow::Result<bool> {
         voxel_size(settings)?;
-        if settings.voxel_size != self.voxel_size {
+        let beam_changed = self.fragment.is_some() && settings.march_beam != self.march_beam;
+        if settings.voxel_size != self.voxel_size || beam_changed {
             return Ok(false);
         }
         // The step budget is `VoxelParams.config[0]`, the uniform's first word.
@@ -258,15 +294,26 @@ impl Method for Voxel {
     }
 
     fn resize(&mut self, shared: &Shared) -> anyhow::Result<()> {
-        // Only the compute variant binds the targets.
+        // The compute variant binds the targets, the fragment pass with the
+        // beam its starts (one per tile of the targets).
         if let Some(c) = &mut self.compute {
             c.depth.resize(shared);
             self.group = voxel_group(
                 shared,
                 &self.group_layout,
-                &self.params,
-                &self.pyramid,
+                (&self.params, &self.pyramid),
                 Some(&c.depth),
+                None,
+            );
+        }
+        if let Some(beam) = &mut self.beam {
+            beam.resize(shared);
+            self.group = voxel_group(
+                shared,
+                &self.group_layout,
+                (&self.params, &self.pyramid),
+                None,
+                Some(beam),
             );
         }
         Ok(())
@@ -274,6 +321,9 @@ impl Method for Voxel {
 
     fn prepare(&mut self, shared: &Shared, _camera: &Camera) -> anyhow::Result<()> {
         self.pyramid.prepare(shared);
+        if let Some(beam) = &mut self.beam {
+            beam.prepare(shared);
+        }
         Ok(())
     }
 
@@ -281,6 +331,9 @@ impl Method for Voxel {
         if self.pyramid.has_work() {
             self.pyramid
                 .record(encoder, frame.timer.compute("voxel occupancy update"));
+        }
+        if let Some(beam) = &self.beam {
+            beam.record(shared, frame, encoder);
         }
         if let Some(pipeline) = &self.fragment {
             draw_fullscreen(shared, frame, encoder, "voxel", pipeline, &self.group);
@@ -302,8 +355,9 @@ impl Method for Voxel {
     fn retained_bytes(&self) -> RetainedBytes {
         let params = std::mem::size_of::<VoxelParams>() as u64;
         let depth = self.compute.as_ref().map_or(0, |c| c.depth.bytes());
+        let beam = self.beam.as_ref().map_or(0, MarchBeam::gpu_bytes);
         RetainedBytes {
-            gpu: self.pyramid.gpu_bytes() + params + depth,
+            gpu: self.pyramid.gpu_bytes() + params + depth + beam,
             // The layout table and the edit queue: a few hundred bytes.
             cpu: 0,
         }
