@@ -42,6 +42,11 @@ pub struct MethodSettings {
     /// normal's share of the mesh's colour error (`mesh:0.5/gradient`).
     #[serde(default)]
     pub mesh_gradient_normal: bool,
+    /// `mesh`: colour each fragment in the raster pass (the path of adapters
+    /// without compute) rather than the deferred frame's one compute pass
+    /// over the covered pixels; for A/B measurements (`mesh:0.5/fragment`).
+    #[serde(default)]
+    pub mesh_fragment: bool,
     /// The shared shadow map (`--no-shadows` turns it off).
     pub shadows: bool,
 }
@@ -59,6 +64,7 @@ impl Default for MethodSettings {
             mesh_outline: false,
             mesh_lod_pixels: default_lod_pixels(),
             mesh_gradient_normal: false,
+            mesh_fragment: false,
             shadows: true,
         }
     }

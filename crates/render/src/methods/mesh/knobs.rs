@@ -1,17 +1,19 @@
-//! `mesh:Q[o][/PX][/gradient]`: the fit quality, the outline-constrained
-//! fit, the LOD tolerance in pixels and the gradient-normal diagnostic.
+//! `mesh:Q[o][/PX][/gradient][/fragment]`: the fit quality, the
+//! outline-constrained fit, the LOD tolerance in pixels, the gradient-normal
+//! diagnostic and the fragment path's colour (for A/B against the deferred
+//! frame).
 
 use super::super::contract::MethodSettings;
 use super::super::knobs::{Flag, Knobs, Slider, SliderKind, Sweep, plain, positive};
 use anyhow::{Context, bail};
 
 pub static KNOBS: Knobs = Knobs {
-    grammar: "Q, q=Q or Qo, then /PX and /gradient",
+    grammar: "Q, q=Q or Qo, then /PX, /gradient and /fragment",
     default: Some("0.5"),
     parse,
     describe: |s| {
         format!(
-            "q={}{} lod={}px{}",
+            "q={}{} lod={}px{}{}",
             s.mesh_quality,
             if s.mesh_outline { " outline" } else { "" },
             s.mesh_lod_pixels,
@@ -19,7 +21,8 @@ pub static KNOBS: Knobs = Knobs {
                 " gradient-normal"
             } else {
                 ""
-            }
+            },
+            if s.mesh_fragment { " fragment" } else { "" }
         )
     },
     keep: |from, to| {
@@ -27,6 +30,7 @@ pub static KNOBS: Knobs = Knobs {
         to.mesh_outline = from.mesh_outline;
         to.mesh_lod_pixels = from.mesh_lod_pixels;
         to.mesh_gradient_normal = from.mesh_gradient_normal;
+        to.mesh_fragment = from.mesh_fragment;
     },
     sliders: &[
         Slider {
@@ -96,6 +100,16 @@ pub static KNOBS: Knobs = Knobs {
             },
         },
         Flag {
+            long: "mesh-fragment",
+            value: None,
+            help: "`mesh`: colour in the raster pass's fragments instead of the deferred compute pass (for A/B).",
+            default: |_| String::new(),
+            apply: |_, s| {
+                s.mesh_fragment = true;
+                Ok(())
+            },
+        },
+        Flag {
             long: "mesh-gradient-normal",
             value: None,
             help: "`mesh`, a diagnostic: shade with the height-field gradient normal instead of the flat one.",
@@ -109,8 +123,9 @@ pub static KNOBS: Knobs = Knobs {
 };
 
 /// `Q`, `q=Q`, `Qo` (outline-constrained), then `/PX` (the LOD tolerance in
-/// pixels; `/`, as `,` separates methods) and `/gradient` (the
-/// gradient-normal diagnostic), in either order.
+/// pixels; `/`, as `,` separates methods), `/gradient` (the
+/// gradient-normal diagnostic) and `/fragment` (the fragment path's colour),
+/// in any order.
 fn parse(text: &str, s: &mut MethodSettings) -> anyhow::Result<()> {
     let mut parts = text.split('/');
     let q = parts.next().unwrap_or_default().trim();
@@ -118,6 +133,8 @@ fn parse(text: &str, s: &mut MethodSettings) -> anyhow::Result<()> {
     for part in parts.map(str::trim) {
         if part == "gradient" {
             s.mesh_gradient_normal = true;
+        } else if part == "fragment" {
+            s.mesh_fragment = true;
         } else if px.replace(part).is_some() {
             bail!("more than one LOD tolerance");
         }

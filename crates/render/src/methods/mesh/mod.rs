@@ -19,6 +19,11 @@
 //! copy's box from the eye, covers at most `mesh_lod_pixels` pixels
 //! (default 1): resolution and field of view decide, not fixed distances.
 //!
+//! Colour is deferred where the adapter has compute (`deferred.rs`): the
+//! raster pass writes depth and two words a pixel, one compute pass colours
+//! every pixel; elsewhere, or with `mesh_fragment` (`mesh:0.5/fragment`),
+//! each fragment is coloured in the raster pass by the same WGSL.
+//!
 //! Edits refit the dirty chunks from scratch (equal to a fresh fit of the
 //! edited level) and rewrite only their slots, off the frame (`refits.rs`,
 //! issue 35): `apply_edit` copies the dirty chunks' samples and queues
@@ -26,6 +31,7 @@
 //! by then without waiting; [`Method::settle_edits`] waits for all of them.
 
 use super::common::{begin_pass, forward_pipeline};
+mod deferred;
 mod fitter;
 mod knobs;
 pub mod paged;
@@ -97,6 +103,8 @@ pub struct Mesh {
     lod_pixels: f32,
     /// The gradient-normal diagnostic (`mesh_gradient_normal`).
     gradient_normal: bool,
+    /// The deferred frame (`None`: the fragment path).
+    deferred: Option<deferred::Deferred>,
     /// This frame's visible copies, front to back (written by `prepare`).
     draws: Vec<Draw>,
     /// Edits' refits in flight (made at the first edit).
@@ -211,6 +219,7 @@ struct MeshSteps {
     options: FitOptions,
     lod_pixels: f32,
     gradient_normal: bool,
+    fragment: bool,
     fit: Option<FitInSteps>,
 }
 
@@ -223,6 +232,7 @@ pub fn build_in_steps(
         options: options_of(settings),
         lod_pixels: lod_pixels_of(settings)?,
         gradient_normal: settings.mesh_gradient_normal,
+        fragment: settings.mesh_fragment,
         fit: None,
     }))
 }
@@ -249,7 +259,7 @@ impl super::contract::BuildSteps for MeshSteps {
             .take()
             .and_then(FitInSteps::finish)
             .ok_or_else(|| anyhow::anyhow!("the mesh fit stopped before its last chunk"))?;
-        let shading = (self.lod_pixels, self.gradient_normal);
+        let shading = (self.lod_pixels, self.gradient_normal, self.fragment);
         from_fit(shared, level, self.tolerance, shading, mesh).map(Some)
     }
 }
@@ -266,7 +276,11 @@ pub fn create(
         shared,
         level,
         tolerance,
-        (lod_pixels, settings.mesh_gradient_normal),
+        (
+            lod_pixels,
+            settings.mesh_gradient_normal,
+            settings.mesh_fragment,
+        ),
         mesh,
     )
 }
@@ -283,12 +297,12 @@ fn mesh_params(layout: &ChunkLayout, gradient_normal: bool) -> [u32; 4] {
 }
 
 /// Upload a fitted mesh and make the method; `shading` is the LOD tolerance
-/// in pixels and the gradient-normal diagnostic.
+/// in pixels, the gradient-normal diagnostic and the fragment path's choice.
 fn from_fit(
     shared: &Shared,
     level: &Level,
     tolerance: f64,
-    (lod_pixels, gradient_normal): (f32, bool),
+    (lod_pixels, gradient_normal, fragment): (f32, bool, bool),
     mesh: LevelMesh,
 ) -> anyhow::Result<Box<dyn Method>> {
     let options = mesh.options;
@@ -324,6 +338,7 @@ fn from_fit(
         &group_layout,
         ("vs_mesh", "fs_mesh"),
     )?;
+    let deferred = deferred_for(shared, fragment, &group_layout, &params)?;
     Ok(Box::new(Mesh {
         pipeline,
         group_layout,
@@ -338,9 +353,24 @@ fn from_fit(
         options,
         lod_pixels,
         gradient_normal,
+        deferred,
         draws: Vec::new(),
         refits: None,
     }))
+}
+
+/// The deferred frame where the adapter can take it and `fragment` (the
+/// `mesh_fragment` setting) does not ask for the fragment path.
+fn deferred_for(
+    shared: &Shared,
+    fragment: bool,
+    layout: &wgpu::BindGroupLayout,
+    params: &wgpu::Buffer,
+) -> anyhow::Result<Option<deferred::Deferred>> {
+    if fragment || !deferred::supported(shared) {
+        return Ok(None);
+    }
+    deferred::Deferred::new(shared, layout, params).map(Some)
 }
 
 /// Spare tail for refits that grow: 1/16 of the level's indices, at least
@@ -465,15 +495,32 @@ impl Method for Mesh {
         shared: &Shared,
         settings: &MethodSettings,
     ) -> anyhow::Result<bool> {
-        // A new quality or outline is a new fit; the LOD tolerance and the
-        // normal diagnostic are per-frame choices, taken in place.
-        settings_in_place(
+        // A new quality or outline is a new fit; the LOD tolerance, the
+        // normal diagnostic and the colour path are taken in place.
+        let same_fit = settings_in_place(
             shared,
             settings,
             (self.tolerance, self.options),
             (&mut self.lod_pixels, &mut self.gradient_normal),
             (&self.layout, &self.params),
-        )
+        )?;
+        let fragment = self.deferred.is_none();
+        if same_fit && settings.mesh_fragment != fragment {
+            self.deferred = deferred_for(
+                shared,
+                settings.mesh_fragment,
+                &self.group_layout,
+                &self.params,
+            )?;
+        }
+        Ok(same_fit)
+    }
+
+    fn resize(&mut self, shared: &Shared) -> anyhow::Result<()> {
+        if let Some(d) = &mut self.deferred {
+            d.resize(shared, &self.params);
+        }
+        Ok(())
     }
 
     fn apply_edit(
@@ -548,11 +595,37 @@ impl Method for Mesh {
     }
 
     fn record(&self, shared: &Shared, frame: &Frame<'_>, encoder: &mut wgpu::CommandEncoder) {
-        let mut pass = begin_pass(shared, frame, encoder, "mesh");
+        let Some(deferred) = &self.deferred else {
+            let pass = begin_pass(shared, frame, encoder, "mesh");
+            self.draw(shared, pass, &self.pipeline);
+            return;
+        };
+        let pass = deferred.begin_raster(shared, frame, encoder);
+        self.draw(shared, pass, &deferred.raster);
+        deferred.record_colour(shared, frame, encoder);
+    }
+
+    fn retained_bytes(&self) -> RetainedBytes {
+        RetainedBytes {
+            gpu: self.pool.gpu_bytes()
+                + self.draws_buffer.size()
+                + self.params.size()
+                + self.deferred.as_ref().map_or(0, deferred::Deferred::bytes),
+            cpu: self.pool.cpu_bytes()
+                + (self.slots.capacity() * std::mem::size_of::<Slot>()
+                    + self.draws.capacity() * std::mem::size_of::<Draw>()) as u64,
+        }
+    }
+}
+
+impl Mesh {
+    /// Draw this frame's chunk copies into `pass` with `pipeline` (the
+    /// fragment path's or the deferred raster pass's).
+    fn draw(&self, shared: &Shared, mut pass: wgpu::RenderPass<'_>, pipeline: &wgpu::RenderPipeline) {
         if self.draws.is_empty() {
             return;
         }
-        pass.set_pipeline(&self.pipeline);
+        pass.set_pipeline(pipeline);
         pass.set_bind_group(0, &shared.frame_group, &[]);
         pass.set_bind_group(1, &self.group, &[]);
         pass.set_index_buffer(self.pool.buffer.slice(..), wgpu::IndexFormat::Uint16);
@@ -564,15 +637,6 @@ impl Method for Mesh {
                     pass.draw_indexed(slot.start + s..slot.start + e, 0, k..k + 1);
                 }
             }
-        }
-    }
-
-    fn retained_bytes(&self) -> RetainedBytes {
-        RetainedBytes {
-            gpu: self.pool.gpu_bytes() + self.draws_buffer.size() + self.params.size(),
-            cpu: self.pool.cpu_bytes()
-                + (self.slots.capacity() * std::mem::size_of::<Slot>()
-                    + self.draws.capacity() * std::mem::size_of::<Draw>()) as u64,
         }
     }
 }
