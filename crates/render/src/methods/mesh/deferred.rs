@@ -49,26 +49,24 @@ fn targets(
         GBUFFER_FORMAT,
         wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
     );
-    let group = shared
-        .device
-        .create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("mesh colour"),
-            layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: params.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: GBUFFER_BINDING,
-                    resource: wgpu::BindingResource::TextureView(&gbuffer),
-                },
-                wgpu::BindGroupEntry {
-                    binding: COLOR_BINDING,
-                    resource: wgpu::BindingResource::TextureView(&shared.color_view),
-                },
-            ],
-        });
+    let group = shared.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("mesh colour"),
+        layout,
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: params.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: GBUFFER_BINDING,
+                resource: wgpu::BindingResource::TextureView(&gbuffer),
+            },
+            wgpu::BindGroupEntry {
+                binding: COLOR_BINDING,
+                resource: wgpu::BindingResource::TextureView(&shared.color_view),
+            },
+        ],
+    });
     let bytes = u64::from(shared.width) * u64::from(shared.height) * 8;
     (gbuffer, group, bytes)
 }

@@ -621,7 +621,12 @@ impl Method for Mesh {
 impl Mesh {
     /// Draw this frame's chunk copies into `pass` with `pipeline` (the
     /// fragment path's or the deferred raster pass's).
-    fn draw(&self, shared: &Shared, mut pass: wgpu::RenderPass<'_>, pipeline: &wgpu::RenderPipeline) {
+    fn draw(
+        &self,
+        shared: &Shared,
+        mut pass: wgpu::RenderPass<'_>,
+        pipeline: &wgpu::RenderPipeline,
+    ) {
         if self.draws.is_empty() {
             return;
         }
