@@ -21,6 +21,30 @@ struct VertexOut {
     @location(1) @interpolate(flat) kind: u32,
 }
 
+// Steps of the field taller than this are walls (`wall_shift`).
+const WALL_STEP: f32 = 6.0;
+
+// The altitude a sample of vertex kind `kind` takes at column (x, y): the
+// floor, or the slab's top where there is one.
+fn kind_field(x: i32, y: i32, kind: u32) -> f32 {
+    let c = decode_column(x, y);
+    return select(c.low, c.high, kind == KIND_TOP);
+}
+
+// How far a sample at (x, y) of altitude `z` moves so that a wall between it
+// and one neighbour along an axis stands on their texel boundary, as the
+// height field's wall does, rather than ramping from centre to centre (whose
+// top lies half a texel inside the wall's silhouette: see-through at grazing
+// views). Both samples of the wall move to the boundary, the high one and the
+// low one alike; a sample with walls on both sides along an axis stays.
+fn wall_shift(x: i32, y: i32, kind: u32, z: f32) -> vec2<f32> {
+    let lo = vec2<f32>(kind_field(x - 1, y, kind), kind_field(x, y - 1, kind)) - vec2<f32>(z);
+    let hi = vec2<f32>(kind_field(x + 1, y, kind), kind_field(x, y + 1, kind)) - vec2<f32>(z);
+    let wall_lo = abs(lo) > vec2<f32>(WALL_STEP);
+    let wall_hi = abs(hi) > vec2<f32>(WALL_STEP);
+    return 0.5 * (vec2<f32>(wall_hi & !wall_lo) - vec2<f32>(wall_lo & !wall_hi));
+}
+
 @vertex
 fn vs_mesh(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) -> VertexOut {
     let kind = v / mesh.grid.y;
@@ -36,8 +60,13 @@ fn vs_mesh(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) -> Ve
         z = c.mid;
     }
     // Samples stand at texel centres, so a ramp between two samples crosses
-    // the texel boundary where the height field steps.
-    let p = vec3<f32>(f32(gx) + 0.5, f32(gy) + 0.5, z);
+    // the texel boundary where the height field steps; a sample beside a
+    // wall on one side only moves half a texel to it (`wall_shift`).
+    var shift = vec2<f32>(0.0);
+    if (kind == KIND_FLOOR || kind == KIND_TOP) {
+        shift = wall_shift(gx, gy, kind, z);
+    }
+    let p = vec3<f32>(f32(gx) + 0.5 + shift.x, f32(gy) + 0.5 + shift.y, z);
     var out: VertexOut;
     out.clip = globals.view_proj * vec4<f32>(p, 1.0);
     out.world = p;
