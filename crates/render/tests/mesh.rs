@@ -49,22 +49,7 @@ fn worst_over(
         "mesh",
         |r, view, reference, distance| {
             common::save_png(r, &format!("mesh-{}", view.name), (w, h));
-            if std::env::var("MESH_DEBUG").as_deref() == Ok(view.name.as_str()) {
-                for j in 0..h as usize {
-                    let row: String = (0..w as usize)
-                        .map(|i| {
-                            let k = j * w as usize + i;
-                            match (reference.distance[k].is_finite(), distance[k].is_finite()) {
-                                (true, true) => '#',
-                                (true, false) => 'R',
-                                (false, true) => 'M',
-                                _ => '.',
-                            }
-                        })
-                        .collect();
-                    eprintln!("{row}");
-                }
-            }
+            common::debug_hit_map("MESH_DEBUG", view, reference, distance, (w, h));
         },
     )
 }

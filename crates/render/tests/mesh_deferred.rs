@@ -110,12 +110,7 @@ fn the_deferred_frame_draws_what_the_fragment_path_draws() {
 #[test]
 fn held_out_views_of_an_unseen_world_show_at_most_one_percent_see_through() {
     let Some(gpu) = common::gpu() else { return };
-    let w = strata_level::generate::generate(&strata_level::generate::GenerateParams {
-        seed: 5,
-        width: 512,
-        height: 1024,
-    })
-    .expect("generated world");
+    let w = common::generated_world_of_seed(5);
     let views = strata_level::views::parse_views(include_str!(
         "../../../bench/issue36-mesh/held-out-seed5.txt"
     ))
@@ -140,22 +135,7 @@ fn held_out_views_of_an_unseen_world_show_at_most_one_percent_see_through() {
         (width, height),
         "mesh",
         |_, view, reference, distance| {
-            if std::env::var("MESH_DEBUG").as_deref() == Ok(view.name.as_str()) {
-                for j in 0..height as usize {
-                    let row: String = (0..width as usize)
-                        .map(|i| {
-                            let k = j * width as usize + i;
-                            match (reference.distance[k].is_finite(), distance[k].is_finite()) {
-                                (true, true) => '#',
-                                (true, false) => 'R',
-                                (false, true) => 'M',
-                                _ => '.',
-                            }
-                        })
-                        .collect();
-                    eprintln!("{row}");
-                }
-            }
+            common::debug_hit_map("MESH_DEBUG", view, reference, distance, (width, height));
         },
     );
     eprintln!("mesh worst (seed 5, held-out, 320x200): {m:?}");
