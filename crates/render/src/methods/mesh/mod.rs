@@ -437,13 +437,11 @@ fn visible_copies(
             let chunk = layout.index(gx.rem_euclid(nx) as u32, gy.rem_euclid(ny) as u32) as u32;
             let z = z_of(chunk);
             let origin = [(gx * sx) as i32, (gy * sy) as i32];
-            // Samples stand at texel centres: (0.5 .. size + 0.5).
-            let lo = Vec3::new(
-                origin[0] as f32 + 0.5,
-                origin[1] as f32 + 0.5,
-                f32::from(z.0),
-            );
-            let hi = lo + Vec3::new(sx as f32, sy as f32, f32::from(z.1 - z.0));
+            // Samples stand at texel centres (0.5 .. size + 0.5), moved up
+            // to half a texel to a wall beside them (`wall_shift` in
+            // mesh.wgsl): 0 .. size + 1.
+            let lo = Vec3::new(origin[0] as f32, origin[1] as f32, f32::from(z.0));
+            let hi = lo + Vec3::new(sx as f32 + 1.0, sy as f32 + 1.0, f32::from(z.1 - z.0));
             if outside_frustum(&m, lo, hi) {
                 continue;
             }

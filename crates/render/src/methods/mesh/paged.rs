@@ -57,8 +57,9 @@ const DRAWS_RESERVED: u32 = 4096;
 
 /// Texels around a chunk's samples whose pages must be resident before it
 /// is drawn: the fragment stage's colour window (`colour_source` in
-/// `mesh.wgsl`: at most 3 texels back and 8 ahead across, and its normal's
-/// neighbours) stays inside it.
+/// `mesh_colour.wgsl`: at most 3 texels back and 8 ahead across, and its
+/// normal's neighbours) stays inside it, and so do the neighbours the vertex
+/// stage's wall test reads (`wall_shift` in `mesh.wgsl`: one texel away).
 pub const COLOUR_MARGIN: u32 = 16;
 
 /// Vertices of a stand-in box: six faces of two triangles.
