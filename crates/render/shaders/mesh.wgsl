@@ -63,7 +63,7 @@ fn vs_mesh(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) -> Ve
     // the texel boundary where the height field steps; a sample beside a
     // wall on one side only moves half a texel to it (`wall_shift`).
     var shift = vec2<f32>(0.0);
-    if (kind == KIND_FLOOR || kind == KIND_TOP) {
+    if ((kind == KIND_FLOOR || kind == KIND_TOP) && mesh.grid.w == 0u) {
         shift = wall_shift(gx, gy, kind, z);
     }
     let p = vec3<f32>(f32(gx) + 0.5 + shift.x, f32(gy) + 0.5 + shift.y, z);

@@ -11,7 +11,8 @@
 
 struct MeshParams {
     // x stride (chunk side + 1), y positions per kind ((side_x + 1) * (side_y + 1)),
-    // z 1: the gradient-normal diagnostic (`mesh_gradient_normal`)
+    // z 1: the gradient-normal diagnostic (`mesh_gradient_normal`), w 1: every
+    // sample at its texel's centre (`mesh_texel_centres`; `wall_shift` in mesh.wgsl)
     grid: vec4<u32>,
 }
 

@@ -47,6 +47,11 @@ pub struct MethodSettings {
     /// over the covered pixels; for A/B measurements (`mesh:0.5/fragment`).
     #[serde(default)]
     pub mesh_fragment: bool,
+    /// `mesh`: every sample at its texel's centre, as before issue 36
+    /// (`mesh:0.5/centres`, for A/B); by default a sample beside a wall on
+    /// one side moves half a texel to it, so walls stand on texel boundaries.
+    #[serde(default)]
+    pub mesh_texel_centres: bool,
     /// The shared shadow map (`--no-shadows` turns it off).
     pub shadows: bool,
 }
@@ -65,6 +70,7 @@ impl Default for MethodSettings {
             mesh_lod_pixels: default_lod_pixels(),
             mesh_gradient_normal: false,
             mesh_fragment: false,
+            mesh_texel_centres: false,
             shadows: true,
         }
     }

@@ -1,19 +1,19 @@
-//! `mesh:Q[o][/PX][/gradient][/fragment]`: the fit quality, the
+//! `mesh:Q[o][/PX][/gradient][/fragment][/centres]`: the fit quality, the
 //! outline-constrained fit, the LOD tolerance in pixels, the gradient-normal
-//! diagnostic and the fragment path's colour (for A/B against the deferred
-//! frame).
+//! diagnostic, and for A/B the fragment path's colour (against the deferred
+//! frame) and samples at texel centres (against samples moved to walls).
 
 use super::super::contract::MethodSettings;
 use super::super::knobs::{Flag, Knobs, Slider, SliderKind, Sweep, plain, positive};
 use anyhow::{Context, bail};
 
 pub static KNOBS: Knobs = Knobs {
-    grammar: "Q, q=Q or Qo, then /PX, /gradient and /fragment",
+    grammar: "Q, q=Q or Qo, then /PX, /gradient, /fragment and /centres",
     default: Some("0.5"),
     parse,
     describe: |s| {
         format!(
-            "q={}{} lod={}px{}{}",
+            "q={}{} lod={}px{}{}{}",
             s.mesh_quality,
             if s.mesh_outline { " outline" } else { "" },
             s.mesh_lod_pixels,
@@ -22,7 +22,12 @@ pub static KNOBS: Knobs = Knobs {
             } else {
                 ""
             },
-            if s.mesh_fragment { " fragment" } else { "" }
+            if s.mesh_fragment { " fragment" } else { "" },
+            if s.mesh_texel_centres {
+                " texel-centres"
+            } else {
+                ""
+            }
         )
     },
     keep: |from, to| {
@@ -31,6 +36,7 @@ pub static KNOBS: Knobs = Knobs {
         to.mesh_lod_pixels = from.mesh_lod_pixels;
         to.mesh_gradient_normal = from.mesh_gradient_normal;
         to.mesh_fragment = from.mesh_fragment;
+        to.mesh_texel_centres = from.mesh_texel_centres;
     },
     sliders: &[
         Slider {
@@ -110,6 +116,16 @@ pub static KNOBS: Knobs = Knobs {
             },
         },
         Flag {
+            long: "mesh-texel-centres",
+            value: None,
+            help: "`mesh`: every sample at its texel's centre, none moved to a wall beside it (for A/B).",
+            default: |_| String::new(),
+            apply: |_, s| {
+                s.mesh_texel_centres = true;
+                Ok(())
+            },
+        },
+        Flag {
             long: "mesh-gradient-normal",
             value: None,
             help: "`mesh`, a diagnostic: shade with the height-field gradient normal instead of the flat one.",
@@ -124,8 +140,8 @@ pub static KNOBS: Knobs = Knobs {
 
 /// `Q`, `q=Q`, `Qo` (outline-constrained), then `/PX` (the LOD tolerance in
 /// pixels; `/`, as `,` separates methods), `/gradient` (the
-/// gradient-normal diagnostic) and `/fragment` (the fragment path's colour),
-/// in any order.
+/// gradient-normal diagnostic), `/fragment` (the fragment path's colour) and
+/// `/centres` (samples at texel centres), in any order.
 fn parse(text: &str, s: &mut MethodSettings) -> anyhow::Result<()> {
     let mut parts = text.split('/');
     let q = parts.next().unwrap_or_default().trim();
@@ -135,6 +151,8 @@ fn parse(text: &str, s: &mut MethodSettings) -> anyhow::Result<()> {
             s.mesh_gradient_normal = true;
         } else if part == "fragment" {
             s.mesh_fragment = true;
+        } else if part == "centres" {
+            s.mesh_texel_centres = true;
         } else if px.replace(part).is_some() {
             bail!("more than one LOD tolerance");
         }
@@ -165,3 +183,23 @@ pub static SWEEP: Sweep = Sweep {
     quick: &["0", "0.5", "1"],
     at_paper_size: true,
 };
+
+#[cfg(test)]
+mod tests {
+    use super::{KNOBS, MethodSettings, parse};
+
+    #[test]
+    fn the_ab_knobs_parse_in_any_order() {
+        for text in ["0.5/fragment/centres/2", "0.5/centres/2/fragment"] {
+            let mut s = MethodSettings::default();
+            parse(text, &mut s).unwrap();
+            assert!(s.mesh_fragment && s.mesh_texel_centres, "{text}");
+            assert_eq!(s.mesh_lod_pixels, 2.0);
+            assert_eq!((KNOBS.describe)(&s), "q=0.5 lod=2px fragment texel-centres");
+        }
+        let mut s = MethodSettings::default();
+        parse("0.5", &mut s).unwrap();
+        assert!(!s.mesh_fragment && !s.mesh_texel_centres);
+        assert!(parse("0.5/fragments", &mut s).is_err());
+    }
+}

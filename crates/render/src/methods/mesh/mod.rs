@@ -101,8 +101,8 @@ pub struct Mesh {
     options: FitOptions,
     /// LOD tolerance in pixels (`mesh_lod_pixels`).
     lod_pixels: f32,
-    /// The gradient-normal diagnostic (`mesh_gradient_normal`).
-    gradient_normal: bool,
+    /// The shaders' per-frame choices (the mesh's uniform).
+    look: Look,
     /// The deferred frame (`None`: the fragment path).
     deferred: Option<deferred::Deferred>,
     /// This frame's visible copies, front to back (written by `prepare`).
@@ -218,7 +218,7 @@ struct MeshSteps {
     tolerance: f64,
     options: FitOptions,
     lod_pixels: f32,
-    gradient_normal: bool,
+    look: Look,
     fragment: bool,
     fit: Option<FitInSteps>,
 }
@@ -231,7 +231,7 @@ pub fn build_in_steps(
         tolerance: tolerance_of(settings)?,
         options: options_of(settings),
         lod_pixels: lod_pixels_of(settings)?,
-        gradient_normal: settings.mesh_gradient_normal,
+        look: Look::of(settings),
         fragment: settings.mesh_fragment,
         fit: None,
     }))
@@ -259,7 +259,7 @@ impl super::contract::BuildSteps for MeshSteps {
             .take()
             .and_then(FitInSteps::finish)
             .ok_or_else(|| anyhow::anyhow!("the mesh fit stopped before its last chunk"))?;
-        let shading = (self.lod_pixels, self.gradient_normal, self.fragment);
+        let shading = (self.lod_pixels, self.look, self.fragment);
         from_fit(shared, level, self.tolerance, shading, mesh).map(Some)
     }
 }
@@ -276,33 +276,47 @@ pub fn create(
         shared,
         level,
         tolerance,
-        (
-            lod_pixels,
-            settings.mesh_gradient_normal,
-            settings.mesh_fragment,
-        ),
+        (lod_pixels, Look::of(settings), settings.mesh_fragment),
         mesh,
     )
 }
 
-/// The method's uniform (`MeshParams` in `mesh.wgsl`).
-fn mesh_params(layout: &ChunkLayout, gradient_normal: bool) -> [u32; 4] {
+/// The choices the mesh's shaders take per frame from its uniform.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) struct Look {
+    /// The gradient-normal diagnostic (`mesh_gradient_normal`).
+    gradient_normal: bool,
+    /// Samples at texel centres, none moved to a wall (`mesh_texel_centres`).
+    texel_centres: bool,
+}
+
+impl Look {
+    pub(super) fn of(settings: &MethodSettings) -> Self {
+        Look {
+            gradient_normal: settings.mesh_gradient_normal,
+            texel_centres: settings.mesh_texel_centres,
+        }
+    }
+}
+
+/// The method's uniform (`MeshParams` in `mesh_colour.wgsl`).
+fn mesh_params(layout: &ChunkLayout, look: Look) -> [u32; 4] {
     let stride = layout.size_x + 1;
     [
         stride,
         stride * (layout.size_y + 1),
-        u32::from(gradient_normal),
-        0,
+        u32::from(look.gradient_normal),
+        u32::from(look.texel_centres),
     ]
 }
 
 /// Upload a fitted mesh and make the method; `shading` is the LOD tolerance
-/// in pixels, the gradient-normal diagnostic and the fragment path's choice.
+/// in pixels, the shaders' choices and the fragment path's.
 fn from_fit(
     shared: &Shared,
     level: &Level,
     tolerance: f64,
-    (lod_pixels, gradient_normal, fragment): (f32, bool, bool),
+    (lod_pixels, look, fragment): (f32, Look, bool),
     mesh: LevelMesh,
 ) -> anyhow::Result<Box<dyn Method>> {
     let options = mesh.options;
@@ -327,7 +341,7 @@ fn from_fit(
             },
         ],
     });
-    let grid = mesh_params(&layout, gradient_normal);
+    let grid = mesh_params(&layout, look);
     let params = shared.uniform_buffer("mesh params", bytemuck::cast_slice(&grid));
     let draws_capacity = 256;
     let (draws_buffer, group) = draws_binding(shared, &group_layout, &params, draws_capacity);
@@ -352,7 +366,7 @@ fn from_fit(
         tolerance,
         options,
         lod_pixels,
-        gradient_normal,
+        look,
         deferred,
         draws: Vec::new(),
         refits: None,
@@ -465,16 +479,16 @@ fn settings_in_place(
     shared: &Shared,
     settings: &MethodSettings,
     fit: (f64, FitOptions),
-    (lod_pixels, gradient_normal): (&mut f32, &mut bool),
+    (lod_pixels, look): (&mut f32, &mut Look),
     (layout, params): (&ChunkLayout, &wgpu::Buffer),
 ) -> anyhow::Result<bool> {
     let q = f64::from(settings.mesh_quality);
     let same_fit = tolerance_for_quality(q) == Some(fit.0) && options_of(settings) == fit.1;
     if same_fit {
         *lod_pixels = lod_pixels_of(settings)?;
-        if settings.mesh_gradient_normal != *gradient_normal {
-            *gradient_normal = settings.mesh_gradient_normal;
-            let grid = mesh_params(layout, *gradient_normal);
+        if Look::of(settings) != *look {
+            *look = Look::of(settings);
+            let grid = mesh_params(layout, *look);
             shared
                 .queue
                 .write_buffer(params, 0, bytemuck::cast_slice(&grid));
@@ -499,7 +513,7 @@ impl Method for Mesh {
             shared,
             settings,
             (self.tolerance, self.options),
-            (&mut self.lod_pixels, &mut self.gradient_normal),
+            (&mut self.lod_pixels, &mut self.look),
             (&self.layout, &self.params),
         )?;
         let fragment = self.deferred.is_none();
@@ -537,7 +551,7 @@ impl Method for Mesh {
             (self.layout, self.pool, self.slots) = (layout, pool, slots);
             // Refits in flight were of the old map.
             self.refits = None;
-            let grid = mesh_params(&layout, self.gradient_normal);
+            let grid = mesh_params(&layout, self.look);
             shared
                 .queue
                 .write_buffer(&self.params, 0, bytemuck::cast_slice(&grid));
