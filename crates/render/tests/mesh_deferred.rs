@@ -101,6 +101,50 @@ fn the_deferred_frame_draws_what_the_fragment_path_draws() {
     }
 }
 
+/// An adapter without compute (or storage textures) keeps the fragment path:
+/// no G-buffer, and the picture the deferred frame draws.
+#[test]
+fn without_compute_the_mesh_colours_in_its_fragments() {
+    for mut gpu in common::gpus() {
+        if !(gpu.caps.compute && gpu.caps.storage_textures) {
+            common::skip_loudly("the deferred mesh needs compute and storage textures");
+            continue;
+        }
+        if !gpu.caps.float32_targets {
+            // Without compute the shared shadow map needs R32Float targets.
+            common::skip_loudly("no adapter without compute to pretend here");
+            continue;
+        }
+        let world = common::generated_world();
+        let colors = TerrainColors::from_world(&world);
+        let settings = MethodSettings {
+            shadows: false,
+            ..MethodSettings::default()
+        };
+        let camera = Camera::from_view(&world.level, &world.views[0], W, H).unwrap();
+        let mut deferred =
+            Renderer::new(&gpu, &world.level, &colors, "mesh", &settings, W, H).unwrap();
+        deferred.render_frame(&camera).unwrap();
+        let want = deferred.read_color().unwrap();
+        let bytes = deferred.retained_bytes().gpu;
+        drop(deferred);
+        gpu.caps.compute = false;
+        gpu.caps.storage_textures = false;
+        let mut r = Renderer::new(&gpu, &world.level, &colors, "mesh", &settings, W, H).unwrap();
+        assert_eq!(bytes - r.retained_bytes().gpu, u64::from(W * H) * 8);
+        r.render_frame(&camera).unwrap();
+        let got = r.read_color().unwrap();
+        let differ = got
+            .chunks(4)
+            .zip(want.chunks(4))
+            .filter(|(a, b)| a != b)
+            .count();
+        eprintln!("{}: {differ} pixels differ", gpu.report.backend);
+        assert_eq!(differ, 0, "the fragment path draws another picture");
+        gpu.errors.check().unwrap();
+    }
+}
+
 /// Issue 36 item 3: held-out views of a world no setting was tuned on
 /// (`strata generate --seed 5 --size 512x1024`; the views in
 /// `bench/issue36-mesh/held-out-seed5.txt`: 250 above the top at -30°, as
