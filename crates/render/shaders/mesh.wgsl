@@ -4,28 +4,45 @@
 // vertex shader reads that column from the terrain texture. The instance
 // index selects the draw's chunk origin in the unwrapped plane (a chunk near
 // the map edge is drawn again at its wrapped copies).
+//
+// Two fragment entries: `fs_mesh_gbuffer` (the deferred frame: two words a
+// pixel, coloured later by `mesh_deferred.wgsl`) and `fs_mesh` (the fragment
+// path, where the adapter has no compute: the same colour step in place).
 #include "frame.wgsl"
 #include "surface.wgsl"
-#include "shading.wgsl"
-#include "column_segment.wgsl"
+#include "mesh_colour.wgsl"
 
-struct MeshParams {
-    // x stride (chunk side + 1), y positions per kind ((side_x + 1) * (side_y + 1)),
-    // z 1: the gradient-normal diagnostic (`mesh_gradient_normal`)
-    grid: vec4<u32>,
-}
-
-@group(1) @binding(0) var<uniform> mesh: MeshParams;
 // Per draw: xy the chunk's sample (0, 0) in unwrapped texels.
 @group(1) @binding(2) var<storage, read> draws: array<vec4<i32>>;
-
-const KIND_FLOOR: u32 = 0u;
-const KIND_TOP: u32 = 1u;
 
 struct VertexOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) world: vec3<f32>,
     @location(1) @interpolate(flat) kind: u32,
+}
+
+// Steps of the field taller than this are walls (`wall_shift`).
+const WALL_STEP: f32 = 6.0;
+
+// The altitude a sample of vertex kind `kind` takes at column (x, y): the
+// floor, or the slab's top where there is one.
+fn kind_field(x: i32, y: i32, kind: u32) -> f32 {
+    let c = decode_column(x, y);
+    return select(c.low, c.high, kind == KIND_TOP);
+}
+
+// How far a sample at (x, y) of altitude `z` moves so that a wall between it
+// and one neighbour along an axis stands on their texel boundary, as the
+// height field's wall does, rather than ramping from centre to centre (whose
+// top lies half a texel inside the wall's silhouette: see-through at grazing
+// views). Both samples of the wall move to the boundary, the high one and the
+// low one alike; a sample with walls on both sides along an axis stays.
+fn wall_shift(x: i32, y: i32, kind: u32, z: f32) -> vec2<f32> {
+    let lo = vec2<f32>(kind_field(x - 1, y, kind), kind_field(x, y - 1, kind)) - vec2<f32>(z);
+    let hi = vec2<f32>(kind_field(x + 1, y, kind), kind_field(x, y + 1, kind)) - vec2<f32>(z);
+    let wall_lo = abs(lo) > vec2<f32>(WALL_STEP);
+    let wall_hi = abs(hi) > vec2<f32>(WALL_STEP);
+    return 0.5 * (vec2<f32>(wall_hi & !wall_lo) - vec2<f32>(wall_lo & !wall_hi));
 }
 
 @vertex
@@ -43,8 +60,13 @@ fn vs_mesh(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) -> Ve
         z = c.mid;
     }
     // Samples stand at texel centres, so a ramp between two samples crosses
-    // the texel boundary where the height field steps.
-    let p = vec3<f32>(f32(gx) + 0.5, f32(gy) + 0.5, z);
+    // the texel boundary where the height field steps; a sample beside a
+    // wall on one side only moves half a texel to it (`wall_shift`).
+    var shift = vec2<f32>(0.0);
+    if ((kind == KIND_FLOOR || kind == KIND_TOP) && mesh.grid.w == 0u) {
+        shift = wall_shift(gx, gy, kind, z);
+    }
+    let p = vec3<f32>(f32(gx) + 0.5 + shift.x, f32(gy) + 0.5 + shift.y, z);
     var out: VertexOut;
     out.clip = globals.view_proj * vec4<f32>(p, 1.0);
     out.world = p;
@@ -52,82 +74,12 @@ fn vs_mesh(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) -> Ve
     return out;
 }
 
-// Where the eye's ray through `p` meets the height field's own surface near
-// `p`: the TIN lies up to its fit error above or below that surface, so the
-// point under `p` is not what the reference sees there (off-axis, the true
-// hit is texels away), and between samples a wall's ramp lies half over the
-// low column, up to the wall's height above its floor (from above, that
-// floor is what shows). The exact segment test (`first_entry`, shared with
-// ray and ray-exact) walks the ray from a few texels before `p` to several
-// past it; the first entry names the column and interval the pixel takes its
-// colour from. The walk costs one decode per texel crossed, so the window is
-// set in texels across (a near-vertical ray may run far: down a wall) and
-// capped along the ray. The mesh's geometry, depth and flat normal are
-// unchanged; a miss keeps the column under the TIN.
-const SURFACE_BACK_TEXELS: f32 = 3.0;
-const SURFACE_AHEAD_TEXELS: f32 = 8.0;
-const SURFACE_MAX_ALONG: f32 = 64.0;
-const SURFACE_MAX_TEXELS: u32 = 16u;
-
-struct ColourSource {
-    column: vec2<i32>,
-    kind: u32,
-}
-
-// The column and interval the pixel at TIN point `p` (flat normal `n`, of a
-// triangle of vertex kind `vkind`) is coloured from.
-fn colour_source(p: vec3<f32>, n: vec3<f32>, vkind: u32) -> ColourSource {
-    let eye = globals.eye.xyz;
-    let dist = length(p - eye);
-    let d = (p - eye) / dist;
-    let across = max(length(d.xy), 1e-4);
-    let back = min(SURFACE_BACK_TEXELS / across, SURFACE_MAX_ALONG);
-    let ahead = min(SURFACE_AHEAD_TEXELS / across, SURFACE_MAX_ALONG);
-    let a = max(dist - back, 0.0);
-    let h = first_entry(eye, d, a, dist + ahead, SURFACE_MAX_TEXELS);
-    var src: ColourSource;
-    if (h.hit && h.t > a) {
-        src.column = h.column;
-        let c = decode_column(h.column.x, h.column.y);
-        src.kind = surface_kind(c, eye.z + d.z * h.t, d.z);
-        return src;
-    }
-    // No surface entered in the window (the TIN bridges a gap, or the window
-    // starts inside the solid): the column under the TIN point, walls half a
-    // texel inwards (a steep ramp between two texel centres lies half over
-    // the low column; its colour belongs to the high one, inside the solid).
-    var at = p.xy;
-    let steep = length(n.xy);
-    if (steep > 0.7) {
-        at -= n.xy / steep * 0.5;
-    }
-    src.column = vec2<i32>(floor(at));
-    src.kind = SURFACE_FLOOR;
-    if (vkind != KIND_FLOOR) {
-        // Slab triangles: tops and walls take the slab top's light, faces
-        // looking down are the cave ceiling.
-        src.kind = select(SURFACE_SLAB_TOP, SURFACE_CEILING, n.z < -0.5);
-    }
-    return src;
+@fragment
+fn fs_mesh_gbuffer(in: VertexOut) -> @location(0) vec2<u32> {
+    return mesh_gbuffer(in.world, in.kind);
 }
 
 @fragment
 fn fs_mesh(in: VertexOut) -> @location(0) vec4<f32> {
-    let p = in.world;
-    // The triangle's flat geometric normal: world position is linear over
-    // the triangle, so its screen derivatives span the triangle's plane.
-    var n = normalize(cross(dpdx(p), dpdy(p)));
-    let to_eye = globals.eye.xyz - p;
-    if (dot(n, to_eye) < 0.0) {
-        // Whichever side is seen is the outside of the solid.
-        n = -n;
-    }
-    let src = colour_source(p, n, in.kind);
-    let c = decode_column(src.column.x, src.column.y);
-    if (mesh.grid.z != 0u) {
-        // Diagnostic: the height-field normal the other methods shade with.
-        let here = select(c.high, c.mid, src.kind == SURFACE_CEILING);
-        n = surface_normal(src.column.x, src.column.y, src.kind, here);
-    }
-    return vec4<f32>(shade_with_normal(p, c, src.kind, n), 1.0);
+    return vec4<f32>(mesh_pixel_colour(in.clip.xy, mesh_gbuffer(in.world, in.kind)), 1.0);
 }

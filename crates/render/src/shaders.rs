@@ -119,6 +119,14 @@ pub const SOURCES: &[(&str, &str)] = &[
         include_str!("../shaders/sliced_refine.wgsl"),
     ),
     ("mesh.wgsl", include_str!("../shaders/mesh.wgsl")),
+    (
+        "mesh_colour.wgsl",
+        include_str!("../shaders/mesh_colour.wgsl"),
+    ),
+    (
+        "mesh_deferred.wgsl",
+        include_str!("../shaders/mesh_deferred.wgsl"),
+    ),
     ("scattered.wgsl", include_str!("../shaders/scattered.wgsl")),
     (
         "scattered_resolve.wgsl",
@@ -186,6 +194,7 @@ pub const ENTRY_SHADERS: &[&str] = &[
     "sliced.wgsl",
     "sliced_refine.wgsl",
     "mesh.wgsl",
+    "mesh_deferred.wgsl",
     "scattered.wgsl",
     "scattered_resolve.wgsl",
     "ray_exact.wgsl",

@@ -2,8 +2,8 @@
 //! world four times larger than the budget draws along a path of views with
 //! no sky where the whole-world mesh shows terrain and never past its
 //! budget (asserted every frame), converges to the whole-world `mesh` image
-//! bit for bit when still, evicts and refits; an edit of its store equals a
-//! fresh open.
+//! (its fragment path, `mesh_fragment`) bit for bit when still, evicts and
+//! refits; an edit of its store equals a fresh open.
 
 mod common;
 
@@ -57,7 +57,12 @@ fn a_world_four_times_the_budget_converges_to_the_whole_world_mesh() {
     let colors = TerrainColors::from_world(&w);
     let source = level_pages(&w);
     for gpu in gpus {
-        let settings = MethodSettings::default();
+        // The paged mesh colours in its fragments (its stand-in boxes share
+        // the pass): the whole-world mesh's fragment path is its twin.
+        let settings = MethodSettings {
+            mesh_fragment: true,
+            ..MethodSettings::default()
+        };
         let mut whole = Renderer::new(&gpu, &w.level, &colors, "mesh", &settings, W, H).unwrap();
         let whole_bytes =
             whole.retained_bytes().gpu + 2 * (w.level.width() * w.level.height()) as u64;

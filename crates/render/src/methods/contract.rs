@@ -42,6 +42,16 @@ pub struct MethodSettings {
     /// normal's share of the mesh's colour error (`mesh:0.5/gradient`).
     #[serde(default)]
     pub mesh_gradient_normal: bool,
+    /// `mesh`: colour each fragment in the raster pass (the path of adapters
+    /// without compute) rather than the deferred frame's one compute pass
+    /// over the covered pixels; for A/B measurements (`mesh:0.5/fragment`).
+    #[serde(default)]
+    pub mesh_fragment: bool,
+    /// `mesh`: every sample at its texel's centre, as before issue 36
+    /// (`mesh:0.5/centres`, for A/B); by default a sample beside a wall on
+    /// one side moves half a texel to it, so walls stand on texel boundaries.
+    #[serde(default)]
+    pub mesh_texel_centres: bool,
     /// The shared shadow map (`--no-shadows` turns it off).
     pub shadows: bool,
     /// `ray`, `voxel`: each camera ray's march begins where its 8x8-pixel
@@ -66,6 +76,8 @@ impl Default for MethodSettings {
             mesh_outline: false,
             mesh_lod_pixels: default_lod_pixels(),
             mesh_gradient_normal: false,
+            mesh_fragment: false,
+            mesh_texel_centres: false,
             shadows: true,
             march_beam: true,
         }

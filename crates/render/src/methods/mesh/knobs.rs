@@ -1,22 +1,30 @@
-//! `mesh:Q[o][/PX][/gradient]`: the fit quality, the outline-constrained
-//! fit, the LOD tolerance in pixels and the gradient-normal diagnostic.
+//! `mesh:Q[o][/PX][/gradient][/fragment][/centres]`: the fit quality, the
+//! outline-constrained fit, the LOD tolerance in pixels, the gradient-normal
+//! diagnostic, and for A/B the fragment path's colour (against the deferred
+//! frame) and samples at texel centres (against samples moved to walls).
 
 use super::super::contract::MethodSettings;
 use super::super::knobs::{Flag, Knobs, Slider, SliderKind, Sweep, plain, positive};
 use anyhow::{Context, bail};
 
 pub static KNOBS: Knobs = Knobs {
-    grammar: "Q, q=Q or Qo, then /PX and /gradient",
+    grammar: "Q, q=Q or Qo, then /PX, /gradient, /fragment and /centres",
     default: Some("0.5"),
     parse,
     describe: |s| {
         format!(
-            "q={}{} lod={}px{}",
+            "q={}{} lod={}px{}{}{}",
             s.mesh_quality,
             if s.mesh_outline { " outline" } else { "" },
             s.mesh_lod_pixels,
             if s.mesh_gradient_normal {
                 " gradient-normal"
+            } else {
+                ""
+            },
+            if s.mesh_fragment { " fragment" } else { "" },
+            if s.mesh_texel_centres {
+                " texel-centres"
             } else {
                 ""
             }
@@ -27,6 +35,8 @@ pub static KNOBS: Knobs = Knobs {
         to.mesh_outline = from.mesh_outline;
         to.mesh_lod_pixels = from.mesh_lod_pixels;
         to.mesh_gradient_normal = from.mesh_gradient_normal;
+        to.mesh_fragment = from.mesh_fragment;
+        to.mesh_texel_centres = from.mesh_texel_centres;
     },
     sliders: &[
         Slider {
@@ -96,6 +106,26 @@ pub static KNOBS: Knobs = Knobs {
             },
         },
         Flag {
+            long: "mesh-fragment",
+            value: None,
+            help: "`mesh`: colour in the raster pass's fragments instead of the deferred compute pass (for A/B).",
+            default: |_| String::new(),
+            apply: |_, s| {
+                s.mesh_fragment = true;
+                Ok(())
+            },
+        },
+        Flag {
+            long: "mesh-texel-centres",
+            value: None,
+            help: "`mesh`: every sample at its texel's centre, none moved to a wall beside it (for A/B).",
+            default: |_| String::new(),
+            apply: |_, s| {
+                s.mesh_texel_centres = true;
+                Ok(())
+            },
+        },
+        Flag {
             long: "mesh-gradient-normal",
             value: None,
             help: "`mesh`, a diagnostic: shade with the height-field gradient normal instead of the flat one.",
@@ -109,8 +139,9 @@ pub static KNOBS: Knobs = Knobs {
 };
 
 /// `Q`, `q=Q`, `Qo` (outline-constrained), then `/PX` (the LOD tolerance in
-/// pixels; `/`, as `,` separates methods) and `/gradient` (the
-/// gradient-normal diagnostic), in either order.
+/// pixels; `/`, as `,` separates methods), `/gradient` (the
+/// gradient-normal diagnostic), `/fragment` (the fragment path's colour) and
+/// `/centres` (samples at texel centres), in any order.
 fn parse(text: &str, s: &mut MethodSettings) -> anyhow::Result<()> {
     let mut parts = text.split('/');
     let q = parts.next().unwrap_or_default().trim();
@@ -118,6 +149,10 @@ fn parse(text: &str, s: &mut MethodSettings) -> anyhow::Result<()> {
     for part in parts.map(str::trim) {
         if part == "gradient" {
             s.mesh_gradient_normal = true;
+        } else if part == "fragment" {
+            s.mesh_fragment = true;
+        } else if part == "centres" {
+            s.mesh_texel_centres = true;
         } else if px.replace(part).is_some() {
             bail!("more than one LOD tolerance");
         }
@@ -148,3 +183,23 @@ pub static SWEEP: Sweep = Sweep {
     quick: &["0", "0.5", "1"],
     at_paper_size: true,
 };
+
+#[cfg(test)]
+mod tests {
+    use super::{KNOBS, MethodSettings, parse};
+
+    #[test]
+    fn the_ab_knobs_parse_in_any_order() {
+        for text in ["0.5/fragment/centres/2", "0.5/centres/2/fragment"] {
+            let mut s = MethodSettings::default();
+            parse(text, &mut s).unwrap();
+            assert!(s.mesh_fragment && s.mesh_texel_centres, "{text}");
+            assert_eq!(s.mesh_lod_pixels, 2.0);
+            assert_eq!((KNOBS.describe)(&s), "q=0.5 lod=2px fragment texel-centres");
+        }
+        let mut s = MethodSettings::default();
+        parse("0.5", &mut s).unwrap();
+        assert!(!s.mesh_fragment && !s.mesh_texel_centres);
+        assert!(parse("0.5/fragments", &mut s).is_err());
+    }
+}

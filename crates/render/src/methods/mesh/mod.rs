@@ -19,6 +19,11 @@
 //! copy's box from the eye, covers at most `mesh_lod_pixels` pixels
 //! (default 1): resolution and field of view decide, not fixed distances.
 //!
+//! Colour is deferred where the adapter has compute (`deferred.rs`): the
+//! raster pass writes depth and two words a pixel, one compute pass colours
+//! every pixel; elsewhere, or with `mesh_fragment` (`mesh:0.5/fragment`),
+//! each fragment is coloured in the raster pass by the same WGSL.
+//!
 //! Edits refit the dirty chunks from scratch (equal to a fresh fit of the
 //! edited level) and rewrite only their slots, off the frame (`refits.rs`,
 //! issue 35): `apply_edit` copies the dirty chunks' samples and queues
@@ -26,6 +31,7 @@
 //! by then without waiting; [`Method::settle_edits`] waits for all of them.
 
 use super::common::{begin_pass, forward_pipeline};
+mod deferred;
 mod fitter;
 mod knobs;
 pub mod paged;
@@ -95,8 +101,10 @@ pub struct Mesh {
     options: FitOptions,
     /// LOD tolerance in pixels (`mesh_lod_pixels`).
     lod_pixels: f32,
-    /// The gradient-normal diagnostic (`mesh_gradient_normal`).
-    gradient_normal: bool,
+    /// The shaders' per-frame choices (the mesh's uniform).
+    look: Look,
+    /// The deferred frame (`None`: the fragment path).
+    deferred: Option<deferred::Deferred>,
     /// This frame's visible copies, front to back (written by `prepare`).
     draws: Vec<Draw>,
     /// Edits' refits in flight (made at the first edit).
@@ -210,7 +218,8 @@ struct MeshSteps {
     tolerance: f64,
     options: FitOptions,
     lod_pixels: f32,
-    gradient_normal: bool,
+    look: Look,
+    fragment: bool,
     fit: Option<FitInSteps>,
 }
 
@@ -222,7 +231,8 @@ pub fn build_in_steps(
         tolerance: tolerance_of(settings)?,
         options: options_of(settings),
         lod_pixels: lod_pixels_of(settings)?,
-        gradient_normal: settings.mesh_gradient_normal,
+        look: Look::of(settings),
+        fragment: settings.mesh_fragment,
         fit: None,
     }))
 }
@@ -249,7 +259,7 @@ impl super::contract::BuildSteps for MeshSteps {
             .take()
             .and_then(FitInSteps::finish)
             .ok_or_else(|| anyhow::anyhow!("the mesh fit stopped before its last chunk"))?;
-        let shading = (self.lod_pixels, self.gradient_normal);
+        let shading = (self.lod_pixels, self.look, self.fragment);
         from_fit(shared, level, self.tolerance, shading, mesh).map(Some)
     }
 }
@@ -266,29 +276,47 @@ pub fn create(
         shared,
         level,
         tolerance,
-        (lod_pixels, settings.mesh_gradient_normal),
+        (lod_pixels, Look::of(settings), settings.mesh_fragment),
         mesh,
     )
 }
 
-/// The method's uniform (`MeshParams` in `mesh.wgsl`).
-fn mesh_params(layout: &ChunkLayout, gradient_normal: bool) -> [u32; 4] {
+/// The choices the mesh's shaders take per frame from its uniform.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) struct Look {
+    /// The gradient-normal diagnostic (`mesh_gradient_normal`).
+    gradient_normal: bool,
+    /// Samples at texel centres, none moved to a wall (`mesh_texel_centres`).
+    texel_centres: bool,
+}
+
+impl Look {
+    pub(super) fn of(settings: &MethodSettings) -> Self {
+        Look {
+            gradient_normal: settings.mesh_gradient_normal,
+            texel_centres: settings.mesh_texel_centres,
+        }
+    }
+}
+
+/// The method's uniform (`MeshParams` in `mesh_colour.wgsl`).
+fn mesh_params(layout: &ChunkLayout, look: Look) -> [u32; 4] {
     let stride = layout.size_x + 1;
     [
         stride,
         stride * (layout.size_y + 1),
-        u32::from(gradient_normal),
-        0,
+        u32::from(look.gradient_normal),
+        u32::from(look.texel_centres),
     ]
 }
 
 /// Upload a fitted mesh and make the method; `shading` is the LOD tolerance
-/// in pixels and the gradient-normal diagnostic.
+/// in pixels, the shaders' choices and the fragment path's.
 fn from_fit(
     shared: &Shared,
     level: &Level,
     tolerance: f64,
-    (lod_pixels, gradient_normal): (f32, bool),
+    (lod_pixels, look, fragment): (f32, Look, bool),
     mesh: LevelMesh,
 ) -> anyhow::Result<Box<dyn Method>> {
     let options = mesh.options;
@@ -313,7 +341,7 @@ fn from_fit(
             },
         ],
     });
-    let grid = mesh_params(&layout, gradient_normal);
+    let grid = mesh_params(&layout, look);
     let params = shared.uniform_buffer("mesh params", bytemuck::cast_slice(&grid));
     let draws_capacity = 256;
     let (draws_buffer, group) = draws_binding(shared, &group_layout, &params, draws_capacity);
@@ -324,6 +352,7 @@ fn from_fit(
         &group_layout,
         ("vs_mesh", "fs_mesh"),
     )?;
+    let deferred = deferred_for(shared, fragment, &group_layout, &params)?;
     Ok(Box::new(Mesh {
         pipeline,
         group_layout,
@@ -337,10 +366,25 @@ fn from_fit(
         tolerance,
         options,
         lod_pixels,
-        gradient_normal,
+        look,
+        deferred,
         draws: Vec::new(),
         refits: None,
     }))
+}
+
+/// The deferred frame where the adapter can take it and `fragment` (the
+/// `mesh_fragment` setting) does not ask for the fragment path.
+fn deferred_for(
+    shared: &Shared,
+    fragment: bool,
+    layout: &wgpu::BindGroupLayout,
+    params: &wgpu::Buffer,
+) -> anyhow::Result<Option<deferred::Deferred>> {
+    if fragment || !deferred::supported(shared) {
+        return Ok(None);
+    }
+    deferred::Deferred::new(shared, layout, params).map(Some)
 }
 
 /// Spare tail for refits that grow: 1/16 of the level's indices, at least
@@ -407,13 +451,11 @@ fn visible_copies(
             let chunk = layout.index(gx.rem_euclid(nx) as u32, gy.rem_euclid(ny) as u32) as u32;
             let z = z_of(chunk);
             let origin = [(gx * sx) as i32, (gy * sy) as i32];
-            // Samples stand at texel centres: (0.5 .. size + 0.5).
-            let lo = Vec3::new(
-                origin[0] as f32 + 0.5,
-                origin[1] as f32 + 0.5,
-                f32::from(z.0),
-            );
-            let hi = lo + Vec3::new(sx as f32, sy as f32, f32::from(z.1 - z.0));
+            // Samples stand at texel centres (0.5 .. size + 0.5), moved up
+            // to half a texel to a wall beside them (`wall_shift` in
+            // mesh.wgsl): 0 .. size + 1.
+            let lo = Vec3::new(origin[0] as f32, origin[1] as f32, f32::from(z.0));
+            let hi = lo + Vec3::new(sx as f32 + 1.0, sy as f32 + 1.0, f32::from(z.1 - z.0));
             if outside_frustum(&m, lo, hi) {
                 continue;
             }
@@ -437,16 +479,16 @@ fn settings_in_place(
     shared: &Shared,
     settings: &MethodSettings,
     fit: (f64, FitOptions),
-    (lod_pixels, gradient_normal): (&mut f32, &mut bool),
+    (lod_pixels, look): (&mut f32, &mut Look),
     (layout, params): (&ChunkLayout, &wgpu::Buffer),
 ) -> anyhow::Result<bool> {
     let q = f64::from(settings.mesh_quality);
     let same_fit = tolerance_for_quality(q) == Some(fit.0) && options_of(settings) == fit.1;
     if same_fit {
         *lod_pixels = lod_pixels_of(settings)?;
-        if settings.mesh_gradient_normal != *gradient_normal {
-            *gradient_normal = settings.mesh_gradient_normal;
-            let grid = mesh_params(layout, *gradient_normal);
+        if Look::of(settings) != *look {
+            *look = Look::of(settings);
+            let grid = mesh_params(layout, *look);
             shared
                 .queue
                 .write_buffer(params, 0, bytemuck::cast_slice(&grid));
@@ -465,15 +507,32 @@ impl Method for Mesh {
         shared: &Shared,
         settings: &MethodSettings,
     ) -> anyhow::Result<bool> {
-        // A new quality or outline is a new fit; the LOD tolerance and the
-        // normal diagnostic are per-frame choices, taken in place.
-        settings_in_place(
+        // A new quality or outline is a new fit; the LOD tolerance, the
+        // normal diagnostic and the colour path are taken in place.
+        let same_fit = settings_in_place(
             shared,
             settings,
             (self.tolerance, self.options),
-            (&mut self.lod_pixels, &mut self.gradient_normal),
+            (&mut self.lod_pixels, &mut self.look),
             (&self.layout, &self.params),
-        )
+        )?;
+        let fragment = self.deferred.is_none();
+        if same_fit && settings.mesh_fragment != fragment {
+            self.deferred = deferred_for(
+                shared,
+                settings.mesh_fragment,
+                &self.group_layout,
+                &self.params,
+            )?;
+        }
+        Ok(same_fit)
+    }
+
+    fn resize(&mut self, shared: &Shared) -> anyhow::Result<()> {
+        if let Some(d) = &mut self.deferred {
+            d.resize(shared, &self.params);
+        }
+        Ok(())
     }
 
     fn apply_edit(
@@ -492,7 +551,7 @@ impl Method for Mesh {
             (self.layout, self.pool, self.slots) = (layout, pool, slots);
             // Refits in flight were of the old map.
             self.refits = None;
-            let grid = mesh_params(&layout, self.gradient_normal);
+            let grid = mesh_params(&layout, self.look);
             shared
                 .queue
                 .write_buffer(&self.params, 0, bytemuck::cast_slice(&grid));
@@ -548,11 +607,42 @@ impl Method for Mesh {
     }
 
     fn record(&self, shared: &Shared, frame: &Frame<'_>, encoder: &mut wgpu::CommandEncoder) {
-        let mut pass = begin_pass(shared, frame, encoder, "mesh");
+        let Some(deferred) = &self.deferred else {
+            let pass = begin_pass(shared, frame, encoder, "mesh");
+            self.draw(shared, pass, &self.pipeline);
+            return;
+        };
+        let pass = deferred.begin_raster(shared, frame, encoder);
+        self.draw(shared, pass, &deferred.raster);
+        deferred.record_colour(shared, frame, encoder);
+    }
+
+    fn retained_bytes(&self) -> RetainedBytes {
+        RetainedBytes {
+            gpu: self.pool.gpu_bytes()
+                + self.draws_buffer.size()
+                + self.params.size()
+                + self.deferred.as_ref().map_or(0, deferred::Deferred::bytes),
+            cpu: self.pool.cpu_bytes()
+                + (self.slots.capacity() * std::mem::size_of::<Slot>()
+                    + self.draws.capacity() * std::mem::size_of::<Draw>()) as u64,
+        }
+    }
+}
+
+impl Mesh {
+    /// Draw this frame's chunk copies into `pass` with `pipeline` (the
+    /// fragment path's or the deferred raster pass's).
+    fn draw(
+        &self,
+        shared: &Shared,
+        mut pass: wgpu::RenderPass<'_>,
+        pipeline: &wgpu::RenderPipeline,
+    ) {
         if self.draws.is_empty() {
             return;
         }
-        pass.set_pipeline(&self.pipeline);
+        pass.set_pipeline(pipeline);
         pass.set_bind_group(0, &shared.frame_group, &[]);
         pass.set_bind_group(1, &self.group, &[]);
         pass.set_index_buffer(self.pool.buffer.slice(..), wgpu::IndexFormat::Uint16);
@@ -564,15 +654,6 @@ impl Method for Mesh {
                     pass.draw_indexed(slot.start + s..slot.start + e, 0, k..k + 1);
                 }
             }
-        }
-    }
-
-    fn retained_bytes(&self) -> RetainedBytes {
-        RetainedBytes {
-            gpu: self.pool.gpu_bytes() + self.draws_buffer.size() + self.params.size(),
-            cpu: self.pool.cpu_bytes()
-                + (self.slots.capacity() * std::mem::size_of::<Slot>()
-                    + self.draws.capacity() * std::mem::size_of::<Draw>()) as u64,
         }
     }
 }

@@ -36,7 +36,7 @@
 
 use super::fitter::{Fitter, mesh_grid};
 use super::paged_pool::PagedPool;
-use super::{DRAW_BYTES, DRAWS_BINDING, Draw, mesh_params, visible_copies};
+use super::{DRAW_BYTES, DRAWS_BINDING, Draw, Look, mesh_params, visible_copies};
 use crate::frame::Shared;
 use crate::methods::common::{begin_pass, forward_pipeline};
 use crate::methods::contract::{Frame, Method, MethodSettings, RetainedBytes};
@@ -57,8 +57,9 @@ const DRAWS_RESERVED: u32 = 4096;
 
 /// Texels around a chunk's samples whose pages must be resident before it
 /// is drawn: the fragment stage's colour window (`colour_source` in
-/// `mesh.wgsl`: at most 3 texels back and 8 ahead across, and its normal's
-/// neighbours) stays inside it.
+/// `mesh_colour.wgsl`: at most 3 texels back and 8 ahead across, and its
+/// normal's neighbours) stays inside it, and so do the neighbours the vertex
+/// stage's wall test reads (`wall_shift` in `mesh.wgsl`: one texel away).
 pub const COLOUR_MARGIN: u32 = 16;
 
 /// Vertices of a stand-in box: six faces of two triangles.
@@ -132,7 +133,7 @@ pub struct PagedMesh {
     tolerance: f64,
     options: FitOptions,
     lod_pixels: f32,
-    gradient_normal: bool,
+    look: Look,
     stamp: u32,
     /// This frame's chunk copies drawn as meshes, front to back.
     draws: Vec<Draw>,
@@ -227,7 +228,7 @@ pub fn build(
             entry(10, S::FRAGMENT, WRITE),
         ],
     });
-    let grid = mesh_params(&layout, settings.mesh_gradient_normal);
+    let grid = mesh_params(&layout, Look::of(settings));
     let params = shared.uniform_buffer("paged mesh params", bytemuck::cast_slice(&grid));
     let stamp_buffer = shared.uniform_buffer("paged mesh stamp", &[0u8; 16]);
     let pipeline = forward_pipeline(
@@ -281,7 +282,7 @@ pub fn build(
         tolerance,
         options,
         lod_pixels,
-        gradient_normal: settings.mesh_gradient_normal,
+        look: Look::of(settings),
         stamp: 0,
         draws: Vec::new(),
         boxes: Vec::new(),
@@ -512,7 +513,7 @@ impl Method for PagedMesh {
             shared,
             settings,
             (self.tolerance, self.options),
-            (&mut self.lod_pixels, &mut self.gradient_normal),
+            (&mut self.lod_pixels, &mut self.look),
             (&self.layout, &self.params),
         )
     }

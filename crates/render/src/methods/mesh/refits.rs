@@ -9,8 +9,8 @@
 //! waiting, at most [`FITS_PER_FRAME`] a frame, and never a fit older than
 //! the one its slot holds. Until then the slot keeps its old triangulation,
 //! whose vertices read the edited texture: the frame shows the new
-//! altitudes at the old vertices. [`Refits::settle`] waits for every
-//! outstanding refit (the protocol's checks against a fresh build).
+//! altitudes at the old vertices. [`Refits::upload`] with `settle` waits
+//! for every outstanding refit (the protocol's checks against a fresh build).
 
 use super::fitter::{Finished, Fitter};
 use super::paged::{FIT_BUDGET_MS, FITS_PER_FRAME, refit_threads};
