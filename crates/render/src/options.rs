@@ -118,10 +118,11 @@ impl ExactOptions {
         // frame: 0.198 ms mean against 0.202 visiting every level.
         log_ratio: 2,
         beam: true,
-        // Wide in a pre-pass: the same starts as in the march, and on
-        // lavapipe the march with the search's barriers in it was 1.4x
-        // slower (`bench/issue36-beam/`); the H100 A/B is to come.
-        beam_search: BeamSearch::WidePass,
+        // Wide, in the march: on the H100 (one call, `bench/issue36-beam/`)
+        // 0.1855 ms a frame against 0.1944 as a pre-pass (`WidePass`),
+        // 0.1893 serial and 0.1966 without the beam. llvmpipe pays for the
+        // barriers over the whole march (1.2-1.5x); the images are the same.
+        beam_search: BeamSearch::Wide,
         shadow_rounds: 8,
     };
 

@@ -46,7 +46,7 @@ pub fn parse_backend(s: &str) -> anyhow::Result<BackendChoice> {
 /// `STRATA_EXACT_CLIMB=all`, `STRATA_EXACT_RATIO=2|4`,
 /// `STRATA_EXACT_BEAM=off|serial|wide|wide-pass` (no beam, the serial
 /// pre-pass, the wide search in the march or in a pre-pass; default
-/// wide-pass), `STRATA_EXACT_SHADOW_ROUNDS=1..8` (the shadow blocks' wide
+/// wide), `STRATA_EXACT_SHADOW_ROUNDS=1..8` (the shadow blocks' wide
 /// search's most rounds) configure `ray-exact`; `STRATA_EXACT_STATS=1` prints its statistics;
 /// `STRATA_TEST_OVERSIZE_BUILD=METHOD` makes that method's build ask for a
 /// buffer over the device's limit (the README's way to see a refused build).

@@ -650,11 +650,11 @@ fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
                 ..d
             },
             ExactOptions {
-                beam_search: BeamSearch::Wide,
+                beam_search: BeamSearch::WidePass,
                 ..d
             },
             ExactOptions {
-                beam_search: BeamSearch::Wide,
+                beam_search: BeamSearch::WidePass,
                 exact_shadow: false,
                 ..d
             },
@@ -663,7 +663,7 @@ fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
                 ..d
             },
         ];
-        assert_eq!(d.beam_search, BeamSearch::WidePass);
+        assert_eq!(d.beam_search, BeamSearch::Wide);
         let mut images = Vec::new();
         for options in variants {
             let m = build(&r.shared_handle(), &w.level, options).unwrap();
