@@ -32,7 +32,7 @@ pub struct Args {
     #[arg(long)]
     pub quick: bool,
     /// Comma-separated methods, each `name` or `name:setting`
-    /// (`ray:64`, `voxel:4,8,2/100`, `scattered:4,4,4`, `sliced:512`, `sliced:512/refine`, `mesh:0.5`, `mesh:0.5o` outline-constrained, `mesh:0.5/2` LOD tolerance 2 px, `mesh:0.5/gradient` shaded with the height-field normal, a diagnostic). Default: all.
+    /// (`ray:64`, `voxel:4,8,2/100`, `scattered:4,4,4`, `sliced:512`, `sliced:512/refine`, `mesh:0.5`, `mesh:0.5o` outline-constrained, `mesh:0.5/2` LOD tolerance 2 px, `mesh:0.5/gradient` shaded with the height-field normal, a diagnostic, `mesh:0.5/fragment` coloured in the raster pass, `mesh:0.5/centres` samples at texel centres, `ray:128/nobeam` and `voxel:/nobeam` marching from the near plane as before the beam). Default: all.
     #[arg(long, value_name = "LIST")]
     pub methods: Option<String>,
     /// `strata tune`'s settings.json: each method named without a setting takes its tuned one.
