@@ -1,0 +1,222 @@
+//! The CPU replay (`replay.rs`, `replay/beam.rs`) against the GPU: the
+//! same steps, and beam starts that never pass a hit.
+
+use super::*;
+
+/// The CPU replay (`replay.rs`) takes the GPU's steps: on every generated
+/// view its hits are the reference's (hit or miss, and the distance), and
+/// the most iterations of a camera ray and of a shadow ray in the frame are
+/// the GPU's own counts (`ExactStats`), up to a step or two where f32
+/// rounding differs on a grazed boundary.
+#[test]
+fn the_replay_takes_the_gpu_steps() {
+    for (search, shadow_rounds) in [
+        (BeamSearch::Wide, 8),
+        (BeamSearch::Serial, 8),
+        (BeamSearch::WidePass, 8),
+        (BeamSearch::WidePass, 1),
+    ] {
+        replay_takes_the_gpu_steps(search, shadow_rounds);
+    }
+}
+
+/// The generated world and its compute pyramid, for a replay.
+fn replay_world() -> (World, strata_maxmip::Pyramid) {
+    let w = common::generated_world();
+    let pyramid = super::super::replay::compute_pyramid(&w.level);
+    (w, pyramid)
+}
+
+/// `Traversal::GPU` with the beam searched by `search` (`beam` on or off).
+fn replay_traversal(search: BeamSearch, beam: bool) -> super::super::replay::Traversal {
+    super::super::replay::Traversal {
+        beam,
+        search,
+        ..super::super::replay::Traversal::GPU
+    }
+}
+
+fn replay_takes_the_gpu_steps(search: BeamSearch, shadow_rounds: u32) {
+    use super::super::replay::{Replay, replay_frame};
+    let (w, pyramid) = replay_world();
+    let mut replay = Replay::new(&w.level, &pyramid);
+    replay.traversal = super::super::replay::Traversal {
+        shadow_rounds,
+        ..replay_traversal(search, true)
+    };
+    let options = ExactOptions {
+        beam_search: search,
+        shadow_rounds,
+        ..ExactOptions::DEFAULT
+    };
+    let shape = crate::frame::LevelShape::of(&w.level);
+    let mut frames = Vec::new();
+    for view in &w.views {
+        let (camera, globals) = view_globals(&w.level, view, (W, H));
+        let f = replay_frame(&mut replay, &globals);
+        // Hits against the CPU reference, pixel by pixel.
+        let reference = render_reference(&w.level, &camera);
+        let (mut disagree, mut worst) = (0, 0.0f32);
+        for y in 0..H {
+            for x in 0..W {
+                let (d, m) = replay.pixel(&globals, x as f32 + 0.5, y as f32 + 0.5);
+                let r = reference.distance[(y * W + x) as usize];
+                match (m.hit, r.is_finite()) {
+                    (Some((t, _)), true) => {
+                        worst = worst.max((t * d.length() - r).abs() / r.max(1.0));
+                    }
+                    (None, false) => {}
+                    _ => disagree += 1,
+                }
+            }
+        }
+        eprintln!(
+            "{search:?} {:10} replay: {} hits, march {:.1} iterations/ray (p99 {}, most {}), shadow {} rays \
+             {:.1} (most {}), {} bytes; vs reference: {disagree} pixels disagree, worst relative \
+             distance {worst:.2e}",
+            view.name,
+            f.hits,
+            f.march.iterations.mean,
+            f.march.iterations.p99,
+            f.most_iterations,
+            f.shadow.rays,
+            f.shadow.iterations.mean,
+            f.shadow_most_iterations,
+            f.bytes(),
+        );
+        assert!(disagree <= 2, "{}: {disagree} pixels", view.name);
+        assert!(worst < 1e-3, "{}: {worst}", view.name);
+        assert!(f.march.rays == u64::from(W * H) && f.hits > 0);
+        assert!(f.shadow.rays == f.shadow_blocks * 64 && f.shadow_blocks > 0);
+        frames.push((camera, f));
+    }
+    // The GPU's counts, one fresh method per view.
+    for gpu in common::gpus() {
+        let colors = TerrainColors::from_world(&w);
+        let r = Renderer::new(
+            &gpu,
+            &w.level,
+            &colors,
+            "ray-exact",
+            &MethodSettings::default(),
+            W,
+            H,
+        )
+        .unwrap();
+        let shared = r.shared_handle();
+        let timer = crate::timing::PassTimer::new(&shared.device, &shared.queue, false);
+        for (index, (camera, f)) in frames.iter().enumerate() {
+            let mut m = build(&shared, &w.level, options).unwrap();
+            let shadow = crate::shadow::ShadowFrame::fit(camera, true);
+            let globals = crate::frame::Globals::new(camera, &shape, &shadow);
+            record_frame(&shared, &mut m, camera, &globals, &timer, index);
+            let s = m.stats().unwrap();
+            eprintln!(
+                "{search:?} {shadow_rounds} view {index}: most iterations GPU {} / {} (shadow), replay {} / {}",
+                s.most_iterations,
+                s.shadow_most_iterations,
+                f.most_iterations,
+                f.shadow_most_iterations
+            );
+            assert!(
+                s.most_iterations.abs_diff(f.most_iterations) <= 2
+                    && s.shadow_most_iterations.abs_diff(f.shadow_most_iterations) <= 2,
+                "{search:?} view {index}: GPU {s:?}, replay {f:?}"
+            );
+        }
+        gpu.errors.check().unwrap();
+    }
+}
+
+/// The beam pre-pass (`ray_exact_beam.wgsl`, its replay `Replay::beam`)
+/// never starts a tile past a hit of any of its rays, and a ray marched from
+/// its tile's start finds the very hit (t and column, bit for bit) it finds
+/// from the near plane (shadow rays from their block's beam likewise, at
+/// 160x100), on every generated view at 160x100 and 640x400
+/// (every tile, every pixel); and it saves iterations.
+#[test]
+fn the_beam_never_passes_a_hit() {
+    for search in [BeamSearch::Wide, BeamSearch::Serial] {
+        beam_never_passes_a_hit(search);
+    }
+}
+
+fn beam_never_passes_a_hit(search: BeamSearch) {
+    use super::super::replay::{BEAM_CAP, BEAM_TILE, Replay, WIDE_ROUNDS};
+    let (w, pyramid) = replay_world();
+    let mut replay = Replay::new(&w.level, &pyramid);
+    replay.traversal = replay_traversal(search, false);
+    // Most iterations (rounds) of a beam, and the invocations each takes:
+    // the wide search's rounds are an interval test by every pixel.
+    let (cap, lanes) = match search {
+        BeamSearch::Serial => (BEAM_CAP, 1),
+        BeamSearch::Wide | BeamSearch::WidePass => {
+            (WIDE_ROUNDS, u64::from(super::super::replay::WIDE_LANES))
+        }
+    };
+    for (width, height) in [(W, H), (640, 400)] {
+        let (mut before, mut after, mut beams, mut tiles_hit) = (0u64, 0u64, 0u64, 0u64);
+        for view in &w.views {
+            let (_, g) = view_globals(&w.level, view, (width, height));
+            for ty in 0..height.div_ceil(BEAM_TILE) {
+                for tx in 0..width.div_ceil(BEAM_TILE) {
+                    let b = replay.tile_start(&g, tx, ty);
+                    beams += u64::from(b.iterations) * lanes;
+                    assert!(b.t.is_finite() && b.iterations <= cap);
+                    let mut any = false;
+                    for y in ty * BEAM_TILE..((ty + 1) * BEAM_TILE).min(height) {
+                        for x in tx * BEAM_TILE..((tx + 1) * BEAM_TILE).min(width) {
+                            let (px, py) = (x as f32 + 0.5, y as f32 + 0.5);
+                            let (_, old) = replay.pixel(&g, px, py);
+                            let (_, new) = replay.pixel_from(&g, px, py, Some(b.t));
+                            before += u64::from(old.iterations);
+                            after += u64::from(new.iterations);
+                            if let Some((t, _)) = old.hit {
+                                any = true;
+                                assert!(
+                                    t >= b.t,
+                                    "{search:?} {} {width}x{height} pixel ({x}, {y}): hit at {t}, its tile starts at {}",
+                                    view.name,
+                                    b.t
+                                );
+                            }
+                            assert!(
+                                old.hit.map(|(t, c)| (t.to_bits(), c))
+                                    == new.hit.map(|(t, c)| (t.to_bits(), c)),
+                                "{search:?} {} {width}x{height} pixel ({x}, {y}): {:?} from the near plane, {:?} from the beam",
+                                view.name,
+                                old.hit,
+                                new.hit
+                            );
+                        }
+                    }
+                    tiles_hit += u64::from(any);
+                }
+            }
+            // Shadow rays too (and the pixels again): every texel of the
+            // blocks the hits stamp, from 255 and from its block's beam.
+            if width == W {
+                let (differ, early) = super::super::replay::beam_disagreements(&mut replay, &g);
+                assert_eq!(
+                    (differ, early),
+                    (0, 0),
+                    "{search:?} {}: shadow beams",
+                    view.name
+                );
+            }
+        }
+        let pixels = u64::from(width * height) * w.views.len() as u64;
+        eprintln!(
+            "{search:?} {width}x{height}: march iterations a pixel {:.2} from the near plane, {:.2} from the beam; \
+             beam {:.3} a pixel; {tiles_hit} tiles with hits",
+            before as f64 / pixels as f64,
+            after as f64 / pixels as f64,
+            beams as f64 / pixels as f64
+        );
+        assert!(tiles_hit > 0);
+        assert!(
+            after + beams < before,
+            "the beam saved nothing: {before} -> {after} + {beams}"
+        );
+    }
+}
