@@ -105,16 +105,27 @@ fn the_deferred_frame_draws_what_the_fragment_path_draws() {
 /// no G-buffer, and the picture the deferred frame draws.
 #[test]
 fn without_compute_the_mesh_colours_in_its_fragments() {
+    // An adapter that cannot stand in for one without compute is passed
+    // over (llvmpipe's GL: no deferred frame to compare, or no R32Float
+    // targets for the shadow map without compute); at least one must run.
+    let mut compared = 0;
     for mut gpu in common::gpus() {
         if !(gpu.caps.compute && gpu.caps.storage_textures) {
-            common::skip_loudly("the deferred mesh needs compute and storage textures");
+            eprintln!(
+                "{}: no deferred mesh here (needs compute and storage textures)",
+                gpu.report.backend
+            );
             continue;
         }
         if !gpu.caps.float32_targets {
             // Without compute the shared shadow map needs R32Float targets.
-            common::skip_loudly("no adapter without compute to pretend here");
+            eprintln!(
+                "{}: cannot pretend to lack compute (no R32Float targets)",
+                gpu.report.backend
+            );
             continue;
         }
+        compared += 1;
         let world = common::generated_world();
         let colors = TerrainColors::from_world(&world);
         let settings = MethodSettings {
@@ -142,6 +153,9 @@ fn without_compute_the_mesh_colours_in_its_fragments() {
         eprintln!("{}: {differ} pixels differ", gpu.report.backend);
         assert_eq!(differ, 0, "the fragment path draws another picture");
         gpu.errors.check().unwrap();
+    }
+    if compared == 0 {
+        common::skip_loudly("no adapter here can stand in for one without compute");
     }
 }
 
