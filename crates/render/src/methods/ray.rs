@@ -7,7 +7,7 @@
 //!
 //! Where the adapter runs compute and lets fragments read storage, each ray
 //! begins at the last of its samples before its 8x8-pixel tile's beam
-//! ([`super::march_beam`]), and a rising ray ends above the map's highest
+//! (`methods/march_beam.rs`), and a rising ray ends above the map's highest
 //! top: the same samples, fewer of them (issue 36 item 2; `ray:N/nobeam`
 //! marches as before).
 

@@ -6,7 +6,7 @@
 //! shared `shade` and write the same depth as `ray`.
 //!
 //! `voxel` (the fragment pass) begins each ray's traversal at the leaf that
-//! holds its 8x8-pixel tile's beam start ([`super::march_beam`]) where the
+//! holds its 8x8-pixel tile's beam start (`methods/march_beam.rs`) where the
 //! adapter runs compute and lets fragments read storage: the same leaves
 //! sampled over the same intervals, in fewer steps (issue 36 item 2;
 //! `voxel:…/nobeam` traverses as before).
