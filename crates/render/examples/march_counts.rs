@@ -87,8 +87,10 @@ fn samples(
 
 /// The voxel traversal's work for one ray: DDA iterations and column
 /// decodes (leaf samples, bisections), a twin of `voxel_core.wgsl`'s
-/// `voxel_march_from` (f32 as there; for counting); with `cached` false, of
-/// the leaf sampling before its column cache.
+/// `voxel_march_from` (f32 as there; for counting) as it sampled a leaf
+/// before the exact texel walk replaced the points (`voxel_leaf`): the
+/// record of `bench/issue36-frag/`'s counts; with `cached` false, of the
+/// leaf sampling before its column cache.
 struct VoxelTwin<'a> {
     level: &'a strata_level::Level,
     pyramid: &'a strata_occupancy::Pyramid,

@@ -7,8 +7,6 @@
 #include "voxel_core.wgsl"
 #include "fullscreen.wgsl"
 
-// The leaf sampling as before the beam: a column decode per point (`voxel_leaf`).
-const VOXEL_LEAF_CACHE: bool = false;
 
 struct FragOut {
     @location(0) color: vec4<f32>,

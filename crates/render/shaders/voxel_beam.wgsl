@@ -9,8 +9,6 @@
 #include "march_beam.wgsl"
 #include "fullscreen.wgsl"
 
-// The leaf sampling decodes a column per texel, not per point (`voxel_leaf`).
-const VOXEL_LEAF_CACHE: bool = true;
 
 struct FragOut {
     @location(0) color: vec4<f32>,

@@ -8,8 +8,6 @@
 #include "voxel_occupancy.wgsl"
 #include "voxel_core.wgsl"
 
-// The leaf sampling decodes a column per texel, not per point (`voxel_leaf`).
-const VOXEL_LEAF_CACHE: bool = true;
 
 @group(1) @binding(2) var color_out: texture_storage_2d<rgba8unorm, write>;
 @group(1) @binding(3) var depth_out: texture_storage_2d<r32float, write>;

@@ -12,7 +12,7 @@ struct VoxelLevel {
 }
 
 struct VoxelParams {
-    // x: step budget, y: level count, z: most leaf samples per voxel, w unused
+    // x: step budget, y: level count, z and w unused
     config: vec4<u32>,
     // level-0 voxel size: x, y texels, z altitude units; w unused
     voxel: vec4<u32>,

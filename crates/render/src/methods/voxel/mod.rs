@@ -29,8 +29,6 @@ use strata_occupancy::VoxelSize;
 
 /// Levels the traversal's uniform table holds (`VOXEL_MAX_LEVELS` in WGSL).
 const MAX_LEVELS: usize = 16;
-/// Most exact samples inside one leaf voxel's ray segment.
-const LEAF_SAMPLES: u32 = 32;
 
 /// Twin of `VoxelParams` in `voxel_occupancy.wgsl`.
 #[repr(C)]
@@ -131,7 +129,9 @@ pub fn build(
         config: [
             settings.voxel_steps,
             layout.levels.len() as u32,
-            LEAF_SAMPLES,
+            // Unused since a leaf's piece of the ray is walked texel by
+            // texel (`voxel_leaf`): it was the most samples in one leaf.
+            0,
             0,
         ],
         voxel: [voxel.x, voxel.y, voxel.z, 0],
