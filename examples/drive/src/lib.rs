@@ -79,6 +79,10 @@ impl Drive {
         // Dig the crater at start: GPU data and collider change together.
         let dirty = strata_level::edit::crater(&mut level, &scene::crater_site());
         renderer.apply_edit(&level, &dirty)?;
+        // `mesh` refits the crater's chunks on worker threads; the scene
+        // starts with the crater in place, so wait for them here (once, at
+        // start) rather than let the first frames draw the old triangles.
+        renderer.settle_edits()?;
 
         Ok(Drive {
             renderer,
