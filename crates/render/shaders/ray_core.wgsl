@@ -64,20 +64,6 @@ fn bisect(o: vec3<f32>, d: vec3<f32>, a0: f32, b0: f32, bisections: u32) -> Marc
     return result;
 }
 
-// `n` uniform samples over (ta, tb] (ta is known empty) until one is solid,
-// then `bisections` halvings between the last empty and the first solid
-// sample: the voxel leaves' refinement.
-fn sample_and_bisect(o: vec3<f32>, d: vec3<f32>, ta: f32, tb: f32, n: u32, bisections: u32) -> MarchHit {
-    let s = first_solid_sample(o, d, ta, tb, n);
-    if (s.x == 0.0) {
-        var miss: MarchHit;
-        miss.hit = false;
-        miss.t = tb;
-        return miss;
-    }
-    return bisect(o, d, s.y, s.z, bisections);
-}
-
 // Most texels the final-interval walk visits. A step of the default march
 // (128 samples over at most 600 units) crosses about 6; a longer interval
 // (a few steps over a long ray) falls back to bisection where its end sample
