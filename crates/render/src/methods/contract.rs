@@ -25,6 +25,11 @@ pub struct MethodSettings {
     /// plain slicer.
     #[serde(default)]
     pub sliced_refine: bool,
+    /// `sliced`: draw every image row with the shader that walks slice gaps,
+    /// as before the rows where no ray can walk got a shader without the
+    /// walk (`sliced:512/allrows`): the same image, for A/B timing.
+    #[serde(default)]
+    pub sliced_all_rows: bool,
     /// `scattered`: footprint grid density (x, y, z); the paper's (4, 4, 4).
     pub scatter_density: [f32; 3],
     /// `mesh`: fit quality q in [0, 1]; max error 2^(4(1 - q)) (0.5 → 4).
@@ -71,6 +76,7 @@ impl Default for MethodSettings {
             voxel_steps: 100,
             slices: 512,
             sliced_refine: false,
+            sliced_all_rows: false,
             scatter_density: [4.0, 4.0, 4.0],
             mesh_quality: 0.5,
             mesh_outline: false,

@@ -5,19 +5,18 @@ use super::super::knobs::{Flag, Knobs, Slider, Sweep, count, plain};
 use anyhow::bail;
 
 pub static KNOBS: Knobs = Knobs {
-    grammar: "N or N/refine",
+    grammar: "N or N/refine, then optionally /allrows",
     default: Some("512"),
     parse,
     describe: |s| {
-        if s.sliced_refine {
-            format!("slices={} refined", s.slices)
-        } else {
-            format!("slices={}", s.slices)
-        }
+        let refined = if s.sliced_refine { " refined" } else { "" };
+        let all_rows = if s.sliced_all_rows { " all-rows" } else { "" };
+        format!("slices={}{refined}{all_rows}", s.slices)
     },
     keep: |from, to| {
         to.slices = from.slices;
         to.sliced_refine = from.sliced_refine;
+        to.sliced_all_rows = from.sliced_all_rows;
     },
     sliders: &[Slider::count(
         "slices",
@@ -47,19 +46,61 @@ pub static KNOBS: Knobs = Knobs {
                 Ok(())
             },
         },
+        Flag {
+            long: "sliced-all-rows",
+            value: None,
+            help: "`sliced`: every image row with the gap-walking shader, none with the steep rows' shader without the walk (the same image, for A/B timing; `sliced:N/allrows`).",
+            default: |_| String::new(),
+            apply: |_, s| {
+                s.sliced_all_rows = true;
+                Ok(())
+            },
+        },
     ],
 };
 
-/// `N` (the paper's plain slicer) or `N/refine`.
+/// `N` (the paper's plain slicer) or `N/refine`, then optionally `/allrows`.
 fn parse(text: &str, s: &mut MethodSettings) -> anyhow::Result<()> {
+    let (text, all_rows) = match text.strip_suffix("/allrows") {
+        Some(rest) => (rest, true),
+        None => (text, false),
+    };
     let (n, refine) = match text.split_once('/') {
         Some((n, "refine")) => (n, true),
-        Some((_, other)) => bail!("`{other}` is not `refine`"),
+        Some((_, other)) => bail!("`{other}` is not `refine` or `allrows`"),
         None => (text, false),
     };
     s.slices = plain(count(n))?;
     s.sliced_refine = refine;
+    s.sliced_all_rows = all_rows;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parses_refine_and_all_rows() {
+        let mut s = MethodSettings::default();
+        parse("256/refine/allrows", &mut s).unwrap();
+        assert_eq!(
+            (s.slices, s.sliced_refine, s.sliced_all_rows),
+            (256, true, true)
+        );
+        parse("512/allrows", &mut s).unwrap();
+        assert_eq!(
+            (s.slices, s.sliced_refine, s.sliced_all_rows),
+            (512, false, true)
+        );
+        parse("64", &mut s).unwrap();
+        assert_eq!(
+            (s.slices, s.sliced_refine, s.sliced_all_rows),
+            (64, false, false)
+        );
+        assert!(parse("512/allrows/refine", &mut s).is_err());
+        assert!(parse("512/fast", &mut s).is_err());
+    }
 }
 
 /// `strata tune`'s sweep. The refined slicer is a setting of the same

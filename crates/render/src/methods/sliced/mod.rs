@@ -8,6 +8,10 @@
 //! `sliced:N/refine` draws the same slices into a marks image instead and
 //! adds one full-screen pass that puts the exact surface crossing behind
 //! each pixel's nearest kept slice (`refine.rs`).
+//!
+//! Either way the slices are drawn band by band of image rows (`rows.rs`):
+//! where no ray of a band can walk a slice gap, with a fragment shader
+//! without the walk.
 
 use super::common::{
     begin_pass, begin_pass_into, forward_pipeline, forward_pipeline_into, index_buffer,
@@ -15,11 +19,13 @@ use super::common::{
 use super::forward::{self, Z_MAX};
 mod knobs;
 mod refine;
+mod rows;
 mod tiles;
 use super::contract::{Frame, Method, MethodSettings, RetainedBytes};
 use crate::frame::{Shared, texture_entry, uniform_layout_entry};
 pub use knobs::{KNOBS, SWEEP};
 use refine::{MARK_FORMAT, Refine};
+use rows::{RowBand, row_bands};
 use strata_camera::Camera;
 use strata_level::Level;
 use tiles::SliceTiles;
@@ -38,7 +44,13 @@ pub const GAP_TEXELS: u32 = 32;
 pub const MAX_SLICES: u32 = 1 << 16;
 
 pub struct Sliced {
+    /// The slices where a ray may walk a gap (`fs_sliced`, `fs_slice_mark`).
     pipeline: wgpu::RenderPipeline,
+    /// The slices on rows where none can (`fs_sliced_steep`,
+    /// `fs_slice_mark_steep`); `None` with `sliced_all_rows`.
+    steep: Option<wgpu::RenderPipeline>,
+    /// This frame's row bands, top to bottom.
+    bands: Vec<RowBand>,
     group: wgpu::BindGroup,
     params: wgpu::Buffer,
     /// The tile maxima that drop air tiles, and the grid over the footprint.
@@ -122,28 +134,38 @@ pub fn create(
     );
     let tiles = SliceTiles::new(shared, level);
     let (layout, group) = slices_binding(shared, &params, &tiles);
-    let (pipeline, refine) = if settings.sliced_refine {
-        let marks = forward_pipeline_into(
+    let marks = |entry| {
+        forward_pipeline_into(
             shared,
             "sliced marks",
             "sliced.wgsl",
             &layout,
-            ("vs_sliced", "fs_slice_mark"),
+            ("vs_sliced", entry),
             MARK_FORMAT,
-        )?;
-        (marks, Some(Refine::new(shared, &params, &tiles)?))
-    } else {
-        let plain = forward_pipeline(
+        )
+    };
+    let plain = |entry| {
+        forward_pipeline(
             shared,
             "sliced",
             "sliced.wgsl",
             &layout,
-            ("vs_sliced", "fs_sliced"),
-        )?;
-        (plain, None)
+            ("vs_sliced", entry),
+        )
+    };
+    let (pipeline, steep, refine) = if settings.sliced_refine {
+        (
+            marks("fs_slice_mark")?,
+            marks("fs_slice_mark_steep")?,
+            Some(Refine::new(shared, &params, &tiles)?),
+        )
+    } else {
+        (plain("fs_sliced")?, plain("fs_sliced_steep")?, None)
     };
     Ok(Box::new(Sliced {
         pipeline,
+        steep: (!settings.sliced_all_rows).then_some(steep),
+        bands: Vec::new(),
         group,
         params,
         tiles,
@@ -182,7 +204,9 @@ impl Method for Sliced {
         settings: &MethodSettings,
     ) -> anyhow::Result<bool> {
         let slices = checked_slices(settings)?;
-        if settings.sliced_refine != self.refine.is_some() {
+        if settings.sliced_refine != self.refine.is_some()
+            || settings.sliced_all_rows != self.steep.is_none()
+        {
             // Another pipeline: a rebuild.
             return Ok(false);
         }
@@ -204,6 +228,7 @@ impl Method for Sliced {
         f.count[1] = self.slices;
         f.count[2] = slice_near(camera.position.z, self.slices);
         f.count[3] = GAP_TEXELS.min(self.tiles.side());
+        self.bands = row_bands(camera, self.slices);
         self.tiles_per_slice = self
             .tiles
             .prepare(shared, [f.origin[0], f.origin[1]], f.extent());
@@ -249,14 +274,30 @@ impl Method for Sliced {
 
 impl Sliced {
     /// The slices, one instanced draw of a quad per slice and tile (slices
-    /// nearest the eye's altitude first).
+    /// nearest the eye's altitude first) per band of rows, each band cut out
+    /// by the scissor and drawn with the walking or the steep shader.
     fn draw_slices(&self, shared: &Shared, pass: &mut wgpu::RenderPass<'_>) {
-        pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &shared.frame_group, &[]);
         pass.set_bind_group(1, &self.group, &[]);
-        // At most MAX_SLICES x MAX_TILES_PER_SLICE = 2^30 instances.
         pass.set_index_buffer(self.quad.slice(..), wgpu::IndexFormat::Uint16);
-        pass.draw_indexed(0..6, 0, 0..self.slices * self.tiles_per_slice);
+        // At most MAX_SLICES x MAX_TILES_PER_SLICE = 2^30 instances.
+        let instances = 0..self.slices * self.tiles_per_slice;
+        let Some(steep) = &self.steep else {
+            pass.set_pipeline(&self.pipeline);
+            pass.draw_indexed(0..6, 0, instances);
+            return;
+        };
+        // The bands are of the camera's image, the target's size.
+        let (width, height) = (shared.width, shared.height);
+        for band in &self.bands {
+            let rows = band.rows.start.min(height)..band.rows.end.min(height);
+            if rows.is_empty() {
+                continue;
+            }
+            pass.set_pipeline(if band.walks { &self.pipeline } else { steep });
+            pass.set_scissor_rect(0, rows.start, width, rows.end - rows.start);
+            pass.draw_indexed(0..6, 0, instances.clone());
+        }
     }
 }
 
