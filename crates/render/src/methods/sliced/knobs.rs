@@ -76,6 +76,30 @@ fn parse(text: &str, s: &mut MethodSettings) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// `strata tune`'s sweep. The refined slicer is a setting of the same
+/// method (its slices still decide coverage), so the rule weighs it against
+/// the paper's plain slicer at equal tuning.
+pub static SWEEP: Sweep = Sweep {
+    order: 2,
+    knob: "slices [/refine]",
+    full: &[
+        "32",
+        "64",
+        "128",
+        "256",
+        "512",
+        "1024",
+        "32/refine",
+        "64/refine",
+        "128/refine",
+        "256/refine",
+        "512/refine",
+        "1024/refine",
+    ],
+    quick: &["32", "512", "1024", "32/refine", "512/refine"],
+    at_paper_size: false,
+};
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -102,27 +126,3 @@ mod tests {
         assert!(parse("512/fast", &mut s).is_err());
     }
 }
-
-/// `strata tune`'s sweep. The refined slicer is a setting of the same
-/// method (its slices still decide coverage), so the rule weighs it against
-/// the paper's plain slicer at equal tuning.
-pub static SWEEP: Sweep = Sweep {
-    order: 2,
-    knob: "slices [/refine]",
-    full: &[
-        "32",
-        "64",
-        "128",
-        "256",
-        "512",
-        "1024",
-        "32/refine",
-        "64/refine",
-        "128/refine",
-        "256/refine",
-        "512/refine",
-        "1024/refine",
-    ],
-    quick: &["32", "512", "1024", "32/refine", "512/refine"],
-    at_paper_size: false,
-};
