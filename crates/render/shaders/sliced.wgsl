@@ -41,6 +41,37 @@ struct VertexOut {
     @location(2) @interpolate(flat) rank: u32,
 }
 
+// The band of image rows this draw fills (`methods::sliced::rows`): x its
+// first row, y the row after its last, in pixels from the top; one draw per
+// band, each at its own dynamic offset.
+struct RowBand {
+    rows: vec4<f32>,
+}
+
+@group(1) @binding(4) var<uniform> row_band: RowBand;
+
+// Whether the quad over [lo, hi] at altitude z may cover a pixel of this
+// draw's band of rows: the rows its corners project to, widened by a row,
+// against the band's (the scissor cuts the band exactly; this only spares
+// the rasteriser the quads it would cut away whole, each band's draw
+// taking every slice's quads again). A corner at or behind the eye's plane:
+// kept.
+fn quad_meets_band(lo: vec2<i32>, hi: vec2<i32>, z: f32) -> bool {
+    var top = 3.0e38;
+    var bottom = -3.0e38;
+    for (var c = 0u; c < 4u; c = c + 1u) {
+        let xy = select(vec2<f32>(lo), vec2<f32>(hi), vec2<bool>((c & 1u) != 0u, (c & 2u) != 0u));
+        let clip = globals.view_proj * vec4<f32>(xy, z, 1.0);
+        if (clip.w <= 1e-3) {
+            return true;
+        }
+        let row = (0.5 - 0.5 * clip.y / clip.w) * globals.screen.y;
+        top = min(top, row);
+        bottom = max(bottom, row);
+    }
+    return bottom >= row_band.rows.x - 1.0 && top <= row_band.rows.y + 1.0;
+}
+
 // Instance i: slice rank i / tiles, tile i % tiles of the footprint's grid;
 // the quad is the tile cut to the footprint bound, or nothing where the
 // tile's highest top is below the slice (all of it air there).
@@ -61,10 +92,20 @@ fn vs_sliced(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) -> 
     var lo = footprint.origin.xy;
     var hi = lo + extent;
     var out: VertexOut;
+    out.altitude = z;
+    out.rank = j;
+    // A degenerate triangle (all three vertices equal) rasterises nothing.
+    out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
+    out.world = vec3<f32>(0.0);
     if (g.z > 0) {
         let t = i % per_slice;
         let tile = g.xy + vec2<i32>(i32(t % u32(g.z)), i32(t / u32(g.z)));
         let k = slice_tiles.tiles.x;
+        lo = max(lo, tile << vec2<u32>(k));
+        hi = min(hi, (tile + vec2<i32>(1)) << vec2<u32>(k));
+        if (!quad_meets_band(lo, hi, z)) {
+            return out;
+        }
         let wrapped = vec2<u32>(tile) & slice_tiles.tiles.yz;
         // The slices within a spacing of the eye's altitude are the first
         // that rays meet, whose gap walks start at the eye: never culled.
@@ -74,23 +115,14 @@ fn vs_sliced(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) -> 
         // see-through on the views measured.)
         let near_eye = abs(z - globals.eye.z) <= SLICE_TOP / f32(n);
         if (!near_eye && z > f32(textureLoad(tile_max, wrapped, 0).r)) {
-            // A degenerate triangle (all three vertices equal) rasterises nothing.
-            out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
-            out.world = vec3<f32>(0.0);
-            out.altitude = z;
-            out.rank = j;
             return out;
         }
-        lo = max(lo, tile << vec2<u32>(k));
-        hi = min(hi, (tile + vec2<i32>(1)) << vec2<u32>(k));
     }
     // Corner v of the quad (indexed: `methods::sliced::QUAD_INDICES`): x bit
     // 0, y bit 1. A float select: naga writes a vector select as mix(),
     // which GLSL ES 3.00 (WebGL2) has for floats only.
     let xy = select(vec2<f32>(lo), vec2<f32>(hi), vec2<bool>((v & 1u) != 0u, (v & 2u) != 0u));
     out.world = vec3<f32>(xy, z);
-    out.altitude = z;
-    out.rank = j;
     out.clip = globals.view_proj * vec4<f32>(out.world, 1.0);
     return out;
 }

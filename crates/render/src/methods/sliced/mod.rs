@@ -51,6 +51,9 @@ pub struct Sliced {
     steep: Option<wgpu::RenderPipeline>,
     /// This frame's row bands, top to bottom.
     bands: Vec<RowBand>,
+    /// Their rows on the GPU, one per [`band_stride`], for the vertex
+    /// shader to drop the quads outside its draw's band.
+    band_rows: wgpu::Buffer,
     group: wgpu::BindGroup,
     params: wgpu::Buffer,
     /// The tile maxima that drop air tiles, and the grid over the footprint.
@@ -95,15 +98,49 @@ fn uniforms_and_textures_layout(device: &wgpu::Device, label: &str) -> wgpu::Bin
     })
 }
 
-/// The slices' group: the footprint uniform, the tile grid uniform and the
-/// tile maxima.
+/// Most row bands a frame draws (`rows::row_bands` gives at most 5 on a
+/// camera without roll; more are drawn as one walking band).
+const MAX_BANDS: usize = 8;
+
+/// Bytes of one band's rows in the bands uniform (`sliced.wgsl::RowBand`).
+const BAND_BYTES: u64 = 16;
+
+/// The slices' group: the footprint uniform, the tile grid uniform, the
+/// tile and block maxima, and the band of rows each draw fills (a dynamic
+/// offset into `bands`).
 fn slices_binding(
     shared: &Shared,
     params: &wgpu::Buffer,
     tiles: &SliceTiles,
+    bands: &wgpu::Buffer,
 ) -> (wgpu::BindGroupLayout, wgpu::BindGroup) {
     let device = &shared.device;
-    let layout = uniforms_and_textures_layout(device, "sliced");
+    let uint_texture = |binding| {
+        texture_entry(
+            binding,
+            wgpu::TextureSampleType::Uint,
+            wgpu::TextureViewDimension::D2,
+        )
+    };
+    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("sliced"),
+        entries: &[
+            uniform_layout_entry(0),
+            uniform_layout_entry(1),
+            uint_texture(2),
+            uint_texture(3),
+            wgpu::BindGroupLayoutEntry {
+                binding: 4,
+                visibility: wgpu::ShaderStages::VERTEX,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: true,
+                    min_binding_size: wgpu::BufferSize::new(BAND_BYTES),
+                },
+                count: None,
+            },
+        ],
+    });
     let group = crate::frame::bind_group(
         device,
         "sliced",
@@ -113,9 +150,20 @@ fn slices_binding(
             tiles.params.as_entire_binding(),
             wgpu::BindingResource::TextureView(tiles.view()),
             wgpu::BindingResource::TextureView(tiles.blocks_view()),
+            wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                buffer: bands,
+                offset: 0,
+                size: wgpu::BufferSize::new(BAND_BYTES),
+            }),
         ],
     );
     (layout, group)
+}
+
+/// Bytes between two bands in the bands uniform: the adapter's dynamic
+/// offset alignment.
+fn band_stride(shared: &Shared) -> u64 {
+    u64::from(shared.device.limits().min_uniform_buffer_offset_alignment).max(BAND_BYTES)
 }
 
 /// A quad's two triangles over its corners (bits: x 1, y 2), as
@@ -133,7 +181,13 @@ pub fn create(
         bytemuck::bytes_of(&forward::FootprintParams::default()),
     );
     let tiles = SliceTiles::new(shared, level);
-    let (layout, group) = slices_binding(shared, &params, &tiles);
+    let bands = shared.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("sliced row bands"),
+        size: band_stride(shared) * MAX_BANDS as u64,
+        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let (layout, group) = slices_binding(shared, &params, &tiles, &bands);
     let marks = |entry| {
         forward_pipeline_into(
             shared,
@@ -166,6 +220,7 @@ pub fn create(
         pipeline,
         steep: (!settings.sliced_all_rows).then_some(steep),
         bands: Vec::new(),
+        band_rows: bands,
         group,
         params,
         tiles,
@@ -228,7 +283,28 @@ impl Method for Sliced {
         f.count[1] = self.slices;
         f.count[2] = slice_near(camera.position.z, self.slices);
         f.count[3] = GAP_TEXELS.min(self.tiles.side());
-        self.bands = row_bands(camera, self.slices);
+        self.bands = if self.steep.is_some() {
+            row_bands(camera, self.slices)
+        } else {
+            Vec::new()
+        };
+        if self.bands.len() > MAX_BANDS || self.bands.is_empty() {
+            self.bands = vec![RowBand {
+                rows: 0..camera.height,
+                walks: true,
+            }];
+        }
+        let stride = band_stride(shared);
+        let mut rows = vec![0u8; (stride * self.bands.len() as u64) as usize];
+        for (band, at) in self
+            .bands
+            .iter()
+            .zip(rows.chunks_exact_mut(stride as usize))
+        {
+            let words = [band.rows.start as f32, band.rows.end as f32, 0.0, 0.0];
+            at[..BAND_BYTES as usize].copy_from_slice(bytemuck::cast_slice(&words));
+        }
+        shared.queue.write_buffer(&self.band_rows, 0, &rows);
         self.tiles_per_slice = self
             .tiles
             .prepare(shared, [f.origin[0], f.origin[1]], f.extent());
@@ -258,6 +334,7 @@ impl Method for Sliced {
 
     fn retained_bytes(&self) -> RetainedBytes {
         // The 48-byte footprint uniform, the quad's 12 bytes of indices, the
+        // row bands' uniform, the
         // tile maxima (kept on the CPU too, for edits), and the refined
         // slicer's marks image.
         let refine = self.refine.as_ref().map(Refine::retained_bytes);
@@ -265,6 +342,7 @@ impl Method for Sliced {
         RetainedBytes {
             gpu: forward::PARAMS_BYTES
                 + quad
+                + self.band_rows.size()
                 + self.tiles.gpu_bytes()
                 + refine.map_or(0, |r| r.gpu),
             cpu: self.tiles.cpu_bytes(),
@@ -278,23 +356,23 @@ impl Sliced {
     /// by the scissor and drawn with the walking or the steep shader.
     fn draw_slices(&self, shared: &Shared, pass: &mut wgpu::RenderPass<'_>) {
         pass.set_bind_group(0, &shared.frame_group, &[]);
-        pass.set_bind_group(1, &self.group, &[]);
         pass.set_index_buffer(self.quad.slice(..), wgpu::IndexFormat::Uint16);
         // At most MAX_SLICES x MAX_TILES_PER_SLICE = 2^30 instances.
         let instances = 0..self.slices * self.tiles_per_slice;
-        let Some(steep) = &self.steep else {
-            pass.set_pipeline(&self.pipeline);
-            pass.draw_indexed(0..6, 0, instances);
-            return;
-        };
         // The bands are of the camera's image, the target's size.
         let (width, height) = (shared.width, shared.height);
-        for band in &self.bands {
+        let stride = band_stride(shared);
+        for (k, band) in self.bands.iter().enumerate() {
             let rows = band.rows.start.min(height)..band.rows.end.min(height);
             if rows.is_empty() {
                 continue;
             }
-            pass.set_pipeline(if band.walks { &self.pipeline } else { steep });
+            let pipeline = match &self.steep {
+                Some(steep) if !band.walks => steep,
+                _ => &self.pipeline,
+            };
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(1, &self.group, &[(stride * k as u64) as u32]);
             pass.set_scissor_rect(0, rows.start, width, rows.end - rows.start);
             pass.draw_indexed(0..6, 0, instances.clone());
         }
