@@ -18,7 +18,9 @@
 const SLICE_TOP: f32 = 256.0;
 // Where a pixel's ray crosses the slices more than GAP_MIN texels apart
 // (grazing rays: the gap is spacing / slope), a thin wall or a peak can sit
-// between two crossings, and the plain point test sees through it. There a
+// between two crossings, and the plain point test sees through it. Plain
+// `sliced` walks such rays once per pixel after the slices
+// (`sliced_gaps.wgsl`); with `/fragwalk` and in the refined slicer's marks a
 // fragment whose point is air walks the ray from the previous slice's
 // crossing (the first slice: from the near plane) to its own point (the
 // last before the far plane: on to the far plane), the last
@@ -26,7 +28,7 @@ const SLICE_TOP: f32 = 256.0;
 // `sliced::GAP_TEXELS`),
 // and keeps the first solid point it meets: the slices then cover the ray
 // without gaps down to slopes of about spacing / count.w. Steeper rays never
-// walk.
+// walk. Rust twin: `sliced::rows::GAP_MIN`.
 const GAP_MIN: f32 = 2.0;
 // The walk from the near plane to the first slice a ray meets: one per
 // pixel, so it may be long (near the horizon the first crossing is hundreds
@@ -39,37 +41,6 @@ struct VertexOut {
     @location(1) @interpolate(flat) altitude: f32,
     // j: the slice at altitude SLICE_TOP - (j + 1) * SLICE_TOP / N
     @location(2) @interpolate(flat) rank: u32,
-}
-
-// The band of image rows this draw fills (`methods::sliced::rows`): x its
-// first row, y the row after its last, in pixels from the top; one draw per
-// band, each at its own dynamic offset.
-struct RowBand {
-    rows: vec4<f32>,
-}
-
-@group(1) @binding(4) var<uniform> row_band: RowBand;
-
-// Whether the quad over [lo, hi] at altitude z may cover a pixel of this
-// draw's band of rows: the rows its corners project to, widened by a row,
-// against the band's (the scissor cuts the band exactly; this only spares
-// the rasteriser the quads it would cut away whole, each band's draw
-// taking every slice's quads again). A corner at or behind the eye's plane:
-// kept.
-fn quad_meets_band(lo: vec2<i32>, hi: vec2<i32>, z: f32) -> bool {
-    var top = 3.0e38;
-    var bottom = -3.0e38;
-    for (var c = 0u; c < 4u; c = c + 1u) {
-        let xy = select(vec2<f32>(lo), vec2<f32>(hi), vec2<bool>((c & 1u) != 0u, (c & 2u) != 0u));
-        let clip = globals.view_proj * vec4<f32>(xy, z, 1.0);
-        if (clip.w <= 1e-3) {
-            return true;
-        }
-        let row = (0.5 - 0.5 * clip.y / clip.w) * globals.screen.y;
-        top = min(top, row);
-        bottom = max(bottom, row);
-    }
-    return bottom >= row_band.rows.x - 1.0 && top <= row_band.rows.y + 1.0;
 }
 
 // Instance i: slice rank i / tiles, tile i % tiles of the footprint's grid;
@@ -92,20 +63,10 @@ fn vs_sliced(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) -> 
     var lo = footprint.origin.xy;
     var hi = lo + extent;
     var out: VertexOut;
-    out.altitude = z;
-    out.rank = j;
-    // A degenerate triangle (all three vertices equal) rasterises nothing.
-    out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
-    out.world = vec3<f32>(0.0);
     if (g.z > 0) {
         let t = i % per_slice;
         let tile = g.xy + vec2<i32>(i32(t % u32(g.z)), i32(t / u32(g.z)));
         let k = slice_tiles.tiles.x;
-        lo = max(lo, tile << vec2<u32>(k));
-        hi = min(hi, (tile + vec2<i32>(1)) << vec2<u32>(k));
-        if (!quad_meets_band(lo, hi, z)) {
-            return out;
-        }
         let wrapped = vec2<u32>(tile) & slice_tiles.tiles.yz;
         // The slices within a spacing of the eye's altitude are the first
         // that rays meet, whose gap walks start at the eye: never culled.
@@ -115,14 +76,23 @@ fn vs_sliced(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) -> 
         // see-through on the views measured.)
         let near_eye = abs(z - globals.eye.z) <= SLICE_TOP / f32(n);
         if (!near_eye && z > f32(textureLoad(tile_max, wrapped, 0).r)) {
+            // A degenerate triangle (all three vertices equal) rasterises nothing.
+            out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
+            out.world = vec3<f32>(0.0);
+            out.altitude = z;
+            out.rank = j;
             return out;
         }
+        lo = max(lo, tile << vec2<u32>(k));
+        hi = min(hi, (tile + vec2<i32>(1)) << vec2<u32>(k));
     }
     // Corner v of the quad (indexed: `methods::sliced::QUAD_INDICES`): x bit
     // 0, y bit 1. A float select: naga writes a vector select as mix(),
     // which GLSL ES 3.00 (WebGL2) has for floats only.
     let xy = select(vec2<f32>(lo), vec2<f32>(hi), vec2<bool>((v & 1u) != 0u, (v & 2u) != 0u));
     out.world = vec3<f32>(xy, z);
+    out.altitude = z;
+    out.rank = j;
     out.clip = globals.view_proj * vec4<f32>(out.world, 1.0);
     return out;
 }
@@ -145,9 +115,8 @@ struct SliceHit {
     maybe: bool,
 }
 
-// The slice's own point test alone: what every fragment of a steep row
-// (`methods::sliced::rows`) needs, whose rays cross the slices at most
-// GAP_MIN texels apart and never walk.
+// The slice's own point test alone, all a fragment needs where its ray
+// crosses the slices at most GAP_MIN texels apart and never walks.
 fn slice_point(in: VertexOut) -> SliceHit {
     var h: SliceHit;
     h.maybe = false;
@@ -209,6 +178,7 @@ fn slice_colour(h: SliceHit) -> vec4<f32> {
     return vec4<f32>(shade_column(h.p, h.cell.x, h.cell.y, h.p - globals.eye.xyz), 1.0);
 }
 
+// `sliced:N/fragwalk`: each air fragment of a grazing ray walks its gap.
 @fragment
 fn fs_sliced(in: VertexOut) -> @location(0) vec4<f32> {
     let h = slice_hit(in, true);
@@ -218,10 +188,11 @@ fn fs_sliced(in: VertexOut) -> @location(0) vec4<f32> {
     return slice_colour(h);
 }
 
-// The rows where no ray walks (`methods::sliced::rows`): the same image as
-// `fs_sliced` there, from a shader without the walk's loop, which costs
-// occupancy on every fragment whether it is taken or not (H100: 9.19 ms
-// against 8.09 with no walk taken).
+// Plain `sliced`: the point test alone, from a shader without the walk's
+// loop, which costs occupancy on every fragment whether it is taken or not
+// (H100: 9.19 ms against 8.09 with no walk taken). The rows of grazing rays
+// are walked once per pixel after the slices (`sliced_gaps.wgsl`); on the
+// others this is `fs_sliced`'s image (`sliced:N/fragwalk`).
 @fragment
 fn fs_sliced_steep(in: VertexOut) -> @location(0) vec4<f32> {
     let h = slice_point(in);
@@ -249,7 +220,8 @@ fn fs_slice_mark(in: VertexOut) -> @location(0) vec4<u32> {
     return vec4<u32>((in.rank + 1u) | select(0u, MARK_MAYBE, h.maybe), 0u, 0u, 0u);
 }
 
-// `fs_slice_mark` on the steep rows: no walk, so never a maybe-mark.
+// `fs_slice_mark` on frames where no ray walks (`methods::sliced::rows`):
+// the same marks without the walk's loop.
 @fragment
 fn fs_slice_mark_steep(in: VertexOut) -> @location(0) vec4<u32> {
     if (!slice_point(in).keep) {

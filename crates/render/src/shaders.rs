@@ -118,6 +118,14 @@ pub const SOURCES: &[(&str, &str)] = &[
         "sliced_refine.wgsl",
         include_str!("../shaders/sliced_refine.wgsl"),
     ),
+    (
+        "sliced_gaps.wgsl",
+        include_str!("../shaders/sliced_gaps.wgsl"),
+    ),
+    (
+        "sliced_gaps_beam.wgsl",
+        include_str!("../shaders/sliced_gaps_beam.wgsl"),
+    ),
     ("mesh.wgsl", include_str!("../shaders/mesh.wgsl")),
     (
         "mesh_colour.wgsl",
@@ -193,6 +201,8 @@ pub const ENTRY_SHADERS: &[&str] = &[
     "painted.wgsl",
     "sliced.wgsl",
     "sliced_refine.wgsl",
+    "sliced_gaps.wgsl",
+    "sliced_gaps_beam.wgsl",
     "mesh.wgsl",
     "mesh_deferred.wgsl",
     "scattered.wgsl",

@@ -111,6 +111,28 @@ pub(crate) fn fullscreen_pipeline(
     ))
 }
 
+/// A full-screen pass that writes its fragments' colour and depth only where
+/// they lie before what the depth target holds (`Less`): a pass that adds
+/// nearer surfaces to a drawn frame.
+pub(crate) fn fullscreen_pipeline_depth_tested(
+    shared: &Shared,
+    label: &str,
+    shader: &str,
+    layout: &wgpu::PipelineLayout,
+    fragment_entry: &str,
+) -> anyhow::Result<wgpu::RenderPipeline> {
+    let module = shared.shader(shader)?;
+    Ok(render_pipeline(
+        shared,
+        label,
+        layout,
+        &module,
+        ("vs_fullscreen", fragment_entry),
+        wgpu::CompareFunction::Less,
+        &[Some(COLOR_FORMAT.into())],
+    ))
+}
+
 /// A compute pipeline of one entry of `shader`.
 pub(crate) fn compute_pipeline(
     shared: &Shared,

@@ -25,11 +25,12 @@ pub struct MethodSettings {
     /// plain slicer.
     #[serde(default)]
     pub sliced_refine: bool,
-    /// `sliced`: draw every image row with the shader that walks slice gaps,
-    /// as before the rows where no ray can walk got a shader without the
-    /// walk (`sliced:512/allrows`): the same image, for A/B timing.
+    /// `sliced`: each slice fragment whose point is air walks its own gap
+    /// along a grazing ray, as issue 36 first did, in place of plain
+    /// `sliced`'s one walk per pixel after the slices (the refined slicer:
+    /// its marks walk on every frame); for A/B (`sliced:512/fragwalk`).
     #[serde(default)]
-    pub sliced_all_rows: bool,
+    pub sliced_fragment_walk: bool,
     /// `scattered`: footprint grid density (x, y, z); the paper's (4, 4, 4).
     pub scatter_density: [f32; 3],
     /// `mesh`: fit quality q in [0, 1]; max error 2^(4(1 - q)) (0.5 → 4).
@@ -76,7 +77,7 @@ impl Default for MethodSettings {
             voxel_steps: 100,
             slices: 512,
             sliced_refine: false,
-            sliced_all_rows: false,
+            sliced_fragment_walk: false,
             scatter_density: [4.0, 4.0, 4.0],
             mesh_quality: 0.5,
             mesh_outline: false,

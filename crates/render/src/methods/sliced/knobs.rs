@@ -5,18 +5,22 @@ use super::super::knobs::{Flag, Knobs, Slider, Sweep, count, plain};
 use anyhow::bail;
 
 pub static KNOBS: Knobs = Knobs {
-    grammar: "N or N/refine, then optionally /allrows",
+    grammar: "N or N/refine, then optionally /fragwalk",
     default: Some("512"),
     parse,
     describe: |s| {
         let refined = if s.sliced_refine { " refined" } else { "" };
-        let all_rows = if s.sliced_all_rows { " all-rows" } else { "" };
-        format!("slices={}{refined}{all_rows}", s.slices)
+        let walk = if s.sliced_fragment_walk {
+            " fragment-walk"
+        } else {
+            ""
+        };
+        format!("slices={}{refined}{walk}", s.slices)
     },
     keep: |from, to| {
         to.slices = from.slices;
         to.sliced_refine = from.sliced_refine;
-        to.sliced_all_rows = from.sliced_all_rows;
+        to.sliced_fragment_walk = from.sliced_fragment_walk;
     },
     sliders: &[Slider::count(
         "slices",
@@ -47,32 +51,32 @@ pub static KNOBS: Knobs = Knobs {
             },
         },
         Flag {
-            long: "sliced-all-rows",
+            long: "sliced-fragment-walk",
             value: None,
-            help: "`sliced`: every image row with the gap-walking shader, none with the steep rows' shader without the walk (the same image, for A/B timing; `sliced:N/allrows`).",
+            help: "`sliced`: each slice fragment walks its own gap on grazing rays, in place of one walk per pixel after the slices (for A/B; `sliced:N/fragwalk`).",
             default: |_| String::new(),
             apply: |_, s| {
-                s.sliced_all_rows = true;
+                s.sliced_fragment_walk = true;
                 Ok(())
             },
         },
     ],
 };
 
-/// `N` (the paper's plain slicer) or `N/refine`, then optionally `/allrows`.
+/// `N` (the paper's plain slicer) or `N/refine`, then optionally `/fragwalk`.
 fn parse(text: &str, s: &mut MethodSettings) -> anyhow::Result<()> {
-    let (text, all_rows) = match text.strip_suffix("/allrows") {
+    let (text, fragment_walk) = match text.strip_suffix("/fragwalk") {
         Some(rest) => (rest, true),
         None => (text, false),
     };
     let (n, refine) = match text.split_once('/') {
         Some((n, "refine")) => (n, true),
-        Some((_, other)) => bail!("`{other}` is not `refine` or `allrows`"),
+        Some((_, other)) => bail!("`{other}` is not `refine` or `fragwalk`"),
         None => (text, false),
     };
     s.slices = plain(count(n))?;
     s.sliced_refine = refine;
-    s.sliced_all_rows = all_rows;
+    s.sliced_fragment_walk = fragment_walk;
     Ok(())
 }
 
@@ -105,24 +109,24 @@ mod tests {
     use super::*;
 
     #[test]
-    fn parses_refine_and_all_rows() {
+    fn parses_refine_and_fragment_walk() {
         let mut s = MethodSettings::default();
-        parse("256/refine/allrows", &mut s).unwrap();
+        parse("256/refine/fragwalk", &mut s).unwrap();
         assert_eq!(
-            (s.slices, s.sliced_refine, s.sliced_all_rows),
+            (s.slices, s.sliced_refine, s.sliced_fragment_walk),
             (256, true, true)
         );
-        parse("512/allrows", &mut s).unwrap();
+        parse("512/fragwalk", &mut s).unwrap();
         assert_eq!(
-            (s.slices, s.sliced_refine, s.sliced_all_rows),
+            (s.slices, s.sliced_refine, s.sliced_fragment_walk),
             (512, false, true)
         );
         parse("64", &mut s).unwrap();
         assert_eq!(
-            (s.slices, s.sliced_refine, s.sliced_all_rows),
+            (s.slices, s.sliced_refine, s.sliced_fragment_walk),
             (64, false, false)
         );
-        assert!(parse("512/allrows/refine", &mut s).is_err());
+        assert!(parse("512/fragwalk/refine", &mut s).is_err());
         assert!(parse("512/fast", &mut s).is_err());
     }
 }

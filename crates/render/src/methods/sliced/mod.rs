@@ -9,30 +9,36 @@
 //! adds one full-screen pass that puts the exact surface crossing behind
 //! each pixel's nearest kept slice (`refine.rs`).
 //!
-//! Either way the slices are drawn band by band of image rows (`rows.rs`):
-//! where no ray of a band can walk a slice gap, with a fragment shader
-//! without the walk.
+//! Grazing rays cross the slices several texels apart, and a thin wall or a
+//! peak between two crossings is missed. Plain `sliced` walks those rays'
+//! gaps once per pixel after the slices, over the bands of rows where they
+//! lie (`rows.rs`, `gaps.rs`); `sliced:N/fragwalk` walks each slice
+//! fragment's own gap instead, as issue 36 first did. The refined slicer's
+//! marks walk theirs in the fragment, on frames that have such rows.
 
 use super::common::{
     begin_pass, begin_pass_into, forward_pipeline, forward_pipeline_into, index_buffer,
 };
 use super::forward::{self, Z_MAX};
+mod gaps;
 mod knobs;
 mod refine;
 mod rows;
 mod tiles;
 use super::contract::{Frame, Method, MethodSettings, RetainedBytes};
 use crate::frame::{Shared, texture_entry, uniform_layout_entry};
+use gaps::Gaps;
 pub use knobs::{KNOBS, SWEEP};
 use refine::{MARK_FORMAT, Refine};
-use rows::{RowBand, row_bands};
+use rows::row_bands;
 use strata_camera::Camera;
 use strata_level::Level;
 use tiles::SliceTiles;
 
 /// Most texel columns a slice fragment whose point is air walks along its
 /// pixel's ray towards it from the previous slice's crossing, where grazing
-/// rays cross the slices more than two texels apart (`sliced.wgsl::slice_hit`),
+/// rays cross the slices more than two texels apart (`sliced.wgsl::slice_hit`:
+/// `sliced:N/fragwalk` and the refined slicer's marks),
 /// at most the culling tiles' side. 32: the slices cover rays without gaps
 /// down to slopes of about 1/48 at 512 slices (the first slice a ray meets
 /// walks from the eye however far; the rays of longer gaps are left to the
@@ -44,16 +50,17 @@ pub const GAP_TEXELS: u32 = 32;
 pub const MAX_SLICES: u32 = 1 << 16;
 
 pub struct Sliced {
-    /// The slices where a ray may walk a gap (`fs_sliced`, `fs_slice_mark`).
+    /// The slices: each fragment's point test (`fs_sliced_steep`, then the
+    /// gap pass), its test and gap walk (`fs_sliced`, `/fragwalk`), or its
+    /// mark (`fs_slice_mark`, refined).
     pipeline: wgpu::RenderPipeline,
-    /// The slices on rows where none can (`fs_sliced_steep`,
-    /// `fs_slice_mark_steep`); `None` with `sliced_all_rows`.
-    steep: Option<wgpu::RenderPipeline>,
-    /// This frame's row bands, top to bottom.
-    bands: Vec<RowBand>,
-    /// Their rows on the GPU, one per [`band_stride`], for the vertex
-    /// shader to drop the quads outside its draw's band.
-    band_rows: wgpu::Buffer,
+    /// The refined slicer's marks without the walk (`fs_slice_mark_steep`),
+    /// on frames where no ray can walk; `None` otherwise.
+    steep_marks: Option<wgpu::RenderPipeline>,
+    /// Plain `sliced`'s gap pass (not with `/fragwalk` or refined).
+    gaps: Option<Gaps>,
+    /// This frame's bands of rows where a ray may walk, top to bottom.
+    walking_rows: Vec<std::ops::Range<u32>>,
     group: wgpu::BindGroup,
     params: wgpu::Buffer,
     /// The tile maxima that drop air tiles, and the grid over the footprint.
@@ -98,49 +105,15 @@ fn uniforms_and_textures_layout(device: &wgpu::Device, label: &str) -> wgpu::Bin
     })
 }
 
-/// Most row bands a frame draws (`rows::row_bands` gives at most 5 on a
-/// camera without roll; more are drawn as one walking band).
-const MAX_BANDS: usize = 8;
-
-/// Bytes of one band's rows in the bands uniform (`sliced.wgsl::RowBand`).
-const BAND_BYTES: u64 = 16;
-
-/// The slices' group: the footprint uniform, the tile grid uniform, the
-/// tile and block maxima, and the band of rows each draw fills (a dynamic
-/// offset into `bands`).
+/// The slices' group: the footprint uniform, the tile grid uniform and the
+/// tile maxima.
 fn slices_binding(
     shared: &Shared,
     params: &wgpu::Buffer,
     tiles: &SliceTiles,
-    bands: &wgpu::Buffer,
 ) -> (wgpu::BindGroupLayout, wgpu::BindGroup) {
     let device = &shared.device;
-    let uint_texture = |binding| {
-        texture_entry(
-            binding,
-            wgpu::TextureSampleType::Uint,
-            wgpu::TextureViewDimension::D2,
-        )
-    };
-    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("sliced"),
-        entries: &[
-            uniform_layout_entry(0),
-            uniform_layout_entry(1),
-            uint_texture(2),
-            uint_texture(3),
-            wgpu::BindGroupLayoutEntry {
-                binding: 4,
-                visibility: wgpu::ShaderStages::VERTEX,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: true,
-                    min_binding_size: wgpu::BufferSize::new(BAND_BYTES),
-                },
-                count: None,
-            },
-        ],
-    });
+    let layout = uniforms_and_textures_layout(device, "sliced");
     let group = crate::frame::bind_group(
         device,
         "sliced",
@@ -150,20 +123,9 @@ fn slices_binding(
             tiles.params.as_entire_binding(),
             wgpu::BindingResource::TextureView(tiles.view()),
             wgpu::BindingResource::TextureView(tiles.blocks_view()),
-            wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                buffer: bands,
-                offset: 0,
-                size: wgpu::BufferSize::new(BAND_BYTES),
-            }),
         ],
     );
     (layout, group)
-}
-
-/// Bytes between two bands in the bands uniform: the adapter's dynamic
-/// offset alignment.
-fn band_stride(shared: &Shared) -> u64 {
-    u64::from(shared.device.limits().min_uniform_buffer_offset_alignment).max(BAND_BYTES)
 }
 
 /// A quad's two triangles over its corners (bits: x 1, y 2), as
@@ -181,13 +143,7 @@ pub fn create(
         bytemuck::bytes_of(&forward::FootprintParams::default()),
     );
     let tiles = SliceTiles::new(shared, level);
-    let bands = shared.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("sliced row bands"),
-        size: band_stride(shared) * MAX_BANDS as u64,
-        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    let (layout, group) = slices_binding(shared, &params, &tiles, &bands);
+    let (layout, group) = slices_binding(shared, &params, &tiles);
     let marks = |entry| {
         forward_pipeline_into(
             shared,
@@ -207,20 +163,26 @@ pub fn create(
             ("vs_sliced", entry),
         )
     };
-    let (pipeline, steep, refine) = if settings.sliced_refine {
-        (
-            marks("fs_slice_mark")?,
-            marks("fs_slice_mark_steep")?,
-            Some(Refine::new(shared, &params, &tiles)?),
-        )
+    let walk_in_fragments = settings.sliced_fragment_walk;
+    let (pipeline, steep_marks, gaps, refine) = if settings.sliced_refine {
+        let steep = if walk_in_fragments {
+            None
+        } else {
+            Some(marks("fs_slice_mark_steep")?)
+        };
+        let refine = Refine::new(shared, &params, &tiles)?;
+        (marks("fs_slice_mark")?, steep, None, Some(refine))
+    } else if walk_in_fragments {
+        (plain("fs_sliced")?, None, None, None)
     } else {
-        (plain("fs_sliced")?, plain("fs_sliced_steep")?, None)
+        let gaps = Gaps::new(shared, level, &params, &tiles)?;
+        (plain("fs_sliced_steep")?, None, Some(gaps), None)
     };
     Ok(Box::new(Sliced {
         pipeline,
-        steep: (!settings.sliced_all_rows).then_some(steep),
-        bands: Vec::new(),
-        band_rows: bands,
+        steep_marks,
+        gaps,
+        walking_rows: Vec::new(),
         group,
         params,
         tiles,
@@ -250,6 +212,9 @@ impl Method for Sliced {
         rects: &[strata_level::DirtyRect],
     ) -> anyhow::Result<()> {
         self.tiles.apply_edit(shared, level, rects);
+        if let Some(gaps) = &mut self.gaps {
+            gaps.apply_edit(rects);
+        }
         Ok(())
     }
 
@@ -260,7 +225,7 @@ impl Method for Sliced {
     ) -> anyhow::Result<bool> {
         let slices = checked_slices(settings)?;
         if settings.sliced_refine != self.refine.is_some()
-            || settings.sliced_all_rows != self.steep.is_none()
+            || settings.sliced_fragment_walk != (self.gaps.is_none() && self.steep_marks.is_none())
         {
             // Another pipeline: a rebuild.
             return Ok(false);
@@ -273,6 +238,9 @@ impl Method for Sliced {
         if let Some(refine) = &mut self.refine {
             refine.resize(shared, &self.params, &self.tiles);
         }
+        if let Some(gaps) = &mut self.gaps {
+            gaps.resize(shared, &self.params, &self.tiles);
+        }
         Ok(())
     }
 
@@ -283,28 +251,15 @@ impl Method for Sliced {
         f.count[1] = self.slices;
         f.count[2] = slice_near(camera.position.z, self.slices);
         f.count[3] = GAP_TEXELS.min(self.tiles.side());
-        self.bands = if self.steep.is_some() {
-            row_bands(camera, self.slices)
-        } else {
-            Vec::new()
-        };
-        if self.bands.len() > MAX_BANDS || self.bands.is_empty() {
-            self.bands = vec![RowBand {
-                rows: 0..camera.height,
-                walks: true,
-            }];
+        self.walking_rows = row_bands(camera, self.slices)
+            .into_iter()
+            .filter(|band| band.walks)
+            .map(|band| band.rows.start.min(shared.height)..band.rows.end.min(shared.height))
+            .filter(|rows| !rows.is_empty())
+            .collect();
+        if let Some(gaps) = &mut self.gaps {
+            gaps.prepare(shared);
         }
-        let stride = band_stride(shared);
-        let mut rows = vec![0u8; (stride * self.bands.len() as u64) as usize];
-        for (band, at) in self
-            .bands
-            .iter()
-            .zip(rows.chunks_exact_mut(stride as usize))
-        {
-            let words = [band.rows.start as f32, band.rows.end as f32, 0.0, 0.0];
-            at[..BAND_BYTES as usize].copy_from_slice(bytemuck::cast_slice(&words));
-        }
-        shared.queue.write_buffer(&self.band_rows, 0, &rows);
         self.tiles_per_slice = self
             .tiles
             .prepare(shared, [f.origin[0], f.origin[1]], f.extent());
@@ -316,9 +271,20 @@ impl Method for Sliced {
 
     fn record(&self, shared: &Shared, frame: &Frame<'_>, encoder: &mut wgpu::CommandEncoder) {
         let Some(refine) = &self.refine else {
+            // The gap pass runs on frames with walking rows only.
+            let gaps = self.gaps.as_ref().filter(|_| !self.walking_rows.is_empty());
+            if let Some(gaps) = gaps {
+                gaps.record_beam(shared, frame, encoder);
+            }
             let mut pass = begin_pass(shared, frame, encoder, "sliced");
-            if !self.empty {
-                self.draw_slices(shared, &mut pass);
+            if self.empty {
+                return;
+            }
+            self.draw_slices(shared, &mut pass);
+            if let Some(gaps) = gaps {
+                for rows in &self.walking_rows {
+                    gaps.draw(shared, &mut pass, rows.clone());
+                }
             }
             return;
         };
@@ -334,17 +300,16 @@ impl Method for Sliced {
 
     fn retained_bytes(&self) -> RetainedBytes {
         // The 48-byte footprint uniform, the quad's 12 bytes of indices, the
-        // row bands' uniform, the
-        // tile maxima (kept on the CPU too, for edits), and the refined
-        // slicer's marks image.
+        // tile maxima (kept on the CPU too, for edits), the refined slicer's
+        // marks image, and the gap pass's beam (its pyramid and starts).
         let refine = self.refine.as_ref().map(Refine::retained_bytes);
         let quad = std::mem::size_of_val(&QUAD_INDICES) as u64;
         RetainedBytes {
             gpu: forward::PARAMS_BYTES
                 + quad
-                + self.band_rows.size()
                 + self.tiles.gpu_bytes()
-                + refine.map_or(0, |r| r.gpu),
+                + refine.map_or(0, |r| r.gpu)
+                + self.gaps.as_ref().map_or(0, Gaps::gpu_bytes),
             cpu: self.tiles.cpu_bytes(),
         }
     }
@@ -352,30 +317,18 @@ impl Method for Sliced {
 
 impl Sliced {
     /// The slices, one instanced draw of a quad per slice and tile (slices
-    /// nearest the eye's altitude first) per band of rows, each band cut out
-    /// by the scissor and drawn with the walking or the steep shader.
+    /// nearest the eye's altitude first).
     fn draw_slices(&self, shared: &Shared, pass: &mut wgpu::RenderPass<'_>) {
+        let pipeline = match &self.steep_marks {
+            Some(steep) if self.walking_rows.is_empty() => steep,
+            _ => &self.pipeline,
+        };
+        pass.set_pipeline(pipeline);
         pass.set_bind_group(0, &shared.frame_group, &[]);
-        pass.set_index_buffer(self.quad.slice(..), wgpu::IndexFormat::Uint16);
+        pass.set_bind_group(1, &self.group, &[]);
         // At most MAX_SLICES x MAX_TILES_PER_SLICE = 2^30 instances.
-        let instances = 0..self.slices * self.tiles_per_slice;
-        // The bands are of the camera's image, the target's size.
-        let (width, height) = (shared.width, shared.height);
-        let stride = band_stride(shared);
-        for (k, band) in self.bands.iter().enumerate() {
-            let rows = band.rows.start.min(height)..band.rows.end.min(height);
-            if rows.is_empty() {
-                continue;
-            }
-            let pipeline = match &self.steep {
-                Some(steep) if !band.walks => steep,
-                _ => &self.pipeline,
-            };
-            pass.set_pipeline(pipeline);
-            pass.set_bind_group(1, &self.group, &[(stride * k as u64) as u32]);
-            pass.set_scissor_rect(0, rows.start, width, rows.end - rows.start);
-            pass.draw_indexed(0..6, 0, instances.clone());
-        }
+        pass.set_index_buffer(self.quad.slice(..), wgpu::IndexFormat::Uint16);
+        pass.draw_indexed(0..6, 0, 0..self.slices * self.tiles_per_slice);
     }
 }
 

@@ -1,15 +1,13 @@
-//! Which image rows of a frame may walk a slice gap, so that the rest are
-//! drawn by a shader without the walk (`sliced.wgsl::fs_sliced_steep`).
-//!
-//! A fragment walks only where its ray crosses the slices more than
-//! [`GAP_MIN`] texels apart (`sliced.wgsl::slice_hit`): rays within a few
-//! degrees of level. The walk's loop costs occupancy on every fragment of
-//! the shader that holds it, walked or not (H100: 9.19 ms a frame with the
-//! walk never taken, against 8.09 without the loop), so the slices are drawn
-//! row band by row band, each with the cheaper shader where no ray of the
-//! band can walk. The camera has no roll, so a row's most level rays are at
-//! its two ends; those are tested, with a margin, and every walking row's
-//! neighbours count as walking too.
+//! Which image rows of a frame hold rays that may cross the slices more
+//! than [`GAP_MIN`] texels apart: rays within a few degrees of level, whose
+//! gaps between slice crossings are walked (`sliced.wgsl::slice_hit`). Plain
+//! `sliced`'s gap pass runs over those rows only (`gaps.rs`), and the refined
+//! slicer's marks use the shader without the walk on frames that have none
+//! (`fs_slice_mark_steep`): the walk's loop costs a shader occupancy on every
+//! fragment, walked or not (H100: 9.19 ms a frame with the walk never taken,
+//! against 8.09 without the loop). The camera has no roll, so a row's most
+//! level rays are at its two ends; those are tested, with a margin, and
+//! every walking row's neighbours count as walking too.
 
 use std::ops::Range;
 use strata_camera::Camera;
@@ -144,11 +142,18 @@ mod tests {
     }
 
     #[test]
-    fn the_rust_twin_matches_the_shader() {
-        let source = include_str!("../../../shaders/sliced.wgsl");
-        assert!(
-            source.contains(&format!("const GAP_MIN: f32 = {GAP_MIN:?};")),
-            "sliced.wgsl's GAP_MIN differs from rows::GAP_MIN ({GAP_MIN:?})"
-        );
+    fn the_rust_twin_matches_the_shaders() {
+        for (name, source) in [
+            ("sliced.wgsl", include_str!("../../../shaders/sliced.wgsl")),
+            (
+                "sliced_gaps.wgsl",
+                include_str!("../../../shaders/sliced_gaps.wgsl"),
+            ),
+        ] {
+            assert!(
+                source.contains(&format!("const GAP_MIN: f32 = {GAP_MIN:?};")),
+                "{name}'s GAP_MIN differs from rows::GAP_MIN ({GAP_MIN:?})"
+            );
+        }
     }
 }

@@ -1,0 +1,150 @@
+//! Issue 36 item 4: grazing rays cross the slices several texels apart.
+//! Plain `sliced` walks their gaps once per pixel after the slices, over the
+//! rows where they lie (`methods::sliced::gaps`); `sliced:512/fragwalk`
+//! walks each slice fragment's own gap, as before. The refined slicer's
+//! marks use a shader without the walk on frames with no such rows.
+//!
+//! On a generated world's twelve views and grazing ones (where the walking
+//! rows sit mid-image):
+//! - plain: against the CPU reference, see-through and covers-sky no worse
+//!   than `/fragwalk`'s (the pass walks every gap whole, long ones too);
+//! - refined: the images equal `/fragwalk`'s (the walking marks shader on
+//!   every frame) bit for bit, colour and depth.
+
+mod common;
+
+use strata_camera::Camera;
+use strata_level::ViewSpec;
+use strata_reference::metrics::Metrics;
+use strata_render::{MethodSettings, Renderer, TerrainColors};
+
+const W: u32 = 320;
+const H: u32 = 200;
+
+fn views(world: &strata_level::World) -> Vec<ViewSpec> {
+    let mut views = world.views.clone();
+    let river = &world.views[0];
+    let at = format!("{},{}", river.x, river.y);
+    for (name, height, pitch) in [
+        ("grazing", 2, 0.0),
+        ("grazing-down", 3, -12.0),
+        ("down-20", 30, -20.0),
+        ("up", 20, 15.0),
+    ] {
+        let spec = format!("{at}:{}:{height}", river.yaw);
+        views.push(ViewSpec::parse(name, &spec, pitch).unwrap());
+    }
+    views
+}
+
+fn settings(refine: bool, fragment_walk: bool) -> MethodSettings {
+    MethodSettings {
+        sliced_refine: refine,
+        sliced_fragment_walk: fragment_walk,
+        ..Default::default()
+    }
+}
+
+#[test]
+fn the_gap_pass_sees_through_no_more_than_fragment_walks() {
+    for gpu in common::gpus() {
+        let world = common::generated_world();
+        let colors = TerrainColors::from_world(&world);
+        let views = views(&world);
+        let mut worst: Vec<Metrics> = Vec::new();
+        for fragment_walk in [false, true] {
+            let label = if fragment_walk {
+                "fragwalk"
+            } else {
+                "gap pass"
+            };
+            let mut r = Renderer::new(
+                &gpu,
+                &world.level,
+                &colors,
+                "sliced",
+                &settings(false, fragment_walk),
+                W,
+                H,
+            )
+            .unwrap();
+            let m = common::worst_over_views(
+                &mut r,
+                &world.level,
+                &views,
+                (W, H),
+                label,
+                |_, _, _, _| {},
+            );
+            eprintln!("{label} worst ({}): {m:?}", gpu.report.backend);
+            worst.push(m);
+        }
+        let (pass, walks) = (&worst[0], &worst[1]);
+        assert!(
+            pass.see_through <= walks.see_through + 0.01,
+            "{pass:?} vs {walks:?}"
+        );
+        assert!(
+            pass.covers_sky <= walks.covers_sky + 0.01,
+            "{pass:?} vs {walks:?}"
+        );
+        assert!(pass.see_through <= 0.5, "{pass:?}");
+        gpu.errors.check().unwrap();
+    }
+}
+
+#[test]
+fn refined_marks_without_the_walk_change_nothing_but_the_work() {
+    for gpu in common::gpus() {
+        let world = common::generated_world();
+        let colors = TerrainColors::from_world(&world);
+        let views = views(&world);
+        let cameras: Vec<Camera> = views
+            .iter()
+            .map(|v| Camera::from_view(&world.level, v, W, H).unwrap())
+            .collect();
+        let mut images = Vec::new();
+        for fragment_walk in [false, true] {
+            let mut r = Renderer::new(
+                &gpu,
+                &world.level,
+                &colors,
+                "sliced",
+                &settings(true, fragment_walk),
+                W,
+                H,
+            )
+            .unwrap();
+            let per_view: Vec<_> = cameras
+                .iter()
+                .map(|c| {
+                    r.render_frame(c).unwrap();
+                    (r.read_depth().unwrap(), r.read_color().unwrap())
+                })
+                .collect();
+            images.push(per_view);
+        }
+        let mut failures = Vec::new();
+        for (view, (steep, walks)) in views.iter().zip(images[0].iter().zip(&images[1])) {
+            let depth = steep.0.iter().zip(&walks.0).filter(|(a, b)| a != b).count();
+            let color = steep
+                .1
+                .chunks_exact(4)
+                .zip(walks.1.chunks_exact(4))
+                .filter(|(a, b)| a != b)
+                .count();
+            eprintln!(
+                "refined {:13} pitch {:5}: {depth} depths, {color} colours differ ({})",
+                view.name, view.pitch, gpu.report.backend
+            );
+            if depth != 0 || color != 0 {
+                failures.push(format!(
+                    "refined {}: {depth} depths and {color} colours differ from /fragwalk",
+                    view.name
+                ));
+            }
+        }
+        assert!(failures.is_empty(), "{}", failures.join("\n"));
+        gpu.errors.check().unwrap();
+    }
+}
