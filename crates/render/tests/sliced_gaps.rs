@@ -148,3 +148,66 @@ fn refined_marks_without_the_walk_change_nothing_but_the_work() {
         gpu.errors.check().unwrap();
     }
 }
+
+/// The gap pass's beam pyramid follows an edit made while the frames had no
+/// walking rows (its queued update runs with the next frame that walks): a
+/// wall raised ahead of a grazing view, the view drawn after a steep frame,
+/// equals a fresh renderer's. Fails when the steep frame drops the queued
+/// update (the beam then starts past the new wall).
+#[test]
+fn an_edit_made_on_a_steep_frame_reaches_the_gap_pass() {
+    for gpu in common::gpus() {
+        let world = common::generated_world();
+        let colors = TerrainColors::from_world(&world);
+        let mut level = world.level.clone();
+        let river = &world.views[0];
+        let grazing = ViewSpec::parse(
+            "grazing",
+            &format!("{},{}:{}:3", river.x, river.y, river.yaw),
+            0.0,
+        )
+        .unwrap();
+        let steep = ViewSpec {
+            pitch: -80.0,
+            ..grazing.clone()
+        };
+        let grazing = Camera::from_view(&level, &grazing, W, H).unwrap();
+        let steep = Camera::from_view(&level, &steep, W, H).unwrap();
+        let settings = settings(false, false);
+        let mut r = Renderer::new(&gpu, &level, &colors, "sliced", &settings, W, H).unwrap();
+        r.render_frame(&grazing).unwrap();
+        // A wall 40 units ahead, across the view.
+        let yaw = grazing.yaw_deg.to_radians();
+        let ahead = grazing.position.truncate() + 40.0 * glam::Vec2::new(yaw.sin(), yaw.cos());
+        let rect = strata_level::edit::EditRect {
+            x: ahead.x as i64 - 12,
+            y: ahead.y as i64 - 12,
+            width: 24,
+            height: 24,
+        };
+        let rects = strata_level::edit::fill_single(&mut level, rect, 250, 3);
+        r.apply_edit(&level, &rects).unwrap();
+        r.render_frame(&steep).unwrap();
+        r.render_frame(&grazing).unwrap();
+        let (depth, color) = (r.read_depth().unwrap(), r.read_color().unwrap());
+        let mut fresh = Renderer::new(&gpu, &level, &colors, "sliced", &settings, W, H).unwrap();
+        fresh.render_frame(&grazing).unwrap();
+        let (want_depth, want_color) = (fresh.read_depth().unwrap(), fresh.read_color().unwrap());
+        let depths = depth
+            .iter()
+            .zip(&want_depth)
+            .filter(|(a, b)| a != b)
+            .count();
+        let colors_differ = color
+            .chunks_exact(4)
+            .zip(want_color.chunks_exact(4))
+            .filter(|(a, b)| a != b)
+            .count();
+        eprintln!(
+            "wall after a steep frame ({}): {depths} depths, {colors_differ} colours differ from a fresh renderer",
+            gpu.report.backend
+        );
+        assert_eq!((depths, colors_differ), (0, 0));
+        gpu.errors.check().unwrap();
+    }
+}

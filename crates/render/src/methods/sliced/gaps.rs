@@ -113,6 +113,8 @@ impl Gaps {
         }
     }
 
+    /// This frame's pyramid updates: only on a frame that records the beam
+    /// ([`Gaps::record_beam`]), which runs them.
     pub fn prepare(&mut self, shared: &Shared) {
         if let Some(beam) = &mut self.beam {
             beam.prepare(shared);

@@ -257,7 +257,10 @@ impl Method for Sliced {
             .map(|band| band.rows.start.min(shared.height)..band.rows.end.min(shared.height))
             .filter(|rows| !rows.is_empty())
             .collect();
-        if let Some(gaps) = &mut self.gaps {
+        // The beam (and its pyramid's queued edits, which `prepare` turns
+        // into this frame's dispatches) runs on frames with walking rows
+        // only; on the others the edits stay queued for the next that has.
+        if let Some(gaps) = self.gaps.as_mut().filter(|_| !self.walking_rows.is_empty()) {
             gaps.prepare(shared);
         }
         self.tiles_per_slice = self
