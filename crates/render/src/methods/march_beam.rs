@@ -207,10 +207,30 @@ impl MarchBeam {
         frame: &Frame<'_>,
         encoder: &mut wgpu::CommandEncoder,
     ) {
+        self.record_pyramid_update(frame, encoder);
+        self.record_beam(shared, frame, encoder);
+    }
+
+    /// The pyramid's update alone, if this frame has one (every frame an
+    /// edit is queued, so the queue never grows; `prepare` schedules it).
+    pub(crate) fn record_pyramid_update(
+        &self,
+        frame: &Frame<'_>,
+        encoder: &mut wgpu::CommandEncoder,
+    ) {
         if self.pyramid.has_work() {
             self.pyramid
                 .record(encoder, frame.timer.compute("march beam pyramid update"));
         }
+    }
+
+    /// The beam pass alone (the pyramid current).
+    pub(crate) fn record_beam(
+        &self,
+        shared: &Shared,
+        frame: &Frame<'_>,
+        encoder: &mut wgpu::CommandEncoder,
+    ) {
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some(self.label),
             timestamp_writes: frame.timer.compute(self.label),

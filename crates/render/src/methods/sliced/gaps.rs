@@ -113,8 +113,7 @@ impl Gaps {
         }
     }
 
-    /// This frame's pyramid updates: only on a frame that records the beam
-    /// ([`Gaps::record_beam`]), which runs them.
+    /// This frame's pyramid updates (run by [`Gaps::record_beam`]).
     pub fn prepare(&mut self, shared: &Shared) {
         if let Some(beam) = &mut self.beam {
             beam.prepare(shared);
@@ -129,15 +128,23 @@ impl Gaps {
         self.group = Self::group(shared, &self.layout, params, tiles, self.beam.as_ref());
     }
 
-    /// The beam pass, before the slices' render pass.
+    /// Before the slices' render pass: the pyramid's update on every frame
+    /// that has one (a frame without walking rows that dropped it would
+    /// leave the pyramid behind the edits; one that kept it queued would
+    /// let the queue grow for as long as the view stays steep), and the
+    /// beam pass where the frame `walks`.
     pub fn record_beam(
         &self,
         shared: &Shared,
         frame: &Frame<'_>,
         encoder: &mut wgpu::CommandEncoder,
+        walks: bool,
     ) {
         if let Some(beam) = &self.beam {
-            beam.record(shared, frame, encoder);
+            beam.record_pyramid_update(frame, encoder);
+            if walks {
+                beam.record_beam(shared, frame, encoder);
+            }
         }
     }
 

@@ -257,10 +257,7 @@ impl Method for Sliced {
             .map(|band| band.rows.start.min(shared.height)..band.rows.end.min(shared.height))
             .filter(|rows| !rows.is_empty())
             .collect();
-        // The beam (and its pyramid's queued edits, which `prepare` turns
-        // into this frame's dispatches) runs on frames with walking rows
-        // only; on the others the edits stay queued for the next that has.
-        if let Some(gaps) = self.gaps.as_mut().filter(|_| !self.walking_rows.is_empty()) {
+        if let Some(gaps) = &mut self.gaps {
             gaps.prepare(shared);
         }
         self.tiles_per_slice = self
@@ -274,11 +271,13 @@ impl Method for Sliced {
 
     fn record(&self, shared: &Shared, frame: &Frame<'_>, encoder: &mut wgpu::CommandEncoder) {
         let Some(refine) = &self.refine else {
-            // The gap pass runs on frames with walking rows only.
-            let gaps = self.gaps.as_ref().filter(|_| !self.walking_rows.is_empty());
-            if let Some(gaps) = gaps {
-                gaps.record_beam(shared, frame, encoder);
+            // The beam's pyramid follows every frame's edits; the beam and
+            // the gap pass run on frames with walking rows only.
+            let walks = !self.walking_rows.is_empty();
+            if let Some(gaps) = &self.gaps {
+                gaps.record_beam(shared, frame, encoder, walks);
             }
+            let gaps = self.gaps.as_ref().filter(|_| walks);
             let mut pass = begin_pass(shared, frame, encoder, "sliced");
             if self.empty {
                 return;
