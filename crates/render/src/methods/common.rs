@@ -99,16 +99,11 @@ pub(crate) fn fullscreen_pipeline(
     layout: &wgpu::PipelineLayout,
     fragment_entry: &str,
 ) -> anyhow::Result<wgpu::RenderPipeline> {
-    let module = shared.shader(shader)?;
-    Ok(render_pipeline(
+    fullscreen_pipeline_with(
         shared,
-        label,
-        layout,
-        &module,
-        ("vs_fullscreen", fragment_entry),
+        (label, shader, layout, fragment_entry),
         wgpu::CompareFunction::Always,
-        &[Some(COLOR_FORMAT.into())],
-    ))
+    )
 }
 
 /// A full-screen pass that writes its fragments' colour and depth only where
@@ -121,6 +116,20 @@ pub(crate) fn fullscreen_pipeline_depth_tested(
     layout: &wgpu::PipelineLayout,
     fragment_entry: &str,
 ) -> anyhow::Result<wgpu::RenderPipeline> {
+    fullscreen_pipeline_with(
+        shared,
+        (label, shader, layout, fragment_entry),
+        wgpu::CompareFunction::Less,
+    )
+}
+
+/// A full-screen triangle's pipeline (label, shader, layout, fragment entry)
+/// into the shared colour format, depth compared by `compare`.
+fn fullscreen_pipeline_with(
+    shared: &Shared,
+    (label, shader, layout, fragment_entry): (&str, &str, &wgpu::PipelineLayout, &str),
+    compare: wgpu::CompareFunction,
+) -> anyhow::Result<wgpu::RenderPipeline> {
     let module = shared.shader(shader)?;
     Ok(render_pipeline(
         shared,
@@ -128,7 +137,7 @@ pub(crate) fn fullscreen_pipeline_depth_tested(
         layout,
         &module,
         ("vs_fullscreen", fragment_entry),
-        wgpu::CompareFunction::Less,
+        compare,
         &[Some(COLOR_FORMAT.into())],
     ))
 }
