@@ -18,7 +18,8 @@
 // count.y: slices N; count.w: the most columns a slice fragment's gap walk
 // takes (`sliced.wgsl::slice_hit`).
 @group(1) @binding(0) var<uniform> footprint: Footprint;
-@group(1) @binding(2) var slice_marks: texture_2d<u32>;
+// (Binding 2 is the beam's tile starts in `sliced_refine_beam.wgsl`.)
+@group(1) @binding(4) var slice_marks: texture_2d<u32>;
 
 // Top of the sliced range (Rust: `forward::Z_MAX`).
 const SLICE_TOP: f32 = 256.0;
@@ -45,8 +46,15 @@ fn gaps_walked(d: vec3<f32>, spacing: f32) -> bool {
     return gap * (abs(d.x) + abs(d.y)) + 2.0 <= f32(footprint.count.w);
 }
 
+// From the near plane (adapters without compute or fragment storage).
 @fragment
 fn fs_sliced_refine(@builtin(position) pos: vec4<f32>) -> RefinedOut {
+    return refine_pixel(pos, 0.0);
+}
+
+// The pixel's search, from `t_start` on (no solid point of its ray lies
+// before it: its tile's beam start, or 0).
+fn refine_pixel(pos: vec4<f32>, t_start: f32) -> RefinedOut {
     let marked = textureLoad(slice_marks, vec2<i32>(pos.xy), 0).x;
     // A maybe-mark: the slice's gap came down to a block's maximum, not
     // necessarily to the ground.
@@ -75,10 +83,24 @@ fn fs_sliced_refine(@builtin(position) pos: vec4<f32>) -> RefinedOut {
     }
     var t = t_k;
     var cell = vec2<i32>(floor((e + d * t_k).xy));
-    var x = walk_gap(e, d, t_near, t_k, REFINE_BLOCKS, true);
-    if (!x.hit && maybe) {
+    // Where the search begins: the start, unless rounding put it at or
+    // past a kept slice point (which is solid, so the start is never truly
+    // past it; then the search runs from the near plane).
+    var t0 = max(t_near, t_start);
+    if (mark != 0u && !maybe && t0 >= t_k) {
+        t0 = t_near;
+    }
+    var x: SegmentHit;
+    x.hit = false;
+    // (`<=`: from the near plane, as before the beam, a zero-length search
+    // at a slice point on the near plane still runs.)
+    if (t0 <= t_k) {
+        x = walk_gap(e, d, t0, t_k, REFINE_BLOCKS, true);
+    }
+    let t_rest = max(t_k, t_start);
+    if (!x.hit && maybe && t_rest <= t_far) {
         // Its depth hid the slices behind: the rest of the ray.
-        x = walk_gap(e, d, t_k, t_far, REFINE_BLOCKS, true);
+        x = walk_gap(e, d, t_rest, t_far, REFINE_BLOCKS, true);
     }
     if (x.hit) {
         t = x.t;

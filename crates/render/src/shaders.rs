@@ -119,6 +119,10 @@ pub const SOURCES: &[(&str, &str)] = &[
         include_str!("../shaders/sliced_refine.wgsl"),
     ),
     (
+        "sliced_refine_beam.wgsl",
+        include_str!("../shaders/sliced_refine_beam.wgsl"),
+    ),
+    (
         "sliced_gaps.wgsl",
         include_str!("../shaders/sliced_gaps.wgsl"),
     ),
@@ -201,6 +205,7 @@ pub const ENTRY_SHADERS: &[&str] = &[
     "painted.wgsl",
     "sliced.wgsl",
     "sliced_refine.wgsl",
+    "sliced_refine_beam.wgsl",
     "sliced_gaps.wgsl",
     "sliced_gaps_beam.wgsl",
     "mesh.wgsl",

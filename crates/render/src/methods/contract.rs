@@ -63,8 +63,10 @@ pub struct MethodSettings {
     /// `ray`, `voxel`: each camera ray's march begins where its 8x8-pixel
     /// tile's beam may first meet the ground (a compute pre-pass over a
     /// max-height pyramid; `ray` also ends a rising ray above the map's
-    /// highest top): the same image in fewer steps. Off (`ray:128/nobeam`,
-    /// `voxel:4,8,2/100/nobeam`): the march as before, for A/B timing.
+    /// highest top): the same image in fewer steps; `sliced`'s per-pixel
+    /// walks (the gap and refine passes) begin there too. Off
+    /// (`ray:128/nobeam`, `voxel:4,8,2/100/nobeam`, `sliced:512/nobeam`):
+    /// from the near plane as before, for A/B timing.
     #[serde(default = "default_march_beam")]
     pub march_beam: bool,
 }

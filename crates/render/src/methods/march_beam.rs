@@ -276,7 +276,7 @@ pub(crate) fn highest_top_in(level: &Level, rects: &[DirtyRect]) -> u32 {
 pub(crate) const NO_BEAM_FLAG: super::knobs::Flag = super::knobs::Flag {
     long: "no-march-beam",
     value: None,
-    help: "`ray`, `voxel`: no beam pre-pass (each ray marches from its near end, as before; `ray:N/nobeam`).",
+    help: "`ray`, `voxel`, `sliced`: no beam pre-pass (each ray marches, and each of `sliced`'s per-pixel walks starts, from its near end, as before; `ray:N/nobeam`).",
     default: |_| String::new(),
     apply: |_, s| {
         s.march_beam = false;

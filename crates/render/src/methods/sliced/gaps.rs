@@ -13,9 +13,11 @@
 
 use super::super::common::fullscreen_pipeline_depth_tested;
 use super::super::contract::Frame;
+use super::super::contract::MethodSettings;
 use super::super::march_beam::MarchBeam;
 use super::tiles::SliceTiles;
-use crate::frame::{Shared, texture_entry, uniform_layout_entry};
+use super::{walk_beam, walk_group, walk_layout};
+use crate::frame::Shared;
 use strata_level::{DirtyRect, Level};
 
 pub struct Gaps {
@@ -30,32 +32,12 @@ impl Gaps {
     pub fn new(
         shared: &Shared,
         level: &Level,
+        settings: &MethodSettings,
         params: &wgpu::Buffer,
         tiles: &SliceTiles,
     ) -> anyhow::Result<Self> {
-        let beam = if MarchBeam::available(shared, level) {
-            Some(MarchBeam::new(shared, level, "sliced gaps beam")?)
-        } else {
-            None
-        };
-        let mut entries = vec![
-            uniform_layout_entry(0),
-            uniform_layout_entry(1),
-            texture_entry(
-                3,
-                wgpu::TextureSampleType::Uint,
-                wgpu::TextureViewDimension::D2,
-            ),
-        ];
-        if beam.is_some() {
-            entries.push(MarchBeam::layout_entry());
-        }
-        let layout = shared
-            .device
-            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("sliced gaps"),
-                entries: &entries,
-            });
+        let beam = walk_beam(shared, level, settings, "sliced gaps beam")?;
+        let layout = walk_layout(&shared.device, "sliced gaps", beam.is_some(), &[]);
         let (shader, entry) = if beam.is_some() {
             ("sliced_gaps_beam.wgsl", "fs_sliced_gaps_beam")
         } else {
@@ -68,41 +50,18 @@ impl Gaps {
             &shared.pipeline_layout("sliced gaps", &[&layout]),
             entry,
         )?;
-        let group = Self::group(shared, &layout, params, tiles, beam.as_ref());
+        let group = walk_group(
+            &shared.device,
+            ("sliced gaps", &layout),
+            (params, tiles),
+            beam.as_ref(),
+            &[],
+        );
         Ok(Gaps {
             layout,
             pipeline,
             group,
             beam,
-        })
-    }
-
-    fn group(
-        shared: &Shared,
-        layout: &wgpu::BindGroupLayout,
-        params: &wgpu::Buffer,
-        tiles: &SliceTiles,
-        beam: Option<&MarchBeam>,
-    ) -> wgpu::BindGroup {
-        let mut entries = vec![
-            wgpu::BindGroupEntry {
-                binding: 0,
-                resource: params.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 1,
-                resource: tiles.params.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 3,
-                resource: wgpu::BindingResource::TextureView(tiles.blocks_view()),
-            },
-        ];
-        entries.extend(beam.map(MarchBeam::binding));
-        shared.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("sliced gaps"),
-            layout,
-            entries: &entries,
         })
     }
 
@@ -125,7 +84,13 @@ impl Gaps {
         if let Some(beam) = &mut self.beam {
             beam.resize(shared);
         }
-        self.group = Self::group(shared, &self.layout, params, tiles, self.beam.as_ref());
+        self.group = walk_group(
+            &shared.device,
+            ("sliced gaps", &self.layout),
+            (params, tiles),
+            self.beam.as_ref(),
+            &[],
+        );
     }
 
     /// Before the slices' render pass: the pyramid's update on every frame

@@ -2,10 +2,11 @@
 
 use super::super::contract::MethodSettings;
 use super::super::knobs::{Flag, Knobs, Slider, Sweep, count, plain};
+use super::super::march_beam::{NO_BEAM_FLAG, nobeam_tag, split_nobeam};
 use anyhow::bail;
 
 pub static KNOBS: Knobs = Knobs {
-    grammar: "N or N/refine, then optionally /fragwalk",
+    grammar: "N or N/refine, then optionally /fragwalk, then optionally /nobeam",
     default: Some("512"),
     parse,
     describe: |s| {
@@ -15,12 +16,13 @@ pub static KNOBS: Knobs = Knobs {
         } else {
             ""
         };
-        format!("slices={}{refined}{walk}", s.slices)
+        format!("slices={}{refined}{walk}{}", s.slices, nobeam_tag(s))
     },
     keep: |from, to| {
         to.slices = from.slices;
         to.sliced_refine = from.sliced_refine;
         to.sliced_fragment_walk = from.sliced_fragment_walk;
+        to.march_beam = from.march_beam;
     },
     sliders: &[Slider::count(
         "slices",
@@ -60,11 +62,16 @@ pub static KNOBS: Knobs = Knobs {
                 Ok(())
             },
         },
+        NO_BEAM_FLAG,
     ],
 };
 
-/// `N` (the paper's plain slicer) or `N/refine`, then optionally `/fragwalk`.
+/// `N` (the paper's plain slicer) or `N/refine`, then optionally
+/// `/fragwalk`, then optionally `/nobeam` (the per-pixel walks from the near
+/// plane).
 fn parse(text: &str, s: &mut MethodSettings) -> anyhow::Result<()> {
+    let (text, beam) = split_nobeam(text);
+    s.march_beam = beam;
     let (text, fragment_walk) = match text.strip_suffix("/fragwalk") {
         Some(rest) => (rest, true),
         None => (text, false),
@@ -127,6 +134,10 @@ mod tests {
             (64, false, false)
         );
         assert!(parse("512/fragwalk/refine", &mut s).is_err());
+        parse("512/refine/nobeam", &mut s).unwrap();
+        assert!(s.sliced_refine && !s.march_beam);
+        parse("512", &mut s).unwrap();
+        assert!(s.march_beam);
         assert!(parse("512/fast", &mut s).is_err());
     }
 }

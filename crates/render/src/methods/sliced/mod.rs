@@ -20,6 +20,7 @@ use super::common::{
     begin_pass, begin_pass_into, forward_pipeline, forward_pipeline_into, index_buffer,
 };
 use super::forward::{self, Z_MAX};
+use super::march_beam::MarchBeam;
 mod gaps;
 mod knobs;
 mod refine;
@@ -61,6 +62,8 @@ pub struct Sliced {
     gaps: Option<Gaps>,
     /// This frame's bands of rows where a ray may walk, top to bottom.
     walking_rows: Vec<std::ops::Range<u32>>,
+    /// `settings.march_beam` at creation (a change rebuilds).
+    march_beam: bool,
     group: wgpu::BindGroup,
     params: wgpu::Buffer,
     /// The tile maxima that drop air tiles, and the grid over the footprint.
@@ -84,8 +87,8 @@ fn checked_slices(settings: &MethodSettings) -> anyhow::Result<u32> {
     Ok(slices)
 }
 
-/// The layout both passes' groups share: uniforms at bindings 0 and 1 (the
-/// footprint, the tile grid), integer textures at 2 and 3.
+/// The slices' layout: uniforms at bindings 0 and 1 (the footprint, the
+/// tile grid), integer textures at 2 and 3 (the tile and block maxima).
 fn uniforms_and_textures_layout(device: &wgpu::Device, label: &str) -> wgpu::BindGroupLayout {
     let uint_texture = |binding| {
         texture_entry(
@@ -103,6 +106,91 @@ fn uniforms_and_textures_layout(device: &wgpu::Device, label: &str) -> wgpu::Bin
             uint_texture(3),
         ],
     })
+}
+
+/// The layout of a per-pixel walk's group (`sliced_walk.wgsl`, the gap and
+/// refine passes): the footprint and tile grid uniforms (0, 1), the block
+/// maxima (3), the beam's tile starts (2, with a beam) and `textures`, more
+/// integer textures (the refine pass's marks).
+fn walk_layout(
+    device: &wgpu::Device,
+    label: &str,
+    beam: bool,
+    textures: &[u32],
+) -> wgpu::BindGroupLayout {
+    let uint_texture = |binding| {
+        texture_entry(
+            binding,
+            wgpu::TextureSampleType::Uint,
+            wgpu::TextureViewDimension::D2,
+        )
+    };
+    let mut entries = vec![
+        uniform_layout_entry(0),
+        uniform_layout_entry(1),
+        uint_texture(3),
+    ];
+    entries.extend(textures.iter().map(|&b| uint_texture(b)));
+    if beam {
+        entries.push(MarchBeam::layout_entry());
+    }
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some(label),
+        entries: &entries,
+    })
+}
+
+/// A group of [`walk_layout`]: `textures` the views at its extra bindings.
+fn walk_group(
+    device: &wgpu::Device,
+    (label, layout): (&str, &wgpu::BindGroupLayout),
+    (params, tiles): (&wgpu::Buffer, &SliceTiles),
+    beam: Option<&MarchBeam>,
+    textures: &[(u32, &wgpu::TextureView)],
+) -> wgpu::BindGroup {
+    let mut entries = vec![
+        wgpu::BindGroupEntry {
+            binding: 0,
+            resource: params.as_entire_binding(),
+        },
+        wgpu::BindGroupEntry {
+            binding: 1,
+            resource: tiles.params.as_entire_binding(),
+        },
+        wgpu::BindGroupEntry {
+            binding: 3,
+            resource: wgpu::BindingResource::TextureView(tiles.blocks_view()),
+        },
+    ];
+    entries.extend(
+        textures
+            .iter()
+            .map(|&(binding, view)| wgpu::BindGroupEntry {
+                binding,
+                resource: wgpu::BindingResource::TextureView(view),
+            }),
+    );
+    entries.extend(beam.map(MarchBeam::binding));
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout,
+        entries: &entries,
+    })
+}
+
+/// The beam of a per-pixel walk, where the adapter runs it and the settings
+/// keep it (`sliced:512/nobeam`: the walks begin at the near plane).
+fn walk_beam(
+    shared: &Shared,
+    level: &Level,
+    settings: &MethodSettings,
+    label: &'static str,
+) -> anyhow::Result<Option<MarchBeam>> {
+    if settings.march_beam && MarchBeam::available(shared, level) {
+        Ok(Some(MarchBeam::new(shared, level, label)?))
+    } else {
+        Ok(None)
+    }
 }
 
 /// The slices' group: the footprint uniform, the tile grid uniform and the
@@ -170,12 +258,12 @@ pub fn create(
         } else {
             Some(marks("fs_slice_mark_steep")?)
         };
-        let refine = Refine::new(shared, &params, &tiles)?;
+        let refine = Refine::new(shared, level, settings, &params, &tiles)?;
         (marks("fs_slice_mark")?, steep, None, Some(refine))
     } else if walk_in_fragments {
         (plain("fs_sliced")?, None, None, None)
     } else {
-        let gaps = Gaps::new(shared, level, &params, &tiles)?;
+        let gaps = Gaps::new(shared, level, settings, &params, &tiles)?;
         (plain("fs_sliced_steep")?, None, Some(gaps), None)
     };
     Ok(Box::new(Sliced {
@@ -183,6 +271,7 @@ pub fn create(
         steep_marks,
         gaps,
         walking_rows: Vec::new(),
+        march_beam: settings.march_beam,
         group,
         params,
         tiles,
@@ -215,6 +304,9 @@ impl Method for Sliced {
         if let Some(gaps) = &mut self.gaps {
             gaps.apply_edit(rects);
         }
+        if let Some(refine) = &mut self.refine {
+            refine.apply_edit(rects);
+        }
         Ok(())
     }
 
@@ -225,6 +317,7 @@ impl Method for Sliced {
     ) -> anyhow::Result<bool> {
         let slices = checked_slices(settings)?;
         if settings.sliced_refine != self.refine.is_some()
+            || settings.march_beam != self.march_beam
             || settings.sliced_fragment_walk != (self.gaps.is_none() && self.steep_marks.is_none())
         {
             // Another pipeline: a rebuild.
@@ -259,6 +352,9 @@ impl Method for Sliced {
             .collect();
         if let Some(gaps) = &mut self.gaps {
             gaps.prepare(shared);
+        }
+        if let Some(refine) = &mut self.refine {
+            refine.prepare(shared);
         }
         self.tiles_per_slice = self
             .tiles

@@ -12,9 +12,16 @@
 //! image; the search runs once per covered pixel.
 
 use super::super::common::{draw_fullscreen_with_depth, fullscreen_pipeline};
+use super::super::contract::MethodSettings;
 use super::super::contract::{Frame, RetainedBytes};
+use super::super::march_beam::MarchBeam;
 use super::tiles::SliceTiles;
+use super::{walk_beam, walk_group, walk_layout};
 use crate::frame::Shared;
+use strata_level::{DirtyRect, Level};
+
+/// The marks' binding in the refine pass's group (`slice_marks`).
+const MARKS_BINDING: u32 = 4;
 
 /// Format of the slice marks: rank + 1 of the kept slice, 0 = none. An
 /// integer format renders everywhere (WebGL2 included), unlike R32Float.
@@ -25,6 +32,9 @@ pub struct Refine {
     layout: wgpu::BindGroupLayout,
     pipeline: wgpu::RenderPipeline,
     marks: Marks,
+    /// The tiles' starts the search begins at (none without compute or
+    /// fragment storage: from the near plane).
+    beam: Option<MarchBeam>,
 }
 
 /// The marks image at the shared targets' size, and the refine pass's group.
@@ -40,22 +50,19 @@ impl Marks {
         layout: &wgpu::BindGroupLayout,
         params: &wgpu::Buffer,
         tiles: &SliceTiles,
+        beam: Option<&MarchBeam>,
     ) -> Self {
         let (_, view) = shared.target_texture(
             "sliced marks",
             MARK_FORMAT,
             wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
         );
-        let group = crate::frame::bind_group(
+        let group = walk_group(
             &shared.device,
-            "sliced refine",
-            layout,
-            &[
-                params.as_entire_binding(),
-                tiles.params.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&view),
-                wgpu::BindingResource::TextureView(tiles.blocks_view()),
-            ],
+            ("sliced refine", layout),
+            (params, tiles),
+            beam,
+            &[(MARKS_BINDING, &view)],
         );
         Marks {
             view,
@@ -67,27 +74,64 @@ impl Marks {
 
 impl Refine {
     /// `params`: the slicer's footprint uniform (slice count, gap walks);
-    /// `tiles`: its block maxima, which let the search step over air.
-    pub fn new(shared: &Shared, params: &wgpu::Buffer, tiles: &SliceTiles) -> anyhow::Result<Self> {
-        let layout = super::uniforms_and_textures_layout(&shared.device, "sliced refine");
+    /// `tiles`: its block maxima, which let the search step over air; the
+    /// search begins at its tile's beam start where the adapter runs the
+    /// beam (`methods::march_beam`).
+    pub fn new(
+        shared: &Shared,
+        level: &Level,
+        settings: &MethodSettings,
+        params: &wgpu::Buffer,
+        tiles: &SliceTiles,
+    ) -> anyhow::Result<Self> {
+        let beam = walk_beam(shared, level, settings, "sliced refine beam")?;
+        let layout = walk_layout(
+            &shared.device,
+            "sliced refine",
+            beam.is_some(),
+            &[MARKS_BINDING],
+        );
+        let (shader, entry) = if beam.is_some() {
+            ("sliced_refine_beam.wgsl", "fs_sliced_refine_beam")
+        } else {
+            ("sliced_refine.wgsl", "fs_sliced_refine")
+        };
         let pipeline = fullscreen_pipeline(
             shared,
             "sliced refine",
-            "sliced_refine.wgsl",
+            shader,
             &shared.pipeline_layout("sliced refine", &[&layout]),
-            "fs_sliced_refine",
+            entry,
         )?;
-        let marks = Marks::new(shared, &layout, params, tiles);
+        let marks = Marks::new(shared, &layout, params, tiles, beam.as_ref());
         Ok(Refine {
             layout,
             pipeline,
             marks,
+            beam,
         })
     }
 
-    /// A marks image at the shared targets' new size.
+    /// A marks image (and beam starts) at the shared targets' new size.
     pub fn resize(&mut self, shared: &Shared, params: &wgpu::Buffer, tiles: &SliceTiles) {
-        self.marks = Marks::new(shared, &self.layout, params, tiles);
+        if let Some(beam) = &mut self.beam {
+            beam.resize(shared);
+        }
+        self.marks = Marks::new(shared, &self.layout, params, tiles, self.beam.as_ref());
+    }
+
+    /// Queue an edit's rectangles for the beam's pyramid.
+    pub fn apply_edit(&mut self, rects: &[DirtyRect]) {
+        if let Some(beam) = &mut self.beam {
+            beam.enqueue(rects);
+        }
+    }
+
+    /// This frame's pyramid updates (run by [`Refine::record`]).
+    pub fn prepare(&mut self, shared: &Shared) {
+        if let Some(beam) = &mut self.beam {
+            beam.prepare(shared);
+        }
     }
 
     /// The slice pass's colour target: the marks, cleared to 0 (no slice).
@@ -106,6 +150,9 @@ impl Refine {
     /// Record the refine pass: sky where no slice was kept (colour cleared,
     /// the slice pass's depth kept), the exact crossing elsewhere.
     pub fn record(&self, shared: &Shared, frame: &Frame<'_>, encoder: &mut wgpu::CommandEncoder) {
+        if let Some(beam) = &self.beam {
+            beam.record(shared, frame, encoder);
+        }
         // Sky where no slice was kept; the slice pass's depth stays.
         draw_fullscreen_with_depth(
             shared,
@@ -118,10 +165,10 @@ impl Refine {
         );
     }
 
-    /// The marks image (4 bytes a pixel).
+    /// The marks image (4 bytes a pixel) and the beam.
     pub fn retained_bytes(&self) -> RetainedBytes {
         RetainedBytes {
-            gpu: self.marks.bytes,
+            gpu: self.marks.bytes + self.beam.as_ref().map_or(0, MarchBeam::gpu_bytes),
             cpu: 0,
         }
     }
