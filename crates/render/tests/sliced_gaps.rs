@@ -45,6 +45,26 @@ fn settings(refine: bool, fragment_walk: bool) -> MethodSettings {
     }
 }
 
+/// `sliced` with `settings` over `cameras`: each view's distances along the
+/// pixels' rays (infinite: sky) and colours.
+fn draw_views(
+    gpu: &strata_render::Gpu,
+    (world, colors): (&strata_level::World, &TerrainColors),
+    settings: &MethodSettings,
+    cameras: &[Camera],
+) -> Vec<(Vec<f32>, Vec<u8>)> {
+    let mut r = Renderer::new(gpu, &world.level, colors, "sliced", settings, W, H).unwrap();
+    cameras
+        .iter()
+        .map(|c| {
+            r.render_frame(c).unwrap();
+            let depth = r.read_depth().unwrap();
+            let distance = strata_reference::metrics::distance_from_depth(c, &depth);
+            (distance, r.read_color().unwrap())
+        })
+        .collect()
+}
+
 #[test]
 fn the_gap_pass_sees_through_no_more_than_fragment_walks() {
     for gpu in common::gpus() {
@@ -103,27 +123,10 @@ fn refined_marks_without_the_walk_change_nothing_but_the_work() {
             .iter()
             .map(|v| Camera::from_view(&world.level, v, W, H).unwrap())
             .collect();
-        let mut images = Vec::new();
-        for fragment_walk in [false, true] {
-            let mut r = Renderer::new(
-                &gpu,
-                &world.level,
-                &colors,
-                "sliced",
-                &settings(true, fragment_walk),
-                W,
-                H,
-            )
-            .unwrap();
-            let per_view: Vec<_> = cameras
-                .iter()
-                .map(|c| {
-                    r.render_frame(c).unwrap();
-                    (r.read_depth().unwrap(), r.read_color().unwrap())
-                })
-                .collect();
-            images.push(per_view);
-        }
+        let images: Vec<_> = [false, true]
+            .into_iter()
+            .map(|walk| draw_views(&gpu, (&world, &colors), &settings(true, walk), &cameras))
+            .collect();
         let mut failures = Vec::new();
         for (view, (steep, walks)) in views.iter().zip(images[0].iter().zip(&images[1])) {
             let depth = steep.0.iter().zip(&walks.0).filter(|(a, b)| a != b).count();
@@ -233,25 +236,16 @@ fn the_beam_start_changes_nothing_but_the_work() {
             .collect();
         let mut failures = Vec::new();
         for refine in [false, true] {
-            let mut images = Vec::new();
-            for beam in [true, false] {
-                let settings = MethodSettings {
-                    march_beam: beam,
-                    ..settings(refine, false)
-                };
-                let mut r =
-                    Renderer::new(&gpu, &world.level, &colors, "sliced", &settings, W, H).unwrap();
-                let per_view: Vec<_> = cameras
-                    .iter()
-                    .map(|c| {
-                        r.render_frame(c).unwrap();
-                        let depth = r.read_depth().unwrap();
-                        let distance = strata_reference::metrics::distance_from_depth(c, &depth);
-                        (distance, r.read_color().unwrap())
-                    })
-                    .collect();
-                images.push(per_view);
-            }
+            let images: Vec<_> = [true, false]
+                .into_iter()
+                .map(|beam| {
+                    let settings = MethodSettings {
+                        march_beam: beam,
+                        ..settings(refine, false)
+                    };
+                    draw_views(&gpu, (&world, &colors), &settings, &cameras)
+                })
+                .collect();
             let label = if refine { "refined" } else { "plain" };
             for (view, (on, off)) in views.iter().zip(images[0].iter().zip(&images[1])) {
                 let class =
