@@ -45,6 +45,22 @@ fn settings(refine: bool, fragment_walk: bool) -> MethodSettings {
     }
 }
 
+/// The views' cameras at the tests' size.
+fn cameras_of(world: &strata_level::World, views: &[ViewSpec]) -> Vec<Camera> {
+    views
+        .iter()
+        .map(|v| Camera::from_view(&world.level, v, W, H).unwrap())
+        .collect()
+}
+
+/// Pixels whose RGBA colours differ.
+fn colours_differ(a: &[u8], b: &[u8]) -> usize {
+    a.chunks_exact(4)
+        .zip(b.chunks_exact(4))
+        .filter(|(a, b)| a != b)
+        .count()
+}
+
 /// `sliced` with `settings` over `cameras`: each view's distances along the
 /// pixels' rays (infinite: sky) and colours.
 fn draw_views(
@@ -119,10 +135,7 @@ fn refined_marks_without_the_walk_change_nothing_but_the_work() {
         let world = common::generated_world();
         let colors = TerrainColors::from_world(&world);
         let views = views(&world);
-        let cameras: Vec<Camera> = views
-            .iter()
-            .map(|v| Camera::from_view(&world.level, v, W, H).unwrap())
-            .collect();
+        let cameras = cameras_of(&world, &views);
         let images: Vec<_> = [false, true]
             .into_iter()
             .map(|walk| draw_views(&gpu, (&world, &colors), &settings(true, walk), &cameras))
@@ -130,12 +143,7 @@ fn refined_marks_without_the_walk_change_nothing_but_the_work() {
         let mut failures = Vec::new();
         for (view, (steep, walks)) in views.iter().zip(images[0].iter().zip(&images[1])) {
             let depth = steep.0.iter().zip(&walks.0).filter(|(a, b)| a != b).count();
-            let color = steep
-                .1
-                .chunks_exact(4)
-                .zip(walks.1.chunks_exact(4))
-                .filter(|(a, b)| a != b)
-                .count();
+            let color = colours_differ(&steep.1, &walks.1);
             eprintln!(
                 "refined {:13} pitch {:5}: {depth} depths, {color} colours differ ({})",
                 view.name, view.pitch, gpu.report.backend
@@ -201,11 +209,7 @@ fn an_edit_made_on_a_steep_frame_reaches_the_gap_pass() {
             .zip(&want_depth)
             .filter(|(a, b)| a != b)
             .count();
-        let colors_differ = color
-            .chunks_exact(4)
-            .zip(want_color.chunks_exact(4))
-            .filter(|(a, b)| a != b)
-            .count();
+        let colors_differ = colours_differ(&color, &want_color);
         eprintln!(
             "wall after a steep frame ({}): {depths} depths, {colors_differ} colours differ from a fresh renderer",
             gpu.report.backend
@@ -230,10 +234,7 @@ fn the_beam_start_changes_nothing_but_the_work() {
         let world = common::generated_world();
         let colors = TerrainColors::from_world(&world);
         let views = views(&world);
-        let cameras: Vec<Camera> = views
-            .iter()
-            .map(|v| Camera::from_view(&world.level, v, W, H).unwrap())
-            .collect();
+        let cameras = cameras_of(&world, &views);
         let mut failures = Vec::new();
         for refine in [false, true] {
             let images: Vec<_> = [true, false]
@@ -262,11 +263,7 @@ fn the_beam_start_changes_nothing_but_the_work() {
                 let rel = rels.iter().copied().fold(0.0, f64::max);
                 let far = rels.iter().filter(|&&r| r > 1e-4).count();
                 let far_pct = 100.0 * far as f64 / f64::from(W * H);
-                let color =
-                    on.1.chunks_exact(4)
-                        .zip(off.1.chunks_exact(4))
-                        .filter(|(a, b)| a != b)
-                        .count();
+                let color = colours_differ(&on.1, &off.1);
                 let color_pct = 100.0 * color as f64 / f64::from(W * H);
                 eprintln!(
                     "{label:7} {:13} pitch {:5}: {class} hit/miss differ, distance {rel:.2e} relative at most, {far} over 1e-4, {color_pct:.4} % colours ({})",
