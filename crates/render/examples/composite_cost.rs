@@ -1,15 +1,19 @@
-//! What `Renderer::render_into` adds to a frame: the GPU time of getting
-//! Strata's colour and depth into the caller's views, per target format
-//! pair and usage, by timestamp queries (wall clock of a submit-and-wait
-//! where the adapter has none). Each line names the road it took
-//! (`strata_render::composite_split`): colour by compute or by copy, depth
-//! by a pass from the method's image or by copy, or the full-screen pass.
-//! The roads that read Strata's own depth target (a depth copy, the pass)
-//! also make a compute method blit its depth image into that target: the
-//! first line's two frame times show what that blit costs.
+//! What `Renderer::render_into` adds to a frame, per target format pair and
+//! usage: the median GPU time of a `render_into` frame (every pass stamped,
+//! `Renderer::render_into_timed`) less that of the same frame drawn into
+//! Strata's own targets (`render_frame`), and, apart, the copy of the last
+//! frame alone (`record_copy_into`, what showing one frame in more targets
+//! costs). Timestamp queries (wall clock of a submit-and-wait where the
+//! adapter has none). Each line names the road `render_into` took
+//! (`strata_render::composite_split`): colour by the method's own shading,
+//! by compute or by copy, depth by a pass from the method's image or by
+//! copy, or the full-screen pass. The roads that read Strata's own depth
+//! target (a depth copy, the pass) also make a compute method blit its depth
+//! image into that target: the first line's two frame times show what that
+//! blit costs.
 //!
 //! ```text
-//! cargo run --release -p strata-render --example composite_cost -- [--size WxH] [--frames N] [--method NAME]
+//! cargo run --release -p strata-render --example composite_cost -- [--size WxH] [--frames N] [--method NAME] [--shadows]
 //! ```
 
 use std::time::Instant;
@@ -19,8 +23,13 @@ use wgpu::TextureFormat as F;
 
 fn main() -> anyhow::Result<()> {
     let (mut size, mut frames, mut method) = ((1280u32, 800u32), 200u32, "mesh".to_string());
+    let mut shadows = false;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
+        if a == "--shadows" {
+            shadows = true;
+            continue;
+        }
         let v = args
             .next()
             .ok_or_else(|| anyhow::anyhow!("{a} needs a value"))?;
@@ -46,7 +55,7 @@ fn main() -> anyhow::Result<()> {
         size.1,
     )?;
     let settings = MethodSettings {
-        shadows: false,
+        shadows,
         ..Default::default()
     };
     let colors = TerrainColors::test_ramps();
@@ -137,6 +146,8 @@ fn main() -> anyhow::Result<()> {
         };
         let (cv, dv) = (target(color), target(depth));
         let targets = TargetViews::new(&cv, &dv);
+        // The copy reads Strata's own targets: a frame drawn into them.
+        r.render_frame(&camera)?;
         let mut times = Vec::new();
         let mut road = None;
         for _ in 0..frames {
@@ -166,9 +177,22 @@ fn main() -> anyhow::Result<()> {
                 None => wall,
             });
         }
-        let road = road.map_or("no frames".to_string(), |r| r.to_string());
+        let copy_road = road.map_or("no frames".to_string(), |r| r.to_string());
+        let into: Vec<f64> = (0..frames)
+            .map(|_| {
+                r.render_into_timed(&camera, &targets)
+                    .map(|t| t.gpu_ms.unwrap_or(t.cpu_ms))
+            })
+            .collect::<anyhow::Result<_>>()?;
+        let road = r.last_road().map_or("none".to_string(), |r| r.to_string());
+        let into = median(into);
+        // The frame alone again, after the copies (the clock may have moved).
+        r.set_depth_attachment(false);
+        let alone_now = frame_ms(&mut r)?;
+        r.set_depth_attachment(true);
         println!(
-            "into {color:?} + {depth:?} x{samples} ({usage:?}): median {:.3} ms, min {:.3} ms over {frames}: {road}",
+            "into {color:?} + {depth:?} x{samples} ({usage:?}): render_into frame {into:.3} ms, the frame alone {alone_now:.3}: adds {:.3} ms ({road}); the copy alone median {:.3} ms, min {:.3} over {frames} ({copy_road})",
+            into - alone_now,
             median(times.clone()),
             times.iter().copied().fold(f64::INFINITY, f64::min)
         );

@@ -35,6 +35,11 @@ pub enum ColorRoute {
     },
     /// A texture copy (the caller's texture is Strata's format).
     Copy,
+    /// No extra pass: the method's own shading stored each pixel into the
+    /// caller's texture (a compute method, into an `Rgba8Unorm` texture with
+    /// `STORAGE_BINDING`; [`crate::Renderer::render_into`] only, where the
+    /// road would otherwise be `Storage { linear: false }`).
+    Direct,
 }
 
 /// How the frame's depth reaches the caller's depth texture.
@@ -70,6 +75,7 @@ impl std::fmt::Display for CompositeRoute {
                 let color = match color {
                     ColorRoute::Storage { .. } => "colour by compute",
                     ColorRoute::Copy => "colour by copy",
+                    ColorRoute::Direct => "colour stored by the method's shading",
                 };
                 let depth = match depth {
                     DepthRoute::FromImage => "depth by a depth-only pass from the method's image",
@@ -356,6 +362,7 @@ impl SplitCache {
         targets: &TargetViews<'_>,
         (color, depth): (ColorRoute, DepthRoute),
         depth_image: Option<&wgpu::Texture>,
+        timer: Option<&crate::timing::PassTimer>,
     ) -> anyhow::Result<()> {
         let device = shared.device.clone();
         let size = wgpu::Extent3d {
@@ -370,7 +377,7 @@ impl SplitCache {
                 let group = self.color_group(shared, targets.color, &built.layout);
                 let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                     label: Some("composite colour"),
-                    timestamp_writes: None,
+                    timestamp_writes: timer.and_then(|t| t.compute("composite colour")),
                 });
                 pass.set_pipeline(&built.pipeline);
                 pass.set_bind_group(0, &group, &[]);
@@ -381,6 +388,7 @@ impl SplitCache {
                 targets.color.texture().as_image_copy(),
                 size,
             ),
+            ColorRoute::Direct => {}
         }
         match depth {
             DepthRoute::Copy => encoder.copy_texture_to_texture(
@@ -409,7 +417,7 @@ impl SplitCache {
                             store: wgpu::StoreOp::Store,
                         }),
                     }),
-                    timestamp_writes: None,
+                    timestamp_writes: timer.and_then(|t| t.render("composite depth")),
                     occlusion_query_set: None,
                     multiview_mask: None,
                 });

@@ -24,7 +24,7 @@
 //! [`wgpu::CompareFunction::Less`] and `LoadOp::Load` on both views.
 
 use crate::composite::{TargetError, TargetViews, key_of, record_composite};
-use crate::composite_split::{CompositeRoute, DepthRoute, RouteInputs, route};
+use crate::composite_split::{ColorRoute, CompositeRoute, DepthRoute, RouteInputs, route};
 use crate::gpu::catching;
 use crate::renderer::Renderer;
 use strata_camera::Camera;
@@ -79,23 +79,33 @@ impl Renderer {
                     // Depth from the method's own image skips the blit into
                     // Strata's depth target; a copy reads that target.
                     let fill_depth = depth == DepthRoute::Copy;
-                    let mut encoder = self.record_frame_with(camera, fill_depth)?;
+                    // A compute method's shading stores straight into a
+                    // storage texture of its own format: no colour pass.
+                    let color_into =
+                        (color == ColorRoute::Storage { linear: false }).then_some(targets.color);
+                    let (mut encoder, direct) =
+                        self.record_frame_into(camera, fill_depth, color_into)?;
+                    let color = if direct { ColorRoute::Direct } else { color };
                     split.record(
                         &mut encoder,
                         self.shared(),
                         targets,
                         (color, depth),
                         self.active_depth_image(),
+                        Some(&self.timer),
                     )?;
-                    anyhow::Ok(encoder.finish())
+                    self.timer.resolve(&mut encoder);
+                    anyhow::Ok((encoder.finish(), CompositeRoute::Split { color, depth }))
                 }
                 CompositeRoute::Pass => {
                     // The composite reads the shared depth target: fill it.
                     let pipeline = composite.pipeline(&device, key)?;
                     let group = composite.group(self.shared());
-                    let mut encoder = self.record_frame_with(camera, true)?;
-                    record_composite(&mut encoder, targets, key, &pipeline, &group, None);
-                    anyhow::Ok(encoder.finish())
+                    let (mut encoder, _) = self.record_frame_into(camera, true, None)?;
+                    let stamps = self.timer.render("composite");
+                    record_composite(&mut encoder, targets, key, &pipeline, &group, stamps);
+                    self.timer.resolve(&mut encoder);
+                    anyhow::Ok((encoder.finish(), route))
                 }
             }
         });
@@ -114,8 +124,55 @@ impl Renderer {
             }
             .into());
         }
-        self.submit(recorded?);
+        let (commands, taken) = recorded?;
+        self.last_road = Some(taken);
+        self.submit(commands);
         self.errors.check()
+    }
+
+    /// [`Renderer::render_into`], then wait for the GPU and return the
+    /// frame's timings, the passes into the caller's views included
+    /// (`composite colour`, `composite depth` or `composite`; a texture copy
+    /// has no pass to stamp). What `examples/composite_cost.rs` sets against
+    /// [`Renderer::render_frame`].
+    pub fn render_into_timed(
+        &mut self,
+        camera: &Camera,
+        targets: &TargetViews<'_>,
+    ) -> anyhow::Result<crate::FrameTimings> {
+        let start = std::time::Instant::now();
+        self.render_into(camera, targets)?;
+        crate::gpu::wait_device(&self.shared().device, &self.errors)?;
+        let cpu_ms = start.elapsed().as_secs_f64() * 1e3;
+        let (gpu_ms, passes) = self.timer.read(&self.shared().device, &self.errors)?;
+        Ok(crate::FrameTimings {
+            gpu_ms,
+            cpu_ms,
+            record_ms: 0.0,
+            passes,
+            untimed_passes: self.timer.untimed(),
+        })
+    }
+
+    /// The road the last [`Renderer::render_into`] took (`None` before the
+    /// first). On the split road with a compute method and an `Rgba8Unorm`
+    /// storage texture, colour is [`ColorRoute::Direct`]: the method's
+    /// shading stored it, and Strata's own colour target does not hold that
+    /// frame ([`Renderer::read_color`] and [`Renderer::record_copy_into`]
+    /// refuse until the next [`Renderer::render_frame`]).
+    pub fn last_road(&self) -> Option<CompositeRoute> {
+        self.last_road
+    }
+
+    /// An error unless Strata's own colour target holds the last frame.
+    pub(crate) fn shared_color_current(&self) -> anyhow::Result<()> {
+        if self.color_target_current {
+            return Ok(());
+        }
+        anyhow::bail!(
+            "the frame last drawn ({}) stored its colour straight into the caller's texture (`render_into`), not into Strata's colour target: read it there, or draw the frame with `render_frame`",
+            self.method_name()
+        )
     }
 }
 
@@ -144,6 +201,7 @@ impl Renderer {
                 ..
             }
         );
+        self.shared_color_current()?;
         if reads_shared_depth && !self.depth_target_current {
             anyhow::bail!(
                 "the frame last drawn ({}) left its depth in the method's own image, not in the shared depth target this copy reads: draw it with `render_into`, or call `set_depth_attachment(true)` before `render_frame`",
@@ -174,6 +232,7 @@ impl Renderer {
                 targets,
                 (color, depth),
                 self.active_depth_image(),
+                None,
             );
             self.split = split;
             recorded?;

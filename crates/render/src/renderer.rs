@@ -42,7 +42,7 @@ pub struct Renderer {
     methods: Vec<Built>,
     active: usize,
     shadow: ShadowPass,
-    timer: PassTimer,
+    pub(crate) timer: PassTimer,
     pub(crate) errors: ErrorSink,
     level_shape: LevelShape,
     frames: u64,
@@ -59,6 +59,12 @@ pub struct Renderer {
     depth_attachment: bool,
     /// Whether the shared depth target holds the last frame's depth.
     pub(crate) depth_target_current: bool,
+    /// Whether the shared colour target holds the last frame's colour (not
+    /// after an embedding frame whose shading stored it into the caller's
+    /// texture: [`Renderer::render_into`]).
+    pub(crate) color_target_current: bool,
+    /// The road the last [`Renderer::render_into`] took.
+    pub(crate) last_road: Option<crate::composite_split::CompositeRoute>,
     /// Depth read-back through a pass, where depth copies are missing.
     depth_reader: Option<DepthReader>,
     /// The newest frame's submission ([`Renderer::hold_busy`] bounds the queue by it).
@@ -154,6 +160,8 @@ impl Renderer {
             shadow_cull: gpu.options.shadow_cull,
             depth_attachment: gpu.options.depth_attachment,
             depth_target_current: false,
+            color_target_current: true,
+            last_road: None,
             depth_reader,
             edit_listener: None,
             composite: Default::default(),
@@ -562,6 +570,22 @@ impl Renderer {
         camera: &Camera,
         depth_attachment: bool,
     ) -> anyhow::Result<wgpu::CommandEncoder> {
+        let (mut encoder, _) = self.record_frame_into(camera, depth_attachment, None)?;
+        self.timer.resolve(&mut encoder);
+        Ok(encoder)
+    }
+
+    /// [`Renderer::record_frame_with`] with the method's shading storing
+    /// colour into `color_into` where it can (an embedding frame; `None`:
+    /// the shared colour target), without resolving the frame's timestamps
+    /// (the caller may time passes after it). Returns whether the colour
+    /// went into `color_into`.
+    pub(crate) fn record_frame_into(
+        &mut self,
+        camera: &Camera,
+        depth_attachment: bool,
+        color_into: Option<&wgpu::TextureView>,
+    ) -> anyhow::Result<(wgpu::CommandEncoder, bool)> {
         if camera.width != self.shared.width || camera.height != self.shared.height {
             anyhow::bail!(
                 "camera is {}x{} but the renderer was built for {}x{}",
@@ -581,6 +605,13 @@ impl Renderer {
             .queue
             .write_buffer(&self.shared.globals, 0, bytemuck::bytes_of(&globals));
         let method = &mut self.methods[self.active].method;
+        // Every frame says where its colour goes: a method left storing into
+        // a caller's texture by the last embedding frame stores into the
+        // shared target again.
+        let direct = color_into.is_some() && method.store_color_into(&self.shared, color_into)?;
+        if color_into.is_none() {
+            method.store_color_into(&self.shared, None)?;
+        }
         method.prepare(&self.shared, camera)?;
 
         let mut encoder = self
@@ -607,8 +638,8 @@ impl Renderer {
             self.shadow_drawn = (!method.shadow_map_is_partial()).then_some(shadow);
         }
         method.record(&self.shared, &frame, &mut encoder);
-        self.timer.resolve(&mut encoder);
-        Ok(encoder)
+        self.color_target_current = !direct;
+        Ok((encoder, direct))
     }
 
     /// Submit a frame's commands and count it.
@@ -726,6 +757,7 @@ impl Renderer {
     /// # Ok(()) }
     /// ```
     pub fn read_color(&self) -> anyhow::Result<Vec<u8>> {
+        self.shared_color_current()?;
         self.read_texture(&self.shared.color, wgpu::TextureAspect::All)
     }
 

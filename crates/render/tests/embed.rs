@@ -328,11 +328,26 @@ fn every_road_on(gpu: &Gpu) {
                 r.render_into(&camera, &targets).unwrap();
                 gpu.wait().unwrap();
                 images.push((read(&color_tex), read(&depth_tex)));
-                // The road `render_into` took, said by the copy-only call
-                // (after a frame that also fills Strata's depth target).
+                let taken = r.last_road().unwrap();
+                if let CompositeRoute::Split {
+                    color: ColorRoute::Direct,
+                    ..
+                } = taken
+                {
+                    // Strata's colour target missed that frame: no stale read.
+                    let refused = r.read_color().unwrap_err().to_string();
+                    assert!(refused.contains("render_into"), "{refused}");
+                }
+                // The copy-only call's road (after a frame that also fills
+                // Strata's depth target).
                 r.set_depth_attachment(true);
                 r.render_frame(&camera).unwrap();
                 r.set_depth_attachment(false);
+                if color_format == F::Rgba8Unorm {
+                    // The frame's colour is back in Strata's target, as the
+                    // pass road stored it.
+                    assert_eq!(r.read_color().unwrap(), images[0].0, "{name} {usage:?}");
+                }
                 let mut encoder = gpu.device.create_command_encoder(&Default::default());
                 let road = r.record_copy_into(&mut encoder, &targets, None).unwrap();
                 gpu.queue.submit([encoder.finish()]);
@@ -347,7 +362,23 @@ fn every_road_on(gpu: &Gpu) {
                 match (road, expected_color) {
                     (CompositeRoute::Split { color, depth }, Some(expected)) => {
                         assert_eq!(color, expected, "{name} {color_format:?} {usage:?}");
-                        roads.push((name, color, depth));
+                        // `render_into` took the same road, or let a compute
+                        // method's shading store the colour itself.
+                        let CompositeRoute::Split {
+                            color: into_color,
+                            depth: into_depth,
+                        } = taken
+                        else {
+                            panic!("{name} {color_format:?} {usage:?}: render_into took {taken}");
+                        };
+                        assert_eq!(into_depth, depth, "{name} {color_format:?} {usage:?}");
+                        let direct = into_color == ColorRoute::Direct
+                            && color == (ColorRoute::Storage { linear: false });
+                        assert!(
+                            into_color == color || direct,
+                            "{name} {color_format:?} {usage:?}: {taken}"
+                        );
+                        roads.push((name, into_color, depth));
                     }
                     (CompositeRoute::Pass, None) => {}
                     // No depth copies (GL): a fragment method's depth takes the pass.
@@ -402,13 +433,31 @@ fn every_road_on(gpu: &Gpu) {
     }
     assert!(tested >= 2, "{tested} methods ran");
     if gpu.caps.compute {
-        // The roads this test exists for were taken at least once each.
+        // The roads this test exists for were taken at least once each (an
+        // 8-bit storage dispatch by a fragment method, which needs depth
+        // copies: the compute methods store that colour themselves).
+        let storage_8bit =
+            |c: &ColorRoute, _: &DepthRoute| matches!(c, ColorRoute::Storage { linear: false });
+        if gpu.caps.depth_copies {
+            assert!(
+                roads.iter().any(|(_, c, d)| storage_8bit(c, d)),
+                "{roads:?}"
+            );
+        }
         for wanted in [
-            |c: &ColorRoute, _: &DepthRoute| matches!(c, ColorRoute::Storage { linear: false }),
             |c: &ColorRoute, _: &DepthRoute| matches!(c, ColorRoute::Storage { linear: true }),
             |_: &ColorRoute, d: &DepthRoute| *d == DepthRoute::FromImage,
+            |c: &ColorRoute, _: &DepthRoute| *c == ColorRoute::Direct,
         ] {
             assert!(roads.iter().any(|(_, c, d)| wanted(c, d)), "{roads:?}");
+        }
+        // Every compute shading that ran stored its colour itself at least once.
+        for method in ["ray-compute", "voxel-compute", "ray-exact", "mesh"] {
+            let ran = roads.iter().any(|(n, _, _)| *n == method);
+            let direct = roads
+                .iter()
+                .any(|(n, c, _)| *n == method && *c == ColorRoute::Direct);
+            assert!(!ran || direct, "{method}: {roads:?}");
         }
     }
 }

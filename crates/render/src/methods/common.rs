@@ -361,6 +361,10 @@ pub(crate) struct DepthCopy {
     points: Option<wgpu::RenderPipeline>,
     layout: wgpu::BindGroupLayout,
     blit_group: wgpu::BindGroup,
+    /// Where the march stores colour instead of the shared colour target:
+    /// the caller's storage texture of an embedding frame
+    /// ([`Method::store_color_into`](super::Method::store_color_into)).
+    color_out: Option<wgpu::TextureView>,
 }
 
 /// The R32Float storage image of the shared targets' size, and the copy
@@ -427,6 +431,7 @@ impl DepthCopy {
             points: None,
             layout,
             blit_group,
+            color_out: None,
         })
     }
 
@@ -469,9 +474,24 @@ impl DepthCopy {
     pub(crate) fn resize(&mut self, shared: &Shared) {
         (self.texture, self.view, self.blit_group) = depth_image(shared, &self.label, &self.layout);
         self.bytes = u64::from(shared.width) * u64::from(shared.height) * 4;
+        // A caller's texture of the old size no longer fits.
+        self.color_out = None;
     }
 
-    /// Layout entries for the march's outputs: the shared colour target at
+    /// Store the march's colour into `view` (an `Rgba8Unorm` storage view of
+    /// the targets' size; `None`: the shared colour target) from the next
+    /// bind group made with [`DepthCopy::bindings`]. Returns whether that
+    /// changes the bindings (the caller then rebuilds its groups).
+    pub(crate) fn set_color_out(&mut self, view: Option<&wgpu::TextureView>) -> bool {
+        if self.color_out.as_ref() == view {
+            return false;
+        }
+        self.color_out = view.cloned();
+        true
+    }
+
+    /// Layout entries for the march's outputs: the colour target (the
+    /// shared one, or the caller's: [`DepthCopy::set_color_out`]) at
     /// `first`, this depth image at `first + 1` (both storage textures).
     pub(crate) fn layout_entries(first: u32) -> [wgpu::BindGroupLayoutEntry; 2] {
         [
@@ -489,7 +509,9 @@ impl DepthCopy {
         [
             wgpu::BindGroupEntry {
                 binding: first,
-                resource: wgpu::BindingResource::TextureView(&shared.color_view),
+                resource: wgpu::BindingResource::TextureView(
+                    self.color_out.as_ref().unwrap_or(&shared.color_view),
+                ),
             },
             wgpu::BindGroupEntry {
                 binding: first + 1,

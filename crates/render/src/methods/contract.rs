@@ -166,6 +166,21 @@ pub trait Method: Send {
         Ok(())
     }
 
+    /// Embedding ([`Renderer::render_into`](crate::Renderer::render_into)):
+    /// make the next frames' shading store colour straight into `view` (the
+    /// caller's `Rgba8Unorm` texture with `STORAGE_BINDING`, of the shared
+    /// targets' size) in place of the shared colour target, or again into
+    /// the shared target (`None`). Returns whether the frames' colour now
+    /// goes where asked: the compute methods can (their shading is a
+    /// storage write), the default only takes `None`.
+    fn store_color_into(
+        &mut self,
+        _shared: &Shared,
+        view: Option<&wgpu::TextureView>,
+    ) -> anyhow::Result<bool> {
+        Ok(view.is_none())
+    }
+
     /// Take new settings without a rebuild where the method can (a uniform,
     /// a count): `Ok(true)`. `Ok(false)` when a setting it reads needs a
     /// rebuild (the mesh's quality, the voxel size); an invalid value is an

@@ -91,6 +91,17 @@ impl Method for RayCompute {
         Ok(())
     }
 
+    fn store_color_into(
+        &mut self,
+        shared: &Shared,
+        view: Option<&wgpu::TextureView>,
+    ) -> anyhow::Result<bool> {
+        if self.depth.set_color_out(view) {
+            self.march_group = march_group(shared, &self.march_layout, &self.params, &self.depth);
+        }
+        Ok(true)
+    }
+
     fn record(&self, shared: &Shared, frame: &Frame<'_>, encoder: &mut wgpu::CommandEncoder) {
         dispatch_per_pixel(
             shared,

@@ -36,9 +36,13 @@ pub(super) struct Deferred {
     group: wgpu::BindGroup,
     gbuffer: wgpu::TextureView,
     bytes: u64,
+    /// The caller's colour texture the colour pass stores into in place of
+    /// the shared target (an embedding frame: `Method::store_color_into`).
+    color_out: Option<wgpu::TextureView>,
 }
 
-/// The G-buffer at the shared targets' size, and the colour pass's group.
+/// The G-buffer at the shared targets' size, and the colour pass's group
+/// (storing into the shared colour target).
 fn targets(
     shared: &Shared,
     layout: &wgpu::BindGroupLayout,
@@ -49,7 +53,20 @@ fn targets(
         GBUFFER_FORMAT,
         wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
     );
-    let group = shared.device.create_bind_group(&wgpu::BindGroupDescriptor {
+    let group = colour_group(shared, layout, params, &gbuffer, &shared.color_view);
+    let bytes = u64::from(shared.width) * u64::from(shared.height) * 8;
+    (gbuffer, group, bytes)
+}
+
+/// The colour pass's group: the G-buffer in, `color` out.
+fn colour_group(
+    shared: &Shared,
+    layout: &wgpu::BindGroupLayout,
+    params: &wgpu::Buffer,
+    gbuffer: &wgpu::TextureView,
+    color: &wgpu::TextureView,
+) -> wgpu::BindGroup {
+    shared.device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("mesh colour"),
         layout,
         entries: &[
@@ -59,16 +76,14 @@ fn targets(
             },
             wgpu::BindGroupEntry {
                 binding: GBUFFER_BINDING,
-                resource: wgpu::BindingResource::TextureView(&gbuffer),
+                resource: wgpu::BindingResource::TextureView(gbuffer),
             },
             wgpu::BindGroupEntry {
                 binding: COLOR_BINDING,
-                resource: wgpu::BindingResource::TextureView(&shared.color_view),
+                resource: wgpu::BindingResource::TextureView(color),
             },
         ],
-    });
-    let bytes = u64::from(shared.width) * u64::from(shared.height) * 8;
-    (gbuffer, group, bytes)
+    })
 }
 
 impl Deferred {
@@ -116,12 +131,30 @@ impl Deferred {
             group,
             gbuffer,
             bytes,
+            color_out: None,
         })
     }
 
     /// The shared targets changed size: a new G-buffer and colour binding.
     pub(super) fn resize(&mut self, shared: &Shared, params: &wgpu::Buffer) {
         (self.gbuffer, self.group, self.bytes) = targets(shared, &self.layout, params);
+        self.color_out = None;
+    }
+
+    /// Store colour into `view` (the caller's `Rgba8Unorm` storage texture of
+    /// the targets' size) or, with `None`, the shared colour target.
+    pub(super) fn store_color_into(
+        &mut self,
+        shared: &Shared,
+        params: &wgpu::Buffer,
+        view: Option<&wgpu::TextureView>,
+    ) {
+        if self.color_out.as_ref() == view {
+            return;
+        }
+        self.color_out = view.cloned();
+        let color = self.color_out.as_ref().unwrap_or(&shared.color_view);
+        self.group = colour_group(shared, &self.layout, params, &self.gbuffer, color);
     }
 
     /// Begin the raster pass: the G-buffer cleared to "no triangle" (0),

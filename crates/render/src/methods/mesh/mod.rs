@@ -535,6 +535,18 @@ impl Method for Mesh {
         Ok(())
     }
 
+    fn store_color_into(
+        &mut self,
+        shared: &Shared,
+        view: Option<&wgpu::TextureView>,
+    ) -> anyhow::Result<bool> {
+        let Some(d) = &mut self.deferred else {
+            return Ok(view.is_none());
+        };
+        d.store_color_into(shared, &self.params, view);
+        Ok(true)
+    }
+
     fn apply_edit(
         &mut self,
         shared: &Shared,

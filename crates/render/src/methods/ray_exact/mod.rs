@@ -517,6 +517,31 @@ impl RayExact {
         }
     }
 
+    /// The compute variant's bind groups again, over its current images,
+    /// beam and colour output (after a resize or a new colour output).
+    fn rebind(&mut self, shared: &Shared) {
+        let Variant::Compute {
+            depth, deferred, ..
+        } = &mut self.variant
+        else {
+            return;
+        };
+        let beam = self.beam.as_ref().map(|b| &b.buffer);
+        if let Some(d) = deferred {
+            let buffers = (&self.params, &self.levels, &self.stats, &self.marks);
+            d.group = Deferred::group(shared, &d.layout, buffers, depth, &d.hits, beam);
+        }
+        self.group = march_group(
+            shared,
+            &self.layout,
+            &self.params,
+            &self.levels,
+            &self.stats,
+            Some(depth),
+            beam,
+        );
+    }
+
     /// Record the queued pyramid update once per frame, before anything reads it.
     fn record_update(&self, frame: &Frame<'_>, encoder: &mut wgpu::CommandEncoder) {
         if let Levels::Whole(pyramid) = &self.levels
@@ -573,23 +598,26 @@ impl Method for RayExact {
             if let Some(beam) = &mut self.beam {
                 beam.resize(shared, (&self.params, &self.levels, &self.stats));
             }
-            let beam = self.beam.as_ref().map(|b| &b.buffer);
             if let Some(d) = deferred {
                 d.hits = hits_image(shared);
-                let buffers = (&self.params, &self.levels, &self.stats, &self.marks);
-                d.group = Deferred::group(shared, &d.layout, buffers, depth, &d.hits, beam);
             }
-            self.group = march_group(
-                shared,
-                &self.layout,
-                &self.params,
-                &self.levels,
-                &self.stats,
-                Some(depth),
-                beam,
-            );
+            self.rebind(shared);
         }
         Ok(())
+    }
+
+    fn store_color_into(
+        &mut self,
+        shared: &Shared,
+        view: Option<&wgpu::TextureView>,
+    ) -> anyhow::Result<bool> {
+        let Variant::Compute { depth, .. } = &mut self.variant else {
+            return Ok(view.is_none());
+        };
+        if depth.set_color_out(view) {
+            self.rebind(shared);
+        }
+        Ok(true)
     }
 
     fn prepare(&mut self, shared: &Shared, camera: &Camera) -> anyhow::Result<()> {

@@ -319,6 +319,26 @@ impl Method for Voxel {
         Ok(())
     }
 
+    fn store_color_into(
+        &mut self,
+        shared: &Shared,
+        view: Option<&wgpu::TextureView>,
+    ) -> anyhow::Result<bool> {
+        let Some(c) = &mut self.compute else {
+            return Ok(view.is_none());
+        };
+        if c.depth.set_color_out(view) {
+            self.group = voxel_group(
+                shared,
+                &self.group_layout,
+                (&self.params, &self.pyramid),
+                Some(&c.depth),
+                None,
+            );
+        }
+        Ok(true)
+    }
+
     fn prepare(&mut self, shared: &Shared, _camera: &Camera) -> anyhow::Result<()> {
         self.pyramid.prepare(shared);
         if let Some(beam) = &mut self.beam {
