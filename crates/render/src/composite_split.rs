@@ -35,10 +35,10 @@ pub enum ColorRoute {
     },
     /// A texture copy (the caller's texture is Strata's format).
     Copy,
-    /// No extra pass: the method's own shading stored each pixel into the
-    /// caller's texture (a compute method, into an `Rgba8Unorm` texture with
-    /// `STORAGE_BINDING`; [`crate::Renderer::render_into`] only, where the
-    /// road would otherwise be `Storage { linear: false }`).
+    /// No extra pass: the method drew each pixel straight into the caller's
+    /// `Rgba8Unorm` texture, its render passes attaching it or its compute
+    /// shading storing into it (`STORAGE_BINDING`);
+    /// [`crate::Renderer::render_into`] only.
     Direct,
 }
 
@@ -49,6 +49,10 @@ pub enum DepthRoute {
     FromImage,
     /// A texture copy from Strata's depth target.
     Copy,
+    /// No extra pass: a rasterising method's render passes drew depth
+    /// straight into the caller's `Depth32Float` texture
+    /// ([`crate::Renderer::render_into`] only).
+    Direct,
 }
 
 /// Which road [`Renderer::render_into`](crate::Renderer::render_into) takes
@@ -75,11 +79,12 @@ impl std::fmt::Display for CompositeRoute {
                 let color = match color {
                     ColorRoute::Storage { .. } => "colour by compute",
                     ColorRoute::Copy => "colour by copy",
-                    ColorRoute::Direct => "colour stored by the method's shading",
+                    ColorRoute::Direct => "colour drawn by the method itself",
                 };
                 let depth = match depth {
                     DepthRoute::FromImage => "depth by a depth-only pass from the method's image",
                     DepthRoute::Copy => "depth by copy",
+                    DepthRoute::Direct => "depth drawn by the method itself",
                 };
                 write!(f, "{color}, {depth}")
             }
@@ -96,6 +101,13 @@ pub(crate) struct RouteInputs {
     pub depth_copies: bool,
     /// The active method keeps its depth in an `R32Float` image.
     pub depth_image: bool,
+    /// The road is for a frame still to draw (`render_into`), which the
+    /// method may draw straight into the targets; not for a copy of the
+    /// last one (`record_copy_into`).
+    pub fresh_frame: bool,
+    /// The active method draws colour through render passes (else a compute
+    /// pass stores it: `Method::draws_color_by_attachment`).
+    pub color_by_attachment: bool,
 }
 
 /// The road for `targets` (already checked by [`crate::composite::key_of`]).
@@ -109,7 +121,21 @@ pub(crate) fn route(targets: &TargetViews<'_>, key: Key, inputs: RouteInputs) ->
     let own_format = targets
         .color_view_format
         .is_none_or(|f| f == color.format());
+    // A target of Strata's own format takes the frame itself: a render
+    // pass attaches it, or a compute shading stores into it.
+    let color_direct_usage = match inputs.color_by_attachment {
+        true => wgpu::TextureUsages::RENDER_ATTACHMENT,
+        false => wgpu::TextureUsages::STORAGE_BINDING,
+    };
     let color_route = match color.format() {
+        f if inputs.fresh_frame
+            && own_format
+            && f == crate::frame::COLOR_FORMAT
+            && (inputs.color_by_attachment || inputs.compute)
+            && has(color, color_direct_usage) =>
+        {
+            Some(ColorRoute::Direct)
+        }
         F::Rgba8Unorm | F::Rgba16Float
             if inputs.compute && own_format && has(color, wgpu::TextureUsages::STORAGE_BINDING) =>
         {
@@ -124,7 +150,14 @@ pub(crate) fn route(targets: &TargetViews<'_>, key: Key, inputs: RouteInputs) ->
         }
         _ => None,
     };
-    let depth_route = if inputs.depth_image {
+    let depth_route = if inputs.fresh_frame
+        && !inputs.depth_image
+        && depth.format() == crate::frame::DEPTH_FORMAT
+        && has(depth, wgpu::TextureUsages::RENDER_ATTACHMENT)
+    {
+        // A rasterising method draws depth straight into it.
+        Some(DepthRoute::Direct)
+    } else if inputs.depth_image {
         Some(DepthRoute::FromImage)
     } else if inputs.depth_copies
         && depth.format() == crate::frame::DEPTH_FORMAT
@@ -135,6 +168,13 @@ pub(crate) fn route(targets: &TargetViews<'_>, key: Key, inputs: RouteInputs) ->
         None
     };
     match (color_route, depth_route) {
+        // Where depth copies are missing (wgpu's GL backend), a frame whose
+        // last command is the colour dispatch read back wrong on llvmpipe
+        // (`tests/embed.rs`, by thousands of half-float steps, not every
+        // run): there such a frame keeps the full-screen pass.
+        (Some(ColorRoute::Storage { .. }), Some(DepthRoute::Direct)) if !inputs.depth_copies => {
+            CompositeRoute::Pass
+        }
         (Some(color), Some(depth)) => CompositeRoute::Split { color, depth },
         _ => CompositeRoute::Pass,
     }
@@ -396,6 +436,7 @@ impl SplitCache {
                 targets.depth.texture().as_image_copy(),
                 size,
             ),
+            DepthRoute::Direct => {}
             DepthRoute::FromImage => {
                 let image = depth_image.ok_or_else(|| {
                     anyhow::anyhow!("the active method keeps no depth image to write depth from")

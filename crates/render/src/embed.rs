@@ -26,6 +26,7 @@
 use crate::composite::{TargetError, TargetViews, key_of, record_composite};
 use crate::composite_split::{ColorRoute, CompositeRoute, DepthRoute, RouteInputs, route};
 use crate::gpu::catching;
+use crate::methods::FrameTargets;
 use crate::renderer::Renderer;
 use strata_camera::Camera;
 
@@ -66,7 +67,7 @@ impl Renderer {
     ) -> anyhow::Result<()> {
         let size = (self.shared().width, self.shared().height);
         let key = key_of(targets, size)?;
-        let route = self.composite_route(targets, key);
+        let route = self.composite_route(targets, key, true);
         let device = self.shared().device.clone();
         // Errors from here on concern the caller's views (a foreign device,
         // a view wgpu refuses): caught here to name them, not left to the
@@ -79,13 +80,12 @@ impl Renderer {
                     // Depth from the method's own image skips the blit into
                     // Strata's depth target; a copy reads that target.
                     let fill_depth = depth == DepthRoute::Copy;
-                    // A compute method's shading stores straight into a
-                    // storage texture of its own format: no colour pass.
-                    let color_into =
-                        (color == ColorRoute::Storage { linear: false }).then_some(targets.color);
-                    let (mut encoder, direct) =
-                        self.record_frame_into(camera, fill_depth, color_into)?;
-                    let color = if direct { ColorRoute::Direct } else { color };
+                    // Targets of Strata's own formats take the frame itself.
+                    let into = FrameTargets {
+                        color: (color == ColorRoute::Direct).then_some(targets.color),
+                        depth: (depth == DepthRoute::Direct).then_some(targets.depth),
+                    };
+                    let mut encoder = self.record_frame_into(camera, fill_depth, into)?;
                     split.record(
                         &mut encoder,
                         self.shared(),
@@ -101,7 +101,8 @@ impl Renderer {
                     // The composite reads the shared depth target: fill it.
                     let pipeline = composite.pipeline(&device, key)?;
                     let group = composite.group(self.shared());
-                    let (mut encoder, _) = self.record_frame_into(camera, true, None)?;
+                    let mut encoder =
+                        self.record_frame_into(camera, true, FrameTargets::default())?;
                     let stamps = self.timer.render("composite");
                     record_composite(&mut encoder, targets, key, &pipeline, &group, stamps);
                     self.timer.resolve(&mut encoder);
@@ -193,7 +194,7 @@ impl Renderer {
         timestamp_writes: Option<wgpu::RenderPassTimestampWrites<'_>>,
     ) -> anyhow::Result<CompositeRoute> {
         let key = key_of(targets, (self.shared().width, self.shared().height))?;
-        let route = self.composite_route(targets, key);
+        let route = self.composite_route(targets, key, false);
         let reads_shared_depth = !matches!(
             route,
             CompositeRoute::Split {
@@ -248,11 +249,13 @@ impl Renderer {
         Ok(route)
     }
 
-    /// The road [`Renderer::render_into`] takes into `targets`.
+    /// The road into `targets`: of a frame still to draw
+    /// ([`Renderer::render_into`], `fresh_frame`) or of the last frame's copy.
     fn composite_route(
         &self,
         targets: &TargetViews<'_>,
         key: crate::composite::Key,
+        fresh_frame: bool,
     ) -> CompositeRoute {
         let caps = &self.shared().caps;
         route(
@@ -262,6 +265,8 @@ impl Renderer {
                 compute: caps.compute,
                 depth_copies: caps.depth_copies,
                 depth_image: self.active_depth_image().is_some(),
+                fresh_frame,
+                color_by_attachment: self.active_method().draws_color_by_attachment(),
             },
         )
     }

@@ -9,7 +9,7 @@
 use crate::depth_read::DepthReader;
 use crate::frame::{Globals, LevelShape, Shared, TerrainColors};
 use crate::gpu::{ErrorSink, Gpu, wait_device};
-use crate::methods::{self, Frame, Method, MethodId, MethodSettings, RetainedBytes};
+use crate::methods::{self, Frame, FrameTargets, Method, MethodId, MethodSettings, RetainedBytes};
 use crate::shadow::{ShadowFrame, ShadowPass};
 use crate::timing::{FrameTimings, PassTimer};
 use std::sync::Arc;
@@ -63,6 +63,9 @@ pub struct Renderer {
     /// after an embedding frame whose shading stored it into the caller's
     /// texture: [`Renderer::render_into`]).
     pub(crate) color_target_current: bool,
+    /// Whether the last frame drew its depth into the caller's texture, not
+    /// the shared target (a rasterising method's embedding frame).
+    depth_in_caller: bool,
     /// The road the last [`Renderer::render_into`] took.
     pub(crate) last_road: Option<crate::composite_split::CompositeRoute>,
     /// Depth read-back through a pass, where depth copies are missing.
@@ -161,6 +164,7 @@ impl Renderer {
             depth_attachment: gpu.options.depth_attachment,
             depth_target_current: false,
             color_target_current: true,
+            depth_in_caller: false,
             last_road: None,
             depth_reader,
             edit_listener: None,
@@ -307,6 +311,11 @@ impl Renderer {
     /// (the compute marches; [`methods::Method::depth_image`]).
     pub(crate) fn active_depth_image(&self) -> Option<&wgpu::Texture> {
         self.methods[self.active].method.depth_image()
+    }
+
+    /// The method drawn now.
+    pub(crate) fn active_method(&self) -> &dyn Method {
+        self.methods[self.active].method.as_ref()
     }
 
     /// The active method's name.
@@ -570,22 +579,26 @@ impl Renderer {
         camera: &Camera,
         depth_attachment: bool,
     ) -> anyhow::Result<wgpu::CommandEncoder> {
-        let (mut encoder, _) = self.record_frame_into(camera, depth_attachment, None)?;
+        let mut encoder =
+            self.record_frame_into(camera, depth_attachment, FrameTargets::default())?;
         self.timer.resolve(&mut encoder);
         Ok(encoder)
     }
 
-    /// [`Renderer::record_frame_with`] with the method's shading storing
-    /// colour into `color_into` where it can (an embedding frame; `None`:
-    /// the shared colour target), without resolving the frame's timestamps
-    /// (the caller may time passes after it). Returns whether the colour
-    /// went into `color_into`.
+    /// [`Renderer::record_frame_with`] drawing colour and depth straight
+    /// into the caller's views `into` where given (an embedding frame whose
+    /// road chose it: `composite_split`), without resolving the frame's
+    /// timestamps (the caller may time passes after it). A compute method
+    /// stores colour into `into.color` from its shading
+    /// ([`Method::store_color_into`]); a rasterising one attaches it.
+    ///
+    /// [`Method::store_color_into`]: crate::methods::Method::store_color_into
     pub(crate) fn record_frame_into(
         &mut self,
         camera: &Camera,
         depth_attachment: bool,
-        color_into: Option<&wgpu::TextureView>,
-    ) -> anyhow::Result<(wgpu::CommandEncoder, bool)> {
+        into: FrameTargets<'_>,
+    ) -> anyhow::Result<wgpu::CommandEncoder> {
         if camera.width != self.shared.width || camera.height != self.shared.height {
             anyhow::bail!(
                 "camera is {}x{} but the renderer was built for {}x{}",
@@ -608,10 +621,17 @@ impl Renderer {
         // Every frame says where its colour goes: a method left storing into
         // a caller's texture by the last embedding frame stores into the
         // shared target again.
-        let direct = color_into.is_some() && method.store_color_into(&self.shared, color_into)?;
-        if color_into.is_none() {
-            method.store_color_into(&self.shared, None)?;
+        let stored = method.store_color_into(&self.shared, into.color)? && into.color.is_some();
+        if into.color.is_some() && !stored && !method.draws_color_by_attachment() {
+            anyhow::bail!(
+                "{} can neither store nor draw its colour into the caller's texture",
+                method.name()
+            );
         }
+        let targets = FrameTargets {
+            color: into.color.filter(|_| !stored),
+            depth: into.depth,
+        };
         method.prepare(&self.shared, camera)?;
 
         let mut encoder = self
@@ -625,9 +645,13 @@ impl Renderer {
             timer: &self.timer,
             index: self.frames,
             depth_attachment,
+            targets,
         };
         let method = &self.methods[self.active].method;
-        self.depth_target_current = depth_attachment || method.depth_image().is_none();
+        self.depth_target_current =
+            (depth_attachment || method.depth_image().is_none()) && into.depth.is_none();
+        self.depth_in_caller = into.depth.is_some();
+        self.color_target_current = into.color.is_none();
         if shadows && !current {
             // The method may fill the map itself (the exact march does).
             if !method.record_shadow_map(&self.shared, &frame, &mut encoder) {
@@ -638,8 +662,7 @@ impl Renderer {
             self.shadow_drawn = (!method.shadow_map_is_partial()).then_some(shadow);
         }
         method.record(&self.shared, &frame, &mut encoder);
-        self.color_target_current = !direct;
-        Ok((encoder, direct))
+        Ok(encoder)
     }
 
     /// Submit a frame's commands and count it.
@@ -768,6 +791,12 @@ impl Renderer {
         if let Some(image) = self.methods[self.active].method.depth_image() {
             let raw = self.read_texture(image, wgpu::TextureAspect::All)?;
             return Ok(bytemuck::cast_slice::<u8, f32>(&raw).to_vec());
+        }
+        if self.depth_in_caller {
+            anyhow::bail!(
+                "the frame last drawn ({}) drew its depth straight into the caller's depth texture (`render_into`), not into Strata's depth target: read it there, or draw the frame with `render_frame`",
+                self.method_name()
+            );
         }
         if let Some(reader) = &self.depth_reader {
             let s = &self.shared;

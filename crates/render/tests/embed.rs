@@ -306,7 +306,7 @@ fn every_road_on(gpu: &Gpu) {
     };
     let copy_usage = USAGE | U::COPY_DST;
     let storage_usage = copy_usage | U::STORAGE_BINDING;
-    let (mut tested, mut roads) = (0, Vec::new());
+    let (mut tested, mut roads, mut directs) = (0, Vec::new(), Vec::new());
     for name in strata_render::methods::names() {
         let mut r = match Renderer::new(gpu, &level, &colors, name, &settings, W, H) {
             Ok(r) => r,
@@ -329,14 +329,24 @@ fn every_road_on(gpu: &Gpu) {
                 gpu.wait().unwrap();
                 images.push((read(&color_tex), read(&depth_tex)));
                 let taken = r.last_road().unwrap();
-                if let CompositeRoute::Split {
-                    color: ColorRoute::Direct,
-                    ..
-                } = taken
-                {
-                    // Strata's colour target missed that frame: no stale read.
-                    let refused = r.read_color().unwrap_err().to_string();
-                    assert!(refused.contains("render_into"), "{refused}");
+                if let CompositeRoute::Split { color, depth } = taken {
+                    // Only Strata's own formats take the frame itself.
+                    let direct_color = color == ColorRoute::Direct;
+                    assert!(
+                        !direct_color || color_format == F::Rgba8Unorm,
+                        "{name} {taken}"
+                    );
+                    // Strata's targets missed what went straight to the
+                    // caller's: no stale read.
+                    if direct_color {
+                        let refused = r.read_color().unwrap_err().to_string();
+                        assert!(refused.contains("render_into"), "{refused}");
+                    }
+                    if depth == DepthRoute::Direct {
+                        let refused = r.read_depth().unwrap_err().to_string();
+                        assert!(refused.contains("render_into"), "{refused}");
+                    }
+                    directs.push((name, color, depth));
                 }
                 // The copy-only call's road (after a frame that also fills
                 // Strata's depth target).
@@ -371,14 +381,13 @@ fn every_road_on(gpu: &Gpu) {
                         else {
                             panic!("{name} {color_format:?} {usage:?}: render_into took {taken}");
                         };
-                        assert_eq!(into_depth, depth, "{name} {color_format:?} {usage:?}");
-                        let direct = into_color == ColorRoute::Direct
-                            && color == (ColorRoute::Storage { linear: false });
+                        // The same road, or the method drew into the target itself.
                         assert!(
-                            into_color == color || direct,
+                            (into_color == color || into_color == ColorRoute::Direct)
+                                && (into_depth == depth || into_depth == DepthRoute::Direct),
                             "{name} {color_format:?} {usage:?}: {taken}"
                         );
-                        roads.push((name, into_color, depth));
+                        roads.push((name, color, depth));
                     }
                     (CompositeRoute::Pass, None) => {}
                     // No depth copies (GL): a fragment method's depth takes the pass.
@@ -447,17 +456,24 @@ fn every_road_on(gpu: &Gpu) {
         for wanted in [
             |c: &ColorRoute, _: &DepthRoute| matches!(c, ColorRoute::Storage { linear: true }),
             |_: &ColorRoute, d: &DepthRoute| *d == DepthRoute::FromImage,
-            |c: &ColorRoute, _: &DepthRoute| *c == ColorRoute::Direct,
         ] {
             assert!(roads.iter().any(|(_, c, d)| wanted(c, d)), "{roads:?}");
         }
-        // Every compute shading that ran stored its colour itself at least once.
-        for method in ["ray-compute", "voxel-compute", "ray-exact", "mesh"] {
-            let ran = roads.iter().any(|(n, _, _)| *n == method);
-            let direct = roads
-                .iter()
-                .any(|(n, c, _)| *n == method && *c == ColorRoute::Direct);
-            assert!(!ran || direct, "{method}: {roads:?}");
+        // Every method that took a split road drew its colour into the
+        // caller's texture itself at least once; every rasterising one drew
+        // its depth too.
+        for (name, _, _) in &directs {
+            let direct = |c: &ColorRoute, d: Option<DepthRoute>| {
+                directs
+                    .iter()
+                    .any(|(n, cc, dd)| n == name && c == cc && d.is_none_or(|d| d == *dd))
+            };
+            assert!(direct(&ColorRoute::Direct, None), "{name}: {directs:?}");
+            let compute = ["ray-compute", "voxel-compute", "ray-exact"].contains(name);
+            assert!(
+                compute || direct(&ColorRoute::Direct, Some(DepthRoute::Direct)),
+                "{name}: {directs:?}"
+            );
         }
     }
 }

@@ -208,19 +208,24 @@ pub(crate) fn index_buffer(shared: &Shared, label: &str, indices: &[u16]) -> wgp
     buffer
 }
 
-/// The shared depth target, cleared to far (the contract: the first pass
-/// that touches it clears it).
-fn depth_attachment(shared: &Shared) -> wgpu::RenderPassDepthStencilAttachment<'_> {
-    depth_attachment_with(shared, wgpu::LoadOp::Clear(1.0))
+/// The frame's depth target (the shared one, or the caller's:
+/// [`Frame::targets`]), cleared to far (the contract: the first pass that
+/// touches it clears it).
+fn depth_attachment<'a>(
+    shared: &'a Shared,
+    frame: &Frame<'a>,
+) -> wgpu::RenderPassDepthStencilAttachment<'a> {
+    depth_attachment_with(shared, frame, wgpu::LoadOp::Clear(1.0))
 }
 
-/// The shared depth target, loaded by `load`.
-fn depth_attachment_with(
-    shared: &Shared,
+/// The frame's depth target, loaded by `load`.
+fn depth_attachment_with<'a>(
+    shared: &'a Shared,
+    frame: &Frame<'a>,
     load: wgpu::LoadOp<f32>,
-) -> wgpu::RenderPassDepthStencilAttachment<'_> {
+) -> wgpu::RenderPassDepthStencilAttachment<'a> {
     wgpu::RenderPassDepthStencilAttachment {
-        view: &shared.depth_view,
+        view: frame.targets.depth.unwrap_or(&shared.depth_view),
         depth_ops: Some(wgpu::Operations {
             load,
             store: wgpu::StoreOp::Store,
@@ -252,7 +257,7 @@ pub(crate) fn begin_pass_with_depth<'e>(
     encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
         label: Some(label),
         color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-            view: &shared.color_view,
+            view: frame.targets.color.unwrap_or(&shared.color_view),
             depth_slice: None,
             resolve_target: None,
             ops: wgpu::Operations {
@@ -260,7 +265,7 @@ pub(crate) fn begin_pass_with_depth<'e>(
                 store: wgpu::StoreOp::Store,
             },
         })],
-        depth_stencil_attachment: Some(depth_attachment_with(shared, depth)),
+        depth_stencil_attachment: Some(depth_attachment_with(shared, frame, depth)),
         timestamp_writes: frame.timer.render(label),
         occlusion_query_set: None,
         multiview_mask: None,
@@ -279,7 +284,7 @@ pub(crate) fn begin_pass_into<'e>(
     encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
         label: Some(label),
         color_attachments: &[Some(color)],
-        depth_stencil_attachment: Some(depth_attachment(shared)),
+        depth_stencil_attachment: Some(depth_attachment(shared, frame)),
         timestamp_writes: frame.timer.render(label),
         occlusion_query_set: None,
         multiview_mask: None,
@@ -558,7 +563,7 @@ impl DepthCopy {
         if !frame.depth_attachment {
             return;
         }
-        let mut attachment = depth_attachment(shared);
+        let mut attachment = depth_attachment(shared, frame);
         if !clear {
             attachment.depth_ops = Some(wgpu::Operations {
                 load: wgpu::LoadOp::Load,
@@ -590,7 +595,7 @@ impl DepthCopy {
         if !frame.depth_attachment {
             return;
         }
-        let mut attachment = depth_attachment(shared);
+        let mut attachment = depth_attachment(shared, frame);
         attachment.depth_ops = Some(wgpu::Operations {
             load: wgpu::LoadOp::Load,
             store: wgpu::StoreOp::Store,

@@ -124,6 +124,20 @@ pub struct Frame<'a> {
     /// their own ([`Method::depth_image`]) copy it there only when this is
     /// set (`Renderer::set_depth_attachment`, `render_into`).
     pub depth_attachment: bool,
+    /// The caller's views the render passes draw into in place of the
+    /// shared targets (an embedding frame whose formats match them).
+    pub targets: FrameTargets<'a>,
+}
+
+/// The caller's views an embedding frame's render passes attach in place of
+/// the shared colour and depth targets (`Renderer::render_into` when the
+/// formats are Strata's own: `COLOR_FORMAT`, `DEPTH_FORMAT`, one sample).
+#[derive(Clone, Copy, Default)]
+pub struct FrameTargets<'a> {
+    /// In place of the shared colour target.
+    pub color: Option<&'a wgpu::TextureView>,
+    /// In place of the shared depth target.
+    pub depth: Option<&'a wgpu::TextureView>,
 }
 
 /// One way of drawing the terrain. `Send`, so a method can be built on a
@@ -179,6 +193,14 @@ pub trait Method: Send {
         view: Option<&wgpu::TextureView>,
     ) -> anyhow::Result<bool> {
         Ok(view.is_none())
+    }
+
+    /// Whether this method's frames draw their colour through render passes
+    /// into the shared colour target (every rasterising method; what an
+    /// embedding frame may point at the caller's texture instead). The
+    /// compute methods store colour from a compute pass and say no.
+    fn draws_color_by_attachment(&self) -> bool {
+        true
     }
 
     /// Take new settings without a rebuild where the method can (a uniform,

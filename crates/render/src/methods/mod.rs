@@ -80,7 +80,8 @@ pub mod voxel;
 pub(crate) mod test_common;
 
 pub use contract::{
-    BuildSteps, Constructor, Frame, Method, MethodSettings, RetainedBytes, StepsConstructor,
+    BuildSteps, Constructor, Frame, FrameTargets, Method, MethodSettings, RetainedBytes,
+    StepsConstructor,
 };
 pub use knobs::{Flag, Knobs, Slider, SliderKind, Sweep};
 

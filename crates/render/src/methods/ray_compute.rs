@@ -91,6 +91,10 @@ impl Method for RayCompute {
         Ok(())
     }
 
+    fn draws_color_by_attachment(&self) -> bool {
+        false
+    }
+
     fn store_color_into(
         &mut self,
         shared: &Shared,

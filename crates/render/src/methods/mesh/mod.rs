@@ -535,6 +535,10 @@ impl Method for Mesh {
         Ok(())
     }
 
+    fn draws_color_by_attachment(&self) -> bool {
+        self.deferred.is_none()
+    }
+
     fn store_color_into(
         &mut self,
         shared: &Shared,

@@ -606,6 +606,10 @@ impl Method for RayExact {
         Ok(())
     }
 
+    fn draws_color_by_attachment(&self) -> bool {
+        matches!(self.variant, Variant::Fragment(_))
+    }
+
     fn store_color_into(
         &mut self,
         shared: &Shared,

@@ -603,6 +603,7 @@ fn record_frame(
         timer,
         index: index as u64,
         depth_attachment: true,
+        targets: Default::default(),
     };
     let mut encoder = shared.device.create_command_encoder(&Default::default());
     assert!(m.record_shadow_map(shared, &frame, &mut encoder));

@@ -319,6 +319,10 @@ impl Method for Voxel {
         Ok(())
     }
 
+    fn draws_color_by_attachment(&self) -> bool {
+        self.compute.is_none()
+    }
+
     fn store_color_into(
         &mut self,
         shared: &Shared,
