@@ -8,6 +8,11 @@
 //! target and a full-screen depth pass each take ~0.08 ms), while a compute
 //! dispatch storing colour into the caller's texture takes 0.02 ms
 //! (`examples/composite_parts.rs`, `bench/composite-h100/`). So:
+//! - **A view of Strata's own format** (`Rgba8Unorm`, `Depth32Float`, one
+//!   sample, one level) takes the frame itself on a fresh frame
+//!   (`render_into`): the render passes attach it, a compute shading stores
+//!   its colour into it (`STORAGE_BINDING`). Nothing is added to the frame
+//!   but a compute method's depth pass (`bench/composite-h100/direct/`).
 //! - **Colour** is stored by a compute dispatch when the caller's colour
 //!   texture allows storage (`STORAGE_BINDING`, `Rgba8Unorm` or
 //!   `Rgba16Float`, one sample, viewed in its own format), else copied when

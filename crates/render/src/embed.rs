@@ -2,14 +2,16 @@
 //! ([`Renderer::render_into`]), so the caller's rasterised objects, drawn
 //! afterwards with the ordinary depth test, compose with it.
 //!
-//! How: the active method renders into Strata's own targets as in
-//! [`Renderer::render_frame`], then, in the same command buffer, the
-//! frame's colour and depth reach the caller's views by the cheapest road
-//! the targets allow ([`crate::composite_split`]): colour by a compute
-//! dispatch into a storage texture or by a copy, depth by a depth-only pass
-//! from a compute method's depth image or by a copy; else by one
-//! full-screen pass that writes colour and depth (`frag_depth`) and serves
-//! every format pair and sample count. Every road stores the same bytes
+//! How: by the cheapest road the targets allow ([`crate::composite_split`]).
+//! Views of Strata's own formats take the frame itself: the render passes
+//! attach them in place of Strata's targets, a compute shading stores its
+//! colour into them. Otherwise the active method renders into Strata's own
+//! targets as in [`Renderer::render_frame`], then, in the same command
+//! buffer, colour reaches the caller's view by a compute dispatch into a
+//! storage texture or by a copy, depth by a depth-only pass from a compute
+//! method's depth image or by a copy; else by one full-screen pass that
+//! writes colour and depth (`frag_depth`) and serves every format pair and
+//! sample count. Every road stores the same bytes
 //! (`tests/embed.rs`). A multisampled target receives each pixel's colour
 //! and depth in all its samples (the terrain is drawn at one sample per
 //! pixel; your objects get the MSAA).
