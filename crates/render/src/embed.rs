@@ -100,11 +100,14 @@ impl Renderer {
                     anyhow::Ok((encoder.finish(), CompositeRoute::Split { color, depth }))
                 }
                 CompositeRoute::Pass => {
-                    // The composite reads the shared depth target: fill it.
+                    // The composite reads a compute method's depth image in
+                    // place, else the shared depth target: fill that.
                     let pipeline = composite.pipeline(&device, key)?;
-                    let group = composite.group(self.shared());
+                    let image = self.active_depth_image().cloned();
+                    let group = composite.group(self.shared(), image.as_ref());
+                    let fill_depth = image.is_none();
                     let mut encoder =
-                        self.record_frame_into(camera, true, FrameTargets::default())?;
+                        self.record_frame_into(camera, fill_depth, FrameTargets::default())?;
                     let stamps = self.timer.render("composite");
                     record_composite(&mut encoder, targets, key, &pipeline, &group, stamps);
                     self.timer.resolve(&mut encoder);
@@ -197,13 +200,12 @@ impl Renderer {
     ) -> anyhow::Result<CompositeRoute> {
         let key = key_of(targets, (self.shared().width, self.shared().height))?;
         let route = self.composite_route(targets, key, false);
-        let reads_shared_depth = !matches!(
-            route,
-            CompositeRoute::Split {
-                depth: DepthRoute::FromImage,
-                ..
-            }
-        );
+        // A compute method's depth is read from its image on every road
+        // but the depth copy.
+        let reads_shared_depth = match route {
+            CompositeRoute::Split { depth, .. } => depth == DepthRoute::Copy,
+            CompositeRoute::Pass => self.active_depth_image().is_none(),
+        };
         self.shared_color_current()?;
         if reads_shared_depth && !self.depth_target_current {
             anyhow::bail!(
@@ -245,7 +247,8 @@ impl Renderer {
         let device = self.shared().device.clone();
         let mut composite = std::mem::take(&mut self.composite);
         let pipeline = composite.pipeline(&device, key);
-        let group = composite.group(self.shared());
+        let image = self.active_depth_image().cloned();
+        let group = composite.group(self.shared(), image.as_ref());
         self.composite = composite;
         record_composite(encoder, targets, key, &pipeline?, &group, timestamp_writes);
         Ok(route)
