@@ -119,6 +119,7 @@ fn main() -> anyhow::Result<()> {
         (F::Rgba8UnormSrgb, F::Depth32Float, 1, copy),
         (F::Rgba8Unorm, F::Depth32Float, 1, plain),
         (F::Bgra8UnormSrgb, F::Depth24Plus, 1, plain),
+        (F::Bgra8UnormSrgb, F::Depth32Float, 1, plain),
         (F::Rgba16Float, F::Depth24PlusStencil8, 1, plain),
         (F::Bgra8UnormSrgb, F::Depth24Plus, 4, plain),
     ] {

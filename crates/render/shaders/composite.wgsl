@@ -20,25 +20,46 @@ fn texel(pos: vec4<f32>) -> vec2<f32> {
     return pos.xy / vec2<f32>(textureDimensions(color_in));
 }
 
-// The bytes Strata's Rgba8Unorm target holds, as they are (a UNORM target).
-@fragment
-fn fs_composite(@builtin(position) pos: vec4<f32>) -> Composite {
-    let uv = texel(pos);
-    let c = textureSampleLevel(color_in, nearest, uv, 0.0);
-    return Composite(c, textureSampleLevel(depth_in, nearest, uv, 0.0).r);
+fn depth_at(pos: vec4<f32>) -> f32 {
+    return textureSampleLevel(depth_in, nearest, texel(pos), 0.0).r;
 }
 
-// Strata's colours are sRGB-encoded: decode them for a target that encodes
-// on write (*Srgb, so it stores the same bytes) or holds linear light (float).
-@fragment
-fn fs_composite_linear(@builtin(position) pos: vec4<f32>) -> Composite {
-    let uv = texel(pos);
-    let c = textureSampleLevel(color_in, nearest, uv, 0.0);
+// The bytes Strata's Rgba8Unorm target holds, as they are (a UNORM target).
+fn color_at(pos: vec4<f32>) -> vec4<f32> {
+    return textureSampleLevel(color_in, nearest, texel(pos), 0.0);
+}
+
+// Strata's colours are sRGB-encoded: decoded for a target that encodes on
+// write (*Srgb, so it stores the same bytes) or holds linear light (float).
+fn linear_color_at(pos: vec4<f32>) -> vec4<f32> {
+    let c = color_at(pos);
     let k = vec3<u32>(round(c.rgb * 255.0));
     let linear = vec3<f32>(
         srgb_to_linear[k.r >> 2u][k.r & 3u],
         srgb_to_linear[k.g >> 2u][k.g & 3u],
         srgb_to_linear[k.b >> 2u][k.b & 3u],
     );
-    return Composite(vec4<f32>(linear, c.a), textureSampleLevel(depth_in, nearest, uv, 0.0).r);
+    return vec4<f32>(linear, c.a);
+}
+
+@fragment
+fn fs_composite(@builtin(position) pos: vec4<f32>) -> Composite {
+    return Composite(color_at(pos), depth_at(pos));
+}
+
+@fragment
+fn fs_composite_linear(@builtin(position) pos: vec4<f32>) -> Composite {
+    return Composite(linear_color_at(pos), depth_at(pos));
+}
+
+// The colour alone (`ColorRoute::Pass`: the frame drew its depth straight
+// into the caller's depth texture).
+@fragment
+fn fs_composite_color(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
+    return color_at(pos);
+}
+
+@fragment
+fn fs_composite_color_linear(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
+    return linear_color_at(pos);
 }

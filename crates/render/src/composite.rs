@@ -196,7 +196,8 @@ pub(crate) struct CompositeCache {
     /// The sRGB decode table (`composite.wgsl`'s `srgb_to_linear`).
     decode: Option<wgpu::Buffer>,
     module: Option<wgpu::ShaderModule>,
-    pipelines: Vec<(Key, wgpu::RenderPipeline)>,
+    /// Per key and whether the pass writes depth too.
+    pipelines: Vec<((Key, bool), wgpu::RenderPipeline)>,
     /// The bind group and the colour and depth textures it was made for (a
     /// resize replaces the shared targets; a compute method's depth image
     /// stands in for the depth target).
@@ -292,12 +293,16 @@ impl CompositeCache {
         group
     }
 
+    /// The pass for `key`, writing colour and depth, or (`with_depth`
+    /// false) colour alone: its depth is drawn straight into the caller's
+    /// texture by the frame (`ColorRoute::Pass`).
     pub(crate) fn pipeline(
         &mut self,
         device: &wgpu::Device,
         key: Key,
+        with_depth: bool,
     ) -> anyhow::Result<wgpu::RenderPipeline> {
-        if let Some((_, p)) = self.pipelines.iter().find(|(k, _)| *k == key) {
+        if let Some((_, p)) = self.pipelines.iter().find(|(k, _)| *k == (key, with_depth)) {
             return Ok(p.clone());
         }
         let module = match &self.module {
@@ -315,10 +320,12 @@ impl CompositeCache {
             immediate_size: 0,
         });
         // Targets that encode on write or hold linear light get decoded colour.
-        let fs = if key.color.is_srgb() || key.color == F::Rgba16Float {
-            "fs_composite_linear"
-        } else {
-            "fs_composite"
+        let linear = key.color.is_srgb() || key.color == F::Rgba16Float;
+        let fs = match (linear, with_depth) {
+            (true, true) => "fs_composite_linear",
+            (false, true) => "fs_composite",
+            (true, false) => "fs_composite_color_linear",
+            (false, false) => "fs_composite_color",
         };
         let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("composite"),
@@ -330,7 +337,7 @@ impl CompositeCache {
                 buffers: &[],
             },
             primitive: Default::default(),
-            depth_stencil: Some(wgpu::DepthStencilState {
+            depth_stencil: with_depth.then(|| wgpu::DepthStencilState {
                 format: key.depth,
                 depth_write_enabled: Some(true),
                 depth_compare: Some(wgpu::CompareFunction::Always),
@@ -350,7 +357,7 @@ impl CompositeCache {
             multiview_mask: None,
             cache: None,
         });
-        self.pipelines.push((key, pipeline.clone()));
+        self.pipelines.push(((key, with_depth), pipeline.clone()));
         Ok(pipeline)
     }
 }
@@ -367,11 +374,13 @@ pub(crate) fn srgb_decode_table() -> [f32; 256] {
     })
 }
 
-/// Record the composite pass: the shared frame into the caller's views.
+/// Record the composite pass: the shared frame into the caller's views
+/// (with `with_depth` false into the colour view alone, by a pipeline made
+/// so).
 pub(crate) fn record_composite(
     encoder: &mut wgpu::CommandEncoder,
     targets: &TargetViews<'_>,
-    key: Key,
+    (key, with_depth): (Key, bool),
     pipeline: &wgpu::RenderPipeline,
     group: &wgpu::BindGroup,
     timestamp_writes: Option<wgpu::RenderPassTimestampWrites<'_>>,
@@ -393,7 +402,7 @@ pub(crate) fn record_composite(
                 store: wgpu::StoreOp::Store,
             },
         })],
-        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+        depth_stencil_attachment: with_depth.then_some(wgpu::RenderPassDepthStencilAttachment {
             view: targets.depth,
             depth_ops: Some(wgpu::Operations {
                 load: every_pixel_written(),

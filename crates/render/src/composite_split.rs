@@ -40,6 +40,10 @@ pub enum ColorRoute {
     },
     /// A texture copy (the caller's texture is Strata's format).
     Copy,
+    /// A full-screen pass writing colour alone (any colour format), after a
+    /// frame that drew its depth straight into the caller's texture
+    /// ([`DepthRoute::Direct`]; [`crate::Renderer::render_into`] only).
+    Pass,
     /// No extra pass: the method drew each pixel straight into the caller's
     /// `Rgba8Unorm` texture, its render passes attaching it or its compute
     /// shading storing into it (`STORAGE_BINDING`);
@@ -85,6 +89,7 @@ impl std::fmt::Display for CompositeRoute {
                     ColorRoute::Storage { .. } => "colour by compute",
                     ColorRoute::Copy => "colour by copy",
                     ColorRoute::Direct => "colour drawn by the method itself",
+                    ColorRoute::Pass => "colour by a colour-only full-screen pass",
                 };
                 let depth = match depth {
                     DepthRoute::FromImage => "depth by a depth-only pass from the method's image",
@@ -181,6 +186,13 @@ pub(crate) fn route(targets: &TargetViews<'_>, key: Key, inputs: RouteInputs) ->
             CompositeRoute::Pass
         }
         (Some(color), Some(depth)) => CompositeRoute::Split { color, depth },
+        // The frame draws depth into the caller's texture: only colour is
+        // left, for one colour-only pass (half the full-screen pass's
+        // writes) in any format.
+        (None, Some(DepthRoute::Direct)) => CompositeRoute::Split {
+            color: ColorRoute::Pass,
+            depth: DepthRoute::Direct,
+        },
         _ => CompositeRoute::Pass,
     }
 }
@@ -433,7 +445,9 @@ impl SplitCache {
                 targets.color.texture().as_image_copy(),
                 size,
             ),
-            ColorRoute::Direct => {}
+            // Drawn by the method, or by the composite's colour-only pass
+            // (`CompositeCache`, recorded by the caller).
+            ColorRoute::Direct | ColorRoute::Pass => {}
         }
         match depth {
             DepthRoute::Copy => encoder.copy_texture_to_texture(

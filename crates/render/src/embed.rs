@@ -96,19 +96,27 @@ impl Renderer {
                         self.active_depth_image(),
                         Some(&self.timer),
                     )?;
+                    if color == ColorRoute::Pass {
+                        let pipeline = composite.pipeline(&device, key, false)?;
+                        let group = composite.group(self.shared(), None);
+                        let stamps = self.timer.render("composite colour");
+                        let key = (key, false);
+                        record_composite(&mut encoder, targets, key, &pipeline, &group, stamps);
+                    }
                     self.timer.resolve(&mut encoder);
                     anyhow::Ok((encoder.finish(), CompositeRoute::Split { color, depth }))
                 }
                 CompositeRoute::Pass => {
                     // The composite reads a compute method's depth image in
                     // place, else the shared depth target: fill that.
-                    let pipeline = composite.pipeline(&device, key)?;
+                    let pipeline = composite.pipeline(&device, key, true)?;
                     let image = self.active_depth_image().cloned();
                     let group = composite.group(self.shared(), image.as_ref());
                     let fill_depth = image.is_none();
                     let mut encoder =
                         self.record_frame_into(camera, fill_depth, FrameTargets::default())?;
                     let stamps = self.timer.render("composite");
+                    let key = (key, true);
                     record_composite(&mut encoder, targets, key, &pipeline, &group, stamps);
                     self.timer.resolve(&mut encoder);
                     anyhow::Ok((encoder.finish(), route))
@@ -246,10 +254,11 @@ impl Renderer {
         }
         let device = self.shared().device.clone();
         let mut composite = std::mem::take(&mut self.composite);
-        let pipeline = composite.pipeline(&device, key);
+        let pipeline = composite.pipeline(&device, key, true);
         let image = self.active_depth_image().cloned();
         let group = composite.group(self.shared(), image.as_ref());
         self.composite = composite;
+        let key = (key, true);
         record_composite(encoder, targets, key, &pipeline?, &group, timestamp_writes);
         Ok(route)
     }

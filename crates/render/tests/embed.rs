@@ -355,9 +355,24 @@ fn every_road_on(gpu: &Gpu) {
                 r.set_depth_attachment(false);
                 if color_format == F::Rgba8Unorm {
                     // The frame's colour is back in Strata's target, as the
-                    // pass road stored it.
+                    // first road stored it.
                     assert_eq!(r.read_color().unwrap(), images[0].0, "{name} {usage:?}");
                 }
+                // And its depth, as every road stored it into the caller's
+                // Depth32Float (each road's own check, not only against the
+                // first road's).
+                let own_depth = r.read_depth().unwrap();
+                let stored = &images.last().unwrap().1;
+                assert_eq!(stored.len(), 4 * own_depth.len(), "{name}");
+                let differ = stored
+                    .chunks_exact(4)
+                    .zip(&own_depth)
+                    .filter(|(a, b)| **a != b.to_le_bytes())
+                    .count();
+                assert_eq!(
+                    differ, 0,
+                    "{name} {color_format:?} {usage:?}: depths differ from read_depth"
+                );
                 let mut encoder = gpu.device.create_command_encoder(&Default::default());
                 let road = r.record_copy_into(&mut encoder, &targets, None).unwrap();
                 gpu.queue.submit([encoder.finish()]);
@@ -441,6 +456,22 @@ fn every_road_on(gpu: &Gpu) {
         tested += 1;
     }
     assert!(tested >= 2, "{tested} methods ran");
+    // A rasterising method into a colour format it cannot draw drew its
+    // depth itself and took the colour-only pass.
+    assert!(
+        directs
+            .iter()
+            .any(|(_, c, d)| *c == ColorRoute::Pass && *d == DepthRoute::Direct),
+        "{directs:?}"
+    );
+    // A rasterising method into a colour format it cannot draw drew its
+    // depth itself and took the colour-only pass.
+    assert!(
+        directs
+            .iter()
+            .any(|(_, c, d)| *c == ColorRoute::Pass && *d == DepthRoute::Direct),
+        "{directs:?}"
+    );
     if gpu.caps.compute {
         // The roads this test exists for were taken at least once each (an
         // 8-bit storage dispatch by a fragment method, which needs depth

@@ -22,8 +22,12 @@ use vehicle::Vehicle;
 
 /// The headless mode's targets: the formats a window's surface usually has.
 pub const HEADLESS_COLOR: wgpu::TextureFormat = wgpu::TextureFormat::Bgra8UnormSrgb;
-/// The headless mode's depth format (the one you would pick for a window).
-pub const DEPTH: wgpu::TextureFormat = wgpu::TextureFormat::Depth24Plus;
+/// The depth format of the window and the headless mode: Strata's own, so
+/// a rasterising method draws the terrain's depth straight into it and
+/// `render_into` adds only a colour pass into a surface format it cannot
+/// draw (`composite_split::DepthRoute::Direct`; any other depth format takes
+/// the full-screen pass that writes both).
+pub const DEPTH: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
 /// The terrain, its collider, your vehicle and the camera.
 pub struct Drive {

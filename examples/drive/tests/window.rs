@@ -71,7 +71,7 @@ fn the_window_draws_frames_and_closes() {
     let (ok, stdout, stderr) = run(command, Duration::from_secs(120));
     println!("{stdout}{stderr}");
     assert!(ok, "the window mode failed: {stderr}");
-    // "drive: N frames in S s (ray into FORMAT + Depth24Plus)"
+    // "drive: N frames in S s (ray into FORMAT + Depth32Float)"
     let frames: u32 = stdout
         .split_once("drive: ")
         .and_then(|(_, rest)| rest.split_whitespace().next()?.parse().ok())
