@@ -169,11 +169,11 @@ impl Renderer {
     }
 
     /// The road the last [`Renderer::render_into`] took (`None` before the
-    /// first). On the split road with a compute method and an `Rgba8Unorm`
-    /// storage texture, colour is [`ColorRoute::Direct`]: the method's
-    /// shading stored it, and Strata's own colour target does not hold that
-    /// frame ([`Renderer::read_color`] and [`Renderer::record_copy_into`]
-    /// refuse until the next [`Renderer::render_frame`]).
+    /// first). Where it says [`ColorRoute::Direct`] or
+    /// [`DepthRoute::Direct`], the method drew that into your view itself and
+    /// Strata's own target does not hold the frame: [`Renderer::read_color`],
+    /// [`Renderer::read_depth`] and [`Renderer::record_copy_into`] refuse
+    /// until the next [`Renderer::render_frame`].
     pub fn last_road(&self) -> Option<CompositeRoute> {
         self.last_road
     }
@@ -192,10 +192,12 @@ impl Renderer {
 
 impl Renderer {
     /// Record only the copy of the frame last drawn (by
-    /// [`Renderer::render_frame`] or [`Renderer::render_into`]) into the
-    /// caller's views, in the caller's encoder: to show one frame in more
-    /// targets, or to time what `render_into` adds to a frame
-    /// (`timestamp_writes`; what `examples/composite_cost.rs` measures).
+    /// [`Renderer::render_frame`], or by [`Renderer::render_into`] where it
+    /// left the frame in Strata's targets: see [`Renderer::last_road`]) into
+    /// the caller's views, in the caller's encoder: to show one frame in
+    /// more targets, or to time a copy road (`timestamp_writes`;
+    /// `examples/composite_cost.rs` reports it beside what `render_into`
+    /// adds).
     /// The same checks and the same road as `render_into`
     /// ([`CompositeRoute`]; on the split road the stamps are written by an
     /// empty compute pass before and one after it); wgpu errors reach the
