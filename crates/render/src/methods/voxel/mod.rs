@@ -259,6 +259,22 @@ fn voxel_group(
     })
 }
 
+impl Voxel {
+    /// The compute variant's group again, over its current depth image and
+    /// colour output (after a resize or a new colour output).
+    fn rebind_compute(&mut self, shared: &Shared) {
+        if let Some(c) = &self.compute {
+            self.group = voxel_group(
+                shared,
+                &self.group_layout,
+                (&self.params, &self.pyramid),
+                Some(&c.depth),
+                None,
+            );
+        }
+    }
+}
+
 impl Method for Voxel {
     fn name(&self) -> &'static str {
         self.name
@@ -298,13 +314,7 @@ impl Method for Voxel {
         // beam its starts (one per tile of the targets).
         if let Some(c) = &mut self.compute {
             c.depth.resize(shared);
-            self.group = voxel_group(
-                shared,
-                &self.group_layout,
-                (&self.params, &self.pyramid),
-                Some(&c.depth),
-                None,
-            );
+            self.rebind_compute(shared);
         }
         if let Some(beam) = &mut self.beam {
             beam.resize(shared);
@@ -332,13 +342,7 @@ impl Method for Voxel {
             return Ok(view.is_none());
         };
         if c.depth.set_color_out(view) {
-            self.group = voxel_group(
-                shared,
-                &self.group_layout,
-                (&self.params, &self.pyramid),
-                Some(&c.depth),
-                None,
-            );
+            self.rebind_compute(shared);
         }
         Ok(true)
     }
