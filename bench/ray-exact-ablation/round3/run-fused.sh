@@ -13,16 +13,6 @@ for v in base fused; do
   case $v in base) S=/tmp/base ;; fused) S=/tmp/strata ;; esac
   timeout 100 $S compare --frames 20 --size 3840x2160 --methods ray-exact --no-edits --out /tmp/4k-$v >> $OUT/log.txt 2>&1
 done
-cd /tmp; V="$V 4k-base 4k-fused" python3 - > $OUT/summary.txt <<'PY'
-import json,glob,os
-for v in os.environ['V'].split():
-    f=glob.glob(f'/tmp/{v}/results-*.json')
-    if not f: print(v,'missing'); continue
-    rs=json.load(open(f[0]))['rows']
-    passes={}
-    for x in rs:
-        for p in x['passes']: passes[p['label']]=passes.get(p['label'],0)+p['mean_ms']/len(rs)
-    print(f"{v} ray-exact: ms {sum(x['gpu_ms_mean'] for x in rs)/len(rs):.4f} flip {sum(x['flip']['mean'] for x in rs)/len(rs):.4f} passes {{{', '.join(f'{k}: {v:.4f}' for k,v in passes.items())}}}")
-PY
+python3 devexp/summarise.py $V 4k-base 4k-fused > $OUT/summary.txt
 cat $OUT/summary.txt; grep -i "error\|panic" $OUT/log.txt | sort | uniq -c | head -8
 cp /tmp/fused/report.md $OUT/report-fused.md
