@@ -36,6 +36,7 @@ fn clip_to_altitudes(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32) -> vec2<f32> 
 fn first_solid_sample(o: vec3<f32>, d: vec3<f32>, ta: f32, tb: f32, n: u32) -> vec3<f32> {
     let dt = (tb - ta) / f32(n);
     var a = ta;
+    // Bounded: n passes (the caller passes at most MAX_MARCH_STEPS).
     for (var i = 1u; i <= n; i = i + 1u) {
         let t = ta + dt * f32(i);
         if (is_solid(o + d * t)) {
@@ -259,10 +260,13 @@ fn march_from(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, steps: u32, start: f
     // The hot loop only finds the next flagged step; its refinement runs
     // outside it (fewer live registers while marching), and a refinement
     // that finds nothing resumes the march at the next step.
+    // Bounded: each pass breaks, returns, or moves `i` one sample on;
+    // the samples end at `last` (at most MAX_MARCH_STEPS).
     loop {
         var flagged = false;
         var t = t1;
         var solid_end = false;
+        // Bounded: `i` rises by one to `last` (at most MAX_MARCH_STEPS).
         for (; i <= last; i = i + 1u) {
             t = t0 + dt * f32(i);
             let p = o + d * t;

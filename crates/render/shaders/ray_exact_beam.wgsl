@@ -145,6 +145,8 @@ fn beam_clear(base: vec2<i32>, lo_in: vec3<f32>, hi_in: vec3<f32>) -> bool {
     let top = xparams.config.x;
     let ext = max(hi.x - lo.x, hi.y - lo.y);
     var shift = EXACT_LOG_RATIO;
+    // Bounded: `shift` rises by EXACT_LOG_RATIO (1 or 2) a pass to `top`,
+    // the pyramid's coarsest level.
     loop {
         if (shift >= top || f32(1u << shift) >= ext) {
             break;
@@ -178,6 +180,7 @@ fn exact_beam(o: vec3<f32>, base: vec2<i32>, d0: vec3<f32>, d1: vec3<f32>, d2: v
     var dt = BEAM_FIRST_STEP / reach;
     var a = beam_box(o, o, o, o, d0, d1, d2, d3, t);
     var n = 0u;
+    // Bounded: at most BEAM_CAP passes (`n`).
     loop {
         if (t >= t1 || n >= BEAM_CAP) {
             break;
@@ -282,6 +285,8 @@ fn wide_search(base: vec2<i32>, o_lo: vec3<f32>, o_hi: vec3<f32>, d_lo: vec3<f32
     }
     var mask = vec2<u32>(workgroupUniformLoad(&wide_mask[0]), workgroupUniformLoad(&wide_mask[1]));
     var round = 1u;
+    // Bounded: each pass returns or clears one of the 64 bits of `mask`,
+    // and the loop returns when none is left (and after WIDE_ROUNDS rounds).
     loop {
         if (all(mask == vec2<u32>(0u))) {
             return tb;

@@ -94,6 +94,8 @@ fn exact_march_at(o: vec3<f32>, base: vec2<i32>, d: vec3<f32>, t0: f32, t1: f32,
     var lvl = min(top, start) / ratio;
     var t = t0;
     var cell = texel_after(o.xy + d.xy * t, d.xy) >> vec2<u32>(lvl * ratio);
+    // Bounded: each pass counts an iteration first and the loop returns
+    // at the cap (`xparams.config.y`, ITERATION_CAP).
     loop {
         if (r.iterations >= cap) {
             r.capped = true;

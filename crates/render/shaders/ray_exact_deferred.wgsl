@@ -58,7 +58,10 @@ fn mark_shadow_blocks(p: vec3<f32>) {
     let blocks = side / MARK_BLOCK;
     let b0 = clamp(lo, vec2<i32>(0), vec2<i32>(side - 1)) / MARK_BLOCK;
     let b1 = clamp(hi, vec2<i32>(0), vec2<i32>(side - 1)) / MARK_BLOCK;
+    // Bounded: b0 and b1 are clamped to the map and lie within 5 texels of
+    // each other: one or two blocks each way.
     for (var by = b0.y; by <= b1.y; by = by + 1) {
+        // Bounded: as `by` is.
         for (var bx = b0.x; bx <= b1.x; bx = bx + 1) {
             // Most pixels of a block find it stamped: read before the
             // exchange; the one exchange that changes the stamp lists it.
@@ -77,6 +80,8 @@ fn mark_shadow_blocks(p: vec3<f32>) {
 fn list_every_block(flat: u32, pixels: u32) {
     let side = u32(globals.shadow_u.w) / 8u;
     let count = side * side;
+    // Bounded: `pixels` is at least 1 (a pixel of the frame calls this) and
+    // `k` stays below `count` (at most 2^20 blocks) + `pixels` (2^26), no wrap.
     for (var k = flat; k < count; k = k + pixels) {
         shadow_blocks[k] = k;
     }

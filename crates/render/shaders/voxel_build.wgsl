@@ -76,6 +76,8 @@ fn cs_leaf(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index
     workgroupBarrier();
     let column_words = bp.tiles.z * 16u;
     let base = bp.dims.w + (ty * bp.tiles.x + tx) * column_words;
+    // Bounded: `w` rises by 64 to `column_words` (16 words a tile of the
+    // column's height: far below u32's end).
     for (var w = li; w < column_words; w = w + 64u) {
         let tz = w >> 4u;
         let wi = w & 15u;

@@ -121,6 +121,7 @@ fn voxel_march_from(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, steps: u32, st
         var new_c = old_c + step[axis];
         cell[axis] = new_c;
         // Climb while the step also left the parent: the next parent may be empty.
+        // Bounded: `lod` rises by one a pass to `top`.
         while (lod < top && (new_c >> 1u) != (old_c >> 1u)) {
             cell = cell >> vec3<u32>(1u);
             old_c = old_c >> 1u;

@@ -319,6 +319,30 @@ fn compose_into(
     Ok(())
 }
 
+/// The runtime checks wgpu's shader translation adds to Strata's own
+/// shaders: all of them (bounds checks where the driver has no robust
+/// access, integer division guards) except naga's forced loop bounding,
+/// unless `STRATA_SHADER_LOOP_BOUNDING=on` asks for it back.
+///
+/// Why: the bounding puts a 64-bit counter and an exit test into every loop
+/// iteration, and the exact march is bound by the instructions it issues
+/// per iteration: on the H100 it made `ray-exact`'s frame 14 % slower
+/// (`bench/issue36-loop-bounding/`). It guards against loops that never end,
+/// which a driver may treat as unreachable; every loop in these sources ends
+/// by construction, and `tests::every_shader_loop_is_bounded` keeps it so.
+pub fn runtime_checks() -> wgpu::ShaderRuntimeChecks {
+    let mut checks = wgpu::ShaderRuntimeChecks::checked();
+    checks.force_loop_bounding =
+        loop_bounding_requested(std::env::var("STRATA_SHADER_LOOP_BOUNDING").ok().as_deref());
+    checks
+}
+
+/// Whether `STRATA_SHADER_LOOP_BOUNDING`'s value turns naga's loop bounding
+/// back on (for measuring it, or for a driver suspected of miscompiling).
+fn loop_bounding_requested(value: Option<&str>) -> bool {
+    matches!(value, Some("on" | "1" | "true"))
+}
+
 /// Compose and create a shader module, turning a WGSL or validation error
 /// into an `Err` (wgpu would otherwise report it asynchronously).
 pub fn create_module(device: &wgpu::Device, name: &str) -> anyhow::Result<wgpu::ShaderModule> {
@@ -330,7 +354,14 @@ pub fn create_module(device: &wgpu::Device, name: &str) -> anyhow::Result<wgpu::
     // In a browser a bad shader reaches the device's error sink instead
     // (checked after each frame).
     let (module, error) = crate::gpu::catching(device, wgpu::ErrorFilter::Validation, || {
-        device.create_shader_module(descriptor)
+        // SAFETY: the one check `runtime_checks` leaves out is the loop
+        // bounding, whose contract is that no loop of the shader runs
+        // forever. Every loop in `SOURCES` either counts towards a bound it
+        // cannot overflow or says in a `// Bounded:` comment why it ends
+        // (the iteration caps of the exact march and the beam, the step
+        // limits of the sampled march); `every_shader_loop_is_bounded`
+        // fails on a loop that does neither. Bounds checks stay on.
+        unsafe { device.create_shader_module_trusted(descriptor, runtime_checks()) }
     });
     if let Some(err) = error {
         anyhow::bail!("shader `{name}` failed to compile: {err}");
@@ -338,9 +369,120 @@ pub fn create_module(device: &wgpu::Device, name: &str) -> anyhow::Result<wgpu::
     Ok(module)
 }
 
+/// The loops of WGSL `text` that neither count up by one towards a strict
+/// bound (`for (var i = ..; i < n; i = i + 1u)`, `i++`, `i += 1`) nor carry
+/// a `// Bounded:` comment in the comment lines just above them saying why
+/// they end: their line numbers (1-based). What [`runtime_checks`] relies on.
+#[cfg(test)]
+fn unexplained_loops(text: &str) -> Vec<usize> {
+    let lines: Vec<&str> = text.lines().collect();
+    let mut found = Vec::new();
+    for (i, line) in lines.iter().enumerate() {
+        let code = line.split("//").next().unwrap_or("").trim();
+        let is_loop = code.starts_with("loop {")
+            || code.starts_with("loop{")
+            || code.starts_with("while ")
+            || code.starts_with("while(")
+            || code.starts_with("for ")
+            || code.starts_with("for(");
+        if !is_loop || counts_up_to_a_strict_bound(code) {
+            continue;
+        }
+        let explained = lines[..i]
+            .iter()
+            .rev()
+            .map(|l| l.trim())
+            .take_while(|l| l.starts_with("//"))
+            .any(|l| l.contains("Bounded:"));
+        if !explained {
+            found.push(i + 1);
+        }
+    }
+    found
+}
+
+/// `for (var X = ..; X < ..; X = X + 1)` (or `X++`, `X += 1`, with or
+/// without a `u`): X rises by one each pass and stops below a bound it
+/// cannot overflow past.
+#[cfg(test)]
+fn counts_up_to_a_strict_bound(code: &str) -> bool {
+    let Some(inner) = code
+        .strip_prefix("for")
+        .map(str::trim_start)
+        .and_then(|r| r.strip_prefix('('))
+        .and_then(|r| r.rsplit_once(')'))
+        .map(|(header, _)| header)
+    else {
+        return false;
+    };
+    let parts: Vec<&str> = inner.split(';').map(str::trim).collect();
+    let [init, cond, update] = parts[..] else {
+        return false;
+    };
+    let Some(var) = init
+        .strip_prefix("var ")
+        .and_then(|r| r.split('=').next())
+        .map(|v| v.split(':').next().unwrap_or("").trim())
+        .filter(|v| !v.is_empty())
+    else {
+        return false;
+    };
+    let strict = cond
+        .strip_prefix(var)
+        .map(str::trim_start)
+        .is_some_and(|r| r.starts_with('<') && !r.starts_with("<="));
+    let one = |r: &str| matches!(r.trim(), "1" | "1u" | "1i");
+    let by_one = update == format!("{var}++")
+        || update
+            .strip_prefix(var)
+            .and_then(|r| r.trim_start().strip_prefix("+="))
+            .is_some_and(one)
+        || update
+            .strip_prefix(var)
+            .and_then(|r| r.trim_start().strip_prefix('='))
+            .and_then(|r| r.trim_start().strip_prefix(var))
+            .and_then(|r| r.trim_start().strip_prefix('+'))
+            .is_some_and(one);
+    strict && by_one
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn every_shader_loop_is_bounded() {
+        let mut missing = Vec::new();
+        for (name, text) in SOURCES {
+            for line in unexplained_loops(text) {
+                missing.push(format!("{name}:{line}"));
+            }
+        }
+        assert!(
+            missing.is_empty(),
+            "loops that neither count up to a strict bound nor say `// Bounded:` why they end \
+             (shaders are created without naga's loop bounding, see `runtime_checks`): {missing:?}"
+        );
+    }
+
+    #[test]
+    fn the_loop_lint_tells_bounded_loops_from_the_rest() {
+        let counted = "for (var i = 0u; i < n; i = i + 1u) {\nfor (var k = 0u; k < 6u; k++) {\nfor (var j: u32 = 2u; j < m; j += 1u) {";
+        assert!(unexplained_loops(counted).is_empty());
+        let text = "fn f() {\n    loop {\n    }\n    // Why it ends.\n    while (a < b) {\n    }\n    \
+                    for (var i = 0u; i <= n; i = i + 1u) {\n    for (var i = 0u; i < n; i = i + 2u) {\n    \
+                    for (; i < n; i = i + 1u) {\n    for (var i = n; i > 0u; i = i - 1u) {\n    \
+                    // Bounded: n is at most 8.\n    // (more words)\n    loop {\n}";
+        assert_eq!(unexplained_loops(text), vec![2, 5, 7, 8, 9, 10]);
+    }
+
+    #[test]
+    fn loop_bounding_is_off_unless_asked_for() {
+        assert!(!loop_bounding_requested(None));
+        assert!(!loop_bounding_requested(Some("off")));
+        assert!(loop_bounding_requested(Some("on")));
+        assert!(loop_bounding_requested(Some("1")));
+    }
 
     #[test]
     fn every_shader_validates() {
