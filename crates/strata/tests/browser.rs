@@ -4,7 +4,7 @@
 //! (computed in the page too) within the native lavapipe tests' limits; a
 //! crater dug through the page shows in the next frames and the edited
 //! level's reference agrees; undo brings the picture back; the screenshot is
-//! not blank; and `?backend=webgl2` draws `ray` and `painted` (and offers `sliced`)
+//! not blank; and `?backend=webgl2` draws `ray`, `painted` and `sliced`
 //! within the same limits.
 //!
 //! Needs Debian's `chromium` and `chromium-driver` and the bundle
@@ -225,18 +225,32 @@ async fn drive(client: Client, url: String, fixture: CompareFixture) {
         "WebGL2 ray: depth p50 {depth} world units off"
     );
     // The object-order methods WebGL2 has: their vertex shaders read the
-    // terrain through GLSL ES 3.00. (While `sliced`'s slice fragments walked
-    // their gaps, a WebGL2 frame of it on SwiftShader outlasted
-    // chromedriver's 10 s screenshot timeout; its gap pass, one walk a
-    // pixel from the near plane there, does not.)
-    for method in ["painted", "sliced"] {
+    // terrain through GLSL ES 3.00. Each is scored against the reference
+    // from the page's own read-back of its picture (a blank or shifted
+    // picture fails the coverage limits).
+    //
+    // Only `painted` is also screenshotted: a WebDriver screenshot waits
+    // for the compositor, which waits behind the frames the page keeps
+    // drawing, and a WebGL2 `sliced` frame on SwiftShader is seconds long
+    // (with Chromium 156.0.8078.108 its screenshot missed chromedriver's
+    // 10 s renderer timeout four times in a row, in CI and on a 2-core
+    // machine; 156.0.8078.129 takes it). That the canvas shows what WebGL2
+    // draws is checked by `ray` and `painted`.
+    for (method, screenshot) in [("painted", true), ("sliced", false)] {
         assert!(
             !unavailable.iter().any(|u| u["method"] == method),
             "{method} must run on WebGL2"
         );
         run(&client, &format!("method {method}"), 300).await;
+        let start = Instant::now();
         let s = run(&client, "frames 2", 300).await;
-        assert_not_blank(&canvas_pixels(&client).await, &format!("WebGL2 {method}"));
+        eprintln!(
+            "WebGL2 {method}: {:.0} ms per frame (2 frames, wall clock)",
+            start.elapsed().as_secs_f64() * 1e3 / 2.0
+        );
+        if screenshot {
+            assert_not_blank(&canvas_pixels(&client).await, &format!("WebGL2 {method}"));
+        }
         let scores = score(&client, &s, method).await;
         eprintln!("WebGL2 {method}: {scores:?}");
         check(method, scores, &mut failures);
