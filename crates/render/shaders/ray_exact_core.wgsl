@@ -39,6 +39,14 @@ override EXACT_CLIMB: u32 = 1u;
 // other one (4, 16, 64, 256, as the CPU reference does).
 override EXACT_LOG_RATIO: u32 = 1u;
 
+// A descent into the texels tests the texel it lands on in the same iteration
+// (a pipeline constant, `ExactOptions::fused_descent`; the same hits either
+// way). Off, the descent is an iteration of its own, as the CPU reference
+// walks; on, near the ground a warp runs the column test once an iteration
+// for its lanes already at the texels and those just come down, rather than
+// a pass of descents and then a pass of column tests.
+override EXACT_FUSED_DESCENT: bool = true;
+
 // The pyramid level rays start at (a pipeline constant): the coarsest kept
 // level at or below it. The whole map's compute pipelines start at 6 (tiles
 // of 64 texels; `ray_exact::START_LEVEL`): on the default views that takes
@@ -107,7 +115,7 @@ fn exact_march_at(o: vec3<f32>, base: vec2<i32>, d: vec3<f32>, t0: f32, t1: f32,
         // stands for its whole block, so descending into it finds nothing
         // new (and a grazing ray would step its plateau texel by texel).
         let leaf = exact_lod_at(t);
-        let shift = lvl * ratio;
+        var shift = lvl * ratio;
         if (shift < leaf && lvl < top / ratio) {
             // The level of detail grew past this tile: take its parent (the
             // point at t is in it) rather than walk fine tiles of one coarse
@@ -118,10 +126,11 @@ fn exact_march_at(o: vec3<f32>, base: vec2<i32>, d: vec3<f32>, t0: f32, t1: f32,
         }
         let size = f32(1u << shift);
         let edge = vec2<f32>(cell + far_side) * size;
-        let tb = select((edge - o.xy) * inv, vec2<f32>(EXACT_BIG), still);
-        let t_exit = min(tb.x, tb.y);
-        let t_out = min(t_exit, t1);
-        if (lvl > 0u && shift > leaf) {
+        var tb = select((edge - o.xy) * inv, vec2<f32>(EXACT_BIG), still);
+        var t_exit = min(tb.x, tb.y);
+        var t_out = min(t_exit, t1);
+        var test_column = !(lvl > 0u && shift > leaf);
+        if (!test_column) {
             let z_min = min(o.z + d.z * t, o.z + d.z * t_out);
             let tile = (base >> vec2<u32>(shift)) + cell;
             if (z_min <= maxmip_get(shift, tile.x, tile.y)) {
@@ -130,9 +139,19 @@ fn exact_march_at(o: vec3<f32>, base: vec2<i32>, d: vec3<f32>, t0: f32, t1: f32,
                 let child = texel_after(o.xy + d.xy * t, d.xy) >> vec2<u32>(shift - ratio);
                 let first = cell << vec2<u32>(ratio);
                 cell = clamp(child, first, first + vec2<i32>((1 << ratio) - 1));
-                continue;
+                if (!EXACT_FUSED_DESCENT || lvl > 0u || leaf != 0u) {
+                    continue;
+                }
+                // Down at the texels: the texel's bounds (as the next
+                // iteration would compute them at size 1), then its column.
+                shift = 0u;
+                tb = select((vec2<f32>(cell + far_side) - o.xy) * inv, vec2<f32>(EXACT_BIG), still);
+                t_exit = min(tb.x, tb.y);
+                t_out = min(t_exit, t1);
+                test_column = true;
             }
-        } else {
+        }
+        if (test_column) {
             // The tile's first texel (the tile itself at level 0).
             let column = base + (cell << vec2<u32>(shift));
             let c = decode_column(column.x, column.y);

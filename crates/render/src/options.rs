@@ -65,6 +65,10 @@ pub struct ExactOptions {
     /// Most rounds of the shadow blocks' wide search, 1 to 8
     /// (`EXACT_SHADOW_ROUNDS`; the camera tiles' search takes up to 8).
     pub shadow_rounds: u32,
+    /// A descent into the texels tests the texel in the same traversal
+    /// iteration (`EXACT_FUSED_DESCENT`; the same hits either way). Off: the
+    /// descent is an iteration of its own, as the CPU reference walks.
+    pub fused_descent: bool,
 }
 
 /// How `ray-exact`'s beam finds where a tile's rays start
@@ -124,6 +128,9 @@ impl ExactOptions {
         // barriers over the whole march (1.2-1.5x); the images are the same.
         beam_search: BeamSearch::Wide,
         shadow_rounds: 8,
+        // On lavapipe (640x400, the twelve views): march 29.7 -> 27.0 ms
+        // (`bench/issue36-fused-descent/`); not yet measured on the H100.
+        fused_descent: true,
     };
 
     /// Which pyramid levels to keep: only those the traversals visit. The

@@ -47,7 +47,9 @@ pub fn parse_backend(s: &str) -> anyhow::Result<BackendChoice> {
 /// `STRATA_EXACT_BEAM=off|serial|wide|wide-pass` (no beam, the serial
 /// pre-pass, the wide search in the march or in a pre-pass; default
 /// wide), `STRATA_EXACT_SHADOW_ROUNDS=1..8` (the shadow blocks' wide
-/// search's most rounds) configure `ray-exact`; `STRATA_EXACT_STATS=1` prints its statistics;
+/// search's most rounds), `STRATA_EXACT_FUSED_DESCENT=off` (a descent into
+/// the texels an iteration of its own) configure `ray-exact`;
+/// `STRATA_EXACT_STATS=1` prints its statistics;
 /// `STRATA_TEST_OVERSIZE_BUILD=METHOD` makes that method's build ask for a
 /// buffer over the device's limit (the README's way to see a refused build).
 pub fn render_options() -> RenderOptions {
@@ -94,6 +96,7 @@ fn render_options_from(var: impl Fn(&str) -> Option<String>) -> RenderOptions {
                 .and_then(|v| v.parse().ok())
                 .filter(|n| (1..=8).contains(n))
                 .unwrap_or(e.shadow_rounds),
+            fused_descent: !is("STRATA_EXACT_FUSED_DESCENT", "off"),
             ..e
         },
         exact_stats: is("STRATA_EXACT_STATS", "1"),
@@ -114,12 +117,15 @@ mod tests {
             "STRATA_EXACT_RATIO" => Some("2".into()),
             "STRATA_EXACT_BEAM" => Some("off".into()),
             "STRATA_EXACT_SHADOW_ROUNDS" => Some("1".into()),
+            "STRATA_EXACT_FUSED_DESCENT" => Some("off".into()),
             "STRATA_TEST_OVERSIZE_BUILD" => Some("voxel".into()),
             _ => None,
         });
         assert!(!o.shadow_cull && !o.shadow_reuse && !o.exact.beam);
         assert_eq!(o.exact.shadow_rounds, 1);
+        assert!(!o.exact.fused_descent);
         assert!(render_options_from(|_| None).exact.beam);
+        assert!(render_options_from(|_| None).exact.fused_descent);
         for (value, search) in [
             ("serial", BeamSearch::Serial),
             ("wide", BeamSearch::Wide),

@@ -68,6 +68,11 @@ pub struct Args {
     /// default 8, `STRATA_EXACT_SHADOW_ROUNDS` there).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=8))]
     shadow_rounds: Option<u32>,
+    /// Try another traversal on paper: a descent into the texels an
+    /// iteration of its own (as `STRATA_EXACT_FUSED_DESCENT=off`; the GPU's
+    /// default tests the texel in the descent's iteration).
+    #[arg(long)]
+    no_fused_descent: bool,
     /// Try another traversal on paper: the visited level camera rays start
     /// at from their tile's beam (the GPU's: 1, tiles of 4 texels).
     #[arg(long, value_parser = clap::value_parser!(u32).range(0..=4))]
@@ -166,6 +171,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         search: args.search.unwrap_or(Traversal::GPU.search),
         shadow_rounds: args.shadow_rounds.unwrap_or(Traversal::GPU.shadow_rounds),
         beam_level: args.beam_level.unwrap_or(Traversal::GPU.beam_level),
+        fused_descent: !args.no_fused_descent,
     };
     let shape = LevelShape::of(&world.level);
     let mut out = std::io::stdout().lock();

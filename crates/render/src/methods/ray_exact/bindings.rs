@@ -170,6 +170,10 @@ pub(super) fn exact_pipeline(
         ("EXACT_CLIMB", f64::from(options.climb)),
         ("EXACT_LOG_RATIO", f64::from(options.log_ratio)),
         ("EXACT_START_LEVEL", f64::from(start)),
+        (
+            "EXACT_FUSED_DESCENT",
+            f64::from(u8::from(options.fused_descent)),
+        ),
     ];
     if reads_beam(levels, shader) {
         constants.push(("EXACT_BEAM", f64::from(u8::from(options.beam))));

@@ -82,6 +82,9 @@ pub struct Traversal {
     /// The visited level camera and shadow rays start at from their beam
     /// (`EXACT_BEAM_LEVEL`).
     pub beam_level: u32,
+    /// A descent into the texels tests the texel in the same iteration
+    /// (`EXACT_FUSED_DESCENT`).
+    pub fused_descent: bool,
 }
 
 impl Traversal {
@@ -93,6 +96,7 @@ impl Traversal {
         search: crate::options::ExactOptions::DEFAULT.beam_search,
         shadow_rounds: crate::options::ExactOptions::DEFAULT.shadow_rounds,
         beam_level: super::BEAM_LEVEL / LOG_RATIO,
+        fused_descent: crate::options::ExactOptions::DEFAULT.fused_descent,
     };
 
     /// Starting at the 256-texel tiles (the GPU's before `START_LEVEL`).
@@ -103,6 +107,7 @@ impl Traversal {
         search: BeamSearch::Serial,
         shadow_rounds: WIDE_ROUNDS,
         beam_level: super::BEAM_LEVEL / LOG_RATIO,
+        fused_descent: false,
     };
 }
 
@@ -286,15 +291,20 @@ impl<'a> Replay<'a> {
             }
             r.iterations += 1;
             let shift = lvl * ratio;
-            let size = (1u32 << shift) as f32;
-            let edge = (cell + far_side).as_vec2() * size;
-            let tb = (edge - oxy) * inv;
-            let tb = Vec2::new(
-                if still[0] { BIG } else { tb.x },
-                if still[1] { BIG } else { tb.y },
-            );
-            let t_exit = tb.x.min(tb.y);
-            let t_out = t_exit.min(t1);
+            // The tile's exit along the ray (`tb`, `t_exit`) and the ray's
+            // end in it (`t_out`).
+            let bounds = |cell: IVec2, shift: u32| {
+                let edge = (cell + far_side).as_vec2() * (1u32 << shift) as f32;
+                let tb = (edge - oxy) * inv;
+                let tb = Vec2::new(
+                    if still[0] { BIG } else { tb.x },
+                    if still[1] { BIG } else { tb.y },
+                );
+                let t_exit = tb.x.min(tb.y);
+                (tb, t_exit, t_exit.min(t1))
+            };
+            let (mut tb, mut t_exit, mut t_out) = bounds(cell, shift);
+            let mut test_column = lvl == 0;
             if lvl > 0 {
                 let z_min = (o.z + d.z * t).min(o.z + d.z * t_out);
                 let tile = (base >> shift as i32) + cell;
@@ -305,9 +315,15 @@ impl<'a> Replay<'a> {
                     let child = texel_after(oxy + dxy * t, dxy) >> (shift - ratio) as i32;
                     let first = cell << ratio as i32;
                     cell = child.clamp(first, first + IVec2::splat((1 << ratio) - 1));
-                    continue;
+                    if !self.traversal.fused_descent || lvl > 0 {
+                        continue;
+                    }
+                    // EXACT_FUSED_DESCENT: the texel in this iteration.
+                    (tb, t_exit, t_out) = bounds(cell, 0);
+                    test_column = true;
                 }
-            } else {
+            }
+            if test_column {
                 let column = base + cell;
                 r.terrain_reads += 1;
                 let c = self.column(column.x, column.y);

@@ -663,8 +663,18 @@ fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
                 shadow_rounds: 1,
                 ..d
             },
+            ExactOptions {
+                fused_descent: false,
+                ..d
+            },
+            ExactOptions {
+                fused_descent: false,
+                exact_shadow: false,
+                ..d
+            },
         ];
         assert_eq!(d.beam_search, BeamSearch::Wide);
+        assert!(d.fused_descent);
         let mut images = Vec::new();
         for options in variants {
             let m = build(&r.shared_handle(), &w.level, options).unwrap();
@@ -688,9 +698,10 @@ fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
         // Climbing as far as a step allows, visiting every other level,
         // loading depth instead of clearing it, or starting every ray at the
         // near plane instead of its tile's beam, or searching the beam
-        // serially or wide in the march instead of wide in a pre-pass,
-        // changes nothing but the work.
-        for other in [3, 4, 5, 6, 8, 10, 12] {
+        // serially or wide in the march instead of wide in a pre-pass, or
+        // a descent into the texels as an iteration of its own, changes
+        // nothing but the work.
+        for other in [3, 4, 5, 6, 8, 10, 12, 13] {
             for (v, (a, b)) in images[1].iter().zip(&images[other]).enumerate() {
                 assert!(
                     a.0 == b.0 && a.1 == b.1,
@@ -700,8 +711,9 @@ fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
         }
         // The one-pass frame (the renderer's shadow map) with the wide
         // beam in a pre-pass, without a beam, with the serial one and with
-        // the wide one in the march: the same image.
-        for other in [7, 9, 11] {
+        // the wide one in the march, and without the fused descent: the same
+        // image.
+        for other in [7, 9, 11, 14] {
             for (v, (a, b)) in images[2].iter().zip(&images[other]).enumerate() {
                 assert!(
                     a.0 == b.0 && a.1 == b.1,

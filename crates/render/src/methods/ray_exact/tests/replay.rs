@@ -7,16 +7,18 @@ use super::*;
 /// view its hits are the reference's (hit or miss, and the distance), and
 /// the most iterations of a camera ray and of a shadow ray in the frame are
 /// the GPU's own counts (`ExactStats`), up to a step or two where f32
-/// rounding differs on a grazed boundary.
+/// rounding differs on a grazed boundary; with the descent into the texels
+/// fused into the texel's iteration (the default) and not.
 #[test]
 fn the_replay_takes_the_gpu_steps() {
-    for (search, shadow_rounds) in [
-        (BeamSearch::Wide, 8),
-        (BeamSearch::Serial, 8),
-        (BeamSearch::WidePass, 8),
-        (BeamSearch::WidePass, 1),
+    for (search, shadow_rounds, fused_descent) in [
+        (BeamSearch::Wide, 8, true),
+        (BeamSearch::Wide, 8, false),
+        (BeamSearch::Serial, 8, true),
+        (BeamSearch::WidePass, 8, true),
+        (BeamSearch::WidePass, 1, true),
     ] {
-        replay_takes_the_gpu_steps(search, shadow_rounds);
+        replay_takes_the_gpu_steps(search, shadow_rounds, fused_descent);
     }
 }
 
@@ -36,17 +38,19 @@ fn replay_traversal(search: BeamSearch, beam: bool) -> super::super::replay::Tra
     }
 }
 
-fn replay_takes_the_gpu_steps(search: BeamSearch, shadow_rounds: u32) {
+fn replay_takes_the_gpu_steps(search: BeamSearch, shadow_rounds: u32, fused_descent: bool) {
     use super::super::replay::{Replay, replay_frame};
     let (w, pyramid) = replay_world();
     let mut replay = Replay::new(&w.level, &pyramid);
     replay.traversal = super::super::replay::Traversal {
         shadow_rounds,
+        fused_descent,
         ..replay_traversal(search, true)
     };
     let options = ExactOptions {
         beam_search: search,
         shadow_rounds,
+        fused_descent,
         ..ExactOptions::DEFAULT
     };
     let shape = crate::frame::LevelShape::of(&w.level);
@@ -112,7 +116,7 @@ fn replay_takes_the_gpu_steps(search: BeamSearch, shadow_rounds: u32) {
             record_frame(&shared, &mut m, camera, &globals, &timer, index);
             let s = m.stats().unwrap();
             eprintln!(
-                "{search:?} {shadow_rounds} view {index}: most iterations GPU {} / {} (shadow), replay {} / {}",
+                "{search:?} {shadow_rounds} fused {fused_descent} view {index}: most iterations GPU {} / {} (shadow), replay {} / {}",
                 s.most_iterations,
                 s.shadow_most_iterations,
                 f.most_iterations,
