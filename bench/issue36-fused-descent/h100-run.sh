@@ -15,7 +15,7 @@ for rep in 1 2; do
     STRATA_EXACT_FUSED_DESCENT=off "$S" compare --level "$W/world" --frames 20 --no-edits --methods ray-exact \
         --out "$W/unfused-$rep" > /dev/null 2>&1
 done
-python3 bench/issue36-fused-descent/summarise.py "$W"/fused-* "$W"/unfused-* | tee "$OUT/summary.txt"
+python3 bench/issue36-loop-bounding/summary_all.py "$W"/fused-* "$W"/unfused-* | tee "$OUT/summary.txt"
 mkdir -p "$OUT/h100"
 for d in "$W"/fused-* "$W"/unfused-*; do cp "$d"/results-*.json "$OUT/h100/$(basename "$d").json"; done
 (cd "$OUT" && tar czf h100.tgz h100 && rm -rf h100)
