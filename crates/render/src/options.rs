@@ -128,7 +128,7 @@ impl ExactOptions {
         // barriers over the whole march (1.2-1.5x); the images are the same.
         beam_search: BeamSearch::Wide,
         shadow_rounds: 8,
-        // On lavapipe (640x400, the twelve views): march 29.7 -> 27.0 ms
+        // On lavapipe (640x400, the twelve views): march 31.3 -> 28.1 ms
         // (`bench/issue36-fused-descent/`); not yet measured on the H100.
         fused_descent: true,
     };
