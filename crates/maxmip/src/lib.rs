@@ -45,6 +45,9 @@
 
 #![warn(missing_docs)]
 
+mod cave;
+pub use cave::{CavePyramid, NO_SLAB};
+
 use rayon::prelude::*;
 use strata_level::model::decode_column;
 use strata_level::{DirtyRect, Level};
@@ -317,7 +320,7 @@ mod tests {
     use strata_level::MidRule;
     use strata_level::model::META_DOUBLE_LEVEL;
 
-    fn level(w: u32, h: u32, seed: u32) -> Level {
+    pub(crate) fn level(w: u32, h: u32, seed: u32) -> Level {
         let n = (w * h) as usize;
         let heights: Vec<u8> = (0..n as u32)
             .map(|i| ((i.wrapping_mul(2654435761) ^ seed) >> 7) as u8)

@@ -12,6 +12,20 @@ fn maxmip_get(k: u32, tx: i32, ty: i32) -> f32 {
     return f32((maxmip[i >> 2u] >> ((i & 3u) << 3u)) & 0xffu);
 }
 
+// Whether a segment whose altitudes over tile (tx, ty) of level k lie in
+// [z_lo, z_hi] passes between its floors and its slabs: above the highest
+// floor top and below the lowest slab bottom of its columns (the cave
+// pyramid after the maxima, from byte `xparams.config.w`; 16 bits a tile:
+// `strata_maxmip::CavePyramid`), by `CAVE_MARGIN` at least on each side.
+// Then nothing in the tile is solid along it, though its maximum (a slab's
+// top) is above it.
+fn cave_clear(k: u32, tx: i32, ty: i32, z_lo: f32, z_hi: f32) -> bool {
+    let l = xparams.levels[k];
+    let i = l.x + (u32(tx) & l.z) + ((u32(ty) & l.w) << l.y);
+    let v = maxmip[(xparams.config.w >> 2u) + (i >> 1u)] >> ((i & 1u) << 4u);
+    return z_lo > f32(v & 0xffu) + CAVE_MARGIN && z_hi < f32((v >> 8u) & 0xffu) - CAVE_MARGIN;
+}
+
 // Hooks for the paged variant, which counts pixels drawn from pages not yet
 // resident: the whole map is always resident.
 fn page_pixel_begin() {}

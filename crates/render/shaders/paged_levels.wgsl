@@ -56,6 +56,11 @@ fn exact_shade_level(t: f32) -> u32 {
     return exact_leaf(t);
 }
 
+// Pages keep no cave pyramid: no tile is skipped between floors and slabs.
+fn cave_clear(k: u32, tx: i32, ty: i32, z_lo: f32, z_hi: f32) -> bool {
+    return false;
+}
+
 // The top of texel (bx, by) of level `level`.
 fn paged_texel_top(level: u32, bx: i32, by: i32) -> f32 {
     let c = decode_column_at(level, bx, by);

@@ -71,6 +71,12 @@ const BEAM_WIDE_PASS: u32 = 2u;
 // leaves them, small tiles (4 texels) take fewer steps than `EXACT_START_LEVEL`.
 override EXACT_BEAM_LEVEL: u32 = 2u;
 
+// A box no wider than a texel is tested against the (at most 2x2) texels
+// that hold it (`texels_clear`), not the 4-texel tiles: near the ground the
+// beam gets much closer to its rays' hits (a pipeline constant,
+// `ExactOptions::beam_texels`).
+override EXACT_BEAM_TEXELS: bool = false;
+
 const BEAM_TILE: u32 = 8u;
 const BEAM_CAP: u32 = 24u;
 const BEAM_FIRST_STEP: f32 = 4.0;
@@ -133,7 +139,8 @@ fn beam_box(o0: vec3<f32>, o1: vec3<f32>, o2: vec3<f32>, o3: vec3<f32>, d0: vec3
 // Whether nothing in the box (lo, hi), relative to `base` and widened by the
 // margin, is solid: its lowest altitude above 255, or above the highest top
 // of the 2x2 tiles, of the finest kept level whose tile is at least its
-// extent, that hold it.
+// extent, that hold it; or (`EXACT_CAVE_SKIP`) its altitudes between every
+// one of those tiles' floors and slabs (`cave_clear`).
 fn beam_clear(base: vec2<i32>, lo_in: vec3<f32>, hi_in: vec3<f32>) -> bool {
     let big = max(abs(lo_in), abs(hi_in));
     let m = BEAM_MARGIN + BEAM_MARGIN_RELATIVE * max(max(big.x, big.y), big.z);
@@ -144,6 +151,9 @@ fn beam_clear(base: vec2<i32>, lo_in: vec3<f32>, hi_in: vec3<f32>) -> bool {
     }
     let top = xparams.config.x;
     let ext = max(hi.x - lo.x, hi.y - lo.y);
+    if (EXACT_BEAM_TEXELS && ext <= 1.0) {
+        return texels_clear(base, lo, hi);
+    }
     var shift = EXACT_LOG_RATIO;
     // Bounded: `shift` rises by EXACT_LOG_RATIO (1 or 2) a pass to `top`,
     // the pyramid's coarsest level.
@@ -165,7 +175,33 @@ fn beam_clear(base: vec2<i32>, lo_in: vec3<f32>, hi_in: vec3<f32>) -> bool {
         max(maxmip_get(shift, c0.x, c0.y), maxmip_get(shift, c1.x, c0.y)),
         max(maxmip_get(shift, c0.x, c1.y), maxmip_get(shift, c1.x, c1.y)),
     );
-    return lo.z > h;
+    if (lo.z > h) {
+        return true;
+    }
+    // Between every one of the four tiles' floors and slabs.
+    return EXACT_CAVE_SKIP
+        && cave_clear(shift, c0.x, c0.y, lo.z, hi.z) && cave_clear(shift, c1.x, c0.y, lo.z, hi.z)
+        && cave_clear(shift, c0.x, c1.y, lo.z, hi.z) && cave_clear(shift, c1.x, c1.y, lo.z, hi.z);
+}
+
+// Whether nothing in the box (lo, hi), relative to `base`, at most a texel
+// wide, is solid: its lowest altitude above the top of each of the (at most
+// 2x2) texels that hold it, or (`EXACT_CAVE_SKIP`) its altitudes between the
+// texel's floor and slab (`CAVE_MARGIN` clear of both).
+fn texels_clear(base: vec2<i32>, lo: vec3<f32>, hi: vec3<f32>) -> bool {
+    let c0 = vec2<i32>(floor(lo.xy)) + base;
+    let c1 = vec2<i32>(floor(hi.xy)) + base;
+    let texels = array<vec2<i32>, 4>(c0, vec2<i32>(c1.x, c0.y), vec2<i32>(c0.x, c1.y), c1);
+    for (var k = 0u; k < 4u; k = k + 1u) {
+        let c = decode_column(texels[k].x, texels[k].y);
+        let bottom = select(f32(CAVE_NO_SLAB), c.mid, c.dual);
+        let above = lo.z > select(c.low, c.high, c.dual);
+        let between = EXACT_CAVE_SKIP && lo.z > c.low + CAVE_MARGIN && hi.z < bottom - CAVE_MARGIN;
+        if (!above && !between) {
+            return false;
+        }
+    }
+    return true;
 }
 
 // The least t in [t0, t1] at which a ray o + t d, d in the convex hull of

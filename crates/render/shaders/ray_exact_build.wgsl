@@ -2,7 +2,10 @@
 // for bit. One invocation per u32 word (4 tiles of a row) of the dispatched
 // rectangle of one level. The layout keeps every s-th level (s = 1 or 2):
 // level s from the terrain texture, level k from level k - s. Every word it
-// is dispatched over is overwritten whole.
+// is dispatched over is overwritten whole. The same invocation writes its
+// four tiles' cave bounds (`strata_maxmip::CavePyramid`: the highest floor
+// top and the lowest slab bottom, 16 bits a tile, two words) into the cave
+// region that follows the maxima in the same buffer.
 #include "frame.wgsl"
 #include "surface.wgsl"
 
@@ -10,7 +13,8 @@
 struct BuildParams {
     // x first byte of this level, y log2 tiles across, z tiles down, w level k
     level: vec4<u32>,
-    // x first byte of level k - s, y its log2 tiles across, z the step s
+    // x first byte of level k - s, y its log2 tiles across, z the step s,
+    // w the cave region's first byte (tile i's bounds: its u16 i there)
     child: vec4<u32>,
     // x first word column, y first row, z word columns, w rows
     // (levels under 4 tiles across: all their words as one row from 0)
@@ -22,6 +26,27 @@ struct BuildParams {
 
 fn child_byte(i: u32) -> u32 {
     return (pyramid[i >> 2u] >> ((i & 3u) << 3u)) & 0xffu;
+}
+
+// A tile's cave bounds when it has no slab (`strata_maxmip::NO_SLAB`).
+const NO_SLAB: u32 = 255u;
+
+// Tile i's cave bounds (x the highest floor top, y the lowest slab bottom).
+fn child_cave(i: u32) -> vec2<u32> {
+    let v = (pyramid[(bp.child.w >> 2u) + (i >> 1u)] >> ((i & 1u) << 4u)) & 0xffffu;
+    return vec2<u32>(v & 0xffu, v >> 8u);
+}
+
+// The cave bounds of the pair holding texel x = 2 px in row y (as
+// `decode_column` reads it): a dual pair's floor and slab bottom, else the
+// higher of the two texels and no slab.
+fn pair_cave(px: u32, y: u32) -> vec2<u32> {
+    let p = terrain_pair(i32(px * 2u), i32(y));
+    if ((p.y & p.w & META_DOUBLE_LEVEL) != 0u) {
+        let code = ((p.y & 3u) << 2u) | (p.w & 3u);
+        return vec2<u32>(p.x, min(p.x + ((code + globals.level.w) << 3u), p.z));
+    }
+    return vec2<u32>(max(p.x, p.z), NO_SLAB);
 }
 
 // The highest top of the pair holding texel x = 2 px in row y.
@@ -41,6 +66,7 @@ fn cs_maxmip(@builtin(global_invocation_id) id: vec3<u32>) {
     let log2w = bp.level.y;
     let first = ((bp.rect.y + id.y) << log2w) + (bp.rect.x + id.x) * 4u;
     var word = 0u;
+    var caves = array<u32, 4>(NO_SLAB << 8u, NO_SLAB << 8u, NO_SLAB << 8u, NO_SLAB << 8u);
     for (var b = 0u; b < 4u; b = b + 1u) {
         let i = first + b;
         let x = i & ((1u << log2w) - 1u);
@@ -52,10 +78,13 @@ fn cs_maxmip(@builtin(global_invocation_id) id: vec3<u32>) {
         let s = bp.child.z;
         let n = 1u << s;
         var m = 0u;
+        var cave = vec2<u32>(0u, NO_SLAB);
         if (bp.level.w == s) {
             for (var r = 0u; r < n; r = r + 1u) {
                 for (var p = 0u; p < n / 2u; p = p + 1u) {
                     m = max(m, pair_top(x * (n / 2u) + p, n * y + r));
+                    let c = pair_cave(x * (n / 2u) + p, n * y + r);
+                    cave = vec2<u32>(max(cave.x, c.x), min(cave.y, c.y));
                 }
             }
         } else {
@@ -63,10 +92,16 @@ fn cs_maxmip(@builtin(global_invocation_id) id: vec3<u32>) {
                 let row = bp.child.x + ((n * y + r) << bp.child.y) + n * x;
                 for (var c = 0u; c < n; c = c + 1u) {
                     m = max(m, child_byte(row + c));
+                    let k = child_cave(row + c);
+                    cave = vec2<u32>(max(cave.x, k.x), min(cave.y, k.y));
                 }
             }
         }
         word = word | (m << (b * 8u));
+        caves[b] = cave.x | (cave.y << 8u);
     }
     pyramid[(bp.level.x + first) >> 2u] = word;
+    let cave_word = (bp.child.w >> 2u) + ((bp.level.x + first) >> 1u);
+    pyramid[cave_word] = caves[0] | (caves[1] << 16u);
+    pyramid[cave_word + 1u] = caves[2] | (caves[3] << 16u);
 }

@@ -47,6 +47,21 @@ override EXACT_LOG_RATIO: u32 = 1u;
 // a pass of descents and then a pass of column tests.
 override EXACT_FUSED_DESCENT: bool = true;
 
+// A tile whose maximum is above the ray is skipped still when the ray
+// passes between the tile's floors and slabs (`cave_clear`: under a bridge,
+// through a cave), rather than descended into (a pipeline constant,
+// `ExactOptions::cave_skip`; the same hits either way). The beam's test
+// (`beam_clear`) likewise.
+override EXACT_CAVE_SKIP: bool = false;
+
+// How far above the highest floor and below the lowest slab bottom of a tile
+// a segment must stay for `cave_clear` (altitude units): a margin for the
+// rounding of the segment's ends, so a tile is skipped only where the exact
+// column test (`column_entry`) would find nothing either.
+const CAVE_MARGIN: f32 = 0.015625;
+// A column's slab bottom when it has none (`strata_maxmip::NO_SLAB`).
+const CAVE_NO_SLAB: u32 = 255u;
+
 // The pyramid level rays start at (a pipeline constant): the coarsest kept
 // level at or below it. The whole map's compute pipelines start at 6 (tiles
 // of 64 texels; `ray_exact::START_LEVEL`): on the default views that takes
@@ -131,9 +146,12 @@ fn exact_march_at(o: vec3<f32>, base: vec2<i32>, d: vec3<f32>, t0: f32, t1: f32,
         var t_out = min(t_exit, t1);
         var test_column = !(lvl > 0u && shift > leaf);
         if (!test_column) {
-            let z_min = min(o.z + d.z * t, o.z + d.z * t_out);
+            let z_a = o.z + d.z * t;
+            let z_b = o.z + d.z * t_out;
+            let z_min = min(z_a, z_b);
             let tile = (base >> vec2<u32>(shift)) + cell;
-            if (z_min <= maxmip_get(shift, tile.x, tile.y)) {
+            if (z_min <= maxmip_get(shift, tile.x, tile.y)
+                && !(EXACT_CAVE_SKIP && cave_clear(shift, tile.x, tile.y, z_min, max(z_a, z_b)))) {
                 // The ray may touch something here: the child it is in at t.
                 lvl = lvl - 1u;
                 let child = texel_after(o.xy + d.xy * t, d.xy) >> vec2<u32>(shift - ratio);

@@ -69,6 +69,16 @@ pub struct ExactOptions {
     /// iteration (`EXACT_FUSED_DESCENT`; the same hits either way). Off: the
     /// descent is an iteration of its own, as the CPU reference walks.
     pub fused_descent: bool,
+    /// The compute traversals and beams skip a tile whose maximum is above
+    /// the ray where the ray passes between the tile's floors and slabs
+    /// (`EXACT_CAVE_SKIP`, the cave pyramid; the same hits either way). Off:
+    /// they descend into it, as the CPU reference walks.
+    pub cave_skip: bool,
+    /// The beams test a box no wider than a texel against the (at most 2x2)
+    /// texels that hold it, not the 4-texel tiles (`EXACT_BEAM_TEXELS`; the
+    /// same hits, later starts). Off: the finest tiles they test are the
+    /// pyramid's 4-texel ones.
+    pub beam_texels: bool,
 }
 
 /// How `ray-exact`'s beam finds where a tile's rays start
@@ -131,6 +141,10 @@ impl ExactOptions {
         // On lavapipe (640x400, the twelve views): march 31.3 -> 28.1 ms
         // (`bench/issue36-fused-descent/`); not yet measured on the H100.
         fused_descent: true,
+        // On paper (`strata exact-counts`, the twelve views, 1280x800):
+        // MEASURED_LATER (`bench/issue36-cave-skip/`).
+        cave_skip: true,
+        beam_texels: true,
     };
 
     /// Which pyramid levels to keep: only those the traversals visit. The

@@ -48,7 +48,9 @@ pub fn parse_backend(s: &str) -> anyhow::Result<BackendChoice> {
 /// pre-pass, the wide search in the march or in a pre-pass; default
 /// wide), `STRATA_EXACT_SHADOW_ROUNDS=1..8` (the shadow blocks' wide
 /// search's most rounds), `STRATA_EXACT_FUSED_DESCENT=off` (a descent into
-/// the texels an iteration of its own) configure `ray-exact`;
+/// the texels an iteration of its own), `STRATA_EXACT_CAVE_SKIP=off` (no
+/// tile skipped between its floors and slabs), `STRATA_EXACT_BEAM_TEXELS=off`
+/// (the beams' finest test on 4-texel tiles) configure `ray-exact`;
 /// `STRATA_EXACT_STATS=1` prints its statistics;
 /// `STRATA_TEST_OVERSIZE_BUILD=METHOD` makes that method's build ask for a
 /// buffer over the device's limit (the README's way to see a refused build).
@@ -97,6 +99,8 @@ fn render_options_from(var: impl Fn(&str) -> Option<String>) -> RenderOptions {
                 .filter(|n| (1..=8).contains(n))
                 .unwrap_or(e.shadow_rounds),
             fused_descent: !is("STRATA_EXACT_FUSED_DESCENT", "off"),
+            cave_skip: !is("STRATA_EXACT_CAVE_SKIP", "off"),
+            beam_texels: !is("STRATA_EXACT_BEAM_TEXELS", "off"),
             ..e
         },
         exact_stats: is("STRATA_EXACT_STATS", "1"),
@@ -118,12 +122,17 @@ mod tests {
             "STRATA_EXACT_BEAM" => Some("off".into()),
             "STRATA_EXACT_SHADOW_ROUNDS" => Some("1".into()),
             "STRATA_EXACT_FUSED_DESCENT" => Some("off".into()),
+            "STRATA_EXACT_CAVE_SKIP" => Some("off".into()),
+            "STRATA_EXACT_BEAM_TEXELS" => Some("off".into()),
             "STRATA_TEST_OVERSIZE_BUILD" => Some("voxel".into()),
             _ => None,
         });
         assert!(!o.shadow_cull && !o.shadow_reuse && !o.exact.beam);
         assert_eq!(o.exact.shadow_rounds, 1);
         assert!(!o.exact.fused_descent);
+        assert!(!o.exact.cave_skip && !o.exact.beam_texels);
+        assert!(render_options_from(|_| None).exact.beam_texels);
+        assert!(render_options_from(|_| None).exact.cave_skip);
         assert!(render_options_from(|_| None).exact.beam);
         assert!(render_options_from(|_| None).exact.fused_descent);
         for (value, search) in [

@@ -73,6 +73,16 @@ pub struct Args {
     /// default tests the texel in the descent's iteration).
     #[arg(long)]
     no_fused_descent: bool,
+    /// Try another traversal on paper: no tile skipped between its floors
+    /// and slabs (as `STRATA_EXACT_CAVE_SKIP=off`; the GPU's default skips
+    /// them by the cave pyramid).
+    #[arg(long)]
+    no_cave_skip: bool,
+    /// Try another beam on paper: its finest test on the pyramid's 4-texel
+    /// tiles (as `STRATA_EXACT_BEAM_TEXELS=off`; the GPU's default tests a
+    /// box no wider than a texel against the texels that hold it).
+    #[arg(long)]
+    no_beam_texels: bool,
     /// Try another traversal on paper: the visited level camera rays start
     /// at from their tile's beam (the GPU's: 1, tiles of 4 texels).
     #[arg(long, value_parser = clap::value_parser!(u32).range(0..=4))]
@@ -172,6 +182,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         shadow_rounds: args.shadow_rounds.unwrap_or(Traversal::GPU.shadow_rounds),
         beam_level: args.beam_level.unwrap_or(Traversal::GPU.beam_level),
         fused_descent: !args.no_fused_descent,
+        cave_skip: !args.no_cave_skip,
+        beam_texels: !args.no_beam_texels,
     };
     let shape = LevelShape::of(&world.level);
     let mut out = std::io::stdout().lock();

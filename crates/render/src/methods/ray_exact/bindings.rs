@@ -174,6 +174,11 @@ pub(super) fn exact_pipeline(
             "EXACT_FUSED_DESCENT",
             f64::from(u8::from(options.fused_descent)),
         ),
+        // Pages keep no cave pyramid (`paged_levels.wgsl` skips nothing).
+        (
+            "EXACT_CAVE_SKIP",
+            f64::from(u8::from(options.cave_skip && !levels.is_paged())),
+        ),
     ];
     if reads_beam(levels, shader) {
         constants.push(("EXACT_BEAM", f64::from(u8::from(options.beam))));
@@ -186,6 +191,10 @@ pub(super) fn exact_pipeline(
         let rounds = options.shadow_rounds.clamp(1, super::replay::WIDE_ROUNDS);
         constants.push(("EXACT_SHADOW_ROUNDS", f64::from(rounds)));
         constants.push(("EXACT_BEAM_LEVEL", f64::from(super::BEAM_LEVEL)));
+        constants.push((
+            "EXACT_BEAM_TEXELS",
+            f64::from(u8::from(options.beam_texels)),
+        ));
     }
     super::super::common::compute_pipeline_with_constants(
         shared,

@@ -201,7 +201,8 @@ pub fn create_fragment(
 /// The traversal's level table for `layout`.
 pub(crate) fn exact_params(layout: &strata_maxmip::Layout) -> ExactParams {
     let mut table = ExactParams {
-        config: [layout.top(), ITERATION_CAP, 0, 0],
+        // w: the cave pyramid's first byte, after the maxima (`GpuMaxMip`).
+        config: [layout.top(), ITERATION_CAP, 0, layout.bytes],
         levels: [[0; 4]; 9],
     };
     for info in &layout.levels {

@@ -1,7 +1,10 @@
 //! The max-height pyramid on the GPU (`ray_exact_build.wgsl`): one storage
 //! buffer laid out by `strata_maxmip::Layout`, filled by one compute dispatch
 //! per level (level 1 from the terrain texture, each coarser one from the
-//! level below), the twin of `strata_maxmip::Pyramid` bit for bit.
+//! level below), the twin of `strata_maxmip::Pyramid` bit for bit. The same
+//! buffer holds, after the maxima, the cave pyramid (the twin of
+//! `strata_maxmip::CavePyramid`: each tile's highest floor top and lowest
+//! slab bottom, 16 bits a tile), built by the same dispatches.
 //!
 //! Creation builds every level in one submission. An edit queues its dirty
 //! rectangles; the next frame's first pass rebuilds exactly the tiles over
@@ -56,8 +59,9 @@ impl GpuMaxMip {
         let layout = Layout::with_step(level.width(), level.height(), step);
         let device = &shared.device;
         let limits = device.limits();
-        // At least one word, so that a map without tiles still binds a buffer.
-        let bytes = u64::from(layout.bytes.max(4));
+        // The maxima, then the cave bounds (two bytes a tile); at least one
+        // word, so that a map without tiles still binds a buffer.
+        let bytes = (3 * u64::from(layout.bytes)).max(4);
         if bytes
             > limits
                 .max_storage_buffer_binding_size
@@ -178,15 +182,32 @@ impl GpuMaxMip {
         }
     }
 
-    /// Copy the whole buffer back (tests).
+    /// Copy the maxima back (tests).
     pub fn read_back(&self, shared: &Shared) -> anyhow::Result<Vec<u32>> {
-        let words = crate::gpu::read_words(
+        let words = self.read_all(shared)?;
+        Ok(words[..self.layout.bytes as usize / 4].to_vec())
+    }
+
+    /// Copy the cave bounds back (tests): `strata_maxmip::CavePyramid::words`.
+    pub fn read_back_caves(&self, shared: &Shared) -> anyhow::Result<Vec<u32>> {
+        let words = self.read_all(shared)?;
+        let first = self.cave_offset() as usize / 4;
+        Ok(words[first..first + self.layout.bytes as usize / 2].to_vec())
+    }
+
+    fn read_all(&self, shared: &Shared) -> anyhow::Result<Vec<u32>> {
+        crate::gpu::read_words(
             &shared.device,
             &shared.queue,
             &self.buffer,
             "ray-exact readback",
-        )?;
-        Ok(words[..self.layout.bytes as usize / 4].to_vec())
+        )
+    }
+
+    /// The cave region's first byte in the buffer (after the maxima; the
+    /// march reads it from `ExactParams::config[3]`).
+    pub fn cave_offset(&self) -> u32 {
+        self.layout.bytes
     }
 
     /// GPU bytes: the pyramid plus the dispatch parameter slots.
@@ -209,9 +230,9 @@ fn params(layout: &Layout, info: &LevelInfo, rect: &DirtyRect) -> BuildParams {
     let (k, s) = (info.log2_tile, layout.step);
     let child = if k > s {
         let c = layout.level(k - s);
-        [c.offset, c.width.trailing_zeros(), s, 0]
+        [c.offset, c.width.trailing_zeros(), s, layout.bytes]
     } else {
-        [0, 0, s, 0]
+        [0, 0, s, layout.bytes]
     };
     let r = layout.dirty_tiles(k, rect);
     let rect = if info.width >= 4 {

@@ -24,7 +24,7 @@
 use crate::frame::Globals;
 use glam::{IVec2, Vec2, Vec3};
 use strata_level::Level;
-use strata_maxmip::Pyramid;
+use strata_maxmip::{CavePyramid, Pyramid};
 
 mod beam;
 pub use crate::options::BeamSearch;
@@ -36,6 +36,8 @@ const BASE_TILE: f32 = 256.0;
 const BIG: f32 = 3.0e38;
 const MAX_ALTITUDE: f32 = 255.0;
 const MARK_BLOCK: i32 = 8;
+/// `CAVE_MARGIN` of `ray_exact_core.wgsl`.
+const CAVE_MARGIN: f32 = 0.015625;
 const SHADOW_BLOCK_TEXELS: u64 = (MARK_BLOCK * MARK_BLOCK) as u64;
 
 /// Bytes of one read or write of each resource.
@@ -85,6 +87,12 @@ pub struct Traversal {
     /// A descent into the texels tests the texel in the same iteration
     /// (`EXACT_FUSED_DESCENT`).
     pub fused_descent: bool,
+    /// A tile the ray passes between the floors and slabs of is skipped
+    /// (`EXACT_CAVE_SKIP`, [`CavePyramid`]); the beams' test likewise.
+    pub cave_skip: bool,
+    /// The beams test a box no wider than a texel against the texels that
+    /// hold it rather than against 4-texel tiles (`EXACT_BEAM_TEXELS`).
+    pub beam_texels: bool,
 }
 
 impl Traversal {
@@ -97,6 +105,8 @@ impl Traversal {
         shadow_rounds: crate::options::ExactOptions::DEFAULT.shadow_rounds,
         beam_level: super::BEAM_LEVEL / LOG_RATIO,
         fused_descent: crate::options::ExactOptions::DEFAULT.fused_descent,
+        cave_skip: crate::options::ExactOptions::DEFAULT.cave_skip,
+        beam_texels: crate::options::ExactOptions::DEFAULT.beam_texels,
     };
 
     /// Starting at the 256-texel tiles (the GPU's before `START_LEVEL`).
@@ -108,6 +118,8 @@ impl Traversal {
         shadow_rounds: WIDE_ROUNDS,
         beam_level: super::BEAM_LEVEL / LOG_RATIO,
         fused_descent: false,
+        cave_skip: false,
+        beam_texels: false,
     };
 }
 
@@ -148,6 +160,8 @@ pub struct Replay<'a> {
     top: u32,
     /// The traversal replayed ([`Traversal::GPU`] unless changed).
     pub traversal: Traversal,
+    /// The cave pyramid beside `pyramid` (built with the replay).
+    caves: CavePyramid,
     terrain_touched: Touched,
     pyramid_touched: Touched,
 }
@@ -227,6 +241,7 @@ impl<'a> Replay<'a> {
             pyramid,
             top: pyramid.top(),
             traversal: Traversal::GPU,
+            caves: CavePyramid::with_step(level, pyramid.layout.step),
             terrain_touched: Touched::new(pairs),
             pyramid_touched: Touched::new(u64::from(pyramid.layout.bytes / 4)),
         }
@@ -249,6 +264,13 @@ impl<'a> Replay<'a> {
             .index(i64::from(tx), i64::from(ty));
         self.pyramid_touched.touch((i / 4) as u64);
         f32::from(self.pyramid.data[i])
+    }
+
+    /// `cave_clear` of `exact_levels.wgsl` (the cave word, counted as a
+    /// pyramid read by the caller).
+    fn cave_clear(&self, k: u32, tx: i32, ty: i32, z_lo: f32, z_hi: f32) -> bool {
+        let (floor, bottom) = self.caves.get(k, i64::from(tx), i64::from(ty));
+        z_lo > f32::from(floor) + CAVE_MARGIN && z_hi < f32::from(bottom) - CAVE_MARGIN
     }
 
     /// `exact_march` of `ray_exact_core.wgsl` on the whole map (level of
@@ -306,10 +328,17 @@ impl<'a> Replay<'a> {
             let (mut tb, mut t_exit, mut t_out) = bounds(cell, shift);
             let mut test_column = lvl == 0;
             if lvl > 0 {
-                let z_min = (o.z + d.z * t).min(o.z + d.z * t_out);
+                let (z_a, z_b) = (o.z + d.z * t, o.z + d.z * t_out);
+                let z_min = z_a.min(z_b);
                 let tile = (base >> shift as i32) + cell;
                 r.pyramid_reads += 1;
-                if z_min <= self.maxmip(shift, tile.x, tile.y) {
+                let under = z_min <= self.maxmip(shift, tile.x, tile.y);
+                // EXACT_CAVE_SKIP: the cave word, read only under the maximum.
+                let between = under && self.traversal.cave_skip && {
+                    r.pyramid_reads += 1;
+                    self.cave_clear(shift, tile.x, tile.y, z_min, z_a.max(z_b))
+                };
+                if under && !between {
                     r.descents += 1;
                     lvl -= 1;
                     let child = texel_after(oxy + dxy * t, dxy) >> (shift - ratio) as i32;

@@ -100,6 +100,13 @@ fn gpu_pyramid_equals_its_twin_before_and_after_an_edit() {
                 "{w}x{h}: {}",
                 first_diff(&got, &cpu.words())
             );
+            let caves = strata_maxmip::CavePyramid::with_step(&level, step);
+            let got = gp.read_back_caves(&shared).unwrap();
+            assert!(
+                got == caves.words(),
+                "{w}x{h}: caves: {}",
+                first_diff(&got, &caves.words())
+            );
             let rects = if w >= 256 {
                 dig(&world, &mut level)
             } else {
@@ -138,7 +145,24 @@ fn gpu_pyramid_equals_its_twin_before_and_after_an_edit() {
                 "{w}x{h}: after the edit: {}",
                 first_diff(&got, &fresh.words())
             );
-            eprintln!("{w}x{h}: GPU pyramid == CPU twin before and after the crater ({rects:?})");
+            let mut cave_twin = caves.clone();
+            for r in &rects {
+                cave_twin.update(&level, r);
+            }
+            let fresh_caves = strata_maxmip::CavePyramid::with_step(&level, step);
+            assert!(
+                cave_twin == fresh_caves,
+                "{w}x{h}: caves: the CPU update differs from a fresh build"
+            );
+            let got = gp.read_back_caves(&shared).unwrap();
+            assert!(
+                got == fresh_caves.words(),
+                "{w}x{h}: caves after the edit: {}",
+                first_diff(&got, &fresh_caves.words())
+            );
+            eprintln!(
+                "{w}x{h}: GPU pyramid and caves == CPU twins before and after the crater ({rects:?})"
+            );
             gpu.errors.check().unwrap();
         }
     }
@@ -181,6 +205,14 @@ fn many_small_edits_in_one_frame_update_the_pyramid_exactly() {
             "after {} rects: {}",
             rects.len(),
             first_diff(&got, &fresh.words())
+        );
+        let caves = strata_maxmip::CavePyramid::with_step(&level, 2);
+        let got = gp.read_back_caves(&shared).unwrap();
+        assert!(
+            got == caves.words(),
+            "caves after {} rects: {}",
+            rects.len(),
+            first_diff(&got, &caves.words())
         );
         gpu.errors.check().unwrap();
     }
@@ -672,9 +704,23 @@ fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
                 exact_shadow: false,
                 ..d
             },
+            ExactOptions {
+                cave_skip: false,
+                ..d
+            },
+            ExactOptions {
+                beam_texels: false,
+                ..d
+            },
+            ExactOptions {
+                cave_skip: false,
+                beam_texels: false,
+                exact_shadow: false,
+                ..d
+            },
         ];
         assert_eq!(d.beam_search, BeamSearch::Wide);
-        assert!(d.fused_descent);
+        assert!(d.fused_descent && d.cave_skip && d.beam_texels);
         let mut images = Vec::new();
         for options in variants {
             let m = build(&r.shared_handle(), &w.level, options).unwrap();
@@ -699,9 +745,10 @@ fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
         // loading depth instead of clearing it, or starting every ray at the
         // near plane instead of its tile's beam, or searching the beam
         // serially or wide in the march instead of wide in a pre-pass, or
-        // a descent into the texels as an iteration of its own, changes
-        // nothing but the work.
-        for other in [3, 4, 5, 6, 8, 10, 12, 13] {
+        // a descent into the texels as an iteration of its own, or no tile
+        // skipped between floors and slabs, or the beams' finest test on
+        // 4-texel tiles, changes nothing but the work.
+        for other in [3, 4, 5, 6, 8, 10, 12, 13, 15, 16] {
             for (v, (a, b)) in images[1].iter().zip(&images[other]).enumerate() {
                 assert!(
                     a.0 == b.0 && a.1 == b.1,
@@ -711,9 +758,9 @@ fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
         }
         // The one-pass frame (the renderer's shadow map) with the wide
         // beam in a pre-pass, without a beam, with the serial one and with
-        // the wide one in the march, and without the fused descent: the same
-        // image.
-        for other in [7, 9, 11, 14] {
+        // the wide one in the march, without the fused descent, and without
+        // the cave skip and the beams' texel test: the same image.
+        for other in [7, 9, 11, 14, 17] {
             for (v, (a, b)) in images[2].iter().zip(&images[other]).enumerate() {
                 assert!(
                     a.0 == b.0 && a.1 == b.1,

@@ -122,6 +122,9 @@ impl Replay<'_> {
             return true;
         }
         let ext = (hi.x - lo.x).max(hi.y - lo.y);
+        if self.traversal.beam_texels && ext <= 1.0 {
+            return self.texels_clear(base, lo, hi, reads);
+        }
         let mut shift = LOG_RATIO;
         while shift < self.top && ((1u32 << shift) as f32) < ext {
             shift += LOG_RATIO;
@@ -142,7 +145,48 @@ impl Replay<'_> {
                 self.maxmip(shift, c0.x, c1.y)
                     .max(self.maxmip(shift, c1.x, c1.y)),
             );
-        lo.z > h
+        if lo.z > h {
+            return true;
+        }
+        if !self.traversal.cave_skip {
+            return false;
+        }
+        // Between every one of the four tiles' floors and slabs (the GPU
+        // reads them in order and stops at the first that is not).
+        for (x, y) in [(c0.x, c0.y), (c1.x, c0.y), (c0.x, c1.y), (c1.x, c1.y)] {
+            *reads += 1;
+            if !self.cave_clear(shift, x, y, lo.z, hi.z) {
+                return false;
+            }
+        }
+        true
+    }
+
+    /// `texels_clear` of `ray_exact_beam.wgsl`: a box at most a texel wide
+    /// against the (at most 2x2) texels that hold it: above every one's top,
+    /// or between every one's floor and slab. Counts the texels read into
+    /// `reads` (the GPU reads them in order and stops at the first that is
+    /// not clear).
+    fn texels_clear(&mut self, base: IVec2, lo: Vec3, hi: Vec3, reads: &mut u32) -> bool {
+        let c0 = lo.truncate().floor().as_ivec2() + base;
+        let c1 = hi.truncate().floor().as_ivec2() + base;
+        for (x, y) in [(c0.x, c0.y), (c1.x, c0.y), (c0.x, c1.y), (c1.x, c1.y)] {
+            *reads += 1;
+            let c = self.column(x, y);
+            let above = lo.z > f32::from(c.top());
+            let bottom = if c.dual {
+                c.mid
+            } else {
+                strata_maxmip::NO_SLAB
+            };
+            let between = self.traversal.cave_skip
+                && lo.z > f32::from(c.low) + super::CAVE_MARGIN
+                && hi.z < f32::from(bottom) - super::CAVE_MARGIN;
+            if !above && !between {
+                return false;
+            }
+        }
+        true
     }
 
     /// `wide_search` of `ray_exact_beam.wgsl`: the least t in [ta, tb] at

@@ -11,14 +11,15 @@ use super::*;
 /// fused into the texel's iteration (the default) and not.
 #[test]
 fn the_replay_takes_the_gpu_steps() {
-    for (search, shadow_rounds, fused_descent) in [
-        (BeamSearch::Wide, 8, true),
-        (BeamSearch::Wide, 8, false),
-        (BeamSearch::Serial, 8, true),
-        (BeamSearch::WidePass, 8, true),
-        (BeamSearch::WidePass, 1, true),
+    for (search, shadow_rounds, fused_descent, caves) in [
+        (BeamSearch::Wide, 8, true, true),
+        (BeamSearch::Wide, 8, false, true),
+        (BeamSearch::Wide, 8, true, false),
+        (BeamSearch::Serial, 8, true, true),
+        (BeamSearch::WidePass, 8, true, true),
+        (BeamSearch::WidePass, 1, true, true),
     ] {
-        replay_takes_the_gpu_steps(search, shadow_rounds, fused_descent);
+        replay_takes_the_gpu_steps(search, shadow_rounds, fused_descent, caves);
     }
 }
 
@@ -38,19 +39,30 @@ fn replay_traversal(search: BeamSearch, beam: bool) -> super::super::replay::Tra
     }
 }
 
-fn replay_takes_the_gpu_steps(search: BeamSearch, shadow_rounds: u32, fused_descent: bool) {
+/// `caves`: the cave skip and the beams' texel test both on (the default)
+/// or both off.
+fn replay_takes_the_gpu_steps(
+    search: BeamSearch,
+    shadow_rounds: u32,
+    fused_descent: bool,
+    caves: bool,
+) {
     use super::super::replay::{Replay, replay_frame};
     let (w, pyramid) = replay_world();
     let mut replay = Replay::new(&w.level, &pyramid);
     replay.traversal = super::super::replay::Traversal {
         shadow_rounds,
         fused_descent,
+        cave_skip: caves,
+        beam_texels: caves,
         ..replay_traversal(search, true)
     };
     let options = ExactOptions {
         beam_search: search,
         shadow_rounds,
         fused_descent,
+        cave_skip: caves,
+        beam_texels: caves,
         ..ExactOptions::DEFAULT
     };
     let shape = crate::frame::LevelShape::of(&w.level);
@@ -116,7 +128,7 @@ fn replay_takes_the_gpu_steps(search: BeamSearch, shadow_rounds: u32, fused_desc
             record_frame(&shared, &mut m, camera, &globals, &timer, index);
             let s = m.stats().unwrap();
             eprintln!(
-                "{search:?} {shadow_rounds} fused {fused_descent} view {index}: most iterations GPU {} / {} (shadow), replay {} / {}",
+                "{search:?} {shadow_rounds} fused {fused_descent} caves {caves} view {index}: most iterations GPU {} / {} (shadow), replay {} / {}",
                 s.most_iterations,
                 s.shadow_most_iterations,
                 f.most_iterations,
@@ -223,4 +235,69 @@ fn beam_never_passes_a_hit(search: BeamSearch) {
             "the beam saved nothing: {before} -> {after} + {beams}"
         );
     }
+}
+
+/// The cave skip (`EXACT_CAVE_SKIP`, the cave pyramid) and the beams' texel
+/// test (`EXACT_BEAM_TEXELS`) change no hit (t and column, bit for bit,
+/// every pixel of every generated view at 320x200, marched from the near
+/// plane and from the tile's beam) and save iterations on those views, whose
+/// rays pass under slabs.
+#[test]
+fn the_cave_skip_and_the_texel_beam_keep_every_hit() {
+    use super::super::replay::{BEAM_TILE, Replay, Traversal};
+    let (w, pyramid) = replay_world();
+    let mut on = Replay::new(&w.level, &pyramid);
+    let mut off = Replay::new(&w.level, &pyramid);
+    off.traversal = Traversal {
+        cave_skip: false,
+        beam_texels: false,
+        ..Traversal::GPU
+    };
+    assert!(on.traversal.cave_skip && on.traversal.beam_texels);
+    let (width, height) = (320, 200);
+    let bits = |h: Option<(f32, glam::IVec2)>| h.map(|(t, c)| (t.to_bits(), c));
+    let (mut iter_on, mut iter_off, mut hits) = (0u64, 0u64, 0u64);
+    for view in &w.views {
+        let (_, g) = view_globals(&w.level, view, (width, height));
+        for ty in 0..height.div_ceil(BEAM_TILE) {
+            for tx in 0..width.div_ceil(BEAM_TILE) {
+                let (b_on, b_off) = (on.tile_start(&g, tx, ty).t, off.tile_start(&g, tx, ty).t);
+                for y in ty * BEAM_TILE..((ty + 1) * BEAM_TILE).min(height) {
+                    for x in tx * BEAM_TILE..((tx + 1) * BEAM_TILE).min(width) {
+                        let (px, py) = (x as f32 + 0.5, y as f32 + 0.5);
+                        let reference = off.pixel(&g, px, py).1;
+                        let near = on.pixel(&g, px, py).1;
+                        let (beam_on, beam_off) = (
+                            on.pixel_from(&g, px, py, Some(b_on)).1,
+                            off.pixel_from(&g, px, py, Some(b_off)).1,
+                        );
+                        for (what, m) in [
+                            ("from the near plane", near),
+                            ("from its beam", beam_on),
+                            ("off, from its beam", beam_off),
+                        ] {
+                            assert!(
+                                bits(m.hit) == bits(reference.hit),
+                                "{} pixel ({x}, {y}) {what}: {:?}, without the skip {:?}",
+                                view.name,
+                                m.hit,
+                                reference.hit
+                            );
+                        }
+                        hits += u64::from(reference.hit.is_some());
+                        iter_on += u64::from(beam_on.iterations);
+                        iter_off += u64::from(beam_off.iterations);
+                    }
+                }
+            }
+        }
+    }
+    eprintln!(
+        "cave skip and texel beam: {iter_on} march iterations against {iter_off} without, {hits} hits"
+    );
+    assert!(hits > 0);
+    assert!(
+        (iter_on as f64) < 0.9 * iter_off as f64,
+        "{iter_on} iterations with the skip, {iter_off} without"
+    );
 }
