@@ -41,11 +41,12 @@ override EXACT_LOG_RATIO: u32 = 1u;
 
 // A descent into the texels tests the texel it lands on in the same iteration
 // (a pipeline constant, `ExactOptions::fused_descent`; the same hits either
-// way). Off, the descent is an iteration of its own, as the CPU reference
-// walks; on, near the ground a warp runs the column test once an iteration
-// for its lanes already at the texels and those just come down, rather than
-// a pass of descents and then a pass of column tests.
-override EXACT_FUSED_DESCENT: bool = true;
+// way). Off (the default), the descent is an iteration of its own, as the
+// CPU reference walks; on, near the ground a warp runs the column test once
+// an iteration for its lanes already at the texels and those just come down,
+// rather than a pass of descents and then a pass of column tests: 20 % fewer
+// iterations, but on the H100 a slower frame (`bench/issue36-cave-skip/`).
+override EXACT_FUSED_DESCENT: bool = false;
 
 // A tile whose maximum is above the ray is skipped still when the ray
 // passes between the tile's floors and slabs (`cave_clear`: under a bridge,

@@ -47,8 +47,9 @@ pub fn parse_backend(s: &str) -> anyhow::Result<BackendChoice> {
 /// `STRATA_EXACT_BEAM=off|serial|wide|wide-pass` (no beam, the serial
 /// pre-pass, the wide search in the march or in a pre-pass; default
 /// wide), `STRATA_EXACT_SHADOW_ROUNDS=1..8` (the shadow blocks' wide
-/// search's most rounds), `STRATA_EXACT_FUSED_DESCENT=off` (a descent into
-/// the texels an iteration of its own), `STRATA_EXACT_CAVE_SKIP=off` (no
+/// search's most rounds), `STRATA_EXACT_FUSED_DESCENT=on|off` (a descent
+/// into the texels tests the texel in its iteration, or is an iteration of
+/// its own as by default), `STRATA_EXACT_CAVE_SKIP=off` (no
 /// tile skipped between its floors and slabs), `STRATA_EXACT_BEAM_TEXELS=off`
 /// (the beams' finest test on 4-texel tiles) configure `ray-exact`;
 /// `STRATA_EXACT_STATS=1` prints its statistics;
@@ -98,7 +99,11 @@ fn render_options_from(var: impl Fn(&str) -> Option<String>) -> RenderOptions {
                 .and_then(|v| v.parse().ok())
                 .filter(|n| (1..=8).contains(n))
                 .unwrap_or(e.shadow_rounds),
-            fused_descent: !is("STRATA_EXACT_FUSED_DESCENT", "off"),
+            fused_descent: match var("STRATA_EXACT_FUSED_DESCENT").as_deref() {
+                Some("on") => true,
+                Some("off") => false,
+                _ => e.fused_descent,
+            },
             cave_skip: !is("STRATA_EXACT_CAVE_SKIP", "off"),
             beam_texels: !is("STRATA_EXACT_BEAM_TEXELS", "off"),
             ..e
@@ -121,7 +126,7 @@ mod tests {
             "STRATA_EXACT_RATIO" => Some("2".into()),
             "STRATA_EXACT_BEAM" => Some("off".into()),
             "STRATA_EXACT_SHADOW_ROUNDS" => Some("1".into()),
-            "STRATA_EXACT_FUSED_DESCENT" => Some("off".into()),
+            "STRATA_EXACT_FUSED_DESCENT" => Some("on".into()),
             "STRATA_EXACT_CAVE_SKIP" => Some("off".into()),
             "STRATA_EXACT_BEAM_TEXELS" => Some("off".into()),
             "STRATA_TEST_OVERSIZE_BUILD" => Some("voxel".into()),
@@ -129,12 +134,12 @@ mod tests {
         });
         assert!(!o.shadow_cull && !o.shadow_reuse && !o.exact.beam);
         assert_eq!(o.exact.shadow_rounds, 1);
-        assert!(!o.exact.fused_descent);
+        assert!(o.exact.fused_descent);
         assert!(!o.exact.cave_skip && !o.exact.beam_texels);
         assert!(render_options_from(|_| None).exact.beam_texels);
         assert!(render_options_from(|_| None).exact.cave_skip);
         assert!(render_options_from(|_| None).exact.beam);
-        assert!(render_options_from(|_| None).exact.fused_descent);
+        assert!(!render_options_from(|_| None).exact.fused_descent);
         for (value, search) in [
             ("serial", BeamSearch::Serial),
             ("wide", BeamSearch::Wide),

@@ -87,8 +87,10 @@ pub struct Traversal {
     /// A descent into the texels tests the texel in the same iteration
     /// (`EXACT_FUSED_DESCENT`).
     pub fused_descent: bool,
-    /// A tile the ray passes between the floors and slabs of is skipped
-    /// (`EXACT_CAVE_SKIP`, [`CavePyramid`]); the beams' test likewise.
+    /// A tile a camera ray passes between the floors and slabs of is
+    /// skipped (`EXACT_CAVE_SKIP`, [`CavePyramid`]); the camera tiles' beams
+    /// likewise. Shadow rays come down from above the map and never pass
+    /// under a slab: their pipeline leaves the test out.
     pub cave_skip: bool,
     /// The beams test a box no wider than a texel against the texels that
     /// hold it rather than against 4-texel tiles (`EXACT_BEAM_TEXELS`).
@@ -439,6 +441,24 @@ impl<'a> Replay<'a> {
 
     /// `cast_texel` from no earlier than `start` (its block's beam).
     pub fn shadow_texel_from(
+        &mut self,
+        g: &Globals,
+        i: u32,
+        j: u32,
+        start: Option<f32>,
+    ) -> MarchCount {
+        self.without_caves(|replay| replay.shadow_texel_march(g, i, j, start))
+    }
+
+    /// Run `f` with the cave skip off (the shadow pipeline's constant).
+    pub(super) fn without_caves<T>(&mut self, f: impl FnOnce(&mut Self) -> T) -> T {
+        let keep = std::mem::replace(&mut self.traversal.cave_skip, false);
+        let out = f(self);
+        self.traversal.cave_skip = keep;
+        out
+    }
+
+    fn shadow_texel_march(
         &mut self,
         g: &Globals,
         i: u32,

@@ -288,10 +288,10 @@ impl Replay<'_> {
 
     /// The shadow block's beam by the traversal's search.
     pub fn shadow_block_start(&mut self, g: &Globals, i: u32, j: u32) -> BeamCount {
-        match self.traversal.search {
-            BeamSearch::Serial => self.shadow_beam(g, i, j),
-            BeamSearch::Wide | BeamSearch::WidePass => self.shadow_beam_wide(g, i, j),
-        }
+        self.without_caves(|replay| match replay.traversal.search {
+            BeamSearch::Serial => replay.shadow_beam(g, i, j),
+            BeamSearch::Wide | BeamSearch::WidePass => replay.shadow_beam_wide(g, i, j),
+        })
     }
 
     /// The shadow block's four corner texels' rays: starts relative to the
