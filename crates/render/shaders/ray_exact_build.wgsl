@@ -14,7 +14,8 @@ struct BuildParams {
     // x first byte of this level, y log2 tiles across, z tiles down, w level k
     level: vec4<u32>,
     // x first byte of level k - s, y its log2 tiles across, z the step s,
-    // w the cave region's first byte (tile i's bounds: its u16 i there)
+    // w the cave region's first byte (tile i's bounds: its u16 i there), or
+    // NO_CAVES for a buffer without one
     child: vec4<u32>,
     // x first word column, y first row, z word columns, w rows
     // (levels under 4 tiles across: all their words as one row from 0)
@@ -30,6 +31,8 @@ fn child_byte(i: u32) -> u32 {
 
 // A tile's cave bounds when it has no slab (`strata_maxmip::NO_SLAB`).
 const NO_SLAB: u32 = 255u;
+// `bp.child.w` of a pyramid without cave bounds (the fragment methods' beams).
+const NO_CAVES: u32 = 0xffffffffu;
 
 // Tile i's cave bounds (x the highest floor top, y the lowest slab bottom).
 fn child_cave(i: u32) -> vec2<u32> {
@@ -101,6 +104,9 @@ fn cs_maxmip(@builtin(global_invocation_id) id: vec3<u32>) {
         caves[b] = cave.x | (cave.y << 8u);
     }
     pyramid[(bp.level.x + first) >> 2u] = word;
+    if (bp.child.w == NO_CAVES) {
+        return;
+    }
     let cave_word = (bp.child.w >> 2u) + ((bp.level.x + first) >> 1u);
     pyramid[cave_word] = caves[0] | (caves[1] << 16u);
     pyramid[cave_word + 1u] = caves[2] | (caves[3] << 16u);

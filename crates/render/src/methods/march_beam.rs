@@ -98,7 +98,7 @@ impl MarchBeam {
             compute: true,
             ..ExactOptions::DEFAULT
         };
-        let pyramid = GpuMaxMip::new(shared, level, options.pyramid_step())?;
+        let pyramid = GpuMaxMip::new(shared, level, options.pyramid_step(), false)?;
         let params = shared.uniform_buffer(
             "march beam params",
             bytemuck::bytes_of(&exact_params(&pyramid.layout)),

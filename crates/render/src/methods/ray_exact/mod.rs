@@ -226,7 +226,7 @@ pub(crate) fn exact_params(layout: &strata_maxmip::Layout) -> ExactParams {
 
 /// Build the method with explicit options.
 pub fn build(shared: &Shared, level: &Level, options: ExactOptions) -> anyhow::Result<RayExact> {
-    let pyramid = GpuMaxMip::new(shared, level, options.pyramid_step())?;
+    let pyramid = GpuMaxMip::new(shared, level, options.pyramid_step(), true)?;
     let table = exact_params(&pyramid.layout);
     build_on(shared, Levels::Whole(pyramid), table, options)
 }

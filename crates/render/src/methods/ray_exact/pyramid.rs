@@ -39,6 +39,8 @@ struct BuildParams {
 pub struct GpuMaxMip {
     pub layout: Layout,
     pub buffer: wgpu::Buffer,
+    /// Whether the buffer holds the cave pyramid after the maxima.
+    caves: bool,
     pipeline: wgpu::ComputePipeline,
     frame_group: wgpu::BindGroup,
     group: wgpu::BindGroup,
@@ -54,14 +56,16 @@ pub struct GpuMaxMip {
 impl GpuMaxMip {
     /// Create the buffer and build levels `step, 2 step, ..`: the levels a
     /// traversal visiting every `step`-th one reads (`EXACT_LOG_RATIO`), and
-    /// no others.
-    pub fn new(shared: &Shared, level: &Level, step: u32) -> anyhow::Result<Self> {
+    /// no others; with `caves`, the cave pyramid after them (`ray-exact`'s
+    /// march reads it; the fragment methods' beams do not).
+    pub fn new(shared: &Shared, level: &Level, step: u32, caves: bool) -> anyhow::Result<Self> {
         let layout = Layout::with_step(level.width(), level.height(), step);
         let device = &shared.device;
         let limits = device.limits();
         // The maxima, then the cave bounds (two bytes a tile); at least one
         // word, so that a map without tiles still binds a buffer.
-        let bytes = (3 * u64::from(layout.bytes)).max(4);
+        let planes = if caves { 3 } else { 1 };
+        let bytes = (planes * u64::from(layout.bytes)).max(4);
         if bytes
             > limits
                 .max_storage_buffer_binding_size
@@ -99,6 +103,7 @@ impl GpuMaxMip {
         });
         let mut pyramid = GpuMaxMip {
             pending: vec![whole(level)],
+            caves,
             layout,
             buffer,
             pipeline,
@@ -141,7 +146,7 @@ impl GpuMaxMip {
         let mut data = Vec::new();
         for info in self.layout.levels.clone() {
             for rect in &self.pending {
-                let p = params(&self.layout, &info, rect);
+                let p = params(&self.layout, &info, rect, self.caves);
                 self.scheduled.push([p.rect[2].div_ceil(64), p.rect[3]]);
                 let at = data.len();
                 data.resize(at + self.slot_stride as usize, 0);
@@ -190,6 +195,7 @@ impl GpuMaxMip {
 
     /// Copy the cave bounds back (tests): `strata_maxmip::CavePyramid::words`.
     pub fn read_back_caves(&self, shared: &Shared) -> anyhow::Result<Vec<u32>> {
+        anyhow::ensure!(self.caves, "this pyramid keeps no cave bounds");
         let words = self.read_all(shared)?;
         let first = self.cave_offset() as usize / 4;
         Ok(words[first..first + self.layout.bytes as usize / 2].to_vec())
@@ -206,7 +212,7 @@ impl GpuMaxMip {
 
     /// The cave region's first byte in the buffer (after the maxima; the
     /// march reads it from `ExactParams::config[3]`).
-    pub fn cave_offset(&self) -> u32 {
+    fn cave_offset(&self) -> u32 {
         self.layout.bytes
     }
 
@@ -226,13 +232,15 @@ fn whole(level: &Level) -> DirtyRect {
 }
 
 /// The dispatch over the words of level `info` holding tiles over `rect`.
-fn params(layout: &Layout, info: &LevelInfo, rect: &DirtyRect) -> BuildParams {
+fn params(layout: &Layout, info: &LevelInfo, rect: &DirtyRect, caves: bool) -> BuildParams {
     let (k, s) = (info.log2_tile, layout.step);
+    // The cave region's first byte, or none (`NO_CAVES` in the shader).
+    let cave = if caves { layout.bytes } else { u32::MAX };
     let child = if k > s {
         let c = layout.level(k - s);
-        [c.offset, c.width.trailing_zeros(), s, layout.bytes]
+        [c.offset, c.width.trailing_zeros(), s, cave]
     } else {
-        [0, 0, s, layout.bytes]
+        [0, 0, s, cave]
     };
     let r = layout.dirty_tiles(k, rect);
     let rect = if info.width >= 4 {

@@ -92,7 +92,7 @@ fn gpu_pyramid_equals_its_twin_before_and_after_an_edit() {
             let world = if w >= 256 { world(w, h, 6) } else { tiny(w, h) };
             let mut level = world.level.clone();
             let shared = shared_for(&gpu, &level);
-            let mut gp = GpuMaxMip::new(&shared, &level, step).unwrap();
+            let mut gp = GpuMaxMip::new(&shared, &level, step, true).unwrap();
             let cpu = strata_maxmip::Pyramid::with_step(&level, step);
             let got = gp.read_back(&shared).unwrap();
             assert!(
@@ -177,7 +177,7 @@ fn many_small_edits_in_one_frame_update_the_pyramid_exactly() {
         let world = world(256, 1024, 6);
         let mut level = world.level.clone();
         let shared = shared_for(&gpu, &level);
-        let mut gp = GpuMaxMip::new(&shared, &level, 2).unwrap();
+        let mut gp = GpuMaxMip::new(&shared, &level, 2, true).unwrap();
         let mut rects = Vec::new();
         for k in 0..200u32 {
             // Tracks lower, ridges raise: a stale tile either way shows.
@@ -232,7 +232,7 @@ fn gpu_trace(gpu: &crate::Gpu, level: &Level, rays: &[TestRay]) -> Vec<[f32; 4]>
     let shared = shared_for(gpu, level);
     let device = &shared.device;
     // `ray_exact_test.wgsl` keeps the default constants: every level.
-    let pyramid = GpuMaxMip::new(&shared, level, 1).unwrap();
+    let pyramid = GpuMaxMip::new(&shared, level, 1, true).unwrap();
     let params = shared.uniform_buffer(
         "test params",
         bytemuck::bytes_of(&exact_params(&pyramid.layout)),
