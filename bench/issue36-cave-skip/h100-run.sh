@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
-# The H100 call of this folder: one binary, the cave skip and the beam's
-# texel test each on and off (and the walk before both, with the fused
-# descent off too: the shipped march before `dbd4d96`), alternated, twice
-# each; the protocol's twelve views at 1280x800 with shadows, 20 frames.
+# Calls 1 and 2 of this folder: one binary, the cave skip and the beam's
+# texel test each on and off, alternated, twice each, with the fused
+# descent on (call 1, `FUSED=on`, the default then) or off (call 2,
+# `FUSED=off`, the default now); call 1 also the walk before both, unfused
+# (the march before `dbd4d96`). The protocol's twelve views at 1280x800
+# with shadows, 20 frames.
 # Run from the repository root on the device with `devbin/strata` (release,
 # stripped; gzipped as devbin/strata.gz is fine) and `.gl/` carried:
 #   OUT=$OUT bash bench/issue36-cave-skip/h100-run.sh
@@ -13,9 +15,10 @@ S=${STRATA:-devbin/strata}
 W=$(mktemp -d); export STRATA_CACHE_DIR=$W/cache
 "$S" generate --out "$W/world" > /dev/null
 nvidia-smi --query-gpu=name,driver_version --format=csv,noheader > "$OUT/gpu.txt" 2>&1
+FUSED=${FUSED:-on}
 run() {
     local name=$1; shift
-    env "$@" timeout 120 "$S" compare --level "$W/world" --frames 20 --no-edits --methods ray-exact \
+    env STRATA_EXACT_FUSED_DESCENT="$FUSED" "$@" timeout 120 "$S" compare --level "$W/world" --frames 20 --no-edits --methods ray-exact \
         --out "$W/$name" > "$W/$name.log" 2>&1 || echo "$name failed: $(tail -2 "$W/$name.log")"
 }
 for rep in 1 2; do

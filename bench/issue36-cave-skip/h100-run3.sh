@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # One H100 call: the shipped defaults (unfused descent, cave skip for camera
 # rays, texel beam) against the walk without the cave skip and the texel
-# beam, and the previous default (fused, neither); then where the march's
+# beam; then where the march's
 # time goes (diagnostics: the same code plus round 2's shader-rewrite hook,
 # `bench/ray-exact-ablation/round2/shader-sed-hook.patch`, rules in `sed/`:
 # `cap0` stops every ray before its first iteration and drops the
@@ -28,18 +28,15 @@ for rep in 1 2; do
     run /tmp/strata "default-$rep"
     run /tmp/strata "neither-$rep" $NEITHER
 done
-run /tmp/strata previous $NEITHER STRATA_EXACT_FUSED_DESCENT=on
+run /tmp/strata-hook hook
 for rep in 1 2; do
-    run /tmp/strata-hook "hook-$rep"
     run /tmp/strata-hook "markdedupe-$rep" STRATA_SHADER_SED_FILE=$SED/markdedupe.txt
-    run /tmp/strata-hook "cap0-$rep" STRATA_SHADER_SED_FILE=$SED/cap0.txt
 done
+run /tmp/strata-hook cap0 STRATA_SHADER_SED_FILE=$SED/cap0.txt
 run /tmp/strata-hook cap0-nobeam STRATA_SHADER_SED_FILE=$SED/cap0.txt STRATA_EXACT_BEAM=off
 run /tmp/strata-hook nomarks STRATA_SHADER_SED_FILE=$SED/nomarks.txt
-run /tmp/strata-hook cap0-nomarks STRATA_SHADER_SED_FILE=$SED/cap0-nomarks.txt
-run /tmp/strata-hook nobeam STRATA_EXACT_BEAM=off
-python3 bench/issue36-loop-bounding/summary_all.py "$W"/default-? "$W"/neither-? "$W"/previous \
-    "$W"/hook-? "$W"/markdedupe-? "$W"/cap0-? "$W"/cap0-nobeam "$W"/nomarks "$W"/cap0-nomarks "$W"/nobeam \
+python3 bench/issue36-loop-bounding/summary_all.py "$W"/default-? "$W"/neither-? \
+    "$W"/hook "$W"/markdedupe-? "$W"/cap0 "$W"/cap0-nobeam "$W"/nomarks \
     | tee "$OUT/summary3.txt"
 mkdir -p "$OUT/h100c"
 for d in "$W"/*/; do

@@ -140,16 +140,18 @@ impl ExactOptions {
         shadow_rounds: 8,
         // Off: 20 % fewer iterations on paper and 10 % less march on
         // lavapipe (640x400: 31.3 -> 28.1 ms, `bench/issue36-fused-descent/`),
-        // but on the H100 the fused walk is slower: 0.1663 ms a frame
-        // unfused against 0.1811 fused, march 0.1131 against 0.1227, shadow
-        // 0.0346 against 0.0397 (`bench/issue36-cave-skip/`, one call each
-        // way twice, cave skip and texel beam off both).
+        // but on the H100 the fused walk is slower: in one call 0.1660 ms a
+        // frame unfused against 0.1811 fused (march 0.1128 against 0.1227,
+        // shadow 0.0346 against 0.0397; cave skip and texel beam off), and in
+        // the next 0.1607 against 0.1738 with both on
+        // (`bench/issue36-cave-skip/`).
         fused_descent: false,
         // The cave skip and the texel beam: on the H100 (unfused, one call,
         // twice each) 0.1607 ms a frame with both against 0.1663 with
         // neither and 0.1622 with the cave skip alone; march 0.1060 against
         // 0.1131 (`bench/issue36-cave-skip/`). On paper (`strata
-        // exact-counts`, the twelve views, 1280x800, unfused): MEASURED_LATER.
+        // exact-counts`, the twelve views, 1280x800, unfused): 9.05 -> 5.89
+        // march iterations a pixel, 11.26 -> 7.99 a warp.
         cave_skip: true,
         beam_texels: true,
     };
