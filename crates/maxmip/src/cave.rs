@@ -6,8 +6,7 @@
 //! it: a ray through a cave, or under a bridge, skips the tile as a ray
 //! above the ground skips one by the max pyramid.
 
-use crate::{DirtyRect, Layout, Level, decode_column};
-use rayon::prelude::*;
+use crate::{DirtyRect, Layout, Level, decode_column, update_levels};
 
 /// A tile's slab bottom when none of its columns has a slab: no ray the
 /// march tests (altitudes up to 255) is below it.
@@ -67,45 +66,17 @@ impl CavePyramid {
     /// Rebuild the tiles over `rect` (already changed in `level`) and their
     /// ancestors, level by level.
     pub fn update(&mut self, level: &Level, rect: &DirtyRect) {
-        let layout = self.layout.clone();
-        for info in &layout.levels {
-            let k = info.log2_tile;
-            let r = layout.dirty_tiles(k, rect);
-            let w = info.width as usize;
-            let start = info.offset as usize + r.y0 as usize * w;
-            let end = info.offset as usize + (r.y1 as usize + 1) * w;
-            let (done, rest) = self.data.split_at_mut(start);
-            let rows = &mut rest[..end - start];
-            let s = layout.step;
-            let child = (k > s).then(|| *layout.level(k - s));
-            let n = 1u32 << s;
-            rows.par_chunks_mut(w).enumerate().for_each(|(i, row)| {
-                let ty = r.y0 + i as u32;
-                for tx in r.x0..=r.x1 {
-                    let (x0, y0) = (n * tx, n * ty);
-                    let (mut floor, mut bottom) = (0u8, NO_SLAB);
-                    for y in y0..y0 + n {
-                        match child {
-                            None => {
-                                for px in x0 / 2..(x0 + n) / 2 {
-                                    let (f, b) = pair_bounds(level, px, y);
-                                    floor = floor.max(f);
-                                    bottom = bottom.min(b);
-                                }
-                            }
-                            Some(c) => {
-                                for x in x0..x0 + n {
-                                    let v = done[c.index(i64::from(x), i64::from(y))];
-                                    floor = floor.max(v as u8);
-                                    bottom = bottom.min((v >> 8) as u8);
-                                }
-                            }
-                        }
-                    }
-                    row[tx as usize] = pack(floor, bottom);
-                }
-            });
-        }
+        update_levels(
+            &self.layout,
+            &mut self.data,
+            rect,
+            pack(0, NO_SLAB),
+            |px, y| {
+                let (floor, bottom) = pair_bounds(level, px, y);
+                pack(floor, bottom)
+            },
+            |a, b| pack((a as u8).max(b as u8), ((a >> 8) as u8).min((b >> 8) as u8)),
+        );
     }
 
     /// Tile (tx, ty) of level `k` (a kept level), wrapping: its highest floor

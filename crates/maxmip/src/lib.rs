@@ -215,6 +215,52 @@ fn pair_top(level: &Level, px: u32, y: u32) -> u8 {
     a.max(b)
 }
 
+/// Rebuild the tiles of every kept level of `layout` over `rect` in `data`
+/// (one `T` per tile; the layout's byte offsets read as tile indices),
+/// finest first: the first kept level folds the texel pairs' values
+/// (`pair(px, y)`: the pair of texels `2 px, 2 px + 1` in row `y`), each
+/// coarser one the tiles of the level below, with `fold` from `empty`. The
+/// walk [`Pyramid`] and [`CavePyramid`] share.
+pub(crate) fn update_levels<T: Copy + Send + Sync>(
+    layout: &Layout,
+    data: &mut [T],
+    rect: &DirtyRect,
+    empty: T,
+    pair: impl Fn(u32, u32) -> T + Sync,
+    fold: impl Fn(T, T) -> T + Sync,
+) {
+    for info in &layout.levels {
+        let k = info.log2_tile;
+        let r = layout.dirty_tiles(k, rect);
+        let w = info.width as usize;
+        let start = info.offset as usize + r.y0 as usize * w;
+        let end = info.offset as usize + (r.y1 as usize + 1) * w;
+        let (done, rest) = data.split_at_mut(start);
+        let rows = &mut rest[..end - start];
+        let s = layout.step;
+        let child = (k > s).then(|| *layout.level(k - s));
+        // A tile is `n x n` tiles of the level `s` below (texels for the first).
+        let n = 1u32 << s;
+        rows.par_chunks_mut(w).enumerate().for_each(|(i, row)| {
+            let ty = r.y0 + i as u32;
+            for tx in r.x0..=r.x1 {
+                let (x0, y0) = (n * tx, n * ty);
+                row[tx as usize] = match child {
+                    // The first level: the pairs of its texel rows.
+                    None => (y0..y0 + n)
+                        .flat_map(|y| (x0 / 2..(x0 + n) / 2).map(move |px| (px, y)))
+                        .map(|(px, y)| pair(px, y))
+                        .fold(empty, &fold),
+                    Some(c) => (y0..y0 + n)
+                        .flat_map(|y| (x0..x0 + n).map(move |x| (x, y)))
+                        .map(|(x, y)| done[c.index(i64::from(x), i64::from(y))])
+                        .fold(empty, &fold),
+                };
+            }
+        });
+    }
+}
+
 impl Pyramid {
     /// Build every level from `level`.
     pub fn new(level: &Level) -> Self {
@@ -250,40 +296,15 @@ impl Pyramid {
     /// Rebuild the tiles over `rect` (already changed in `level`) and their
     /// ancestors, level by level.
     pub fn update(&mut self, level: &Level, rect: &DirtyRect) {
-        let layout = self.layout.clone();
-        for info in &layout.levels {
-            let k = info.log2_tile;
-            let r = layout.dirty_tiles(k, rect);
-            let w = info.width as usize;
-            let start = info.offset as usize + r.y0 as usize * w;
-            let end = info.offset as usize + (r.y1 as usize + 1) * w;
-            let (done, rest) = self.data.split_at_mut(start);
-            let rows = &mut rest[..end - start];
-            let s = layout.step;
-            let child = (k > s).then(|| *layout.level(k - s));
-            // A tile is `n x n` tiles of the level `s` below (texels for the first).
-            let n = 1u32 << s;
-            rows.par_chunks_mut(w).enumerate().for_each(|(i, row)| {
-                let ty = r.y0 + i as u32;
-                for tx in r.x0..=r.x1 {
-                    let (x0, y0) = (n * tx, n * ty);
-                    row[tx as usize] = match child {
-                        // The first level: the pairs of its texel rows.
-                        None => (y0..y0 + n)
-                            .flat_map(|y| (x0 / 2..(x0 + n) / 2).map(move |px| (px, y)))
-                            .map(|(px, y)| pair_top(level, px, y))
-                            .max()
-                            .unwrap_or(0),
-                        Some(c) => (y0..y0 + n)
-                            .flat_map(|y| (x0..x0 + n).map(move |x| (x, y)))
-                            .map(|(x, y)| done[c.index(i64::from(x), i64::from(y))])
-                            .max()
-                            .unwrap_or(0),
-                    };
-                }
-            });
-        }
-        if let Some(top) = layout.levels.last() {
+        update_levels(
+            &self.layout,
+            &mut self.data,
+            rect,
+            0,
+            |px, y| pair_top(level, px, y),
+            u8::max,
+        );
+        if let Some(top) = self.layout.levels.last() {
             let plane = &self.data[top.offset as usize..(top.offset + top.bytes()) as usize];
             self.global_max = plane.iter().copied().max().unwrap_or(0);
         }
