@@ -32,10 +32,14 @@ fn cs_ray_exact(
         if (s.capped) {
             atomicAdd(&xstats[0], 1u);
         }
-        atomicMax(&group_most, s.iterations);
+        if (EXACT_ITERATION_STATS) {
+            atomicMax(&group_most, s.iterations);
+        }
     }
-    workgroupBarrier();
-    if (li == 0u) {
-        atomicMax(&xstats[1], atomicLoad(&group_most));
+    if (EXACT_ITERATION_STATS) {
+        workgroupBarrier();
+        if (li == 0u) {
+            atomicMax(&xstats[1], atomicLoad(&group_most));
+        }
     }
 }

@@ -48,6 +48,13 @@ override EXACT_LOG_RATIO: u32 = 1u;
 // iterations, but on the H100 a slower frame (`bench/issue36-cave-skip/`).
 override EXACT_FUSED_DESCENT: bool = false;
 
+// Keep the most iterations of any camera and of any shadow ray (`xstats[1]`
+// and `[3]`; a pipeline constant, `ExactOptions::iteration_stats`). They cost
+// each workgroup a barrier and a global atomic on one shared word (1.2 % of
+// the H100 frame, `bench/issue36-floors/`), so they are kept only when asked;
+// rays stopped by the cap are counted always.
+override EXACT_ITERATION_STATS: bool = false;
+
 // A tile whose maximum is above the ray is skipped still when the ray
 // passes between the tile's floors and slabs (`cave_clear`: under a bridge,
 // through a cave), rather than descended into (a pipeline constant,

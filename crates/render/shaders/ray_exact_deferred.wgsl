@@ -4,14 +4,18 @@
 // sample: on the default views 25-86 % of the map, where the visible surface
 // samples 2-17 %.)
 //
-// 1. `cs_exact_march_hits`: the exact march per pixel; writes the hit's `t`
-//    into `depth_io`, its column (relative to the eye's 256-texel tile) into
-//    `hits`, and stamps the 8x8-texel blocks of the shadow map its shading
-//    can read in `shadow_marks`.
+// 1. `cs_exact_march_hits`: the exact march per pixel; writes the hit's
+//    column (relative to the eye's 256-texel tile) and `t` into `hits`, and
+//    stamps the 8x8-texel blocks of the shadow map its shading can read in
+//    `shadow_marks`.
 // 2. `ray_exact_shadow.wgsl` casts the texels of stamped blocks.
 // 3. `cs_exact_shade`: shades each hit exactly as the one-pass march does
-//    (`exact_pixel_shade`: same `t`, same column) and replaces `t` by the
-//    depth-buffer value in `depth_io`.
+//    (`exact_pixel_shade`: same `t`, same column) and writes the
+//    depth-buffer value into `depth_out`.
+//
+// The hits are a storage buffer rather than images: on the H100 the shading
+// pass is bound by its image and texture operations, where a buffer's loads
+// and stores take the load/store path.
 #include "frame.wgsl"
 #include "surface.wgsl"
 #include "shading.wgsl"
@@ -21,22 +25,25 @@
 #include "ray_exact_beam.wgsl"
 
 @group(1) @binding(3) var color_out: texture_storage_2d<rgba8unorm, write>;
-// The hit's t after the march, the depth-buffer value after the shading.
-@group(1) @binding(4) var depth_io: texture_storage_2d<r32float, read_write>;
-// The hit column relative to the eye's tile, x and y + 32768 in 16 bits
-// each; HIT_NONE for the sky.
-@group(1) @binding(5) var hits: texture_storage_2d<r32uint, read_write>;
-// One stamp per 8x8-texel block of the shadow map: `xparams.config.z` when a
-// pixel of this frame may sample the block.
+// The depth-buffer value of each pixel (the shading writes it).
+@group(1) @binding(4) var depth_out: texture_storage_2d<r32float, write>;
+// Pixel (x, y)'s hit at y * width + x: x its column relative to the eye's
+// tile, x and y + 32768 in 16 bits each (HIT_NONE for the sky), y the bits
+// of its `t` (negative: marched through a missing page, see below).
+@group(1) @binding(5) var<storage, read_write> hits: array<vec2<u32>>;
+// Words 0-2: the shadow pass's indirect dispatch (x the number of listed
+// blocks, 0 at the frame's start; y and z 1). From word MARK_STAMPS, one
+// stamp per 8x8-texel block of the shadow map: `xparams.config.z` when a
+// pixel of this frame may sample the block. (One binding for both: paged
+// terrain's frame binds as many storage buffers as WebGPU allows.)
 @group(1) @binding(6) var<storage, read_write> shadow_marks: array<atomic<u32>>;
 // The blocks stamped this frame, in the order they were first stamped.
 @group(1) @binding(7) var<storage, read_write> shadow_blocks: array<u32>;
-// The shadow pass's indirect dispatch: x the number of listed blocks (0 at
-// the frame's start), y and z 1.
-@group(1) @binding(8) var<storage, read_write> shadow_dispatch: array<atomic<u32>, 3>;
 
 const HIT_NONE: u32 = 0xffffffffu;
 const MARK_BLOCK: i32 = 8;
+// Twin of `deferred::MARK_STAMPS`.
+const MARK_STAMPS: u32 = 4u;
 
 var<workgroup> group_most: atomic<u32>;
 
@@ -67,8 +74,9 @@ fn mark_shadow_blocks(p: vec3<f32>) {
             // exchange; the one exchange that changes the stamp lists it.
             let i = u32(by * blocks + bx);
             let stamp = xparams.config.z;
-            if (atomicLoad(&shadow_marks[i]) != stamp && atomicExchange(&shadow_marks[i], stamp) != stamp) {
-                shadow_blocks[atomicAdd(&shadow_dispatch[0], 1u)] = i;
+            let m = MARK_STAMPS + i;
+            if (atomicLoad(&shadow_marks[m]) != stamp && atomicExchange(&shadow_marks[m], stamp) != stamp) {
+                shadow_blocks[atomicAdd(&shadow_marks[0], 1u)] = i;
             }
         }
     }
@@ -86,7 +94,7 @@ fn list_every_block(flat: u32, pixels: u32) {
         shadow_blocks[k] = k;
     }
     if (flat == 0u) {
-        atomicStore(&shadow_dispatch[0], count);
+        atomicStore(&shadow_marks[0], count);
     }
 }
 
@@ -102,31 +110,34 @@ fn cs_exact_march_hits(
     if (all(id.xy < size)) {
         page_pixel_begin();
         let h = exact_pixel_hit_from(f32(id.x) + 0.5, f32(id.y) + 0.5, start, exact_tile_level());
-        var packed = HIT_NONE;
+        var hit = vec2<u32>(HIT_NONE, 0u);
         if (h.hit) {
             let rel = h.column - exact_base(globals.eye.xy) + vec2<i32>(32768);
-            packed = u32(rel.x) | (u32(rel.y) << 16u);
             // A hit on a missing page's box carries its pending mark to the
             // shading as a negative t (t >= 0 otherwise).
             let t_kept = select(h.t, -1.0 - h.t, page_pixel_missed());
-            textureStore(depth_io, id.xy, vec4<f32>(t_kept, 0.0, 0.0, 0.0));
+            hit = vec2<u32>(u32(rel.x) | (u32(rel.y) << 16u), bitcast<u32>(t_kept));
             if (globals.light_dir.w != 0.0 && globals.shadow_cover_count.x != 0u) {
                 let d = camera_ray(f32(id.x) + 0.5, f32(id.y) + 0.5);
                 mark_shadow_blocks(globals.eye.xyz + d * h.t);
             }
         }
-        textureStore(hits, id.xy, vec4<u32>(packed, 0u, 0u, 0u));
+        hits[id.y * size.x + id.x] = hit;
         if (globals.shadow_cover_count.x == 0u) {
             list_every_block(id.y * size.x + id.x, size.x * size.y);
         }
         if (h.capped) {
             atomicAdd(&xstats[0], 1u);
         }
-        atomicMax(&group_most, h.iterations);
+        if (EXACT_ITERATION_STATS) {
+            atomicMax(&group_most, h.iterations);
+        }
     }
-    workgroupBarrier();
-    if (li == 0u) {
-        atomicMax(&xstats[1], atomicLoad(&group_most));
+    if (EXACT_ITERATION_STATS) {
+        workgroupBarrier();
+        if (li == 0u) {
+            atomicMax(&xstats[1], atomicLoad(&group_most));
+        }
     }
 }
 
@@ -136,19 +147,20 @@ fn cs_exact_shade(@builtin(global_invocation_id) id: vec3<u32>) {
     if (any(id.xy >= size)) {
         return;
     }
-    let packed = textureLoad(hits, id.xy).x;
+    let hit = hits[id.y * size.x + id.x];
+    let packed = hit.x;
     var s = exact_pixel_sky();
     page_pixel_begin();
     var marched_missing = false;
     if (packed != HIT_NONE) {
         let rel = vec2<i32>(vec2<u32>(packed & 0xffffu, packed >> 16u)) - vec2<i32>(32768);
         let column = exact_base(globals.eye.xy) + rel;
-        var t = textureLoad(depth_io, id.xy).x;
+        var t = bitcast<f32>(hit.y);
         marched_missing = t < 0.0;
         t = select(t, -1.0 - t, marched_missing);
         s = exact_pixel_shade(f32(id.x) + 0.5, f32(id.y) + 0.5, t, column);
     }
     page_pixel_end(marched_missing || page_pixel_missed());
     textureStore(color_out, id.xy, s.color);
-    textureStore(depth_io, id.xy, vec4<f32>(s.depth, 0.0, 0.0, 0.0));
+    textureStore(depth_out, id.xy, vec4<f32>(s.depth, 0.0, 0.0, 0.0));
 }

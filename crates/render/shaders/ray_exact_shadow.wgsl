@@ -37,7 +37,9 @@ fn cast_texel_from(id: vec2<u32>, start: f32, level: u32) {
     if (h.capped) {
         atomicAdd(&xstats[2], 1u);
     }
-    atomicMax(&group_most, h.iterations);
+    if (EXACT_ITERATION_STATS) {
+        atomicMax(&group_most, h.iterations);
+    }
 }
 
 // Every texel of the view's cover (`shadow_texel_cast`); a miss elsewhere.
@@ -55,9 +57,11 @@ fn cs_exact_shadow(
             textureStore(shadow_out, id.xy, vec4<f32>(SHADOW_MISS, 0.0, 0.0, 0.0));
         }
     }
-    workgroupBarrier();
-    if (li == 0u) {
-        atomicMax(&xstats[3], atomicLoad(&group_most));
+    if (EXACT_ITERATION_STATS) {
+        workgroupBarrier();
+        if (li == 0u) {
+            atomicMax(&xstats[3], atomicLoad(&group_most));
+        }
     }
 }
 
@@ -77,8 +81,10 @@ fn cs_exact_shadow_blocks(
     // at once (`ray_exact_beam.wgsl`).
     let start = exact_shadow_block_start(first, li);
     cast_texel_from(first + local.xy, start, exact_tile_level());
-    workgroupBarrier();
-    if (li == 0u) {
-        atomicMax(&xstats[3], atomicLoad(&group_most));
+    if (EXACT_ITERATION_STATS) {
+        workgroupBarrier();
+        if (li == 0u) {
+            atomicMax(&xstats[3], atomicLoad(&group_most));
+        }
     }
 }

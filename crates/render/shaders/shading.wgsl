@@ -49,7 +49,11 @@ fn interval_field(x: i32, y: i32, kind: u32, fallback: f32) -> f32 {
 }
 
 fn interval_field_at(level: u32, x: i32, y: i32, kind: u32, fallback: f32) -> f32 {
-    let c = decode_column_at(level, x, y);
+    return interval_of(decode_column_at(level, x, y), kind, fallback);
+}
+
+// `interval_field` of column `c`.
+fn interval_of(c: Column, kind: u32, fallback: f32) -> f32 {
     if (kind == SURFACE_FLOOR) {
         return c.low;
     }
@@ -69,8 +73,20 @@ fn surface_normal(x: i32, y: i32, kind: u32, here: f32) -> vec3<f32> {
 // `surface_normal` at texel (x, y) of level of detail `level`, whose texels
 // are 2^level units apart.
 fn surface_normal_at(level: u32, x: i32, y: i32, kind: u32, here: f32) -> vec3<f32> {
+    return surface_normal_in(level, x, y, kind, here, terrain_pair_at(level, x, y));
+}
+
+// `surface_normal_at` given `pair`, the pair texel holding (x, y): one of
+// the row's two neighbours is the other texel of that pair, so the normal
+// takes three more fetches, not four.
+fn surface_normal_in(level: u32, x: i32, y: i32, kind: u32, here: f32, pair: vec4<u32>) -> vec3<f32> {
     let spacing = f32(1u << level);
-    let gx = 0.5 * (interval_field_at(level, x + 1, y, kind, here) - interval_field_at(level, x - 1, y, kind, here)) / spacing;
+    let odd = (x & 1) == 1;
+    // The pair holding the neighbour that is not in `pair`.
+    let other = terrain_pair_at(level, select(x - 1, x + 1, odd), y);
+    let east = interval_of(decode_pair(select(pair, other, odd), x + 1), kind, here);
+    let west = interval_of(decode_pair(select(other, pair, odd), x - 1), kind, here);
+    let gx = 0.5 * (east - west) / spacing;
     let gy = 0.5 * (interval_field_at(level, x, y + 1, kind, here) - interval_field_at(level, x, y - 1, kind, here)) / spacing;
     if (kind == SURFACE_CEILING) {
         return normalize(vec3<f32>(gx, gy, -1.0));
@@ -150,9 +166,10 @@ fn shade_column(p: vec3<f32>, x: i32, y: i32, dir: vec3<f32>) -> vec3<f32> {
 
 // `shade_column` for a hit on texel (x, y) of level of detail `level`.
 fn shade_column_at(p: vec3<f32>, level: u32, x: i32, y: i32, dir: vec3<f32>) -> vec3<f32> {
-    let c = decode_column_at(level, x, y);
+    let pair = terrain_pair_at(level, x, y);
+    let c = decode_pair(pair, x);
     let kind = surface_kind(c, p.z, dir.z);
     let here = select(c.high, c.mid, kind == SURFACE_CEILING);
-    let n = surface_normal_at(level, x, y, kind, here);
+    let n = surface_normal_in(level, x, y, kind, here, pair);
     return shade_with_normal(p, c, kind, n);
 }

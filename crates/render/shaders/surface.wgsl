@@ -25,7 +25,12 @@ fn decode_column(x: i32, y: i32) -> Column {
 
 // The column at texel (x, y) of level of detail `level` (0: the map).
 fn decode_column_at(level: u32, x: i32, y: i32) -> Column {
-    let p = terrain_pair_at(level, x, y);
+    return decode_pair(terrain_pair_at(level, x, y), x);
+}
+
+// The column of texel x (its row is the pair's) of pair texel `p`
+// (`terrain_pair`): both texels of a pair decode from the one fetch.
+fn decode_pair(p: vec4<u32>, x: i32) -> Column {
     var c: Column;
     // The one pair rule: dual iff both texels carry the flag.
     if ((p.y & p.w & META_DOUBLE_LEVEL) != 0u) {

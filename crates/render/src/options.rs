@@ -79,6 +79,11 @@ pub struct ExactOptions {
     /// same hits, later starts). Off: the finest tiles they test are the
     /// pyramid's 4-texel ones.
     pub beam_texels: bool,
+    /// Keep the most iterations of any camera and shadow ray
+    /// (`EXACT_ITERATION_STATS`, `ExactStats::most_iterations`): a barrier
+    /// and a global atomic a workgroup, so off unless asked (the renderer's
+    /// `exact_stats` turns it on too). Capped rays are counted either way.
+    pub iteration_stats: bool,
 }
 
 /// How `ray-exact`'s beam finds where a tile's rays start
@@ -154,6 +159,9 @@ impl ExactOptions {
         // march iterations a pixel, 11.26 -> 7.99 a warp.
         cave_skip: true,
         beam_texels: true,
+        // Off: on the H100 the statistic cost 0.0019 ms of a 0.1591 ms frame
+        // (`bench/issue36-floors/`).
+        iteration_stats: false,
     };
 
     /// Which pyramid levels to keep: only those the traversals visit. The

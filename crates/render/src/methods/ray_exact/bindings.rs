@@ -184,6 +184,12 @@ pub(super) fn exact_pipeline(
                 options.cave_skip && !levels.is_paged() && shader != "ray_exact_shadow.wgsl",
             )),
         ),
+        (
+            "EXACT_ITERATION_STATS",
+            f64::from(u8::from(
+                options.iteration_stats || shared.options.exact_stats,
+            )),
+        ),
     ];
     if reads_beam(levels, shader) {
         constants.push(("EXACT_BEAM", f64::from(u8::from(options.beam))));

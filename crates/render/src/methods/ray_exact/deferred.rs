@@ -7,37 +7,48 @@ use super::bindings::Levels;
 use super::bindings::{
     beam_binding, beam_layout_entry, buffer_entry, core_bindings, core_entries, exact_pipeline,
 };
-use crate::frame::{Shared, storage_texture_entry, storage_texture_entry_with, texture_2d};
+use crate::frame::{Shared, storage_texture_entry};
 use crate::methods::common::DepthCopy;
 use crate::options::ExactOptions;
-use wgpu::StorageTextureAccess::ReadWrite;
 
 /// The compute variant's frame on frames that cast the shadow map
-/// (`ray_exact_deferred.wgsl`): march (hit `t` into the depth image, hit
-/// column into `hits`, the shadow blocks its shading reads stamped), then the
-/// exact shadow pass over the stamped blocks only, then shading. The other
-/// frames (map reused, shadows off) march and shade in one pass.
+/// (`ray_exact_deferred.wgsl`): march (each pixel's hit column and `t` into
+/// `hits`, the shadow blocks its shading reads stamped), then the exact
+/// shadow pass over the stamped blocks only, then shading. The other frames
+/// (map reused, shadows off) march and shade in one pass.
+///
+/// The hits go from march to shading in a storage buffer, not in images: on
+/// the H100 the shading pass is bound by its image and texture operations,
+/// and a buffer's loads and stores take the load/store path instead.
 pub(super) struct Deferred {
     pub(super) march: wgpu::ComputePipeline,
     pub(super) shade: wgpu::ComputePipeline,
     pub(super) layout: wgpu::BindGroupLayout,
     pub(super) group: wgpu::BindGroup,
-    /// R32Uint: each pixel's hit column relative to the eye's tile.
-    pub(super) hits: wgpu::TextureView,
+    /// Each pixel's hit: its column relative to the eye's tile and its `t`
+    /// (`hits` in `ray_exact_deferred.wgsl`, [`HIT_BYTES`] a pixel).
+    pub(super) hits: wgpu::Buffer,
 }
 
 /// Side of the shadow map's stamped blocks, texels (`MARK_BLOCK` in
 /// `ray_exact_deferred.wgsl`).
 pub(super) const MARK_BLOCK: u32 = 8;
 
-/// The deferred frame's record of the shadow blocks its pixels sample: a
-/// stamp per block, the list of blocks stamped this frame, and the shadow
-/// pass's indirect dispatch (one workgroup per listed block).
+/// The deferred frame's record of the shadow blocks its pixels sample: the
+/// shadow pass's indirect dispatch (one workgroup per listed block) and a
+/// stamp per block in one buffer (one storage binding fewer: paged terrain's
+/// frame binds eight, WebGPU's default limit), and the list of blocks
+/// stamped this frame.
 pub(super) struct ShadowMarks {
-    stamps: wgpu::Buffer,
+    /// Words 0-2: the indirect dispatch (x the number of listed blocks);
+    /// from word [`MARK_STAMPS`]: block k's stamp.
+    pub(super) stamps: wgpu::Buffer,
     pub(super) list: wgpu::Buffer,
-    pub(super) dispatch: wgpu::Buffer,
 }
+
+/// The first stamp's word in [`ShadowMarks::stamps`] (`MARK_STAMPS` in
+/// `ray_exact_deferred.wgsl`), after the dispatch's three.
+pub(super) const MARK_STAMPS: u32 = 4;
 
 impl ShadowMarks {
     pub(super) fn new(device: &wgpu::Device, blocks: u32) -> Self {
@@ -49,28 +60,22 @@ impl ShadowMarks {
                 mapped_at_creation: false,
             })
         };
-        let bytes = u64::from(blocks) * 4;
         ShadowMarks {
             stamps: buffer(
                 "ray-exact shadow stamps",
-                bytes,
-                wgpu::BufferUsages::empty(),
+                u64::from(MARK_STAMPS + blocks) * 4,
+                wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
             ),
             list: buffer(
                 "ray-exact shadow blocks",
-                bytes,
+                u64::from(blocks) * 4,
                 wgpu::BufferUsages::empty(),
-            ),
-            dispatch: buffer(
-                "ray-exact shadow dispatch",
-                12,
-                wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
             ),
         }
     }
 
     pub(super) fn bytes(&self) -> u64 {
-        self.stamps.size() + self.list.size() + self.dispatch.size()
+        self.stamps.size() + self.list.size()
     }
 }
 
@@ -86,10 +91,9 @@ impl Deferred {
         let mut entries = core_entries(wgpu::ShaderStages::COMPUTE, levels.is_paged());
         entries.extend([
             storage_texture_entry(3, crate::frame::COLOR_FORMAT),
-            storage_texture_entry_with(4, wgpu::TextureFormat::R32Float, ReadWrite),
-            storage_texture_entry_with(5, wgpu::TextureFormat::R32Uint, ReadWrite),
+            storage_texture_entry(4, wgpu::TextureFormat::R32Float),
         ]);
-        for binding in 6..=8 {
+        for binding in 5..=7 {
             entries.push(buffer_entry(
                 binding,
                 wgpu::ShaderStages::COMPUTE,
@@ -115,7 +119,7 @@ impl Deferred {
         };
         let march = pipeline("ray-exact march", "cs_exact_march_hits")?;
         let shade = pipeline("ray-exact shade", "cs_exact_shade")?;
-        let hits = hits_image(shared);
+        let hits = hits_buffer(shared);
         let group = Self::group(
             shared,
             &layout,
@@ -138,16 +142,16 @@ impl Deferred {
         layout: &wgpu::BindGroupLayout,
         (params, levels, stats, marks): (&wgpu::Buffer, &Levels, &wgpu::Buffer, &ShadowMarks),
         depth: &DepthCopy,
-        hits: &wgpu::TextureView,
+        hits: &wgpu::Buffer,
         beam: Option<&wgpu::Buffer>,
     ) -> wgpu::BindGroup {
         let mut entries = core_bindings(params, levels, stats);
         entries.extend(depth.bindings(shared, 3));
         entries.push(wgpu::BindGroupEntry {
             binding: 5,
-            resource: wgpu::BindingResource::TextureView(hits),
+            resource: hits.as_entire_binding(),
         });
-        for (binding, buffer) in [(6, &marks.stamps), (7, &marks.list), (8, &marks.dispatch)] {
+        for (binding, buffer) in [(6, &marks.stamps), (7, &marks.list)] {
             entries.push(wgpu::BindGroupEntry {
                 binding,
                 resource: buffer.as_entire_binding(),
@@ -162,14 +166,15 @@ impl Deferred {
     }
 }
 
-/// The deferred frame's per-pixel hit columns: R32Uint at the targets' size.
-pub(super) fn hits_image(shared: &Shared) -> wgpu::TextureView {
-    let (_, view) = texture_2d(
-        &shared.device,
-        "ray-exact hits",
-        (shared.width, shared.height),
-        wgpu::TextureFormat::R32Uint,
-        wgpu::TextureUsages::STORAGE_BINDING,
-    );
-    view
+/// Bytes of the deferred frame's hits a pixel: the packed column and `t`.
+pub(super) const HIT_BYTES: u64 = 8;
+
+/// The deferred frame's per-pixel hits at the targets' size.
+pub(super) fn hits_buffer(shared: &Shared) -> wgpu::Buffer {
+    shared.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("ray-exact hits"),
+        size: u64::from(shared.width) * u64::from(shared.height) * HIT_BYTES,
+        usage: wgpu::BufferUsages::STORAGE,
+        mapped_at_creation: false,
+    })
 }

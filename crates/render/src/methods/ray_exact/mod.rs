@@ -119,11 +119,12 @@ pub(crate) struct ExactParams {
 pub struct ExactStats {
     /// Camera rays stopped by [`ITERATION_CAP`] (must be 0).
     pub cap_hits: u32,
-    /// Most iterations any camera ray took (compute variant only).
+    /// Most iterations any camera ray took (compute variant only; 0 unless
+    /// [`ExactOptions::iteration_stats`] or the renderer's `exact_stats`).
     pub most_iterations: u32,
     /// Shadow-map rays stopped by the cap (must be 0).
     pub shadow_cap_hits: u32,
-    /// Most iterations any shadow-map ray took.
+    /// Most iterations any shadow-map ray took (as `most_iterations`).
     pub shadow_most_iterations: u32,
 }
 
@@ -525,7 +526,7 @@ impl RayExact {
         pass.set_bind_group(1, &shadow.group, &[]);
         if listed {
             pass.set_pipeline(&shadow.blocks);
-            pass.dispatch_workgroups_indirect(&self.marks.dispatch, 0);
+            pass.dispatch_workgroups_indirect(&self.marks.stamps, 0);
         } else {
             pass.set_pipeline(&shadow.pipeline);
             pass.dispatch_workgroups(SHADOW_SIZE.div_ceil(8), SHADOW_SIZE.div_ceil(8), 1);
@@ -614,7 +615,7 @@ impl Method for RayExact {
                 beam.resize(shared, (&self.params, &self.levels, &self.stats));
             }
             if let Some(d) = deferred {
-                d.hits = hits_image(shared);
+                d.hits = deferred::hits_buffer(shared);
             }
             self.rebind(shared);
         }
@@ -656,7 +657,7 @@ impl Method for RayExact {
         // dispatches one workgroup per listed block.
         shared
             .queue
-            .write_buffer(&self.marks.dispatch, 0, bytemuck::cast_slice(&[0u32, 1, 1]));
+            .write_buffer(&self.marks.stamps, 0, bytemuck::cast_slice(&[0u32, 1, 1]));
         Ok(())
     }
 
@@ -761,8 +762,7 @@ impl Method for RayExact {
             Variant::Compute {
                 depth, deferred, ..
             } => {
-                // The hit image: 4 bytes per pixel, as the depth image.
-                let hits = deferred.as_ref().map_or(0, |_| depth.bytes());
+                let hits = deferred.as_ref().map_or(0, |d| d.hits.size());
                 depth.bytes()
                     + hits
                     + self.marks.bytes()
@@ -815,7 +815,7 @@ use crate::paged::PagedTerrain;
 use beam::Beam;
 pub use bindings::Levels;
 use bindings::{buffer_entry, core_bindings, core_entries, exact_pipeline, march_group};
-use deferred::{Deferred, MARK_BLOCK, ShadowMarks, hits_image};
+use deferred::{Deferred, MARK_BLOCK, ShadowMarks};
 
 #[cfg(test)]
 mod tests;

@@ -805,9 +805,8 @@ pub fn replay_frame(replay: &mut Replay<'_>, g: &Globals) -> FrameCount {
     }
     let pixels = u64::from(w) * u64::from(h);
     let mut march = march.finish(warps_of(w, h));
-    // hits (4 B each pixel), depth_io (4 B per hit), stamps and list.
-    march.bytes_written =
-        pixels * TEXEL_BYTES + hits.len() as u64 * TEXEL_BYTES + listed.len() as u64 * 8;
+    // hits (column and t, 8 B each pixel), stamps and list.
+    march.bytes_written = pixels * 2 * TEXEL_BYTES + listed.len() as u64 * 8;
     if replay.traversal.beam && !wide {
         // Each pixel reads its tile's start.
         march.bytes_read += pixels * 4;
@@ -842,15 +841,17 @@ pub fn replay_frame(replay: &mut Replay<'_>, g: &Globals) -> FrameCount {
     shadow.bytes_written = listed.len() as u64 * SHADOW_BLOCK_TEXELS * TEXEL_BYTES;
     let shadow_most_iterations = shadow.iterations.max;
 
-    // Shading: the column, its four neighbours, the taps.
+    // Shading: the column's pair (it holds one row neighbour too), the pair
+    // of the other row neighbour, the column neighbours, the taps.
     let mut shade_terrain = Vec::with_capacity(hits.len());
     let mut taps = 0;
     for &(p, d, column) in &hits {
         let c = replay.column(column.x, column.y);
-        for (dx, dy) in [(1, 0), (-1, 0), (0, 1), (0, -1)] {
+        let across = if column.x & 1 == 1 { 1 } else { -1 };
+        for (dx, dy) in [(across, 0), (0, 1), (0, -1)] {
             replay.column(column.x + dx, column.y + dy);
         }
-        shade_terrain.push(5);
+        shade_terrain.push(4);
         taps += shadow_taps(g, p, &c, d);
     }
     let terrain = Spread::of(shade_terrain);
@@ -858,9 +859,8 @@ pub fn replay_frame(replay: &mut Replay<'_>, g: &Globals) -> FrameCount {
         rays: hits.len() as u64,
         terrain_reads: terrain,
         shadow_reads: taps,
-        // hits for every pixel, depth_io and the taps for the hits.
-        bytes_read: pixels * TEXEL_BYTES
-            + hits.len() as u64 * TEXEL_BYTES
+        // hits for every pixel (8 B) and the taps for the hits.
+        bytes_read: pixels * 2 * TEXEL_BYTES
             + terrain.total * TERRAIN_TEXEL_BYTES
             + taps * TEXEL_BYTES,
         // colour and depth of every pixel.

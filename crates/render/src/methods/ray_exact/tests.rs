@@ -795,7 +795,11 @@ fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
         // Statistics of a fresh method over every view, frames recorded by
         // hand (the renderer owns its methods): the cap is never hit.
         let shared = r.shared_handle();
-        let mut m = build(&shared, &w.level, d).unwrap();
+        let counting = ExactOptions {
+            iteration_stats: true,
+            ..d
+        };
+        let mut m = build(&shared, &w.level, counting).unwrap();
         assert_eq!(m.stats().unwrap(), ExactStats::default());
         let timer = crate::timing::PassTimer::new(&shared.device, &shared.queue, false);
         for (index, view) in w.views.iter().enumerate() {
@@ -814,6 +818,11 @@ fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
         );
         m.reset_stats();
         assert_eq!(m.stats().unwrap(), ExactStats::default());
+        // The default keeps no most-iterations statistic (and caps no ray).
+        let mut plain = build(&shared, &w.level, d).unwrap();
+        let (camera, globals) = view_globals(&w.level, &w.views[0], (W, H));
+        record_frame(&shared, &mut plain, &camera, &globals, &timer, 0);
+        assert_eq!(plain.stats().unwrap(), ExactStats::default());
         gpu.errors.check().unwrap();
     }
 }

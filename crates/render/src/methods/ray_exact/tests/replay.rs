@@ -63,6 +63,7 @@ fn replay_takes_the_gpu_steps(
         fused_descent,
         cave_skip: caves,
         beam_texels: caves,
+        iteration_stats: true,
         ..ExactOptions::DEFAULT
     };
     let shape = crate::frame::LevelShape::of(&w.level);
