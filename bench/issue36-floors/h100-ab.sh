@@ -2,7 +2,8 @@
 # One H100 call: the baseline binary (`devbin/strata.xz`) against the
 # change (`devnew/strata.xz`), alternated, REPS (3) runs each: the protocol's
 # twelve views, 1280x800, shadows, 20 frames, `ray-exact` only.
-# Carry `.gl`, `devbin`, `devnew`.   OUT=$OUT [REPS=3] bash this
+# Carry `.gl` and the two folders (BASE=devbin, NEW=devnew by default).
+#   OUT=$OUT [REPS=3] [BASE=dir] [NEW=dir] bash this
 set -u
 for f in .gl/*.deb; do dpkg -x "$f" /; done; ldconfig
 # A carried binary: DIR/strata.xz (smaller: the tree that travels is at most
@@ -14,7 +15,7 @@ unpack() {
         gunzip -c "$1/strata.gz" > "$2"
     fi
 }
-unpack devbin /tmp/strata-base; unpack devnew /tmp/strata-new
+unpack "${BASE:-devbin}" /tmp/strata-base; unpack "${NEW:-devnew}" /tmp/strata-new
 chmod +x /tmp/strata-base /tmp/strata-new
 W=$(mktemp -d); export STRATA_CACHE_DIR=$W/cache
 /tmp/strata-new generate --out "$W/world" > /dev/null

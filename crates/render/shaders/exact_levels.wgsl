@@ -20,9 +20,19 @@ fn maxmip_get(k: u32, tx: i32, ty: i32) -> f32 {
 // Then nothing in the tile is solid along it, though its maximum (a slab's
 // top) is above it.
 fn cave_clear(k: u32, tx: i32, ty: i32, z_lo: f32, z_hi: f32) -> bool {
+    return cave_word_clear(cave_word(k, tx, ty), z_lo, z_hi);
+}
+
+// Tile (tx, ty)'s cave word of level k: its highest floor top in the low
+// byte, its lowest slab bottom in the next.
+fn cave_word(k: u32, tx: i32, ty: i32) -> u32 {
     let l = xparams.levels[k];
     let i = l.x + (u32(tx) & l.z) + ((u32(ty) & l.w) << l.y);
-    let v = maxmip[(xparams.config.w >> 2u) + (i >> 1u)] >> ((i & 1u) << 4u);
+    return maxmip[(xparams.config.w >> 2u) + (i >> 1u)] >> ((i & 1u) << 4u);
+}
+
+// `cave_clear` of a tile whose `cave_word` is `v`.
+fn cave_word_clear(v: u32, z_lo: f32, z_hi: f32) -> bool {
     return z_lo > f32(v & 0xffu) + CAVE_MARGIN && z_hi < f32((v >> 8u) & 0xffu) - CAVE_MARGIN;
 }
 

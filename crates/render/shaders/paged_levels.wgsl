@@ -61,6 +61,14 @@ fn cave_clear(k: u32, tx: i32, ty: i32, z_lo: f32, z_hi: f32) -> bool {
     return false;
 }
 
+fn cave_word(k: u32, tx: i32, ty: i32) -> u32 {
+    return 0u;
+}
+
+fn cave_word_clear(v: u32, z_lo: f32, z_hi: f32) -> bool {
+    return false;
+}
+
 // The top of texel (bx, by) of level `level`.
 fn paged_texel_top(level: u32, bx: i32, by: i32) -> f32 {
     let c = decode_column_at(level, bx, by);

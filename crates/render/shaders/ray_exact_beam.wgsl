@@ -178,10 +178,17 @@ fn beam_clear(base: vec2<i32>, lo_in: vec3<f32>, hi_in: vec3<f32>) -> bool {
     if (lo.z > h) {
         return true;
     }
-    // Between every one of the four tiles' floors and slabs.
-    return EXACT_CAVE_SKIP
-        && cave_clear(shift, c0.x, c0.y, lo.z, hi.z) && cave_clear(shift, c1.x, c0.y, lo.z, hi.z)
-        && cave_clear(shift, c0.x, c1.y, lo.z, hi.z) && cave_clear(shift, c1.x, c1.y, lo.z, hi.z);
+    // Between every one of the four tiles' floors and slabs (their words
+    // read at once, not one after another).
+    if (!EXACT_CAVE_SKIP) {
+        return false;
+    }
+    let w00 = cave_word(shift, c0.x, c0.y);
+    let w10 = cave_word(shift, c1.x, c0.y);
+    let w01 = cave_word(shift, c0.x, c1.y);
+    let w11 = cave_word(shift, c1.x, c1.y);
+    return cave_word_clear(w00, lo.z, hi.z) && cave_word_clear(w10, lo.z, hi.z)
+        && cave_word_clear(w01, lo.z, hi.z) && cave_word_clear(w11, lo.z, hi.z);
 }
 
 // Whether nothing in the box (lo, hi), relative to `base`, at most a texel
@@ -193,15 +200,21 @@ fn texels_clear(base: vec2<i32>, lo: vec3<f32>, hi: vec3<f32>) -> bool {
     let c1 = vec2<i32>(floor(hi.xy)) + base;
     let texels = array<vec2<i32>, 4>(c0, vec2<i32>(c1.x, c0.y), vec2<i32>(c0.x, c1.y), c1);
     for (var k = 0u; k < 4u; k = k + 1u) {
-        let c = decode_column(texels[k].x, texels[k].y);
-        let bottom = select(f32(CAVE_NO_SLAB), c.mid, c.dual);
-        let above = lo.z > select(c.low, c.high, c.dual);
-        let between = EXACT_CAVE_SKIP && lo.z > c.low + CAVE_MARGIN && hi.z < bottom - CAVE_MARGIN;
-        if (!above && !between) {
+        if (!texel_clear(decode_column(texels[k].x, texels[k].y), lo, hi)) {
             return false;
         }
     }
     return true;
+}
+
+// Whether nothing of column `c` is in the box (lo, hi): the box's lowest
+// altitude above its top, or (`EXACT_CAVE_SKIP`) its altitudes between the
+// column's floor and slab, `CAVE_MARGIN` clear of both.
+fn texel_clear(c: Column, lo: vec3<f32>, hi: vec3<f32>) -> bool {
+    let bottom = select(f32(CAVE_NO_SLAB), c.mid, c.dual);
+    let above = lo.z > select(c.low, c.high, c.dual);
+    let between = EXACT_CAVE_SKIP && lo.z > c.low + CAVE_MARGIN && hi.z < bottom - CAVE_MARGIN;
+    return above || between;
 }
 
 // The least t in [t0, t1] at which a ray o + t d, d in the convex hull of

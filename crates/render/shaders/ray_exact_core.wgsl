@@ -158,8 +158,14 @@ fn exact_march_at(o: vec3<f32>, base: vec2<i32>, d: vec3<f32>, t0: f32, t1: f32,
             let z_b = o.z + d.z * t_out;
             let z_min = min(z_a, z_b);
             let tile = (base >> vec2<u32>(shift)) + cell;
-            if (z_min <= maxmip_get(shift, tile.x, tile.y)
-                && !(EXACT_CAVE_SKIP && cave_clear(shift, tile.x, tile.y, z_min, max(z_a, z_b)))) {
+            // The cave word is read beside the maximum, not after it: the
+            // step waits for one fetch, not two in a row.
+            let tile_top = maxmip_get(shift, tile.x, tile.y);
+            var caves = 0u;
+            if (EXACT_CAVE_SKIP) {
+                caves = cave_word(shift, tile.x, tile.y);
+            }
+            if (z_min <= tile_top && !(EXACT_CAVE_SKIP && cave_word_clear(caves, z_min, max(z_a, z_b)))) {
                 // The ray may touch something here: the child it is in at t.
                 lvl = lvl - 1u;
                 let child = texel_after(o.xy + d.xy * t, d.xy) >> vec2<u32>(shift - ratio);

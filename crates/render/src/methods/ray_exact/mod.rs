@@ -66,6 +66,15 @@
 //! ([`ExactOptions::beam_texels`], `EXACT_BEAM_TEXELS`). Same hits; on the
 //! H100 the frame goes from 0.1663 to 0.1607 ms (`bench/issue36-cave-skip/`).
 //!
+//! What bounds the march on the H100 (`bench/issue36-floors/`): the driver
+//! gives it 31 registers a thread (`examples/pipeline_stats.rs`), so SMs
+//! hold as many warps as they can, yet one more dependent load per
+//! iteration costs 6 % of the march and 16 dependent multiply-adds 3 %:
+//! each step's chain of dependent work is what the walk pays for. So a
+//! step reads a tile's cave word beside its maximum rather than after it;
+//! fetching the next steps' tiles ahead of need cost 30 % (more loads per
+//! step), and so did testing wider beam boxes against their texels.
+//!
 //! Measuring switches ([`ExactOptions`] and `exact_stats` in
 //! [`crate::options::RenderOptions`], read at creation from the shared
 //! frame; the `strata` binary sets them from `STRATA_EXACT_*`; H100 numbers

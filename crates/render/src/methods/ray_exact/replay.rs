@@ -335,11 +335,14 @@ impl<'a> Replay<'a> {
                 let tile = (base >> shift as i32) + cell;
                 r.pyramid_reads += 1;
                 let under = z_min <= self.maxmip(shift, tile.x, tile.y);
-                // EXACT_CAVE_SKIP: the cave word, read only under the maximum.
-                let between = under && self.traversal.cave_skip && {
+                // EXACT_CAVE_SKIP: the cave word, read beside the maximum
+                // (its test matters only under the maximum).
+                if self.traversal.cave_skip {
                     r.pyramid_reads += 1;
-                    self.cave_clear(shift, tile.x, tile.y, z_min, z_a.max(z_b))
-                };
+                }
+                let between = under
+                    && self.traversal.cave_skip
+                    && self.cave_clear(shift, tile.x, tile.y, z_min, z_a.max(z_b));
                 if under && !between {
                     r.descents += 1;
                     lvl -= 1;
