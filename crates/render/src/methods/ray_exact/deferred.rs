@@ -28,6 +28,9 @@ pub(super) struct Deferred {
     /// Each pixel's hit: its column relative to the eye's tile and its `t`
     /// (`hits` in `ray_exact_deferred.wgsl`, [`HIT_BYTES`] a pixel).
     pub(super) hits: wgpu::Buffer,
+    /// The hits of a frame of the targets' size fit the device
+    /// ([`hits_fit`]); else every frame takes the one-pass route.
+    pub(super) fits: bool,
 }
 
 /// Side of the shadow map's stamped blocks, texels (`MARK_BLOCK` in
@@ -129,6 +132,7 @@ impl Deferred {
             beam,
         );
         Ok(Deferred {
+            fits: hits_fit(shared),
             march,
             shade,
             layout,
@@ -169,11 +173,32 @@ impl Deferred {
 /// Bytes of the deferred frame's hits a pixel: the packed column and `t`.
 pub(super) const HIT_BYTES: u64 = 8;
 
-/// The deferred frame's per-pixel hits at the targets' size.
+/// Whether the hits of a frame of the targets' size fit one storage
+/// binding of the device. Past it (under WebGPU's default 128 MiB binding, a
+/// frame of more than 16.7 million pixels) the method marches and shades in
+/// one pass after casting the view's whole shadow cover, as on frames that
+/// reuse the map: the same picture, without the deferred frame's savings.
+pub(super) fn hits_fit(shared: &Shared) -> bool {
+    hits_fit_in(shared.width, shared.height, &shared.device.limits())
+}
+
+/// [`hits_fit`] for a frame of `width` x `height` under `limits`.
+pub(super) fn hits_fit_in(width: u32, height: u32, limits: &wgpu::Limits) -> bool {
+    let bytes = u64::from(width) * u64::from(height) * HIT_BYTES;
+    bytes <= limits.max_storage_buffer_binding_size && bytes <= limits.max_buffer_size
+}
+
+/// The deferred frame's per-pixel hits at the targets' size (a placeholder
+/// of one pixel where they do not fit: [`hits_fit`]).
 pub(super) fn hits_buffer(shared: &Shared) -> wgpu::Buffer {
+    let pixels = if hits_fit(shared) {
+        u64::from(shared.width) * u64::from(shared.height)
+    } else {
+        1
+    };
     shared.device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("ray-exact hits"),
-        size: u64::from(shared.width) * u64::from(shared.height) * HIT_BYTES,
+        size: pixels * HIT_BYTES,
         usage: wgpu::BufferUsages::STORAGE,
         mapped_at_creation: false,
     })

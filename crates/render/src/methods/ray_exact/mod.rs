@@ -542,6 +542,19 @@ impl RayExact {
         }
     }
 
+    /// Whether frames that cast the shadow map take the deferred route
+    /// (march, shadow blocks, shading): the compute variant with the exact
+    /// shadow map, at a frame size whose hits fit the device.
+    fn defers(&self) -> bool {
+        matches!(
+            &self.variant,
+            Variant::Compute {
+                deferred: Some(d),
+                ..
+            } if d.fits
+        )
+    }
+
     /// The compute variant's bind groups again, over its current images,
     /// beam and colour output (after a resize or a new colour output).
     fn rebind(&mut self, shared: &Shared) {
@@ -625,6 +638,7 @@ impl Method for RayExact {
             }
             if let Some(d) = deferred {
                 d.hits = deferred::hits_buffer(shared);
+                d.fits = deferred::hits_fit(shared);
             }
             self.rebind(shared);
         }
@@ -680,13 +694,7 @@ impl Method for RayExact {
             return false;
         }
         self.record_update(frame, encoder);
-        if matches!(
-            &self.variant,
-            Variant::Compute {
-                deferred: Some(_),
-                ..
-            }
-        ) {
+        if self.defers() {
             // Cast in `record`, between the march and the shading.
             self.shadow_due.set(true);
         } else {
@@ -696,13 +704,7 @@ impl Method for RayExact {
     }
 
     fn shadow_map_is_partial(&self) -> bool {
-        matches!(
-            &self.variant,
-            Variant::Compute {
-                deferred: Some(_),
-                ..
-            }
-        )
+        self.defers()
     }
 
     fn record(&self, shared: &Shared, frame: &Frame<'_>, encoder: &mut wgpu::CommandEncoder) {
@@ -718,7 +720,7 @@ impl Method for RayExact {
                     beam.record(shared, frame, encoder);
                 }
                 match (deferred, self.shadow_due.replace(false)) {
-                    (Some(d), true) => {
+                    (Some(d), true) if d.fits => {
                         let label = "ray-exact march";
                         dispatch_per_pixel(shared, frame, encoder, label, &d.march, &d.group);
                         self.record_shadow_pass(frame, encoder, true);

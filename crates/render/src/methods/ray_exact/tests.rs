@@ -644,6 +644,55 @@ fn record_frame(
 }
 
 #[test]
+fn hits_fit_webgpu_default_limits_up_to_16_7_million_pixels() {
+    let limits = wgpu::Limits::default();
+    // 128 MiB binding, 8 bytes a pixel.
+    assert!(deferred::hits_fit_in(4096, 4096, &limits));
+    assert!(deferred::hits_fit_in(5120, 2880, &limits));
+    assert!(!deferred::hits_fit_in(4097, 4096, &limits));
+    assert!(!deferred::hits_fit_in(7680, 4320, &limits));
+}
+
+#[test]
+fn a_frame_whose_hits_do_not_fit_takes_the_one_pass_route_to_the_same_picture() {
+    for gpu in common::gpus() {
+        let w = common::generated_world();
+        let colors = TerrainColors::from_world(&w);
+        let settings = MethodSettings::default();
+        let mut r = Renderer::new(&gpu, &w.level, &colors, "ray-exact", &settings, W, H).unwrap();
+        let mut pictures = Vec::new();
+        for fits in [true, false] {
+            let mut m = build(&r.shared_handle(), &w.level, ExactOptions::DEFAULT).unwrap();
+            assert!(m.defers());
+            if let Variant::Compute {
+                deferred: Some(d), ..
+            } = &mut m.variant
+            {
+                // As `resize` finds a frame past the device's binding.
+                d.fits = fits;
+            }
+            assert_eq!(m.defers(), fits);
+            assert_eq!(m.shadow_map_is_partial(), fits);
+            r.insert_method(Box::new(m), settings.clone());
+            let mut per_view = Vec::new();
+            for view in w.views.iter().take(4) {
+                let camera = Camera::from_view(&w.level, view, W, H).unwrap();
+                r.render_frame(&camera).unwrap();
+                per_view.push((r.read_depth().unwrap(), r.read_color().unwrap()));
+            }
+            pictures.push(per_view);
+        }
+        for (v, (a, b)) in pictures[0].iter().zip(&pictures[1]).enumerate() {
+            assert!(
+                a.0 == b.0 && a.1 == b.1,
+                "view {v}: the one-pass route changed the picture"
+            );
+        }
+        gpu.errors.check().unwrap();
+    }
+}
+
+#[test]
 fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
     for gpu in common::gpus() {
         let w = common::generated_world();
