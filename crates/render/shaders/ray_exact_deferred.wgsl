@@ -13,9 +13,10 @@
 //    (`exact_pixel_shade`: same `t`, same column) and writes the
 //    depth-buffer value into `depth_out`.
 //
-// The hits are a storage buffer rather than images: on the H100 the shading
-// pass is bound by its image and texture operations, where a buffer's loads
-// and stores take the load/store path.
+// The hits are one storage buffer (8 bytes a pixel) rather than two
+// images. Measured on the H100 only together with the shading's four
+// terrain fetches (`bench/issue36-floors/`, call 4): the march 0.0009 ms
+// faster, the shading 0.0007 slower.
 #include "frame.wgsl"
 #include "surface.wgsl"
 #include "shading.wgsl"

@@ -17,9 +17,8 @@ use crate::options::ExactOptions;
 /// shadow pass over the stamped blocks only, then shading. The other frames
 /// (map reused, shadows off) march and shade in one pass.
 ///
-/// The hits go from march to shading in a storage buffer, not in images: on
-/// the H100 the shading pass is bound by its image and texture operations,
-/// and a buffer's loads and stores take the load/store path instead.
+/// The hits go from march to shading in one storage buffer, not in two
+/// images (`ray_exact_deferred.wgsl` says what the H100 measured).
 pub(super) struct Deferred {
     pub(super) march: wgpu::ComputePipeline,
     pub(super) shade: wgpu::ComputePipeline,
