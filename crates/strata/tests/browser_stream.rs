@@ -294,8 +294,11 @@ async fn stream_and_compare(client: &Client, url: &str, fixture: &Fixture, query
     );
     // Where the chunks were decoded, and what that cost the page's thread.
     // The workers start after the first frame, so a small view's pages may
-    // all be read before one is ready: with them, turn around once they
-    // are, until pages come from them.
+    // all be read before one is ready: with them, fly on once they are, to
+    // ground none of whose pages is resident, until pages come from them.
+    // (Turning around was not enough: on CI the first view's pages already
+    // held what lay behind it, nothing new was asked for, and the wait
+    // timed out.)
     let s = if query.contains("decode=main") {
         state(client).await
     } else {
@@ -303,12 +306,7 @@ async fn stream_and_compare(client: &Client, url: &str, fixture: &Fixture, query
             s["stream_decoder"]["where"] == "worker"
         })
         .await;
-        run(client, "turn 180 0\nframes 3", 120).await;
-        wait_for(client, "pages read in workers", 300, |s| {
-            s["stream_page_thread"]["in_workers"].as_u64().unwrap_or(0) > 0
-                && s["stream"]["in_flight"] == 0
-        })
-        .await
+        read_in_workers(client).await
     };
     let decoder = &s["stream_decoder"];
     let thread = &s["stream_page_thread"];
@@ -329,6 +327,35 @@ async fn stream_and_compare(client: &Client, url: &str, fixture: &Fixture, query
     } else {
         assert_eq!(decoder["where"], "worker", "{decoder}");
     }
+}
+
+/// Fly until the page reads a chunk in a worker, and return its state then.
+/// Each leg goes 1500 forward and 1100 right: whatever the heading, it
+/// moves the eye over a thousand texels along the store's long side, past
+/// every resident page.
+async fn read_in_workers(client: &Client) -> Value {
+    const LEGS: usize = 4;
+    for leg in 1..=LEGS {
+        run(client, "fly 1500 1100 0 2\nframes 3", 120).await;
+        let start = Instant::now();
+        while start.elapsed() < Duration::from_secs(75) {
+            let s = state(client).await;
+            if let Some(error) = s.get("error") {
+                panic!("the page shows an error while flying to new pages: {error}");
+            }
+            if s["stream_page_thread"]["in_workers"].as_u64().unwrap_or(0) > 0
+                && s["stream"]["in_flight"] == 0
+            {
+                return s;
+            }
+            tokio::time::sleep(Duration::from_millis(200)).await;
+        }
+        eprintln!("leg {leg} of {LEGS}: no page read in a worker yet");
+    }
+    panic!(
+        "no page read in a worker after {LEGS} legs; state {}",
+        state(client).await
+    );
 }
 
 /// A store far past WebGPU's limits (issue 34 asks for 32768² at least):
