@@ -46,7 +46,9 @@
 #![warn(missing_docs)]
 
 mod cave;
+mod texels;
 pub use cave::{CavePyramid, NO_SLAB};
+pub use texels::{DECODE as TEXEL_DECODE, TexelTops};
 
 use rayon::prelude::*;
 use strata_level::model::decode_column;

@@ -36,6 +36,24 @@ fn cave_word_clear(v: u32, z_lo: f32, z_hi: f32) -> bool {
     return z_lo > f32(v & 0xffu) + CAVE_MARGIN && z_hi < f32((v >> 8u) & 0xffu) - CAVE_MARGIN;
 }
 
+// The texel plane's bytes of the 4x4 texels of level-2 tile (tx, ty)
+// (`strata_maxmip::TexelTops`, after the pyramids; laid out by
+// `xparams.levels[0]`: x first byte, y log2 words across, z words across -
+// 1, w rows - 1): row r's four in word r, texel x = 4 tx + i in byte i. A
+// byte is the column's top where it is a single floor, `TEXEL_DECODE`
+// where the column must be decoded. Four loads side by side.
+fn texel_block_rows(tx: i32, ty: i32) -> vec4<u32> {
+    let l = xparams.levels[0];
+    let first = (l.x >> 2u) + (u32(tx) & l.z);
+    let y = u32(ty) << 2u;
+    return vec4<u32>(
+        maxmip[first + ((y & l.w) << l.y)],
+        maxmip[first + (((y + 1u) & l.w) << l.y)],
+        maxmip[first + (((y + 2u) & l.w) << l.y)],
+        maxmip[first + (((y + 3u) & l.w) << l.y)],
+    );
+}
+
 // Hooks for the paged variant, which counts pixels drawn from pages not yet
 // resident: the whole map is always resident.
 fn page_pixel_begin() {}

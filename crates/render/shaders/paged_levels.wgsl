@@ -69,6 +69,12 @@ fn cave_word_clear(v: u32, z_lo: f32, z_hi: f32) -> bool {
     return false;
 }
 
+// Pages keep no texel plane (`EXACT_TEXEL_BLOCKS` is off over them): every
+// texel reads as one to decode.
+fn texel_block_rows(tx: i32, ty: i32) -> vec4<u32> {
+    return vec4<u32>(0xffffffffu);
+}
+
 // The top of texel (bx, by) of level `level`.
 fn paged_texel_top(level: u32, bx: i32, by: i32) -> f32 {
     let c = decode_column_at(level, bx, by);

@@ -12,6 +12,7 @@
 // Twin of `methods::ray_exact_build::BuildParams`.
 struct BuildParams {
     // x first byte of this level, y log2 tiles across, z tiles down, w level k
+    // (0: the texel plane, `strata_maxmip::TexelTops`, one byte per texel)
     level: vec4<u32>,
     // x first byte of level k - s, y its log2 tiles across, z the step s,
     // w the cave region's first byte (tile i's bounds: its u16 i there), or
@@ -61,6 +62,17 @@ fn pair_top(px: u32, y: u32) -> u32 {
     return max(p.x, p.z);
 }
 
+// The texel plane's bytes of the pair `p` (`terrain_pair`), in the low 16
+// bits: each texel's height where the pair is single floors, 255
+// (`strata_maxmip::TEXEL_DECODE`: decode the column) for both where it is a
+// slab pair. A single floor of 255 is 255 either way.
+fn pair_texel_bytes(p: vec4<u32>) -> u32 {
+    if ((p.y & p.w & META_DOUBLE_LEVEL) != 0u) {
+        return 0xffffu;
+    }
+    return p.x | (p.z << 8u);
+}
+
 @compute @workgroup_size(64, 1, 1)
 fn cs_maxmip(@builtin(global_invocation_id) id: vec3<u32>) {
     if (id.x >= bp.rect.z || id.y >= bp.rect.w) {
@@ -68,6 +80,15 @@ fn cs_maxmip(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let log2w = bp.level.y;
     let first = ((bp.rect.y + id.y) << log2w) + (bp.rect.x + id.x) * 4u;
+    if (bp.level.w == 0u) {
+        // The texel plane: this word's four texels, two pairs of one row.
+        let x = first & ((1u << log2w) - 1u);
+        let y = first >> log2w;
+        let a = pair_texel_bytes(terrain_pair(i32(x), i32(y)));
+        let b = pair_texel_bytes(terrain_pair(i32(x + 2u), i32(y)));
+        pyramid[(bp.level.x + first) >> 2u] = a | (b << 16u);
+        return;
+    }
     var word = 0u;
     var caves = array<u32, 4>(NO_SLAB << 8u, NO_SLAB << 8u, NO_SLAB << 8u, NO_SLAB << 8u);
     for (var b = 0u; b < 4u; b = b + 1u) {

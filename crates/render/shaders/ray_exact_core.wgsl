@@ -20,8 +20,9 @@
 struct ExactParams {
     // x coarsest level, y iteration cap, z/w unused
     config: vec4<u32>,
-    // level k at index k (index 0 unused): x first byte, y log2 tiles across,
-    // z tiles across - 1, w tiles down - 1
+    // level k at index k: x first byte, y log2 tiles across, z tiles across
+    // - 1, w tiles down - 1; index 0 the texel plane's, if any
+    // (`texel_block_rows`)
     levels: array<vec4<u32>, 9>,
 }
 
@@ -69,6 +70,15 @@ override EXACT_CAVE_SKIP: bool = false;
 const CAVE_MARGIN: f32 = 0.015625;
 // A column's slab bottom when it has none (`strata_maxmip::NO_SLAB`).
 const CAVE_NO_SLAB: u32 = 255u;
+
+// A ray that comes down into a 4x4-texel tile walks its texels from the
+// texel plane (`texel_block_rows`: the tile's sixteen tops in four loads
+// side by side) rather than a terrain fetch per texel, decoding only the
+// columns that have a slab (a pipeline constant, `ExactOptions::texel_blocks`;
+// the same hits, the same iterations, fewer of them waiting on memory).
+override EXACT_TEXEL_BLOCKS: bool = false;
+// A texel plane byte whose column must be decoded (`strata_maxmip::TEXEL_DECODE`).
+const TEXEL_DECODE: u32 = 255u;
 
 // The pyramid level rays start at (a pipeline constant): the coarsest kept
 // level at or below it. The whole map's compute pipelines start at 6 (tiles
@@ -166,6 +176,62 @@ fn exact_march_at(o: vec3<f32>, base: vec2<i32>, d: vec3<f32>, t0: f32, t1: f32,
                 caves = cave_word(shift, tile.x, tile.y);
             }
             if (z_min <= tile_top && !(EXACT_CAVE_SKIP && cave_word_clear(caves, z_min, max(z_a, z_b)))) {
+                if (EXACT_TEXEL_BLOCKS && shift == 2u && leaf == 0u) {
+                    // The tile's texels from the texel plane: the iterations
+                    // the walk below would take at level 0, one per texel,
+                    // with the same bounds and tests.
+                    let first = cell << vec2<u32>(2u);
+                    let rows = texel_block_rows(tile.x, tile.y);
+                    var texel = clamp(texel_after(o.xy + d.xy * t, d.xy), first, first + vec2<i32>(3));
+                    // Bounded: each texel steps out along x or y, so the
+                    // walk leaves the tile after 7 at most; and each pass
+                    // counts an iteration, returning at the cap.
+                    loop {
+                        if (r.iterations >= cap) {
+                            r.capped = true;
+                            return r;
+                        }
+                        r.iterations = r.iterations + 1u;
+                        let tt = select((vec2<f32>(texel + far_side) - o.xy) * inv, vec2<f32>(EXACT_BIG), still);
+                        let tt_exit = min(tt.x, tt.y);
+                        let at = vec2<u32>(texel - first);
+                        let byte = (rows[at.y] >> (at.x << 3u)) & 0xffu;
+                        let column = base + texel;
+                        var c: Column;
+                        if (byte == TEXEL_DECODE) {
+                            c = decode_column(column.x, column.y);
+                        } else {
+                            c.low = f32(byte);
+                            c.mid = c.low;
+                            c.high = c.low;
+                            c.dual = false;
+                        }
+                        let e = column_entry(c, o.z, d.z, t, min(tt_exit, t1));
+                        if (e.x >= 0.0) {
+                            return exact_hit(r, e, column, t > t0 && e.x <= t, d.z);
+                        }
+                        if (tt_exit >= t1) {
+                            return r;
+                        }
+                        t = tt_exit;
+                        let was = texel;
+                        if (tt.x <= tt.y) {
+                            texel.x = texel.x + step.x;
+                        }
+                        if (tt.y <= tt.x) {
+                            texel.y = texel.y + step.y;
+                        }
+                        if (any(texel >> vec2<u32>(2u) != cell)) {
+                            // Out of the tile: climb from the texels as the
+                            // walk at level 0 would.
+                            let up = exact_climb(was, texel, 0u);
+                            cell = up.xy;
+                            lvl = u32(up.z);
+                            break;
+                        }
+                    }
+                    continue;
+                }
                 // The ray may touch something here: the child it is in at t.
                 lvl = lvl - 1u;
                 let child = texel_after(o.xy + d.xy * t, d.xy) >> vec2<u32>(shift - ratio);
@@ -189,17 +255,7 @@ fn exact_march_at(o: vec3<f32>, base: vec2<i32>, d: vec3<f32>, t0: f32, t1: f32,
             let c = decode_column(column.x, column.y);
             let e = column_entry(c, o.z, d.z, t, t_out);
             if (e.x >= 0.0) {
-                r.hit = true;
-                r.t = e.x;
-                r.column = column;
-                if (t > t0 && e.x <= t) {
-                    r.hit_class = 4u;
-                } else if (e.y == 0.0) {
-                    r.hit_class = 1u;
-                } else {
-                    r.hit_class = select(3u, 2u, d.z < 0.0);
-                }
-                return r;
+                return exact_hit(r, e, column, t > t0 && e.x <= t, d.z);
             }
         }
         if (t_exit >= t1) {
@@ -213,20 +269,49 @@ fn exact_march_at(o: vec3<f32>, base: vec2<i32>, d: vec3<f32>, t0: f32, t1: f32,
         if (tb.y <= tb.x) {
             cell.y = cell.y + step.y;
         }
-        // Left the parent tile: climb (one level by default, as the reference
-        // does, so a ray skimming rough ground does not climb high and come
-        // back down at every crossing).
-        var was = old;
-        for (var n = 0u; n < EXACT_CLIMB; n = n + 1u) {
-            if (lvl >= top / ratio || all((was >> vec2<u32>(ratio)) == (cell >> vec2<u32>(ratio)))) {
-                break;
-            }
-            was = was >> vec2<u32>(ratio);
-            cell = cell >> vec2<u32>(ratio);
-            lvl = lvl + 1u;
-        }
+        let up = exact_climb(old, cell, lvl);
+        cell = up.xy;
+        lvl = u32(up.z);
     }
     return r;
+}
+
+// `r` with the hit `e` (`column_entry`'s) in `column`: a wall where the ray
+// entered the column through its side (`side`).
+fn exact_hit(r0: ExactHit, e: vec2<f32>, column: vec2<i32>, side: bool, dz: f32) -> ExactHit {
+    var r = r0;
+    r.hit = true;
+    r.t = e.x;
+    r.column = column;
+    if (side) {
+        r.hit_class = 4u;
+    } else if (e.y == 0.0) {
+        r.hit_class = 1u;
+    } else {
+        r.hit_class = select(3u, 2u, dz < 0.0);
+    }
+    return r;
+}
+
+// After a step from cell `was` to `cell` of visited level `lvl`: if it left
+// the parent tile, climb (one level by default, as the reference does, so a
+// ray skimming rough ground does not climb high and come back down at every
+// crossing). The cell (xy) and the visited level (z) after.
+fn exact_climb(was0: vec2<i32>, cell0: vec2<i32>, lvl0: u32) -> vec3<i32> {
+    let ratio = EXACT_LOG_RATIO;
+    let top = xparams.config.x / ratio;
+    var was = was0;
+    var cell = cell0;
+    var lvl = lvl0;
+    for (var n = 0u; n < EXACT_CLIMB; n = n + 1u) {
+        if (lvl >= top || all((was >> vec2<u32>(ratio)) == (cell >> vec2<u32>(ratio)))) {
+            break;
+        }
+        was = was >> vec2<u32>(ratio);
+        cell = cell >> vec2<u32>(ratio);
+        lvl = lvl + 1u;
+    }
+    return vec3<i32>(cell, i32(lvl));
 }
 
 // A texel of the shadow map's ray along the light: where it comes down to

@@ -79,6 +79,13 @@ pub struct ExactOptions {
     /// same hits, later starts). Off: the finest tiles they test are the
     /// pyramid's 4-texel ones.
     pub beam_texels: bool,
+    /// A ray that comes down into a 4x4-texel tile walks its texels from
+    /// the texel plane (`EXACT_TEXEL_BLOCKS`, `strata_maxmip::TexelTops`: a
+    /// byte per texel after the pyramids, a map's area in GPU bytes) and
+    /// decodes only the columns with a slab: the same hits and iterations,
+    /// fewer of them waiting on a fetch. Whole maps only (pages keep no
+    /// plane), and only where the plane fits a storage binding.
+    pub texel_blocks: bool,
     /// Keep the most iterations of any camera and shadow ray
     /// (`EXACT_ITERATION_STATS`, `ExactStats::most_iterations`): a barrier
     /// and a global atomic a workgroup, so off unless asked (the renderer's
@@ -159,6 +166,11 @@ impl ExactOptions {
         // march iterations a pixel, 11.26 -> 7.99 a warp.
         cave_skip: true,
         beam_texels: true,
+        // Off until timed on the H100 (`bench/issue36-texel-blocks/`): on
+        // paper the walk waits on fewer fetches, but it costs a map's area in
+        // GPU bytes, and walks that look shorter on paper were slower there
+        // before (the fused descent).
+        texel_blocks: false,
         // Off: on the H100 the statistic cost 0.0019 ms of a 0.1591 ms frame
         // (`bench/issue36-floors/`).
         iteration_stats: false,

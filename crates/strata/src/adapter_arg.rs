@@ -51,7 +51,8 @@ pub fn parse_backend(s: &str) -> anyhow::Result<BackendChoice> {
 /// into the texels tests the texel in its iteration, or is an iteration of
 /// its own as by default), `STRATA_EXACT_CAVE_SKIP=off` (no
 /// tile skipped between its floors and slabs), `STRATA_EXACT_BEAM_TEXELS=off`
-/// (the beams' finest test on 4-texel tiles) configure `ray-exact`;
+/// (the beams' finest test on 4-texel tiles), `STRATA_EXACT_TEXEL_BLOCKS=on`
+/// (a 4x4 tile's texels walked from the texel plane) configure `ray-exact`;
 /// `STRATA_EXACT_STATS=1` prints its statistics;
 /// `STRATA_TEST_OVERSIZE_BUILD=METHOD` makes that method's build ask for a
 /// buffer over the device's limit (the README's way to see a refused build).
@@ -106,6 +107,11 @@ fn render_options_from(var: impl Fn(&str) -> Option<String>) -> RenderOptions {
             },
             cave_skip: !is("STRATA_EXACT_CAVE_SKIP", "off"),
             beam_texels: !is("STRATA_EXACT_BEAM_TEXELS", "off"),
+            texel_blocks: match var("STRATA_EXACT_TEXEL_BLOCKS").as_deref() {
+                Some("on") => true,
+                Some("off") => false,
+                _ => e.texel_blocks,
+            },
             ..e
         },
         exact_stats: is("STRATA_EXACT_STATS", "1"),
@@ -129,12 +135,14 @@ mod tests {
             "STRATA_EXACT_FUSED_DESCENT" => Some("on".into()),
             "STRATA_EXACT_CAVE_SKIP" => Some("off".into()),
             "STRATA_EXACT_BEAM_TEXELS" => Some("off".into()),
+            "STRATA_EXACT_TEXEL_BLOCKS" => Some("on".into()),
             "STRATA_TEST_OVERSIZE_BUILD" => Some("voxel".into()),
             _ => None,
         });
         assert!(!o.shadow_cull && !o.shadow_reuse && !o.exact.beam);
         assert_eq!(o.exact.shadow_rounds, 1);
-        assert!(o.exact.fused_descent);
+        assert!(o.exact.fused_descent && o.exact.texel_blocks);
+        assert!(!render_options_from(|_| None).exact.texel_blocks);
         assert!(!o.exact.cave_skip && !o.exact.beam_texels);
         assert!(render_options_from(|_| None).exact.beam_texels);
         assert!(render_options_from(|_| None).exact.cave_skip);

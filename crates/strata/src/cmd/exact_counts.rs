@@ -84,6 +84,12 @@ pub struct Args {
     /// box no wider than a texel against the texels that hold it).
     #[arg(long)]
     no_beam_texels: bool,
+    /// Try another traversal on paper: a 4x4 tile's texels walked from the
+    /// texel plane (as `STRATA_EXACT_TEXEL_BLOCKS=on`): only columns with
+    /// a slab wait on a terrain fetch ("waits" counts the fetches each
+    /// ray's steps wait on).
+    #[arg(long)]
+    texel_blocks: bool,
     /// Try another traversal on paper: the visited level camera rays start
     /// at from their tile's beam (the GPU's: 1, tiles of 4 texels).
     #[arg(long, value_parser = clap::value_parser!(u32).range(0..=4))]
@@ -122,6 +128,10 @@ struct Report {
     mean_march_warp_iterations: f64,
     mean_shadow_iterations: f64,
     mean_shadow_warp_iterations: f64,
+    /// The most waits (fetches a ray's steps wait on) of a warp's lanes,
+    /// camera and shadow rays.
+    mean_march_warp_waits: f64,
+    mean_shadow_warp_waits: f64,
     /// The shadow blocks' beams' iterations over the shadow rays.
     mean_shadow_beam_iterations_per_ray: f64,
     /// The shadow blocks' beams' rounds a block (each round one interval
@@ -133,7 +143,7 @@ struct Report {
 fn pass_line(name: &str, p: &PassCount) -> String {
     format!(
         "  {name:7} {:>9} rays  iter {:6.1} (p99 {:4}, max {:4}; warp {:6.1}, SIMD {:3.0} %; down {:5.1}, up {:5.1})  pyramid {:6.1} (p99 {:4})  \
-         terrain {:5.1} (p99 {:3})  shadow taps {:>8}  read {:8.2} MB  written {:6.2} MB",
+         terrain {:5.1} (p99 {:3})  waits {:5.1} (warp {:5.1})  shadow taps {:>8}  read {:8.2} MB  written {:6.2} MB",
         p.rays,
         p.iterations.mean,
         p.iterations.p99,
@@ -146,6 +156,8 @@ fn pass_line(name: &str, p: &PassCount) -> String {
         p.pyramid_reads.p99,
         p.terrain_reads.mean,
         p.terrain_reads.p99,
+        p.waits.mean,
+        p.warp_waits,
         p.shadow_reads,
         p.bytes_read as f64 / 1e6,
         p.bytes_written as f64 / 1e6,
@@ -185,6 +197,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         fused_descent: args.fused_descent,
         cave_skip: !args.no_cave_skip,
         beam_texels: !args.no_beam_texels,
+        texel_blocks: args.texel_blocks,
     };
     let shape = LevelShape::of(&world.level);
     let mut out = std::io::stdout().lock();
@@ -252,6 +265,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         mean_march_warp_iterations: mean(&|c| c.frame.march.warp_iterations),
         mean_shadow_iterations: mean(&|c| c.frame.shadow.iterations.mean),
         mean_shadow_warp_iterations: mean(&|c| c.frame.shadow.warp_iterations),
+        mean_march_warp_waits: mean(&|c| c.frame.march.warp_waits),
+        mean_shadow_warp_waits: mean(&|c| c.frame.shadow.warp_waits),
         mean_shadow_beam_iterations_per_ray: mean(&|c| {
             c.frame.shadow_beam_iterations as f64 / c.frame.shadow.rays.max(1) as f64
         }),
@@ -269,7 +284,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             out,
             "mean over {} views: {:.2} MB a frame, {:.2} march iterations a pixel ({:.2} a warp) \
              + {:.3} beam iterations a pixel ({:.2} a tile), {:.0} shadow rays of {:.2} iterations ({:.2} a warp) \
-             + {:.2} beam rounds a block",
+             + {:.2} beam rounds a block; waits a warp: march {:.2}, shadow {:.2}",
             report.views.len(),
             report.mean_bytes / 1e6,
             report.mean_march_iterations,
@@ -280,6 +295,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             report.mean_shadow_iterations,
             report.mean_shadow_warp_iterations,
             report.mean_shadow_beam_rounds_per_block,
+            report.mean_march_warp_waits,
+            report.mean_shadow_warp_waits,
         )?;
     }
     Ok(())

@@ -29,12 +29,20 @@ pub(super) fn buffer_entry(
 /// level and page pyramids (with its page table, feedback and parameters).
 pub enum Levels {
     /// The whole map's pyramid, built and updated on the GPU.
-    Whole(GpuMaxMip),
+    Whole(Box<GpuMaxMip>),
     /// Pages of a world of any size (`crate::paged`).
     Paged(Box<PagedTerrain>),
 }
 
 impl Levels {
+    /// The texel plane's first byte in the buffer, if it holds one.
+    pub fn texel_plane(&self) -> Option<u32> {
+        match self {
+            Levels::Whole(p) => p.texel_plane(),
+            Levels::Paged(_) => None,
+        }
+    }
+
     /// The buffer `maxmip` binds.
     fn buffer(&self) -> &wgpu::Buffer {
         match self {
@@ -182,6 +190,14 @@ pub(super) fn exact_pipeline(
             "EXACT_CAVE_SKIP",
             f64::from(u8::from(
                 options.cave_skip && !levels.is_paged() && shader != "ray_exact_shadow.wgsl",
+            )),
+        ),
+        // The texel walk needs the plane, which only a whole map's pyramid
+        // may hold (`GpuMaxMip::texel_plane`).
+        (
+            "EXACT_TEXEL_BLOCKS",
+            f64::from(u8::from(
+                options.texel_blocks && levels.texel_plane().is_some(),
             )),
         ),
         (

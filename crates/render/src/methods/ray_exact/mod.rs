@@ -75,6 +75,16 @@
 //! fetching the next steps' tiles ahead of need cost 30 % (more loads per
 //! step), and so did testing wider beam boxes against their texels.
 //!
+//! The texel plane's walk ([`ExactOptions::texel_blocks`],
+//! `EXACT_TEXEL_BLOCKS`, `STRATA_EXACT_TEXEL_BLOCKS=on`) shortens that
+//! chain: a ray that comes down into a 4x4-texel tile loads the tile's
+//! sixteen texel bytes (`strata_maxmip::TexelTops`, after the pyramids:
+//! each column's top, or "decode" where it has a slab) in four loads side
+//! by side and tests each single-floor texel from them, fetching only the
+//! columns with a slab. Same hits and iterations; on paper (`strata
+//! exact-counts --texel-blocks`) fewer fetches a warp waits on
+//! (`bench/issue36-texel-blocks/`). Off until timed on the H100.
+//!
 //! Measuring switches ([`ExactOptions`] and `exact_stats` in
 //! [`crate::options::RenderOptions`], read at creation from the shared
 //! frame; the `strata` binary sets them from `STRATA_EXACT_*`; H100 numbers
@@ -236,9 +246,21 @@ pub(crate) fn exact_params(layout: &strata_maxmip::Layout) -> ExactParams {
 
 /// Build the method with explicit options.
 pub fn build(shared: &Shared, level: &Level, options: ExactOptions) -> anyhow::Result<RayExact> {
-    let pyramid = GpuMaxMip::new(shared, level, options.pyramid_step(), true)?;
-    let table = exact_params(&pyramid.layout);
-    build_on(shared, Levels::Whole(pyramid), table, options)
+    let pyramid = GpuMaxMip::with_texels(
+        shared,
+        level,
+        options.pyramid_step(),
+        true,
+        options.texel_blocks && options.compute,
+    )?;
+    let mut table = exact_params(&pyramid.layout);
+    if let Some(first) = pyramid.texel_plane() {
+        // Index 0 (no pyramid level): the texel plane, as `texel_block_rows`
+        // reads it (words across, their log2, rows).
+        let words = level.width() / 4;
+        table.levels[0] = [first, words.trailing_zeros(), words - 1, level.height() - 1];
+    }
+    build_on(shared, Levels::Whole(Box::new(pyramid)), table, options)
 }
 
 /// Build the method over paged terrain (`crate::paged`): the shared frame's

@@ -4,7 +4,10 @@
 //! level below), the twin of `strata_maxmip::Pyramid` bit for bit. The same
 //! buffer holds, after the maxima, the cave pyramid (the twin of
 //! `strata_maxmip::CavePyramid`: each tile's highest floor top and lowest
-//! slab bottom, 16 bits a tile), built by the same dispatches.
+//! slab bottom, 16 bits a tile), built by the same dispatches. With the
+//! texel plane asked for (`ExactOptions::texel_blocks`), the buffer ends
+//! with it (`strata_maxmip::TexelTops`: a byte per texel, built by the same
+//! pipeline as a level 0).
 //!
 //! Creation builds every level in one submission. An edit queues its dirty
 //! rectangles; the next frame's first pass rebuilds exactly the tiles over
@@ -17,7 +20,7 @@ use super::super::coalesce::coalesce;
 use crate::frame::Shared;
 use crate::timing::PassTimer;
 use strata_level::{DirtyRect, Level};
-use strata_maxmip::{Layout, LevelInfo};
+use strata_maxmip::{Layout, LevelInfo, TexelTops};
 
 /// Dispatches one submission can hold (uniform slots).
 const MAX_SLOTS: usize = 256;
@@ -41,6 +44,8 @@ pub struct GpuMaxMip {
     pub buffer: wgpu::Buffer,
     /// Whether the buffer holds the cave pyramid after the maxima.
     caves: bool,
+    /// The texel plane's first byte, when the buffer ends with one.
+    texels: Option<u32>,
     pipeline: wgpu::ComputePipeline,
     frame_group: wgpu::BindGroup,
     group: wgpu::BindGroup,
@@ -59,18 +64,41 @@ impl GpuMaxMip {
     /// no others; with `caves`, the cave pyramid after them (`ray-exact`'s
     /// march reads it; the fragment methods' beams do not).
     pub fn new(shared: &Shared, level: &Level, step: u32, caves: bool) -> anyhow::Result<Self> {
+        Self::with_texels(shared, level, step, caves, false)
+    }
+
+    /// [`GpuMaxMip::new`], and with `texels` the texel plane after the rest
+    /// where the map has one ([`TexelTops::fits`]) and the adapter binds
+    /// it; [`GpuMaxMip::texel_plane`] says whether it did.
+    pub fn with_texels(
+        shared: &Shared,
+        level: &Level,
+        step: u32,
+        caves: bool,
+        texels: bool,
+    ) -> anyhow::Result<Self> {
         let layout = Layout::with_step(level.width(), level.height(), step);
         let device = &shared.device;
         let limits = device.limits();
+        let most = limits
+            .max_storage_buffer_binding_size
+            .min(limits.max_buffer_size);
         // The maxima, then the cave bounds (two bytes a tile); at least one
         // word, so that a map without tiles still binds a buffer.
         let planes = if caves { 3 } else { 1 };
         let bytes = (planes * u64::from(layout.bytes)).max(4);
-        if bytes
-            > limits
-                .max_storage_buffer_binding_size
-                .min(limits.max_buffer_size)
-        {
+        // The texel plane after them, on a 16-byte boundary; left out (the
+        // march then walks the texels from the terrain) where it does not
+        // fit the binding.
+        let plane_at = bytes.next_multiple_of(16);
+        let plane_end = plane_at + u64::from(level.width()) * u64::from(level.height());
+        let texels = (texels
+            && TexelTops::fits(level.width(), level.height())
+            && plane_end <= most
+            && plane_end <= u64::from(u32::MAX))
+        .then_some(plane_at as u32);
+        let bytes = if texels.is_some() { plane_end } else { bytes };
+        if bytes > most {
             anyhow::bail!(
                 "the max pyramid of a {}x{} map needs {bytes} bytes of storage buffer, more than this adapter binds",
                 level.width(),
@@ -104,6 +132,7 @@ impl GpuMaxMip {
         let mut pyramid = GpuMaxMip {
             pending: vec![whole(level)],
             caves,
+            texels,
             layout,
             buffer,
             pipeline,
@@ -138,21 +167,31 @@ impl GpuMaxMip {
         if self.pending.is_empty() {
             return;
         }
-        let levels = self.layout.levels.len().max(1);
+        let levels = self.layout.levels.len().max(1) + usize::from(self.texels.is_some());
         // Many small rectangles (a game's frame of track stamps): merge
         // neighbours into their bounding boxes (exact: a larger rectangle
         // recomputes more tiles), never the whole map's 33 M texels.
         coalesce(&mut self.pending, MAX_RECTS.min(MAX_SLOTS / levels).max(1));
-        let mut data = Vec::new();
-        for info in self.layout.levels.clone() {
+        let mut planes = Vec::new();
+        if let Some(offset) = self.texels {
+            planes.extend(
+                self.pending
+                    .iter()
+                    .map(|r| texel_params(&self.layout, offset, r)),
+            );
+        }
+        for info in &self.layout.levels {
             for rect in &self.pending {
-                let p = params(&self.layout, &info, rect, self.caves);
-                self.scheduled.push([p.rect[2].div_ceil(64), p.rect[3]]);
-                let at = data.len();
-                data.resize(at + self.slot_stride as usize, 0);
-                data[at..at + std::mem::size_of::<BuildParams>()]
-                    .copy_from_slice(bytemuck::bytes_of(&p));
+                planes.push(params(&self.layout, info, rect, self.caves));
             }
+        }
+        let mut data = Vec::new();
+        for p in planes {
+            self.scheduled.push([p.rect[2].div_ceil(64), p.rect[3]]);
+            let at = data.len();
+            data.resize(at + self.slot_stride as usize, 0);
+            data[at..at + std::mem::size_of::<BuildParams>()]
+                .copy_from_slice(bytemuck::bytes_of(&p));
         }
         self.pending.clear();
         if !data.is_empty() {
@@ -210,6 +249,22 @@ impl GpuMaxMip {
         )
     }
 
+    /// Copy the texel plane back (tests): `strata_maxmip::TexelTops::words`.
+    pub fn read_back_texels(&self, shared: &Shared) -> anyhow::Result<Vec<u32>> {
+        let first = self
+            .texels
+            .ok_or_else(|| anyhow::anyhow!("this pyramid keeps no texel plane"))?;
+        let words = self.read_all(shared)?;
+        let (w, h) = (self.layout.map_width, self.layout.map_height);
+        let first = first as usize / 4;
+        Ok(words[first..first + (w * h) as usize / 4].to_vec())
+    }
+
+    /// The texel plane's first byte in the buffer, if it holds one.
+    pub fn texel_plane(&self) -> Option<u32> {
+        self.texels
+    }
+
     /// The cave region's first byte in the buffer (after the maxima; the
     /// march reads it from `ExactParams::config[3]`).
     fn cave_offset(&self) -> u32 {
@@ -228,6 +283,23 @@ fn whole(level: &Level) -> DirtyRect {
         y: 0,
         width: level.width(),
         height: level.height(),
+    }
+}
+
+/// The dispatch over the texel plane's words (at byte `offset`) holding
+/// the texels of `rect`: whole words of each of its rows.
+fn texel_params(layout: &Layout, offset: u32, rect: &DirtyRect) -> BuildParams {
+    let (x0, x1) = (rect.x / 4, (rect.x + rect.width.max(1) - 1) / 4);
+    BuildParams {
+        level: [
+            offset,
+            layout.map_width.trailing_zeros(),
+            layout.map_height,
+            0,
+        ],
+        // No child level and no cave bounds (`NO_CAVES`).
+        child: [0, 0, layout.step, u32::MAX],
+        rect: [x0, rect.y, x1 - x0 + 1, rect.height],
     }
 }
 

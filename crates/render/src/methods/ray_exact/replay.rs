@@ -24,7 +24,7 @@
 use crate::frame::Globals;
 use glam::{IVec2, Vec2, Vec3};
 use strata_level::Level;
-use strata_maxmip::{CavePyramid, Pyramid};
+use strata_maxmip::{CavePyramid, Pyramid, TexelTops};
 
 mod beam;
 pub use crate::options::BeamSearch;
@@ -56,6 +56,10 @@ pub struct MarchCount {
     pub pyramid_reads: u32,
     /// Terrain texels read.
     pub terrain_reads: u32,
+    /// Iterations whose test waited on a read (a tile's maximum, a texel's
+    /// column), and the texel plane's block reads
+    /// ([`Traversal::texel_blocks`]): the ray's chain of dependent fetches.
+    pub waits: u32,
     /// Iterations that went down a level.
     pub descents: u32,
     /// Levels climbed after steps that left the parent tile.
@@ -95,6 +99,9 @@ pub struct Traversal {
     /// The beams test a box no wider than a texel against the texels that
     /// hold it rather than against 4-texel tiles (`EXACT_BEAM_TEXELS`).
     pub beam_texels: bool,
+    /// A 4x4 tile's texels are walked from the texel plane
+    /// (`EXACT_TEXEL_BLOCKS`, [`TexelTops`]).
+    pub texel_blocks: bool,
 }
 
 impl Traversal {
@@ -109,6 +116,7 @@ impl Traversal {
         fused_descent: crate::options::ExactOptions::DEFAULT.fused_descent,
         cave_skip: crate::options::ExactOptions::DEFAULT.cave_skip,
         beam_texels: crate::options::ExactOptions::DEFAULT.beam_texels,
+        texel_blocks: crate::options::ExactOptions::DEFAULT.texel_blocks,
     };
 
     /// Starting at the 256-texel tiles (the GPU's before `START_LEVEL`).
@@ -122,6 +130,7 @@ impl Traversal {
         fused_descent: false,
         cave_skip: false,
         beam_texels: false,
+        texel_blocks: false,
     };
 }
 
@@ -164,6 +173,8 @@ pub struct Replay<'a> {
     pub traversal: Traversal,
     /// The cave pyramid beside `pyramid` (built with the replay).
     caves: CavePyramid,
+    /// The texel plane (built when a traversal first walks it).
+    texels: Option<TexelTops>,
     terrain_touched: Touched,
     pyramid_touched: Touched,
 }
@@ -244,6 +255,7 @@ impl<'a> Replay<'a> {
             top: pyramid.top(),
             traversal: Traversal::GPU,
             caves: CavePyramid::with_step(level, pyramid.layout.step),
+            texels: None,
             terrain_touched: Touched::new(pairs),
             pyramid_touched: Touched::new(u64::from(pyramid.layout.bytes / 4)),
         }
@@ -334,6 +346,7 @@ impl<'a> Replay<'a> {
                 let z_min = z_a.min(z_b);
                 let tile = (base >> shift as i32) + cell;
                 r.pyramid_reads += 1;
+                r.waits += 1;
                 let under = z_min <= self.maxmip(shift, tile.x, tile.y);
                 // EXACT_CAVE_SKIP: the cave word, read beside the maximum
                 // (its test matters only under the maximum).
@@ -343,6 +356,18 @@ impl<'a> Replay<'a> {
                 let between = under
                     && self.traversal.cave_skip
                     && self.cave_clear(shift, tile.x, tile.y, z_min, z_a.max(z_b));
+                if under && !between && self.traversal.texel_blocks && shift == 2 {
+                    // EXACT_TEXEL_BLOCKS: the tile's texels from the plane.
+                    r.descents += 1;
+                    match self.texel_block(&mut r, o, base, d, t1, &mut t, cell) {
+                        Some((c, l)) => {
+                            cell = c;
+                            lvl = l;
+                            continue;
+                        }
+                        None => return r,
+                    }
+                }
                 if under && !between {
                     r.descents += 1;
                     lvl -= 1;
@@ -360,6 +385,7 @@ impl<'a> Replay<'a> {
             if test_column {
                 let column = base + cell;
                 r.terrain_reads += 1;
+                r.waits += 1;
                 let c = self.column(column.x, column.y);
                 let e = column_entry(&c, o.z, d.z, t, t_out);
                 if e >= 0.0 {
@@ -378,16 +404,113 @@ impl<'a> Replay<'a> {
             if tb.y <= tb.x {
                 cell.y += step.y;
             }
-            // EXACT_CLIMB.
-            let mut was = old;
-            for _ in 0..self.traversal.climb {
-                if lvl >= top || (was >> ratio as i32) == (cell >> ratio as i32) {
-                    break;
+            (cell, lvl) = self.climb(&mut r, old, cell, lvl);
+        }
+    }
+
+    /// `exact_climb`: after a step from `was` to `cell` at visited level
+    /// `lvl`, the cell and level (EXACT_CLIMB).
+    fn climb(
+        &self,
+        r: &mut MarchCount,
+        mut was: IVec2,
+        mut cell: IVec2,
+        mut lvl: u32,
+    ) -> (IVec2, u32) {
+        let ratio = LOG_RATIO as i32;
+        for _ in 0..self.traversal.climb {
+            if lvl >= self.top / LOG_RATIO || (was >> ratio) == (cell >> ratio) {
+                break;
+            }
+            was >>= ratio;
+            cell >>= ratio;
+            lvl += 1;
+            r.climbs += 1;
+        }
+        (cell, lvl)
+    }
+
+    /// The texel walk of `exact_march_at` over the 4x4 tile `cell` (level
+    /// 2, relative to `base`) from the texel plane, from `t` on: `None`
+    /// when the ray ends in it (hit, or `t1`), else the cell and visited
+    /// level after it leaves the tile (`t` its exit).
+    #[allow(clippy::too_many_arguments)]
+    fn texel_block(
+        &mut self,
+        r: &mut MarchCount,
+        o: Vec3,
+        base: IVec2,
+        d: Vec3,
+        t1: f32,
+        t: &mut f32,
+        cell: IVec2,
+    ) -> Option<(IVec2, u32)> {
+        let level = self.level;
+        let texels = self.texels.get_or_insert_with(|| TexelTops::new(level));
+        let (dxy, oxy) = (d.truncate(), o.truncate());
+        let pos = [d.x > 0.0, d.y > 0.0];
+        let step = IVec2::new(if pos[0] { 1 } else { -1 }, if pos[1] { 1 } else { -1 });
+        let far_side = IVec2::new(i32::from(pos[0]), i32::from(pos[1]));
+        let still = [d.x == 0.0, d.y == 0.0];
+        let inv = Vec2::new(
+            if still[0] { 0.0 } else { 1.0 / d.x },
+            if still[1] { 0.0 } else { 1.0 / d.y },
+        );
+        let first = cell << 2;
+        // The block's four row words, side by side: one wait.
+        r.pyramid_reads += 4;
+        r.waits += 1;
+        let mut texel = texel_after(oxy + dxy * *t, dxy).clamp(first, first + IVec2::splat(3));
+        loop {
+            if r.iterations >= super::ITERATION_CAP {
+                return None;
+            }
+            r.iterations += 1;
+            let tb = ((texel + far_side).as_vec2() - oxy) * inv;
+            let tb = Vec2::new(
+                if still[0] { BIG } else { tb.x },
+                if still[1] { BIG } else { tb.y },
+            );
+            let t_exit = tb.x.min(tb.y);
+            let column = base + texel;
+            let byte = texels.get(i64::from(column.x), i64::from(column.y));
+            let c = if byte == strata_maxmip::TEXEL_DECODE {
+                r.terrain_reads += 1;
+                r.waits += 1;
+                let (w, h) = (level.width() as i32, level.height() as i32);
+                let pair = ((column.x & (w - 1)) >> 1) as u64
+                    + (column.y & (h - 1)) as u64 * (w / 2) as u64;
+                self.terrain_touched.touch(pair);
+                level.column(i64::from(column.x), i64::from(column.y))
+            } else {
+                // A single floor (its terrain type is not needed to test it).
+                strata_level::model::Column {
+                    low: byte,
+                    mid: byte,
+                    high: byte,
+                    dual: false,
+                    lower_type: 0,
+                    upper_type: 0,
                 }
-                was >>= ratio as i32;
-                cell >>= ratio as i32;
-                lvl += 1;
-                r.climbs += 1;
+            };
+            let e = column_entry(&c, o.z, d.z, *t, t_exit.min(t1));
+            if e >= 0.0 {
+                r.hit = Some((e, column));
+                return None;
+            }
+            if t_exit >= t1 {
+                return None;
+            }
+            *t = t_exit;
+            let was = texel;
+            if tb.x <= tb.y {
+                texel.x += step.x;
+            }
+            if tb.y <= tb.x {
+                texel.y += step.y;
+            }
+            if (texel >> 2) != cell {
+                return Some(self.climb(r, was, texel, 0));
             }
         }
     }
@@ -540,6 +663,12 @@ pub struct PassCount {
     /// Mean over 32-lane warps (8x4 pixels or texels of an 8x8 workgroup) of
     /// the most iterations of a lane: a warp steps as long as its longest ray.
     pub warp_iterations: f64,
+    /// Waits per ray ([`MarchCount::waits`]).
+    pub waits: Spread,
+    /// Mean over warps of the most waits of a lane: the warp's chain of
+    /// dependent fetches, if a lane's iterations without a fetch cost
+    /// nothing beside them.
+    pub warp_waits: f64,
     /// Iterations over warp steps x 32: the share of lanes doing work.
     pub simd_efficiency: f64,
     /// Bytes read, all requests (terrain, pyramid, shadow map, the pass's
@@ -601,6 +730,7 @@ struct PassAcc {
     iterations: Vec<u32>,
     pyramid: Vec<u32>,
     terrain: Vec<u32>,
+    waits: Vec<u32>,
 }
 
 impl PassAcc {
@@ -610,16 +740,18 @@ impl PassAcc {
         self.iterations.push(m.iterations);
         self.pyramid.push(m.pyramid_reads);
         self.terrain.push(m.terrain_reads);
+        self.waits.push(m.waits);
     }
 
     /// `warps`: the lanes of each warp, as indices into the rays.
     fn finish(self, warps: impl Iterator<Item = Vec<usize>>) -> PassCount {
         let rays = self.iterations.len() as u64;
-        let (mut count, mut steps) = (0u64, 0u64);
+        let (mut count, mut steps, mut waits) = (0u64, 0u64, 0u64);
         for lanes in warps {
             let most = lanes.iter().map(|&i| self.iterations[i]).max().unwrap_or(0);
             count += 1;
             steps += u64::from(most);
+            waits += u64::from(lanes.iter().map(|&i| self.waits[i]).max().unwrap_or(0));
         }
         let work: u64 = self.iterations.iter().map(|&x| u64::from(x)).sum();
         let pyramid = Spread::of(self.pyramid);
@@ -630,6 +762,8 @@ impl PassAcc {
             descents: self.descents as f64 / rays.max(1) as f64,
             climbs: self.climbs as f64 / rays.max(1) as f64,
             warp_iterations: steps as f64 / count.max(1) as f64,
+            warp_waits: waits as f64 / count.max(1) as f64,
+            waits: Spread::of(self.waits),
             simd_efficiency: work as f64 / (steps * 32).max(1) as f64,
             iterations: Spread::of(self.iterations),
             pyramid_reads: pyramid,

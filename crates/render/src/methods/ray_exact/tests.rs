@@ -92,8 +92,15 @@ fn gpu_pyramid_equals_its_twin_before_and_after_an_edit() {
             let world = if w >= 256 { world(w, h, 6) } else { tiny(w, h) };
             let mut level = world.level.clone();
             let shared = shared_for(&gpu, &level);
-            let mut gp = GpuMaxMip::new(&shared, &level, step, true).unwrap();
+            let mut gp = GpuMaxMip::with_texels(&shared, &level, step, true, true).unwrap();
             let cpu = strata_maxmip::Pyramid::with_step(&level, step);
+            let texels = strata_maxmip::TexelTops::new(&level);
+            let got = gp.read_back_texels(&shared).unwrap();
+            assert!(
+                got == texels.words(),
+                "{w}x{h}: texel plane: {}",
+                first_diff(&got, &texels.words())
+            );
             let got = gp.read_back(&shared).unwrap();
             assert!(
                 got == cpu.words(),
@@ -160,8 +167,23 @@ fn gpu_pyramid_equals_its_twin_before_and_after_an_edit() {
                 "{w}x{h}: caves after the edit: {}",
                 first_diff(&got, &fresh_caves.words())
             );
+            let mut texel_twin = texels.clone();
+            for r in &rects {
+                texel_twin.update(&level, r);
+            }
+            let fresh_texels = strata_maxmip::TexelTops::new(&level);
+            assert!(
+                texel_twin == fresh_texels && texel_twin != texels,
+                "{w}x{h}: texel plane: the CPU update differs from a fresh build, or the edit changed nothing"
+            );
+            let got = gp.read_back_texels(&shared).unwrap();
+            assert!(
+                got == fresh_texels.words(),
+                "{w}x{h}: texel plane after the edit: {}",
+                first_diff(&got, &fresh_texels.words())
+            );
             eprintln!(
-                "{w}x{h}: GPU pyramid and caves == CPU twins before and after the crater ({rects:?})"
+                "{w}x{h}: GPU pyramid, caves and texel plane == CPU twins before and after the crater ({rects:?})"
             );
             gpu.errors.check().unwrap();
         }
@@ -237,7 +259,7 @@ fn gpu_trace(gpu: &crate::Gpu, level: &Level, rays: &[TestRay]) -> Vec<[f32; 4]>
         "test params",
         bytemuck::bytes_of(&exact_params(&pyramid.layout)),
     );
-    let pyramid = Levels::Whole(pyramid);
+    let pyramid = Levels::Whole(Box::new(pyramid));
     let stats = device.create_buffer(&wgpu::BufferDescriptor {
         label: None,
         size: 16,
@@ -767,9 +789,18 @@ fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
                 exact_shadow: false,
                 ..d
             },
+            ExactOptions {
+                texel_blocks: true,
+                ..d
+            },
+            ExactOptions {
+                texel_blocks: true,
+                exact_shadow: false,
+                ..d
+            },
         ];
         assert_eq!(d.beam_search, BeamSearch::Wide);
-        assert!(!d.fused_descent && d.cave_skip && d.beam_texels);
+        assert!(!d.fused_descent && d.cave_skip && d.beam_texels && !d.texel_blocks);
         let mut images = Vec::new();
         for options in variants {
             let m = build(&r.shared_handle(), &w.level, options).unwrap();
@@ -796,8 +827,9 @@ fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
         // serially or wide in the march instead of wide in a pre-pass, or
         // a descent into the texels fused with the texel's test, or no tile
         // skipped between floors and slabs, or the beams' finest test on
-        // 4-texel tiles, changes nothing but the work.
-        for other in [3, 4, 5, 6, 8, 10, 12, 13, 15, 16] {
+        // 4-texel tiles, or a 4x4 tile's texels walked from the texel
+        // plane, changes nothing but the work.
+        for other in [3, 4, 5, 6, 8, 10, 12, 13, 15, 16, 18] {
             for (v, (a, b)) in images[1].iter().zip(&images[other]).enumerate() {
                 assert!(
                     a.0 == b.0 && a.1 == b.1,
@@ -808,8 +840,9 @@ fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
         // The one-pass frame (the renderer's shadow map) with the wide
         // beam in a pre-pass, without a beam, with the serial one and with
         // the wide one in the march, with the fused descent, and without
-        // the cave skip and the beams' texel test: the same image.
-        for other in [7, 9, 11, 14, 17] {
+        // the cave skip and the beams' texel test, and with the texel
+        // plane: the same image.
+        for other in [7, 9, 11, 14, 17, 19] {
             for (v, (a, b)) in images[2].iter().zip(&images[other]).enumerate() {
                 assert!(
                     a.0 == b.0 && a.1 == b.1,

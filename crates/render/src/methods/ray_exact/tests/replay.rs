@@ -11,16 +11,67 @@ use super::*;
 /// fused into the texel's iteration (the default) and not.
 #[test]
 fn the_replay_takes_the_gpu_steps() {
-    for (search, shadow_rounds, fused_descent, caves) in [
-        (BeamSearch::Wide, 8, true, true),
-        (BeamSearch::Wide, 8, false, true),
-        (BeamSearch::Wide, 8, true, false),
-        (BeamSearch::Serial, 8, true, true),
-        (BeamSearch::WidePass, 8, true, true),
-        (BeamSearch::WidePass, 1, true, true),
+    for (search, shadow_rounds, fused_descent, caves, texel_blocks) in [
+        (BeamSearch::Wide, 8, true, true, false),
+        (BeamSearch::Wide, 8, false, true, false),
+        (BeamSearch::Wide, 8, false, true, true),
+        (BeamSearch::Wide, 8, true, false, false),
+        (BeamSearch::Serial, 8, true, true, false),
+        (BeamSearch::WidePass, 8, true, true, false),
+        (BeamSearch::WidePass, 1, true, true, false),
     ] {
-        replay_takes_the_gpu_steps(search, shadow_rounds, fused_descent, caves);
+        replay_takes_the_gpu_steps(search, shadow_rounds, fused_descent, caves, texel_blocks);
     }
+}
+
+/// The texel plane's walk (`EXACT_TEXEL_BLOCKS`) on paper: every view's
+/// rays take the same iterations to the same hits as the default walk's,
+/// and wait on fewer fetches (a single floor's test reads the block's
+/// words, loaded once per 4x4 tile, not a terrain texel).
+#[test]
+fn the_texel_plane_walk_takes_the_same_steps_waiting_on_fewer_fetches() {
+    use super::super::replay::{Replay, replay_frame};
+    let (w, pyramid) = replay_world();
+    let mut plain = Replay::new(&w.level, &pyramid);
+    let mut blocks = Replay::new(&w.level, &pyramid);
+    blocks.traversal.texel_blocks = true;
+    let (mut waits, mut block_waits) = (0.0, 0.0);
+    for view in &w.views {
+        let (_, globals) = view_globals(&w.level, view, (W, H));
+        let a = replay_frame(&mut plain, &globals);
+        let b = replay_frame(&mut blocks, &globals);
+        assert_eq!(a.hits, b.hits, "{}", view.name);
+        for (name, p, q) in [
+            ("march", &a.march, &b.march),
+            ("shadow", &a.shadow, &b.shadow),
+        ] {
+            assert_eq!(p.iterations, q.iterations, "{} {name}", view.name);
+            assert!(
+                q.terrain_reads.total < p.terrain_reads.total,
+                "{} {name}: terrain reads {} with the plane, {} without",
+                view.name,
+                q.terrain_reads.total,
+                p.terrain_reads.total
+            );
+        }
+        waits += a.march.warp_waits + a.shadow.warp_waits;
+        block_waits += b.march.warp_waits + b.shadow.warp_waits;
+        for y in (0..H).step_by(7) {
+            for x in (0..W).step_by(5) {
+                let (px, py) = (x as f32 + 0.5, y as f32 + 0.5);
+                assert_eq!(
+                    plain.pixel(&globals, px, py).1.hit,
+                    blocks.pixel(&globals, px, py).1.hit,
+                    "{} pixel ({x}, {y})",
+                    view.name
+                );
+            }
+        }
+    }
+    eprintln!(
+        "waits a warp, march + shadow, summed over the views: {waits:.1} -> {block_waits:.1}"
+    );
+    assert!(block_waits < 0.9 * waits, "{waits} -> {block_waits}");
 }
 
 /// The generated world and its compute pyramid, for a replay.
@@ -46,6 +97,7 @@ fn replay_takes_the_gpu_steps(
     shadow_rounds: u32,
     fused_descent: bool,
     caves: bool,
+    texel_blocks: bool,
 ) {
     use super::super::replay::{Replay, replay_frame};
     let (w, pyramid) = replay_world();
@@ -55,6 +107,7 @@ fn replay_takes_the_gpu_steps(
         fused_descent,
         cave_skip: caves,
         beam_texels: caves,
+        texel_blocks,
         ..replay_traversal(search, true)
     };
     let options = ExactOptions {
@@ -63,6 +116,7 @@ fn replay_takes_the_gpu_steps(
         fused_descent,
         cave_skip: caves,
         beam_texels: caves,
+        texel_blocks,
         iteration_stats: true,
         ..ExactOptions::DEFAULT
     };
@@ -129,7 +183,7 @@ fn replay_takes_the_gpu_steps(
             record_frame(&shared, &mut m, camera, &globals, &timer, index);
             let s = m.stats().unwrap();
             eprintln!(
-                "{search:?} {shadow_rounds} fused {fused_descent} caves {caves} view {index}: most iterations GPU {} / {} (shadow), replay {} / {}",
+                "{search:?} {shadow_rounds} fused {fused_descent} caves {caves} blocks {texel_blocks} view {index}: most iterations GPU {} / {} (shadow), replay {} / {}",
                 s.most_iterations,
                 s.shadow_most_iterations,
                 f.most_iterations,
