@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # One H100 call: one binary (`devbin/strata.xz`), `ray-exact` with the
-# texel plane's walk off (the default) and on (STRATA_EXACT_TEXEL_BLOCKS=on),
-# alternated, REPS (3) runs each: the protocol's twelve views, 1280x800,
-# shadows, 20 frames. Carry `.gl` and `devbin`.
+# terrain walk (the default, STRATA_EXACT_TEXEL_BLOCKS=off) and the texel
+# plane's two walks (=plane, =beside), alternated, REPS (3) runs each: the
+# protocol's twelve views, 1280x800, shadows, 20 frames. Carry `.gl` and
+# `devbin`.
 #   OUT=$OUT [REPS=3] bash bench/issue36-texel-blocks/h100-ab.sh
 set -u
 for f in .gl/*.deb; do dpkg -x "$f" /; done; ldconfig
@@ -16,10 +17,11 @@ run() {
         --out "$W/$name" > "$W/$name.log" 2>&1 || echo "$name failed: $(tail -2 "$W/$name.log")"
 }
 for k in $(seq 1 "${REPS:-3}"); do
-    run plain-$k STRATA_EXACT_TEXEL_BLOCKS=off
-    run blocks-$k STRATA_EXACT_TEXEL_BLOCKS=on
+    for walk in off plane beside; do
+        run $walk-$k STRATA_EXACT_TEXEL_BLOCKS=$walk
+    done
 done
-python3 bench/issue36-loop-bounding/summary_all.py "$W"/plain-* "$W"/blocks-* | tee "$OUT/summary.txt"
+python3 bench/issue36-loop-bounding/summary_all.py "$W"/off-* "$W"/plane-* "$W"/beside-* | tee "$OUT/summary.txt"
 mkdir -p "$OUT/runs"
 for d in "$W"/*/; do
     n=$(basename "$d"); case $n in world|cache) continue ;; esac

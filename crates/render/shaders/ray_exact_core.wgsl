@@ -71,12 +71,14 @@ const CAVE_MARGIN: f32 = 0.015625;
 // A column's slab bottom when it has none (`strata_maxmip::NO_SLAB`).
 const CAVE_NO_SLAB: u32 = 255u;
 
-// A ray that comes down into a 4x4-texel tile walks its texels from the
-// texel plane (`texel_block_rows`: the tile's sixteen tops in four loads
-// side by side) rather than a terrain fetch per texel, decoding only the
-// columns that have a slab (a pipeline constant, `ExactOptions::texel_blocks`;
-// the same hits, the same iterations, fewer of them waiting on memory).
-override EXACT_TEXEL_BLOCKS: bool = false;
+// How a ray walks the texels of a 4x4-texel tile it comes down into (a
+// pipeline constant, `ExactOptions::texel_walk`; the same hits, the same
+// iterations): 0 a terrain fetch per texel; 1 from the texel plane
+// (`texel_block_rows`: the tile's sixteen tops in four loads side by side),
+// loaded once the ray comes down into the tile, decoding only the columns
+// that have a slab; 2 the same, the plane's words loaded beside the tile's
+// maximum at every step over a 4x4 tile, so coming down waits on nothing.
+override EXACT_TEXEL_BLOCKS: u32 = 0u;
 // A texel plane byte whose column must be decoded (`strata_maxmip::TEXEL_DECODE`).
 const TEXEL_DECODE: u32 = 255u;
 
@@ -175,13 +177,20 @@ fn exact_march_at(o: vec3<f32>, base: vec2<i32>, d: vec3<f32>, t0: f32, t1: f32,
             if (EXACT_CAVE_SKIP) {
                 caves = cave_word(shift, tile.x, tile.y);
             }
+            let block = EXACT_TEXEL_BLOCKS != 0u && shift == 2u && leaf == 0u;
+            var rows = vec4<u32>(0u);
+            if (EXACT_TEXEL_BLOCKS == 2u && block) {
+                rows = texel_block_rows(tile.x, tile.y);
+            }
             if (z_min <= tile_top && !(EXACT_CAVE_SKIP && cave_word_clear(caves, z_min, max(z_a, z_b)))) {
-                if (EXACT_TEXEL_BLOCKS && shift == 2u && leaf == 0u) {
+                if (block) {
                     // The tile's texels from the texel plane: the iterations
                     // the walk below would take at level 0, one per texel,
                     // with the same bounds and tests.
                     let first = cell << vec2<u32>(2u);
-                    let rows = texel_block_rows(tile.x, tile.y);
+                    if (EXACT_TEXEL_BLOCKS == 1u) {
+                        rows = texel_block_rows(tile.x, tile.y);
+                    }
                     var texel = clamp(texel_after(o.xy + d.xy * t, d.xy), first, first + vec2<i32>(3));
                     // Bounded: each texel steps out along x or y, so the
                     // walk leaves the tile after 7 at most; and each pass

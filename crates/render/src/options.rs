@@ -79,18 +79,50 @@ pub struct ExactOptions {
     /// same hits, later starts). Off: the finest tiles they test are the
     /// pyramid's 4-texel ones.
     pub beam_texels: bool,
-    /// A ray that comes down into a 4x4-texel tile walks its texels from
-    /// the texel plane (`EXACT_TEXEL_BLOCKS`, `strata_maxmip::TexelTops`: a
-    /// byte per texel after the pyramids, a map's area in GPU bytes) and
-    /// decodes only the columns with a slab: the same hits and iterations,
-    /// fewer of them waiting on a fetch. Whole maps only (pages keep no
-    /// plane), and only where the plane fits a storage binding.
-    pub texel_blocks: bool,
+    /// How a ray walks the texels of a 4x4-texel tile it comes down into
+    /// (`EXACT_TEXEL_BLOCKS`; the same hits and iterations either way).
+    pub texel_walk: TexelWalk,
     /// Keep the most iterations of any camera and shadow ray
     /// (`EXACT_ITERATION_STATS`, `ExactStats::most_iterations`): a barrier
     /// and a global atomic a workgroup, so off unless asked (the renderer's
     /// `exact_stats` turns it on too). Capped rays are counted either way.
     pub iteration_stats: bool,
+}
+
+/// How `ray-exact`'s march walks the texels of a 4x4-texel tile it comes
+/// down into (`EXACT_TEXEL_BLOCKS`; the same hits and iterations either
+/// way). The plane (`strata_maxmip::TexelTops`: a byte per texel after the
+/// pyramids, a map's area in GPU bytes) holds each column's top where it is
+/// a single floor, so only columns with a slab wait on a terrain fetch.
+/// Whole maps only (pages keep no plane), and only where the plane fits a
+/// storage binding; else the terrain walk.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TexelWalk {
+    /// A terrain fetch per texel, as the CPU reference walks.
+    Terrain,
+    /// From the texel plane: the tile's four row words, loaded side by side
+    /// once the ray comes down into it (one more wait per tile).
+    Plane,
+    /// From the texel plane, its words loaded beside the tile's maximum at
+    /// every step over a 4x4 tile (no wait of their own, four more loads
+    /// a step).
+    PlaneBeside,
+}
+
+impl TexelWalk {
+    /// `EXACT_TEXEL_BLOCKS`: 0, 1 or 2.
+    pub fn constant(self) -> u32 {
+        match self {
+            TexelWalk::Terrain => 0,
+            TexelWalk::Plane => 1,
+            TexelWalk::PlaneBeside => 2,
+        }
+    }
+
+    /// Whether the walk reads the texel plane.
+    pub fn reads_plane(self) -> bool {
+        self != TexelWalk::Terrain
+    }
 }
 
 /// How `ray-exact`'s beam finds where a tile's rays start
@@ -166,11 +198,12 @@ impl ExactOptions {
         // march iterations a pixel, 11.26 -> 7.99 a warp.
         cave_skip: true,
         beam_texels: true,
-        // Off until timed on the H100 (`bench/issue36-texel-blocks/`): on
-        // paper the walk waits on fewer fetches, but it costs a map's area in
-        // GPU bytes, and walks that look shorter on paper were slower there
-        // before (the fused descent).
-        texel_blocks: false,
+        // The terrain walk until the plane's are timed on the H100
+        // (`bench/issue36-texel-blocks/`): on paper they wait on fewer
+        // fetches, but they cost a map's area in GPU bytes, and walks that
+        // looked shorter on paper were slower there before (the fused
+        // descent).
+        texel_walk: TexelWalk::Terrain,
         // Off: on the H100 the statistic cost 0.0019 ms of a 0.1591 ms frame
         // (`bench/issue36-floors/`).
         iteration_stats: false,

@@ -2,7 +2,7 @@
 //! renderer's measuring switches, which the binary (never the library) reads
 //! from the environment.
 
-use strata_render::options::{BeamSearch, DepthMode, ExactOptions, RenderOptions};
+use strata_render::options::{BeamSearch, DepthMode, ExactOptions, RenderOptions, TexelWalk};
 use strata_render::{AdapterChoice, BackendChoice, Gpu};
 
 #[derive(clap::Args, Clone, Debug, Default)]
@@ -51,8 +51,10 @@ pub fn parse_backend(s: &str) -> anyhow::Result<BackendChoice> {
 /// into the texels tests the texel in its iteration, or is an iteration of
 /// its own as by default), `STRATA_EXACT_CAVE_SKIP=off` (no
 /// tile skipped between its floors and slabs), `STRATA_EXACT_BEAM_TEXELS=off`
-/// (the beams' finest test on 4-texel tiles), `STRATA_EXACT_TEXEL_BLOCKS=on`
-/// (a 4x4 tile's texels walked from the texel plane) configure `ray-exact`;
+/// (the beams' finest test on 4-texel tiles),
+/// `STRATA_EXACT_TEXEL_BLOCKS=plane|beside` (a 4x4 tile's texels walked
+/// from the texel plane, its words loaded on the way down or beside the
+/// tile's maximum) configure `ray-exact`;
 /// `STRATA_EXACT_STATS=1` prints its statistics;
 /// `STRATA_TEST_OVERSIZE_BUILD=METHOD` makes that method's build ask for a
 /// buffer over the device's limit (the README's way to see a refused build).
@@ -107,10 +109,11 @@ fn render_options_from(var: impl Fn(&str) -> Option<String>) -> RenderOptions {
             },
             cave_skip: !is("STRATA_EXACT_CAVE_SKIP", "off"),
             beam_texels: !is("STRATA_EXACT_BEAM_TEXELS", "off"),
-            texel_blocks: match var("STRATA_EXACT_TEXEL_BLOCKS").as_deref() {
-                Some("on") => true,
-                Some("off") => false,
-                _ => e.texel_blocks,
+            texel_walk: match var("STRATA_EXACT_TEXEL_BLOCKS").as_deref() {
+                Some("off") => TexelWalk::Terrain,
+                Some("plane") => TexelWalk::Plane,
+                Some("beside") => TexelWalk::PlaneBeside,
+                _ => e.texel_walk,
             },
             ..e
         },
@@ -135,14 +138,17 @@ mod tests {
             "STRATA_EXACT_FUSED_DESCENT" => Some("on".into()),
             "STRATA_EXACT_CAVE_SKIP" => Some("off".into()),
             "STRATA_EXACT_BEAM_TEXELS" => Some("off".into()),
-            "STRATA_EXACT_TEXEL_BLOCKS" => Some("on".into()),
+            "STRATA_EXACT_TEXEL_BLOCKS" => Some("beside".into()),
             "STRATA_TEST_OVERSIZE_BUILD" => Some("voxel".into()),
             _ => None,
         });
         assert!(!o.shadow_cull && !o.shadow_reuse && !o.exact.beam);
         assert_eq!(o.exact.shadow_rounds, 1);
-        assert!(o.exact.fused_descent && o.exact.texel_blocks);
-        assert!(!render_options_from(|_| None).exact.texel_blocks);
+        assert!(o.exact.fused_descent && o.exact.texel_walk == TexelWalk::PlaneBeside);
+        assert_eq!(
+            render_options_from(|_| None).exact.texel_walk,
+            TexelWalk::Terrain
+        );
         assert!(!o.exact.cave_skip && !o.exact.beam_texels);
         assert!(render_options_from(|_| None).exact.beam_texels);
         assert!(render_options_from(|_| None).exact.cave_skip);

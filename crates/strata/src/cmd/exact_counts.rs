@@ -17,6 +17,7 @@ use strata_render::methods::ray_exact::replay::{
     BeamSearch, FrameCount, PassCount, Replay, Traversal, beam_disagreements, compute_pyramid,
     replay_frame,
 };
+use strata_render::options::TexelWalk;
 
 fn parse_search(s: &str) -> Result<BeamSearch, String> {
     match s {
@@ -25,6 +26,17 @@ fn parse_search(s: &str) -> Result<BeamSearch, String> {
         "wide-pass" => Ok(BeamSearch::WidePass),
         _ => Err(format!(
             "`{s}`: the beam search is `serial`, `wide` or `wide-pass`"
+        )),
+    }
+}
+
+fn parse_texel_walk(s: &str) -> Result<TexelWalk, String> {
+    match s {
+        "off" => Ok(TexelWalk::Terrain),
+        "plane" => Ok(TexelWalk::Plane),
+        "beside" => Ok(TexelWalk::PlaneBeside),
+        _ => Err(format!(
+            "`{s}`: the texel walk is `off`, `plane` or `beside`"
         )),
     }
 }
@@ -85,11 +97,13 @@ pub struct Args {
     #[arg(long)]
     no_beam_texels: bool,
     /// Try another traversal on paper: a 4x4 tile's texels walked from the
-    /// texel plane (as `STRATA_EXACT_TEXEL_BLOCKS=on`): only columns with
-    /// a slab wait on a terrain fetch ("waits" counts the fetches each
-    /// ray's steps wait on).
-    #[arg(long)]
-    texel_blocks: bool,
+    /// texel plane, its words loaded on the way down (`plane`) or beside
+    /// the tile's maximum (`beside`), as `STRATA_EXACT_TEXEL_BLOCKS`: only
+    /// columns with a slab wait on a terrain fetch ("waits" counts the
+    /// fetches each ray's steps wait on). Default `off`: a terrain fetch per
+    /// texel.
+    #[arg(long, value_parser = parse_texel_walk, default_value = "off")]
+    texel_walk: TexelWalk,
     /// Try another traversal on paper: the visited level camera rays start
     /// at from their tile's beam (the GPU's: 1, tiles of 4 texels).
     #[arg(long, value_parser = clap::value_parser!(u32).range(0..=4))]
@@ -197,7 +211,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         fused_descent: args.fused_descent,
         cave_skip: !args.no_cave_skip,
         beam_texels: !args.no_beam_texels,
-        texel_blocks: args.texel_blocks,
+        texel_walk: args.texel_walk,
     };
     let shape = LevelShape::of(&world.level);
     let mut out = std::io::stdout().lock();

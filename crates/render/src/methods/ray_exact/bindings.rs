@@ -196,9 +196,11 @@ pub(super) fn exact_pipeline(
         // may hold (`GpuMaxMip::texel_plane`).
         (
             "EXACT_TEXEL_BLOCKS",
-            f64::from(u8::from(
-                options.texel_blocks && levels.texel_plane().is_some(),
-            )),
+            f64::from(if levels.texel_plane().is_some() {
+                options.texel_walk.constant()
+            } else {
+                0
+            }),
         ),
         (
             "EXACT_ITERATION_STATS",

@@ -75,14 +75,16 @@
 //! fetching the next steps' tiles ahead of need cost 30 % (more loads per
 //! step), and so did testing wider beam boxes against their texels.
 //!
-//! The texel plane's walk ([`ExactOptions::texel_blocks`],
-//! `EXACT_TEXEL_BLOCKS`, `STRATA_EXACT_TEXEL_BLOCKS=on`) shortens that
-//! chain: a ray that comes down into a 4x4-texel tile loads the tile's
+//! The texel plane's walks ([`ExactOptions::texel_walk`], [`TexelWalk`],
+//! `EXACT_TEXEL_BLOCKS`, `STRATA_EXACT_TEXEL_BLOCKS=plane|beside`) shorten
+//! that chain: a ray that comes down into a 4x4-texel tile has the tile's
 //! sixteen texel bytes (`strata_maxmip::TexelTops`, after the pyramids:
 //! each column's top, or "decode" where it has a slab) in four loads side
-//! by side and tests each single-floor texel from them, fetching only the
-//! columns with a slab. Same hits and iterations; on paper (`strata
-//! exact-counts --texel-blocks`) fewer fetches a warp waits on
+//! by side, and tests each single-floor texel from them, fetching only the
+//! columns with a slab. `plane` loads them once the ray comes down into
+//! the tile, `beside` with the tile's maximum at every step over a 4x4
+//! tile. Same hits and iterations; on paper (`strata exact-counts
+//! --texel-walk`) fewer fetches a warp waits on
 //! (`bench/issue36-texel-blocks/`). Off until timed on the H100.
 //!
 //! Measuring switches ([`ExactOptions`] and `exact_stats` in
@@ -200,7 +202,7 @@ pub struct RayExact {
     update_ms: Vec<f64>,
 }
 
-pub use crate::options::{BeamSearch, DepthMode, ExactOptions};
+pub use crate::options::{BeamSearch, DepthMode, ExactOptions, TexelWalk};
 
 pub fn create(
     shared: &Shared,
@@ -251,7 +253,7 @@ pub fn build(shared: &Shared, level: &Level, options: ExactOptions) -> anyhow::R
         level,
         options.pyramid_step(),
         true,
-        options.texel_blocks && options.compute,
+        options.texel_walk.reads_plane() && options.compute,
     )?;
     let mut table = exact_params(&pyramid.layout);
     if let Some(first) = pyramid.texel_plane() {

@@ -5,7 +5,7 @@
 //! buffer holds, after the maxima, the cave pyramid (the twin of
 //! `strata_maxmip::CavePyramid`: each tile's highest floor top and lowest
 //! slab bottom, 16 bits a tile), built by the same dispatches. With the
-//! texel plane asked for (`ExactOptions::texel_blocks`), the buffer ends
+//! texel plane asked for (`ExactOptions::texel_walk`), the buffer ends
 //! with it (`strata_maxmip::TexelTops`: a byte per texel, built by the same
 //! pipeline as a level 0).
 //!

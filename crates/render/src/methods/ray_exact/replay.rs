@@ -22,6 +22,7 @@
 //! boundary it grazes (the tests bound that).
 
 use crate::frame::Globals;
+use crate::options::TexelWalk;
 use glam::{IVec2, Vec2, Vec3};
 use strata_level::Level;
 use strata_maxmip::{CavePyramid, Pyramid, TexelTops};
@@ -58,7 +59,7 @@ pub struct MarchCount {
     pub terrain_reads: u32,
     /// Iterations whose test waited on a read (a tile's maximum, a texel's
     /// column), and the texel plane's block reads
-    /// ([`Traversal::texel_blocks`]): the ray's chain of dependent fetches.
+    /// ([`Traversal::texel_walk`]): the ray's chain of dependent fetches.
     pub waits: u32,
     /// Iterations that went down a level.
     pub descents: u32,
@@ -99,9 +100,9 @@ pub struct Traversal {
     /// The beams test a box no wider than a texel against the texels that
     /// hold it rather than against 4-texel tiles (`EXACT_BEAM_TEXELS`).
     pub beam_texels: bool,
-    /// A 4x4 tile's texels are walked from the texel plane
-    /// (`EXACT_TEXEL_BLOCKS`, [`TexelTops`]).
-    pub texel_blocks: bool,
+    /// How a 4x4 tile's texels are walked: from the terrain, or from the
+    /// texel plane (`EXACT_TEXEL_BLOCKS`, [`TexelTops`]).
+    pub texel_walk: TexelWalk,
 }
 
 impl Traversal {
@@ -116,7 +117,7 @@ impl Traversal {
         fused_descent: crate::options::ExactOptions::DEFAULT.fused_descent,
         cave_skip: crate::options::ExactOptions::DEFAULT.cave_skip,
         beam_texels: crate::options::ExactOptions::DEFAULT.beam_texels,
-        texel_blocks: crate::options::ExactOptions::DEFAULT.texel_blocks,
+        texel_walk: crate::options::ExactOptions::DEFAULT.texel_walk,
     };
 
     /// Starting at the 256-texel tiles (the GPU's before `START_LEVEL`).
@@ -130,7 +131,7 @@ impl Traversal {
         fused_descent: false,
         cave_skip: false,
         beam_texels: false,
-        texel_blocks: false,
+        texel_walk: TexelWalk::Terrain,
     };
 }
 
@@ -356,7 +357,13 @@ impl<'a> Replay<'a> {
                 let between = under
                     && self.traversal.cave_skip
                     && self.cave_clear(shift, tile.x, tile.y, z_min, z_a.max(z_b));
-                if under && !between && self.traversal.texel_blocks && shift == 2 {
+                let block = self.traversal.texel_walk.reads_plane() && shift == 2;
+                if block && self.traversal.texel_walk == TexelWalk::PlaneBeside {
+                    // The block's words beside the maximum: no wait of
+                    // their own.
+                    r.pyramid_reads += 4;
+                }
+                if under && !between && block {
                     // EXACT_TEXEL_BLOCKS: the tile's texels from the plane.
                     r.descents += 1;
                     match self.texel_block(&mut r, o, base, d, t1, &mut t, cell) {
@@ -457,9 +464,11 @@ impl<'a> Replay<'a> {
             if still[1] { 0.0 } else { 1.0 / d.y },
         );
         let first = cell << 2;
-        // The block's four row words, side by side: one wait.
-        r.pyramid_reads += 4;
-        r.waits += 1;
+        if self.traversal.texel_walk == TexelWalk::Plane {
+            // The block's four row words, side by side: one wait.
+            r.pyramid_reads += 4;
+            r.waits += 1;
+        }
         let mut texel = texel_after(oxy + dxy * *t, dxy).clamp(first, first + IVec2::splat(3));
         loop {
             if r.iterations >= super::ITERATION_CAP {

@@ -790,17 +790,28 @@ fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
                 ..d
             },
             ExactOptions {
-                texel_blocks: true,
+                texel_walk: TexelWalk::Plane,
                 ..d
             },
             ExactOptions {
-                texel_blocks: true,
+                texel_walk: TexelWalk::Plane,
+                exact_shadow: false,
+                ..d
+            },
+            ExactOptions {
+                texel_walk: TexelWalk::PlaneBeside,
+                ..d
+            },
+            ExactOptions {
+                texel_walk: TexelWalk::PlaneBeside,
                 exact_shadow: false,
                 ..d
             },
         ];
         assert_eq!(d.beam_search, BeamSearch::Wide);
-        assert!(!d.fused_descent && d.cave_skip && d.beam_texels && !d.texel_blocks);
+        assert!(
+            !d.fused_descent && d.cave_skip && d.beam_texels && d.texel_walk == TexelWalk::Terrain
+        );
         let mut images = Vec::new();
         for options in variants {
             let m = build(&r.shared_handle(), &w.level, options).unwrap();
@@ -829,7 +840,7 @@ fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
         // skipped between floors and slabs, or the beams' finest test on
         // 4-texel tiles, or a 4x4 tile's texels walked from the texel
         // plane, changes nothing but the work.
-        for other in [3, 4, 5, 6, 8, 10, 12, 13, 15, 16, 18] {
+        for other in [3, 4, 5, 6, 8, 10, 12, 13, 15, 16, 18, 20] {
             for (v, (a, b)) in images[1].iter().zip(&images[other]).enumerate() {
                 assert!(
                     a.0 == b.0 && a.1 == b.1,
@@ -842,7 +853,7 @@ fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
         // the wide one in the march, with the fused descent, and without
         // the cave skip and the beams' texel test, and with the texel
         // plane: the same image.
-        for other in [7, 9, 11, 14, 17, 19] {
+        for other in [7, 9, 11, 14, 17, 19, 21] {
             for (v, (a, b)) in images[2].iter().zip(&images[other]).enumerate() {
                 assert!(
                     a.0 == b.0 && a.1 == b.1,

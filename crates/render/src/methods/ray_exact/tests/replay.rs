@@ -11,30 +11,43 @@ use super::*;
 /// fused into the texel's iteration (the default) and not.
 #[test]
 fn the_replay_takes_the_gpu_steps() {
-    for (search, shadow_rounds, fused_descent, caves, texel_blocks) in [
-        (BeamSearch::Wide, 8, true, true, false),
-        (BeamSearch::Wide, 8, false, true, false),
-        (BeamSearch::Wide, 8, false, true, true),
-        (BeamSearch::Wide, 8, true, false, false),
-        (BeamSearch::Serial, 8, true, true, false),
-        (BeamSearch::WidePass, 8, true, true, false),
-        (BeamSearch::WidePass, 1, true, true, false),
+    use TexelWalk::{Plane, PlaneBeside, Terrain};
+    for (search, shadow_rounds, fused_descent, caves, texel_walk) in [
+        (BeamSearch::Wide, 8, true, true, Terrain),
+        (BeamSearch::Wide, 8, false, true, Terrain),
+        (BeamSearch::Wide, 8, false, true, Plane),
+        (BeamSearch::Wide, 8, false, true, PlaneBeside),
+        (BeamSearch::Wide, 8, true, false, Terrain),
+        (BeamSearch::Serial, 8, true, true, Terrain),
+        (BeamSearch::WidePass, 8, true, true, Terrain),
+        (BeamSearch::WidePass, 1, true, true, Terrain),
     ] {
-        replay_takes_the_gpu_steps(search, shadow_rounds, fused_descent, caves, texel_blocks);
+        replay_takes_the_gpu_steps(search, shadow_rounds, fused_descent, caves, texel_walk);
     }
 }
 
-/// The texel plane's walk (`EXACT_TEXEL_BLOCKS`) on paper: every view's
-/// rays take the same iterations to the same hits as the default walk's,
+/// The texel plane's walks (`EXACT_TEXEL_BLOCKS`) on paper: every view's
+/// rays take the same iterations to the same hits as the terrain walk's,
 /// and wait on fewer fetches (a single floor's test reads the block's
-/// words, loaded once per 4x4 tile, not a terrain texel).
+/// words, loaded once per 4x4 tile, not a terrain texel); fewer still with
+/// the words loaded beside the tile's maximum.
 #[test]
-fn the_texel_plane_walk_takes_the_same_steps_waiting_on_fewer_fetches() {
+fn the_texel_plane_walks_take_the_same_steps_waiting_on_fewer_fetches() {
+    let mut waits = Vec::new();
+    for walk in [TexelWalk::Plane, TexelWalk::PlaneBeside] {
+        waits.push(plane_walk_against_the_terrain_walk(walk));
+    }
+    assert!(waits[1] < waits[0], "{waits:?}");
+}
+
+/// The summed waits a warp of `walk`, after checking it takes the terrain
+/// walk's steps to the same hits and waits less.
+fn plane_walk_against_the_terrain_walk(walk: TexelWalk) -> f64 {
     use super::super::replay::{Replay, replay_frame};
     let (w, pyramid) = replay_world();
     let mut plain = Replay::new(&w.level, &pyramid);
     let mut blocks = Replay::new(&w.level, &pyramid);
-    blocks.traversal.texel_blocks = true;
+    blocks.traversal.texel_walk = walk;
     let (mut waits, mut block_waits) = (0.0, 0.0);
     for view in &w.views {
         let (_, globals) = view_globals(&w.level, view, (W, H));
@@ -69,9 +82,13 @@ fn the_texel_plane_walk_takes_the_same_steps_waiting_on_fewer_fetches() {
         }
     }
     eprintln!(
-        "waits a warp, march + shadow, summed over the views: {waits:.1} -> {block_waits:.1}"
+        "{walk:?}: waits a warp, march + shadow, summed over the views: {waits:.1} -> {block_waits:.1}"
     );
-    assert!(block_waits < 0.9 * waits, "{waits} -> {block_waits}");
+    assert!(
+        block_waits < 0.9 * waits,
+        "{walk:?}: {waits} -> {block_waits}"
+    );
+    block_waits
 }
 
 /// The generated world and its compute pyramid, for a replay.
@@ -97,7 +114,7 @@ fn replay_takes_the_gpu_steps(
     shadow_rounds: u32,
     fused_descent: bool,
     caves: bool,
-    texel_blocks: bool,
+    texel_walk: TexelWalk,
 ) {
     use super::super::replay::{Replay, replay_frame};
     let (w, pyramid) = replay_world();
@@ -107,7 +124,7 @@ fn replay_takes_the_gpu_steps(
         fused_descent,
         cave_skip: caves,
         beam_texels: caves,
-        texel_blocks,
+        texel_walk,
         ..replay_traversal(search, true)
     };
     let options = ExactOptions {
@@ -116,7 +133,7 @@ fn replay_takes_the_gpu_steps(
         fused_descent,
         cave_skip: caves,
         beam_texels: caves,
-        texel_blocks,
+        texel_walk,
         iteration_stats: true,
         ..ExactOptions::DEFAULT
     };
@@ -183,7 +200,7 @@ fn replay_takes_the_gpu_steps(
             record_frame(&shared, &mut m, camera, &globals, &timer, index);
             let s = m.stats().unwrap();
             eprintln!(
-                "{search:?} {shadow_rounds} fused {fused_descent} caves {caves} blocks {texel_blocks} view {index}: most iterations GPU {} / {} (shadow), replay {} / {}",
+                "{search:?} {shadow_rounds} fused {fused_descent} caves {caves} {texel_walk:?} view {index}: most iterations GPU {} / {} (shadow), replay {} / {}",
                 s.most_iterations,
                 s.shadow_most_iterations,
                 f.most_iterations,
