@@ -1,0 +1,189 @@
+//! The GPU pyramid, cave bounds and texel plane against their CPU twins
+//! (`strata_maxmip`), built and after edits.
+
+use super::*;
+
+/// Record and submit the pyramid's queued updates.
+fn run_pending(p: &mut GpuMaxMip, shared: &Shared) {
+    p.prepare(shared);
+    let mut encoder = shared.device.create_command_encoder(&Default::default());
+    p.record(&mut encoder, None);
+    shared.queue.submit([encoder.finish()]);
+}
+
+fn first_diff(a: &[u32], b: &[u32]) -> String {
+    let bad: Vec<usize> = (0..a.len().min(b.len()))
+        .filter(|&i| a[i] != b[i])
+        .collect();
+    format!(
+        "{} of {} words differ, first at {:?}",
+        bad.len(),
+        a.len(),
+        bad.first()
+    )
+}
+
+#[test]
+fn gpu_pyramid_equals_its_twin_before_and_after_an_edit() {
+    for gpu in common::gpus() {
+        // A square map, a tall one (the default world's shape) and one
+        // narrower than a word at its coarsest level.
+        // Every level, and every other one (what the default traversal reads).
+        for (w, h, step) in [
+            (512, 512, 1),
+            (256, 1024, 1),
+            (8, 16, 1),
+            (512, 512, 2),
+            (256, 1024, 2),
+            (8, 16, 2),
+        ] {
+            let world = if w >= 256 { world(w, h, 6) } else { tiny(w, h) };
+            let mut level = world.level.clone();
+            let shared = shared_for(&gpu, &level);
+            let mut gp = GpuMaxMip::with_texels(&shared, &level, step, true, true).unwrap();
+            let cpu = strata_maxmip::Pyramid::with_step(&level, step);
+            let texels = strata_maxmip::TexelTops::new(&level);
+            let got = gp.read_back_texels(&shared).unwrap();
+            assert!(
+                got == texels.words(),
+                "{w}x{h}: texel plane: {}",
+                first_diff(&got, &texels.words())
+            );
+            let got = gp.read_back(&shared).unwrap();
+            assert!(
+                got == cpu.words(),
+                "{w}x{h}: {}",
+                first_diff(&got, &cpu.words())
+            );
+            let caves = strata_maxmip::CavePyramid::with_step(&level, step);
+            let got = gp.read_back_caves(&shared).unwrap();
+            assert!(
+                got == caves.words(),
+                "{w}x{h}: caves: {}",
+                first_diff(&got, &caves.words())
+            );
+            let rects = if w >= 256 {
+                dig(&world, &mut level)
+            } else {
+                let r = DirtyRect {
+                    x: 2,
+                    y: 5,
+                    width: 3,
+                    height: 4,
+                };
+                for y in r.y..r.y + r.height {
+                    for x in r.x..r.x + r.width {
+                        level.planes_mut().0[(y * w + x) as usize] = 250 - (x + y) as u8;
+                    }
+                }
+                vec![r]
+            };
+            shared
+                .terrain
+                .upload(&shared.queue, &level, &rects)
+                .unwrap();
+            gp.enqueue(&rects);
+            run_pending(&mut gp, &shared);
+            let mut twin = cpu.clone();
+            for r in &rects {
+                twin.update(&level, r);
+            }
+            let fresh = strata_maxmip::Pyramid::with_step(&level, step);
+            assert!(
+                twin == fresh,
+                "{w}x{h}: the CPU update differs from a fresh build"
+            );
+            assert!(twin != cpu, "{w}x{h}: the crater changed no tile");
+            let got = gp.read_back(&shared).unwrap();
+            assert!(
+                got == fresh.words(),
+                "{w}x{h}: after the edit: {}",
+                first_diff(&got, &fresh.words())
+            );
+            let mut cave_twin = caves.clone();
+            for r in &rects {
+                cave_twin.update(&level, r);
+            }
+            let fresh_caves = strata_maxmip::CavePyramid::with_step(&level, step);
+            assert!(
+                cave_twin == fresh_caves,
+                "{w}x{h}: caves: the CPU update differs from a fresh build"
+            );
+            let got = gp.read_back_caves(&shared).unwrap();
+            assert!(
+                got == fresh_caves.words(),
+                "{w}x{h}: caves after the edit: {}",
+                first_diff(&got, &fresh_caves.words())
+            );
+            let mut texel_twin = texels.clone();
+            for r in &rects {
+                texel_twin.update(&level, r);
+            }
+            let fresh_texels = strata_maxmip::TexelTops::new(&level);
+            assert!(
+                texel_twin == fresh_texels && texel_twin != texels,
+                "{w}x{h}: texel plane: the CPU update differs from a fresh build, or the edit changed nothing"
+            );
+            let got = gp.read_back_texels(&shared).unwrap();
+            assert!(
+                got == fresh_texels.words(),
+                "{w}x{h}: texel plane after the edit: {}",
+                first_diff(&got, &fresh_texels.words())
+            );
+            eprintln!(
+                "{w}x{h}: GPU pyramid, caves and texel plane == CPU twins before and after the crater ({rects:?})"
+            );
+            gpu.errors.check().unwrap();
+        }
+    }
+}
+
+/// Issue 35: a game's frame of edits (here 200 small rectangles, more than
+/// the update's slots) is merged into fewer rectangles, and the GPU
+/// pyramid still equals a fresh one.
+#[test]
+fn many_small_edits_in_one_frame_update_the_pyramid_exactly() {
+    for gpu in common::gpus() {
+        let world = world(256, 1024, 6);
+        let mut level = world.level.clone();
+        let shared = shared_for(&gpu, &level);
+        let mut gp = GpuMaxMip::new(&shared, &level, 2, true).unwrap();
+        let mut rects = Vec::new();
+        for k in 0..200u32 {
+            // Tracks lower, ridges raise: a stale tile either way shows.
+            let (x, y) = ((k * 37) % 250, (k * 101) % 1020);
+            let rect = strata_level::edit::EditRect {
+                x: i64::from(x),
+                y: i64::from(y),
+                width: 3,
+                height: 3,
+            };
+            let height = if k % 2 == 0 { 0 } else { 250 };
+            rects.extend(strata_level::edit::fill_single(&mut level, rect, height, 1));
+        }
+        assert!(rects.len() >= 150, "{} rects", rects.len());
+        shared
+            .terrain
+            .upload(&shared.queue, &level, &rects)
+            .unwrap();
+        gp.enqueue(&rects);
+        run_pending(&mut gp, &shared);
+        let fresh = strata_maxmip::Pyramid::with_step(&level, 2);
+        let got = gp.read_back(&shared).unwrap();
+        assert!(
+            got == fresh.words(),
+            "after {} rects: {}",
+            rects.len(),
+            first_diff(&got, &fresh.words())
+        );
+        let caves = strata_maxmip::CavePyramid::with_step(&level, 2);
+        let got = gp.read_back_caves(&shared).unwrap();
+        assert!(
+            got == caves.words(),
+            "caves after {} rects: {}",
+            rects.len(),
+            first_diff(&got, &caves.words())
+        );
+        gpu.errors.check().unwrap();
+    }
+}
