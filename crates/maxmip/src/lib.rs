@@ -330,11 +330,17 @@ impl Pyramid {
 
     /// The buffer as little-endian words (what the GPU holds).
     pub fn words(&self) -> Vec<u32> {
-        self.data
-            .chunks_exact(4)
-            .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-            .collect()
+        le_words(&self.data)
     }
+}
+
+/// Bytes as the little-endian `u32` words the GPU holds them in (a length
+/// that is a multiple of 4).
+fn le_words(bytes: &[u8]) -> Vec<u32> {
+    bytes
+        .chunks_exact(4)
+        .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+        .collect()
 }
 
 #[cfg(test)]

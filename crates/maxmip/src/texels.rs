@@ -92,10 +92,7 @@ impl TexelTops {
 
     /// The plane as little-endian words (what the GPU holds).
     pub fn words(&self) -> Vec<u32> {
-        self.data
-            .chunks_exact(4)
-            .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-            .collect()
+        crate::le_words(&self.data)
     }
 }
 

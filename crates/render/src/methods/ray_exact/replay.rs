@@ -249,6 +249,64 @@ fn exact_clip(o: Vec3, d: Vec3, t0: f32, t1: f32) -> (f32, f32) {
     (a, b)
 }
 
+/// A ray's walk over a grid of tiles (relative to its base): the
+/// direction's signs and reciprocals, as `exact_march_at` sets them up.
+struct RayGrid {
+    o: Vec3,
+    d: Vec3,
+    step: IVec2,
+    far_side: IVec2,
+    still: [bool; 2],
+    inv: Vec2,
+}
+
+impl RayGrid {
+    fn new(o: Vec3, d: Vec3) -> Self {
+        let pos = [d.x > 0.0, d.y > 0.0];
+        let still = [d.x == 0.0, d.y == 0.0];
+        RayGrid {
+            o,
+            d,
+            step: IVec2::new(if pos[0] { 1 } else { -1 }, if pos[1] { 1 } else { -1 }),
+            far_side: IVec2::new(i32::from(pos[0]), i32::from(pos[1])),
+            still,
+            inv: Vec2::new(
+                if still[0] { 0.0 } else { 1.0 / d.x },
+                if still[1] { 0.0 } else { 1.0 / d.y },
+            ),
+        }
+    }
+
+    /// The texel holding the ray's point at `t`.
+    fn texel_at(&self, t: f32) -> IVec2 {
+        texel_after(self.o.truncate() + self.d.truncate() * t, self.d.truncate())
+    }
+
+    /// Tile `cell` of side `2^shift`: where the ray crosses its far x and y
+    /// lines (`tb`), its exit (`t_exit`) and the ray's end in it (`t_out`).
+    fn bounds(&self, cell: IVec2, shift: u32, t1: f32) -> (Vec2, f32, f32) {
+        let edge = (cell + self.far_side).as_vec2() * (1u32 << shift) as f32;
+        let tb = (edge - self.o.truncate()) * self.inv;
+        let tb = Vec2::new(
+            if self.still[0] { BIG } else { tb.x },
+            if self.still[1] { BIG } else { tb.y },
+        );
+        let t_exit = tb.x.min(tb.y);
+        (tb, t_exit, t_exit.min(t1))
+    }
+
+    /// The next cell after `cell`, whose far lines the ray crosses at `tb`.
+    fn next(&self, mut cell: IVec2, tb: Vec2) -> IVec2 {
+        if tb.x <= tb.y {
+            cell.x += self.step.x;
+        }
+        if tb.y <= tb.x {
+            cell.y += self.step.y;
+        }
+        cell
+    }
+}
+
 impl<'a> Replay<'a> {
     /// A replay over `level` and its compute pyramid ([`compute_pyramid`]).
     pub fn new(level: &'a Level, pyramid: &'a Pyramid) -> Self {
@@ -312,38 +370,18 @@ impl<'a> Replay<'a> {
             return r;
         }
         let ratio = LOG_RATIO;
-        let (dxy, oxy) = (d.truncate(), o.truncate());
-        let pos = [d.x > 0.0, d.y > 0.0];
-        let step = IVec2::new(if pos[0] { 1 } else { -1 }, if pos[1] { 1 } else { -1 });
-        let far_side = IVec2::new(i32::from(pos[0]), i32::from(pos[1]));
-        let still = [d.x == 0.0, d.y == 0.0];
-        let inv = Vec2::new(
-            if still[0] { 0.0 } else { 1.0 / d.x },
-            if still[1] { 0.0 } else { 1.0 / d.y },
-        );
+        let grid = RayGrid::new(o, d);
         let top = self.top / ratio;
         let mut lvl = start.map_or(top, |s| s.min(top));
         let mut t = t0;
-        let mut cell = texel_after(oxy + dxy * t, dxy) >> (lvl * ratio) as i32;
+        let mut cell = grid.texel_at(t) >> (lvl * ratio) as i32;
         loop {
             if r.iterations >= super::ITERATION_CAP {
                 return r;
             }
             r.iterations += 1;
             let shift = lvl * ratio;
-            // The tile's exit along the ray (`tb`, `t_exit`) and the ray's
-            // end in it (`t_out`).
-            let bounds = |cell: IVec2, shift: u32| {
-                let edge = (cell + far_side).as_vec2() * (1u32 << shift) as f32;
-                let tb = (edge - oxy) * inv;
-                let tb = Vec2::new(
-                    if still[0] { BIG } else { tb.x },
-                    if still[1] { BIG } else { tb.y },
-                );
-                let t_exit = tb.x.min(tb.y);
-                (tb, t_exit, t_exit.min(t1))
-            };
-            let (mut tb, mut t_exit, mut t_out) = bounds(cell, shift);
+            let (mut tb, mut t_exit, mut t_out) = grid.bounds(cell, shift, t1);
             let mut test_column = lvl == 0;
             if lvl > 0 {
                 let (z_a, z_b) = (o.z + d.z * t, o.z + d.z * t_out);
@@ -369,7 +407,7 @@ impl<'a> Replay<'a> {
                 if under && !between && block {
                     // EXACT_TEXEL_BLOCKS: the tile's texels from the plane.
                     r.descents += 1;
-                    match self.texel_block(&mut r, o, base, d, t1, &mut t, cell) {
+                    match self.texel_block(&mut r, &grid, base, t1, &mut t, cell) {
                         Some((c, l)) => {
                             cell = c;
                             lvl = l;
@@ -381,14 +419,14 @@ impl<'a> Replay<'a> {
                 if under && !between {
                     r.descents += 1;
                     lvl -= 1;
-                    let child = texel_after(oxy + dxy * t, dxy) >> (shift - ratio) as i32;
+                    let child = grid.texel_at(t) >> (shift - ratio) as i32;
                     let first = cell << ratio as i32;
                     cell = child.clamp(first, first + IVec2::splat((1 << ratio) - 1));
                     if !self.traversal.fused_descent || lvl > 0 {
                         continue;
                     }
                     // EXACT_FUSED_DESCENT: the texel in this iteration.
-                    (tb, t_exit, t_out) = bounds(cell, 0);
+                    (tb, t_exit, t_out) = grid.bounds(cell, 0, t1);
                     test_column = true;
                 }
             }
@@ -408,13 +446,7 @@ impl<'a> Replay<'a> {
             }
             t = t_exit;
             let old = cell;
-            if tb.x <= tb.y {
-                cell.x += step.x;
-            }
-            if tb.y <= tb.x {
-                cell.y += step.y;
-            }
-            (cell, lvl) = self.climb(&mut r, old, cell, lvl);
+            (cell, lvl) = self.climb(&mut r, old, grid.next(cell, tb), lvl);
         }
     }
 
@@ -444,46 +476,30 @@ impl<'a> Replay<'a> {
     /// 2, relative to `base`) from the texel plane, from `t` on: `None`
     /// when the ray ends in it (hit, or `t1`), else the cell and visited
     /// level after it leaves the tile (`t` its exit).
-    #[allow(clippy::too_many_arguments)]
     fn texel_block(
         &mut self,
         r: &mut MarchCount,
-        o: Vec3,
+        grid: &RayGrid,
         base: IVec2,
-        d: Vec3,
         t1: f32,
         t: &mut f32,
         cell: IVec2,
     ) -> Option<(IVec2, u32)> {
         let level = self.level;
         let texels = self.texels.get_or_insert_with(|| TexelTops::new(level));
-        let (dxy, oxy) = (d.truncate(), o.truncate());
-        let pos = [d.x > 0.0, d.y > 0.0];
-        let step = IVec2::new(if pos[0] { 1 } else { -1 }, if pos[1] { 1 } else { -1 });
-        let far_side = IVec2::new(i32::from(pos[0]), i32::from(pos[1]));
-        let still = [d.x == 0.0, d.y == 0.0];
-        let inv = Vec2::new(
-            if still[0] { 0.0 } else { 1.0 / d.x },
-            if still[1] { 0.0 } else { 1.0 / d.y },
-        );
         let first = cell << 2;
         if self.traversal.texel_walk == TexelWalk::Plane {
             // The block's four row words, side by side: one wait.
             r.pyramid_reads += 4;
             r.waits += 1;
         }
-        let mut texel = texel_after(oxy + dxy * *t, dxy).clamp(first, first + IVec2::splat(3));
+        let mut texel = grid.texel_at(*t).clamp(first, first + IVec2::splat(3));
         loop {
             if r.iterations >= super::ITERATION_CAP {
                 return None;
             }
             r.iterations += 1;
-            let tb = ((texel + far_side).as_vec2() - oxy) * inv;
-            let tb = Vec2::new(
-                if still[0] { BIG } else { tb.x },
-                if still[1] { BIG } else { tb.y },
-            );
-            let t_exit = tb.x.min(tb.y);
+            let (tb, t_exit, t_out) = grid.bounds(texel, 0, t1);
             let column = base + texel;
             let byte = texels.get(i64::from(column.x), i64::from(column.y));
             let c = if byte == strata_maxmip::TEXEL_DECODE {
@@ -505,7 +521,7 @@ impl<'a> Replay<'a> {
                     upper_type: 0,
                 }
             };
-            let e = column_entry(&c, o.z, d.z, *t, t_exit.min(t1));
+            let e = column_entry(&c, grid.o.z, grid.d.z, *t, t_out);
             if e >= 0.0 {
                 r.hit = Some((e, column));
                 return None;
@@ -515,12 +531,7 @@ impl<'a> Replay<'a> {
             }
             *t = t_exit;
             let was = texel;
-            if tb.x <= tb.y {
-                texel.x += step.x;
-            }
-            if tb.y <= tb.x {
-                texel.y += step.y;
-            }
+            texel = grid.next(texel, tb);
             if (texel >> 2) != cell {
                 return Some(self.climb(r, was, texel, 0));
             }
