@@ -23,6 +23,24 @@ fn first_diff(a: &[u32], b: &[u32]) -> String {
     )
 }
 
+/// The GPU's words read back equal the CPU twin's.
+fn same_words(got: anyhow::Result<Vec<u32>>, want: Vec<u32>, what: &str) {
+    let got = got.unwrap();
+    assert!(got == want, "{what}: {}", first_diff(&got, &want));
+}
+
+/// `twin` updated by `update` equals `fresh` (a fresh build) and differs
+/// from `twin` (the edit changed something).
+fn updated_twin<T: Clone + PartialEq>(twin: &T, fresh: &T, update: impl Fn(&mut T), what: &str) {
+    let mut t = twin.clone();
+    update(&mut t);
+    assert!(
+        t == *fresh,
+        "{what}: the CPU update differs from a fresh build"
+    );
+    assert!(t != *twin, "{what}: the edit changed nothing");
+}
+
 #[test]
 fn gpu_pyramid_equals_its_twin_before_and_after_an_edit() {
     for gpu in common::gpus() {
@@ -42,25 +60,15 @@ fn gpu_pyramid_equals_its_twin_before_and_after_an_edit() {
             let shared = shared_for(&gpu, &level);
             let mut gp = GpuMaxMip::with_texels(&shared, &level, step, true, true).unwrap();
             let cpu = strata_maxmip::Pyramid::with_step(&level, step);
-            let texels = strata_maxmip::TexelTops::new(&level);
-            let got = gp.read_back_texels(&shared).unwrap();
-            assert!(
-                got == texels.words(),
-                "{w}x{h}: texel plane: {}",
-                first_diff(&got, &texels.words())
-            );
-            let got = gp.read_back(&shared).unwrap();
-            assert!(
-                got == cpu.words(),
-                "{w}x{h}: {}",
-                first_diff(&got, &cpu.words())
-            );
             let caves = strata_maxmip::CavePyramid::with_step(&level, step);
-            let got = gp.read_back_caves(&shared).unwrap();
-            assert!(
-                got == caves.words(),
-                "{w}x{h}: caves: {}",
-                first_diff(&got, &caves.words())
+            let texels = strata_maxmip::TexelTops::new(&level);
+            let what = |plane: &str| format!("{w}x{h}: {plane}");
+            same_words(gp.read_back(&shared), cpu.words(), &what("maxima"));
+            same_words(gp.read_back_caves(&shared), caves.words(), &what("caves"));
+            same_words(
+                gp.read_back_texels(&shared),
+                texels.words(),
+                &what("texel plane"),
             );
             let rects = if w >= 256 {
                 dig(&world, &mut level)
@@ -84,51 +92,43 @@ fn gpu_pyramid_equals_its_twin_before_and_after_an_edit() {
                 .unwrap();
             gp.enqueue(&rects);
             run_pending(&mut gp, &shared);
-            let mut twin = cpu.clone();
-            for r in &rects {
-                twin.update(&level, r);
-            }
+            // The CPU twins updated over the rectangles equal fresh builds
+            // and changed; the GPU's updated planes equal them.
             let fresh = strata_maxmip::Pyramid::with_step(&level, step);
-            assert!(
-                twin == fresh,
-                "{w}x{h}: the CPU update differs from a fresh build"
+            updated_twin(
+                &cpu,
+                &fresh,
+                |t| rects.iter().for_each(|r| t.update(&level, r)),
+                &what("maxima"),
             );
-            assert!(twin != cpu, "{w}x{h}: the crater changed no tile");
-            let got = gp.read_back(&shared).unwrap();
-            assert!(
-                got == fresh.words(),
-                "{w}x{h}: after the edit: {}",
-                first_diff(&got, &fresh.words())
+            same_words(
+                gp.read_back(&shared),
+                fresh.words(),
+                &what("maxima after the edit"),
             );
-            let mut cave_twin = caves.clone();
-            for r in &rects {
-                cave_twin.update(&level, r);
-            }
-            let fresh_caves = strata_maxmip::CavePyramid::with_step(&level, step);
-            assert!(
-                cave_twin == fresh_caves,
-                "{w}x{h}: caves: the CPU update differs from a fresh build"
+            let fresh = strata_maxmip::CavePyramid::with_step(&level, step);
+            updated_twin(
+                &caves,
+                &fresh,
+                |t| rects.iter().for_each(|r| t.update(&level, r)),
+                &what("caves"),
             );
-            let got = gp.read_back_caves(&shared).unwrap();
-            assert!(
-                got == fresh_caves.words(),
-                "{w}x{h}: caves after the edit: {}",
-                first_diff(&got, &fresh_caves.words())
+            same_words(
+                gp.read_back_caves(&shared),
+                fresh.words(),
+                &what("caves after the edit"),
             );
-            let mut texel_twin = texels.clone();
-            for r in &rects {
-                texel_twin.update(&level, r);
-            }
-            let fresh_texels = strata_maxmip::TexelTops::new(&level);
-            assert!(
-                texel_twin == fresh_texels && texel_twin != texels,
-                "{w}x{h}: texel plane: the CPU update differs from a fresh build, or the edit changed nothing"
+            let fresh = strata_maxmip::TexelTops::new(&level);
+            updated_twin(
+                &texels,
+                &fresh,
+                |t| rects.iter().for_each(|r| t.update(&level, r)),
+                &what("texel plane"),
             );
-            let got = gp.read_back_texels(&shared).unwrap();
-            assert!(
-                got == fresh_texels.words(),
-                "{w}x{h}: texel plane after the edit: {}",
-                first_diff(&got, &fresh_texels.words())
+            same_words(
+                gp.read_back_texels(&shared),
+                fresh.words(),
+                &what("texel plane after the edit"),
             );
             eprintln!(
                 "{w}x{h}: GPU pyramid, caves and texel plane == CPU twins before and after the crater ({rects:?})"
