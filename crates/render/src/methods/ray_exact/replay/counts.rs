@@ -79,7 +79,7 @@ pub struct FrameCount {
     /// The beams (one per 8x8-pixel tile; empty without them): per tile,
     /// the serial search's iterations or the wide search's rounds.
     pub beam: PassCount,
-    /// Invocations per beam: 1 (serial) or [`WIDE_LANES`] (wide, every
+    /// Invocations per beam: 1 (serial) or [`super::WIDE_LANES`] (wide, every
     /// invocation of the tile's workgroup tests an interval each round).
     pub beam_lanes: u32,
     /// The camera march.
