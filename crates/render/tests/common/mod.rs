@@ -349,3 +349,17 @@ pub fn crater_against_fresh(gpu: &Gpu, method: &str) -> (f64, f32, usize) {
 }
 
 pub mod paged;
+
+/// Where two word buffers (a GPU read-back and its CPU twin) differ: how
+/// many words, of how many, and the first.
+pub fn word_diff(a: &[u32], b: &[u32]) -> String {
+    let bad: Vec<usize> = (0..a.len().min(b.len()))
+        .filter(|&i| a[i] != b[i])
+        .collect();
+    format!(
+        "{} of {} words differ, first at {:?}",
+        bad.len(),
+        a.len(),
+        bad.first()
+    )
+}

@@ -77,7 +77,7 @@ fn gpu_pyramid_equals_cpu_twin_before_and_after_an_edit() {
             assert!(
                 got == cpu.words,
                 "({voxel}) GPU build differs from the CPU twin: {}",
-                diff(&got, &cpu.words)
+                common::word_diff(&got, &cpu.words)
             );
 
             let rects = dig(&w, &mut level);
@@ -94,7 +94,7 @@ fn gpu_pyramid_equals_cpu_twin_before_and_after_an_edit() {
             assert!(
                 got == fresh.words,
                 "({voxel}) GPU after the edit differs: {}",
-                diff(&got, &fresh.words)
+                common::word_diff(&got, &fresh.words)
             );
             eprintln!(
                 "({voxel}) budget {budget}: GPU == CPU before and after the crater ({frames} budgeted frames)"
@@ -102,18 +102,6 @@ fn gpu_pyramid_equals_cpu_twin_before_and_after_an_edit() {
             gpu.errors.check().unwrap();
         }
     }
-}
-
-fn diff(a: &[u32], b: &[u32]) -> String {
-    let bad: Vec<usize> = (0..a.len().min(b.len()))
-        .filter(|&i| a[i] != b[i])
-        .collect();
-    format!(
-        "{} of {} words differ, first at {:?}",
-        bad.len(),
-        a.len(),
-        bad.first()
-    )
 }
 
 #[test]

@@ -11,22 +11,10 @@ fn run_pending(p: &mut GpuMaxMip, shared: &Shared) {
     shared.queue.submit([encoder.finish()]);
 }
 
-fn first_diff(a: &[u32], b: &[u32]) -> String {
-    let bad: Vec<usize> = (0..a.len().min(b.len()))
-        .filter(|&i| a[i] != b[i])
-        .collect();
-    format!(
-        "{} of {} words differ, first at {:?}",
-        bad.len(),
-        a.len(),
-        bad.first()
-    )
-}
-
 /// The GPU's words read back equal the CPU twin's.
 fn same_words(got: anyhow::Result<Vec<u32>>, want: Vec<u32>, what: &str) {
     let got = got.unwrap();
-    assert!(got == want, "{what}: {}", first_diff(&got, &want));
+    assert!(got == want, "{what}: {}", common::word_diff(&got, &want));
 }
 
 /// `twin` updated by `update` equals `fresh` (a fresh build) and differs
@@ -174,7 +162,7 @@ fn many_small_edits_in_one_frame_update_the_pyramid_exactly() {
             got == fresh.words(),
             "after {} rects: {}",
             rects.len(),
-            first_diff(&got, &fresh.words())
+            common::word_diff(&got, &fresh.words())
         );
         let caves = strata_maxmip::CavePyramid::with_step(&level, 2);
         let got = gp.read_back_caves(&shared).unwrap();
@@ -182,7 +170,7 @@ fn many_small_edits_in_one_frame_update_the_pyramid_exactly() {
             got == caves.words(),
             "caves after {} rects: {}",
             rects.len(),
-            first_diff(&got, &caves.words())
+            common::word_diff(&got, &caves.words())
         );
         gpu.errors.check().unwrap();
     }
