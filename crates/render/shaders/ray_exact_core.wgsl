@@ -78,6 +78,7 @@ const CAVE_NO_SLAB: u32 = 255u;
 // loaded once the ray comes down into the tile, decoding only the columns
 // that have a slab; 2 the same, the plane's words loaded beside the tile's
 // maximum at every step over a 4x4 tile, so coming down waits on nothing.
+// Both are slower on the H100 than 0 (`bench/issue36-texel-blocks/`).
 override EXACT_TEXEL_BLOCKS: u32 = 0u;
 // A texel plane byte whose column must be decoded (`strata_maxmip::TEXEL_DECODE`).
 const TEXEL_DECODE: u32 = 255u;

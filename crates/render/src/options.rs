@@ -198,11 +198,11 @@ impl ExactOptions {
         // march iterations a pixel, 11.26 -> 7.99 a warp.
         cave_skip: true,
         beam_texels: true,
-        // The terrain walk until the plane's are timed on the H100
-        // (`bench/issue36-texel-blocks/`): on paper they wait on fewer
-        // fetches, but they cost a map's area in GPU bytes, and walks that
-        // looked shorter on paper were slower there before (the fused
-        // descent).
+        // The terrain walk: on paper the plane's walks wait on fewer
+        // fetches, but on the H100 they are slower (frame 0.1557 ms against
+        // 0.1621 `Plane` and 0.1640 `PlaneBeside` in one call; the shadow
+        // pass 22 % slower; `bench/issue36-texel-blocks/`), and they cost a
+        // map's area in GPU bytes.
         texel_walk: TexelWalk::Terrain,
         // Off: on the H100 the statistic cost 0.0019 ms of a 0.1591 ms frame
         // (`bench/issue36-floors/`).

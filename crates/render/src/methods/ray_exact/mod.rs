@@ -84,8 +84,10 @@
 //! columns with a slab. `plane` loads them once the ray comes down into
 //! the tile, `beside` with the tile's maximum at every step over a 4x4
 //! tile. Same hits and iterations; on paper (`strata exact-counts
-//! --texel-walk`) fewer fetches a warp waits on
-//! (`bench/issue36-texel-blocks/`). Off until timed on the H100.
+//! --texel-walk`) half the fetches a warp waits on, yet on the H100 both
+//! are slower (0.1557 ms a frame with the terrain walk, 0.1621 `plane`,
+//! 0.1640 `beside`, one call; `bench/issue36-texel-blocks/`): the walk
+//! issues more to wait less, and waiting is not what bounds it. Off.
 //!
 //! Measuring switches ([`ExactOptions`] and `exact_stats` in
 //! [`crate::options::RenderOptions`], read at creation from the shared
