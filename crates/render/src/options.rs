@@ -200,7 +200,7 @@ impl ExactOptions {
         beam_texels: true,
         // The terrain walk: on paper the plane's walks wait on fewer
         // fetches, but on the H100 they are slower (frame 0.1557 ms against
-        // 0.1621 `Plane` and 0.1640 `PlaneBeside` in one call; the shadow
+        // 0.1621 `Plane` and 0.1639 `PlaneBeside` in one call; the shadow
         // pass 22 % slower; `bench/issue36-texel-blocks/`), and they cost a
         // map's area in GPU bytes.
         texel_walk: TexelWalk::Terrain,

@@ -86,7 +86,7 @@
 //! tile. Same hits and iterations; on paper (`strata exact-counts
 //! --texel-walk`) half the fetches a warp waits on, yet on the H100 both
 //! are slower (0.1557 ms a frame with the terrain walk, 0.1621 `plane`,
-//! 0.1640 `beside`, one call; `bench/issue36-texel-blocks/`): the walk
+//! 0.1639 `beside`, one call; `bench/issue36-texel-blocks/`): the walk
 //! issues more to wait less, and waiting is not what bounds it. Off.
 //!
 //! Measuring switches ([`ExactOptions`] and `exact_stats` in
