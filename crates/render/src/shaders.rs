@@ -130,6 +130,14 @@ pub const SOURCES: &[(&str, &str)] = &[
         "sliced_gaps_beam.wgsl",
         include_str!("../shaders/sliced_gaps_beam.wgsl"),
     ),
+    (
+        "sliced_shade.wgsl",
+        include_str!("../shaders/sliced_shade.wgsl"),
+    ),
+    (
+        "sliced_shade_compute.wgsl",
+        include_str!("../shaders/sliced_shade_compute.wgsl"),
+    ),
     ("mesh.wgsl", include_str!("../shaders/mesh.wgsl")),
     (
         "mesh_colour.wgsl",
@@ -208,6 +216,8 @@ pub const ENTRY_SHADERS: &[&str] = &[
     "sliced_refine_beam.wgsl",
     "sliced_gaps.wgsl",
     "sliced_gaps_beam.wgsl",
+    "sliced_shade.wgsl",
+    "sliced_shade_compute.wgsl",
     "mesh.wgsl",
     "mesh_deferred.wgsl",
     "scattered.wgsl",

@@ -9,7 +9,9 @@
 //! - plain: against the CPU reference, see-through and covers-sky no worse
 //!   than `/fragwalk`'s (the pass walks every gap whole, long ones too);
 //! - refined: the images equal `/fragwalk`'s (the walking marks shader on
-//!   every frame) bit for bit, colour and depth.
+//!   every frame) bit for bit, colour and depth;
+//! - plain, shaded once a pixel after the slices: the images equal
+//!   `/forward`'s (every kept fragment shaded in the slice pass) bit for bit.
 
 mod common;
 
@@ -155,6 +157,58 @@ fn refined_marks_without_the_walk_change_nothing_but_the_work() {
                 ));
             }
         }
+        assert!(failures.is_empty(), "{}", failures.join("\n"));
+        gpu.errors.check().unwrap();
+    }
+}
+
+/// Plain `sliced` shades each pixel's nearest kept slice once, after the
+/// slices (`methods::sliced::shade`); `/forward` shades every kept slice
+/// fragment in the slice pass. The slice point is the same, so are the
+/// images: colour and depth bit for bit on every view, the grazing ones
+/// (where the gap pass draws over the shading) included. Fails if the
+/// deferred pass shades another point, misses the sky, or loses the gaps.
+#[test]
+fn deferred_shading_draws_what_forward_shading_draws() {
+    for gpu in common::gpus() {
+        let world = common::generated_world();
+        let colors = TerrainColors::from_world(&world);
+        let views = views(&world);
+        let cameras = cameras_of(&world, &views);
+        let images: Vec<_> = [false, true]
+            .into_iter()
+            .map(|forward| {
+                let settings = MethodSettings {
+                    sliced_forward_shading: forward,
+                    ..settings(false, false)
+                };
+                draw_views(&gpu, (&world, &colors), &settings, &cameras)
+            })
+            .collect();
+        let mut failures = Vec::new();
+        let mut shades = std::collections::HashSet::new();
+        for (view, (deferred, forward)) in views.iter().zip(images[0].iter().zip(&images[1])) {
+            let depth = deferred
+                .0
+                .iter()
+                .zip(&forward.0)
+                .filter(|(a, b)| a.to_bits() != b.to_bits())
+                .count();
+            let color = colours_differ(&deferred.1, &forward.1);
+            shades.extend(deferred.1.chunks_exact(4));
+            eprintln!(
+                "plain {:13} pitch {:5}: {depth} depths, {color} colours differ from /forward ({})",
+                view.name, view.pitch, gpu.report.backend
+            );
+            if depth != 0 || color != 0 {
+                failures.push(format!(
+                    "{}: {depth} depths and {color} colours differ",
+                    view.name
+                ));
+            }
+        }
+        // Not two blank pictures alike.
+        assert!(shades.len() >= 20, "{} colours in all the views", shades.len());
         assert!(failures.is_empty(), "{}", failures.join("\n"));
         gpu.errors.check().unwrap();
     }

@@ -19,6 +19,16 @@ fn depth_write(compare: wgpu::CompareFunction) -> wgpu::DepthStencilState {
     }
 }
 
+/// Depth attached but neither tested nor written: a pass that colours what
+/// an earlier pass of the frame put in depth.
+fn depth_kept() -> wgpu::DepthStencilState {
+    wgpu::DepthStencilState {
+        depth_write_enabled: Some(false),
+        depth_compare: Some(wgpu::CompareFunction::Always),
+        ..depth_write(wgpu::CompareFunction::Always)
+    }
+}
+
 /// A render pipeline of one vertex and one fragment entry of `module`, no
 /// vertex buffers (the vertex shaders derive their corners from indices) and
 /// no culling (the forward shaders pick the faces themselves).
@@ -28,7 +38,7 @@ fn render_pipeline(
     layout: &wgpu::PipelineLayout,
     module: &wgpu::ShaderModule,
     entries: (&str, &str),
-    depth_compare: wgpu::CompareFunction,
+    depth: wgpu::DepthStencilState,
     targets: &[Option<wgpu::ColorTargetState>],
 ) -> wgpu::RenderPipeline {
     shared
@@ -43,7 +53,7 @@ fn render_pipeline(
                 buffers: &[],
             },
             primitive: wgpu::PrimitiveState::default(),
-            depth_stencil: Some(depth_write(depth_compare)),
+            depth_stencil: Some(depth),
             multisample: Default::default(),
             fragment: Some(wgpu::FragmentState {
                 module,
@@ -85,7 +95,7 @@ pub(crate) fn forward_pipeline_into(
         &shared.pipeline_layout(label, &[layout]),
         &module,
         entries,
-        wgpu::CompareFunction::Less,
+        depth_write(wgpu::CompareFunction::Less),
         &[Some(format.into())],
     ))
 }
@@ -102,7 +112,7 @@ pub(crate) fn fullscreen_pipeline(
     fullscreen_pipeline_with(
         shared,
         (label, shader, layout, fragment_entry),
-        wgpu::CompareFunction::Always,
+        depth_write(wgpu::CompareFunction::Always),
     )
 }
 
@@ -119,16 +129,33 @@ pub(crate) fn fullscreen_pipeline_depth_tested(
     fullscreen_pipeline_with(
         shared,
         (label, shader, layout, fragment_entry),
-        wgpu::CompareFunction::Less,
+        depth_write(wgpu::CompareFunction::Less),
+    )
+}
+
+/// A full-screen pass that writes colour only, over the depth an earlier
+/// pass of the frame wrote (attached, not tested, not written): a deferred
+/// frame's shading.
+pub(crate) fn fullscreen_pipeline_colour_only(
+    shared: &Shared,
+    label: &str,
+    shader: &str,
+    layout: &wgpu::PipelineLayout,
+    fragment_entry: &str,
+) -> anyhow::Result<wgpu::RenderPipeline> {
+    fullscreen_pipeline_with(
+        shared,
+        (label, shader, layout, fragment_entry),
+        depth_kept(),
     )
 }
 
 /// A full-screen triangle's pipeline (label, shader, layout, fragment entry)
-/// into the shared colour format, depth compared by `compare`.
+/// into the shared colour format, over the depth target as `depth` says.
 fn fullscreen_pipeline_with(
     shared: &Shared,
     (label, shader, layout, fragment_entry): (&str, &str, &wgpu::PipelineLayout, &str),
-    compare: wgpu::CompareFunction,
+    depth: wgpu::DepthStencilState,
 ) -> anyhow::Result<wgpu::RenderPipeline> {
     let module = shared.shader(shader)?;
     Ok(render_pipeline(
@@ -137,7 +164,7 @@ fn fullscreen_pipeline_with(
         layout,
         &module,
         ("vs_fullscreen", fragment_entry),
-        compare,
+        depth,
         &[Some(COLOR_FORMAT.into())],
     ))
 }
@@ -266,6 +293,32 @@ pub(crate) fn begin_pass_with_depth<'e>(
             },
         })],
         depth_stencil_attachment: Some(depth_attachment_with(shared, frame, depth)),
+        timestamp_writes: frame.timer.render(label),
+        occlusion_query_set: None,
+        multiview_mask: None,
+    })
+}
+
+/// A pass over what earlier passes of the frame drew: colour and depth
+/// both loaded.
+pub(crate) fn begin_pass_over<'e>(
+    shared: &Shared,
+    frame: &Frame<'_>,
+    encoder: &'e mut wgpu::CommandEncoder,
+    label: &str,
+) -> wgpu::RenderPass<'e> {
+    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view: frame.targets.color.unwrap_or(&shared.color_view),
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations {
+                load: wgpu::LoadOp::Load,
+                store: wgpu::StoreOp::Store,
+            },
+        })],
+        depth_stencil_attachment: Some(depth_attachment_with(shared, frame, wgpu::LoadOp::Load)),
         timestamp_writes: frame.timer.render(label),
         occlusion_query_set: None,
         multiview_mask: None,
@@ -424,7 +477,7 @@ impl DepthCopy {
             &pipeline_layout,
             &module,
             ("vs_fullscreen", "fs_depth_blit"),
-            wgpu::CompareFunction::Always,
+            depth_write(wgpu::CompareFunction::Always),
             &[],
         );
         Ok(Self {

@@ -31,6 +31,11 @@ pub struct MethodSettings {
     /// its marks walk on every frame); for A/B (`sliced:512/fragwalk`).
     #[serde(default)]
     pub sliced_fragment_walk: bool,
+    /// `sliced`: shade every kept slice fragment in the slice pass, as the
+    /// paper's slicer does, in place of plain `sliced`'s marks and one
+    /// shading a pixel after them; for A/B (`sliced:512/forward`).
+    #[serde(default)]
+    pub sliced_forward_shading: bool,
     /// `scattered`: footprint grid density (x, y, z); the paper's (4, 4, 4).
     pub scatter_density: [f32; 3],
     /// `mesh`: fit quality q in [0, 1]; max error 2^(4(1 - q)) (0.5 → 4).
@@ -80,6 +85,7 @@ impl Default for MethodSettings {
             slices: 512,
             sliced_refine: false,
             sliced_fragment_walk: false,
+            sliced_forward_shading: false,
             scatter_density: [4.0, 4.0, 4.0],
             mesh_quality: 0.5,
             mesh_outline: false,

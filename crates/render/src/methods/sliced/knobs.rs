@@ -1,4 +1,5 @@
-//! `sliced:N` and `sliced:N/refine`: the slice count, and the refining pass.
+//! `sliced:N` and `sliced:N/refine`: the slice count, and the refining pass;
+//! `/fragwalk` and `/forward` put back earlier ways of the plain slicer for A/B.
 
 use super::super::contract::MethodSettings;
 use super::super::knobs::{Flag, Knobs, Slider, Sweep, count, plain};
@@ -6,7 +7,7 @@ use super::super::march_beam::{NO_BEAM_FLAG, nobeam_tag, split_nobeam};
 use anyhow::bail;
 
 pub static KNOBS: Knobs = Knobs {
-    grammar: "N or N/refine, then optionally /fragwalk, then optionally /nobeam",
+    grammar: "N or N/refine, then optionally /fragwalk (or, for N, /forward), then optionally /nobeam",
     default: Some("512"),
     parse,
     describe: |s| {
@@ -16,12 +17,22 @@ pub static KNOBS: Knobs = Knobs {
         } else {
             ""
         };
-        format!("slices={}{refined}{walk}{}", s.slices, nobeam_tag(s))
+        let forward = if s.sliced_forward_shading {
+            " forward-shading"
+        } else {
+            ""
+        };
+        format!(
+            "slices={}{refined}{walk}{forward}{}",
+            s.slices,
+            nobeam_tag(s)
+        )
     },
     keep: |from, to| {
         to.slices = from.slices;
         to.sliced_refine = from.sliced_refine;
         to.sliced_fragment_walk = from.sliced_fragment_walk;
+        to.sliced_forward_shading = from.sliced_forward_shading;
         to.march_beam = from.march_beam;
     },
     sliders: &[Slider::count(
@@ -62,13 +73,23 @@ pub static KNOBS: Knobs = Knobs {
                 Ok(())
             },
         },
+        Flag {
+            long: "sliced-forward",
+            value: None,
+            help: "`sliced`: shade every kept slice fragment in the slice pass, in place of marks and one shading a pixel after them (for A/B; `sliced:N/forward`).",
+            default: |_| String::new(),
+            apply: |_, s| {
+                s.sliced_forward_shading = true;
+                Ok(())
+            },
+        },
         NO_BEAM_FLAG,
     ],
 };
 
 /// `N` (the paper's plain slicer) or `N/refine`, then optionally
-/// `/fragwalk`, then optionally `/nobeam` (the per-pixel walks from the near
-/// plane).
+/// `/fragwalk` (or, plain, `/forward`), then optionally `/nobeam` (the
+/// per-pixel walks from the near plane).
 fn parse(text: &str, s: &mut MethodSettings) -> anyhow::Result<()> {
     let (text, beam) = split_nobeam(text);
     s.march_beam = beam;
@@ -76,14 +97,20 @@ fn parse(text: &str, s: &mut MethodSettings) -> anyhow::Result<()> {
         Some(rest) => (rest, true),
         None => (text, false),
     };
+    let (text, forward) = match text.strip_suffix("/forward") {
+        Some(rest) if !fragment_walk => (rest, true),
+        _ => (text, false),
+    };
     let (n, refine) = match text.split_once('/') {
-        Some((n, "refine")) => (n, true),
-        Some((_, other)) => bail!("`{other}` is not `refine` or `fragwalk`"),
+        Some((n, "refine")) if !forward => (n, true),
+        Some((_, "refine")) => bail!("`/forward` is the plain slicer's (not with `refine`)"),
+        Some((_, other)) => bail!("`{other}` is not `refine`, `fragwalk` or `forward`"),
         None => (text, false),
     };
     s.slices = plain(count(n))?;
     s.sliced_refine = refine;
     s.sliced_fragment_walk = fragment_walk;
+    s.sliced_forward_shading = forward;
     Ok(())
 }
 
@@ -139,5 +166,11 @@ mod tests {
         parse("512", &mut s).unwrap();
         assert!(s.march_beam);
         assert!(parse("512/fast", &mut s).is_err());
+        parse("512/forward/nobeam", &mut s).unwrap();
+        assert!(s.sliced_forward_shading && !s.sliced_refine && !s.march_beam);
+        parse("512", &mut s).unwrap();
+        assert!(!s.sliced_forward_shading);
+        assert!(parse("512/refine/forward", &mut s).is_err());
+        assert!(parse("512/forward/fragwalk", &mut s).is_err());
     }
 }

@@ -9,6 +9,10 @@
 //! adds one full-screen pass that puts the exact surface crossing behind
 //! each pixel's nearest kept slice (`refine.rs`).
 //!
+//! Plain `sliced` draws its slices as marks (the nearest kept slice's rank)
+//! and shades each pixel's once afterwards (`shade.rs`); `sliced:N/forward`
+//! shades every kept fragment in the slice pass, as the paper's slicer does.
+//!
 //! Grazing rays cross the slices several texels apart, and a thin wall or a
 //! peak between two crossings is missed. Plain `sliced` walks those rays'
 //! gaps once per pixel after the slices, over the bands of rows where they
@@ -25,6 +29,7 @@ mod gaps;
 mod knobs;
 mod refine;
 mod rows;
+mod shade;
 mod tiles;
 use super::contract::{Frame, Method, MethodSettings, RetainedBytes};
 use crate::frame::{Shared, texture_entry, uniform_layout_entry};
@@ -32,6 +37,7 @@ use gaps::Gaps;
 pub use knobs::{KNOBS, SWEEP};
 use refine::{MARK_FORMAT, Refine};
 use rows::row_bands;
+use shade::Shade;
 use strata_camera::Camera;
 use strata_level::Level;
 use tiles::SliceTiles;
@@ -60,6 +66,9 @@ pub struct Sliced {
     steep_marks: Option<wgpu::RenderPipeline>,
     /// Plain `sliced`'s gap pass (not with `/fragwalk` or refined).
     gaps: Option<Gaps>,
+    /// Plain `sliced`'s deferred shading (not with `/forward`, `/fragwalk`
+    /// or refined): `pipeline` writes marks.
+    shade: Option<Shade>,
     /// This frame's bands of rows where a ray may walk, top to bottom.
     walking_rows: Vec<std::ops::Range<u32>>,
     /// `settings.march_beam` at creation (a change rebuilds).
@@ -252,6 +261,7 @@ pub fn create(
         )
     };
     let walk_in_fragments = settings.sliced_fragment_walk;
+    let mut shade = None;
     let (pipeline, steep_marks, gaps, refine) = if settings.sliced_refine {
         let steep = if walk_in_fragments {
             None
@@ -264,12 +274,18 @@ pub fn create(
         (plain("fs_sliced")?, None, None, None)
     } else {
         let gaps = Gaps::new(shared, level, settings, &params, &tiles)?;
-        (plain("fs_sliced_steep")?, None, Some(gaps), None)
+        if settings.sliced_forward_shading {
+            (plain("fs_sliced_steep")?, None, Some(gaps), None)
+        } else {
+            shade = Some(Shade::new(shared, &params)?);
+            (marks("fs_slice_mark_steep")?, None, Some(gaps), None)
+        }
     };
     Ok(Box::new(Sliced {
         pipeline,
         steep_marks,
         gaps,
+        shade,
         walking_rows: Vec::new(),
         march_beam: settings.march_beam,
         group,
@@ -281,6 +297,11 @@ pub fn create(
         refine,
         empty: true,
     }))
+}
+
+/// Whether `settings` take plain `sliced`'s deferred shading ([`Shade`]).
+fn deferred(settings: &MethodSettings) -> bool {
+    !settings.sliced_refine && !settings.sliced_fragment_walk && !settings.sliced_forward_shading
 }
 
 /// The slice index (0 = the top one, z = 256 - 256/N) nearest altitude `z`.
@@ -319,6 +340,7 @@ impl Method for Sliced {
         if settings.sliced_refine != self.refine.is_some()
             || settings.march_beam != self.march_beam
             || settings.sliced_fragment_walk != (self.gaps.is_none() && self.steep_marks.is_none())
+            || deferred(settings) != self.shade.is_some()
         {
             // Another pipeline: a rebuild.
             return Ok(false);
@@ -333,6 +355,9 @@ impl Method for Sliced {
         }
         if let Some(gaps) = &mut self.gaps {
             gaps.resize(shared, &self.params, &self.tiles);
+        }
+        if let Some(shade) = &mut self.shade {
+            shade.resize(shared, &self.params);
         }
         Ok(())
     }
@@ -373,16 +398,30 @@ impl Method for Sliced {
             if let Some(gaps) = &self.gaps {
                 gaps.record_beam(shared, frame, encoder, walks);
             }
-            let gaps = self.gaps.as_ref().filter(|_| walks);
+            let gaps = self.gaps.as_ref().filter(|_| walks && !self.empty);
+            let draw_gaps = |pass: &mut wgpu::RenderPass<'_>| {
+                for rows in &self.walking_rows {
+                    gaps.expect("walking rows").draw(shared, pass, rows.clone());
+                }
+            };
+            if let Some(shade) = &self.shade {
+                {
+                    let mut pass =
+                        begin_pass_into(shared, frame, encoder, "sliced", shade.marks_attachment());
+                    if !self.empty {
+                        self.draw_slices(shared, &mut pass);
+                    }
+                }
+                shade.record(shared, frame, encoder, gaps.map(|_| &draw_gaps as _));
+                return;
+            }
             let mut pass = begin_pass(shared, frame, encoder, "sliced");
             if self.empty {
                 return;
             }
             self.draw_slices(shared, &mut pass);
-            if let Some(gaps) = gaps {
-                for rows in &self.walking_rows {
-                    gaps.draw(shared, &mut pass, rows.clone());
-                }
+            if gaps.is_some() {
+                draw_gaps(&mut pass);
             }
             return;
         };
@@ -399,7 +438,8 @@ impl Method for Sliced {
     fn retained_bytes(&self) -> RetainedBytes {
         // The 48-byte footprint uniform, the quad's 12 bytes of indices, the
         // tile maxima (kept on the CPU too, for edits), the refined slicer's
-        // marks image, and the gap pass's beam (its pyramid and starts).
+        // marks image, the gap pass's beam (its pyramid and starts), and the
+        // plain slicer's marks image.
         let refine = self.refine.as_ref().map(Refine::retained_bytes);
         let quad = std::mem::size_of_val(&QUAD_INDICES) as u64;
         RetainedBytes {
@@ -407,7 +447,8 @@ impl Method for Sliced {
                 + quad
                 + self.tiles.gpu_bytes()
                 + refine.map_or(0, |r| r.gpu)
-                + self.gaps.as_ref().map_or(0, Gaps::gpu_bytes),
+                + self.gaps.as_ref().map_or(0, Gaps::gpu_bytes)
+                + self.shade.as_ref().map_or(0, Shade::gpu_bytes),
             cpu: self.tiles.cpu_bytes(),
         }
     }

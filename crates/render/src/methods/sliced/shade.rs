@@ -1,0 +1,211 @@
+//! Plain `sliced`'s deferred frame: the slices write each pixel's nearest
+//! kept slice (its rank + 1, `fs_slice_mark_steep`) and depth, and one pass
+//! then shades that slice's point once a pixel (`shaders/sliced_shade.wgsl`),
+//! before the gap pass draws over it.
+//!
+//! Why: a slice fragment decides in its shader whether it is kept (it
+//! discards air), so its depth is written after the shader has run, and
+//! every solid slice a pixel's ray crosses behind the nearest one was shaded
+//! too unless an earlier draw had already put a nearer depth there. The
+//! marks cost a word per fragment instead of the shading: on the H100 the
+//! marks alone took 3.9-6.5 ms on the steep views where the plain slice
+//! pass took 7.1-12.2 (`bench/issue36-sliced/gaps/h100-beam/`).
+//! `sliced:N/forward` keeps the shading in the slice fragments, for A/B.
+//!
+//! The shading runs as a compute pass where the adapter has compute and
+//! storage textures and the frame's colour is the shared target (the whole
+//! chip, not the graphics path's few SMs); otherwise as a full-screen
+//! triangle in the pass that then draws the gaps.
+
+use super::super::common::{
+    begin_pass_over, begin_pass_with_depth, compute_pipeline, dispatch_per_pixel,
+    fullscreen_pipeline_colour_only,
+};
+use super::super::contract::Frame;
+use super::refine::MARK_FORMAT;
+use crate::frame::{
+    COLOR_FORMAT, Shared, storage_texture_entry, texture_entry, uniform_layout_entry,
+};
+
+/// Bindings of the shading's group 1: the footprint uniform (slice count),
+/// the marks, and (compute) the colour target.
+const MARKS_BINDING: u32 = 4;
+const COLOR_BINDING: u32 = 5;
+
+/// What draws over the shaded slices in the same frame (the gap pass's rows).
+pub type DrawOver<'a> = &'a dyn Fn(&mut wgpu::RenderPass<'_>);
+
+pub struct Shade {
+    /// The full-screen triangle's pipeline and group (every adapter).
+    fragment: (wgpu::RenderPipeline, wgpu::BindGroupLayout),
+    /// The compute pipeline and its layout, where the adapter has both.
+    compute: Option<(wgpu::ComputePipeline, wgpu::BindGroupLayout)>,
+    targets: Targets,
+}
+
+/// The marks image and the groups that read it, at the targets' size.
+struct Targets {
+    marks: wgpu::TextureView,
+    fragment_group: wgpu::BindGroup,
+    compute_group: Option<wgpu::BindGroup>,
+    bytes: u64,
+}
+
+fn layout(device: &wgpu::Device, label: &str, storage: bool) -> wgpu::BindGroupLayout {
+    let mut entries = vec![
+        uniform_layout_entry(0),
+        texture_entry(
+            MARKS_BINDING,
+            wgpu::TextureSampleType::Uint,
+            wgpu::TextureViewDimension::D2,
+        ),
+    ];
+    if storage {
+        entries.push(storage_texture_entry(COLOR_BINDING, COLOR_FORMAT));
+    }
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some(label),
+        entries: &entries,
+    })
+}
+
+fn group(
+    shared: &Shared,
+    layout: &wgpu::BindGroupLayout,
+    params: &wgpu::Buffer,
+    marks: &wgpu::TextureView,
+    color: Option<&wgpu::TextureView>,
+) -> wgpu::BindGroup {
+    let mut entries = vec![
+        wgpu::BindGroupEntry {
+            binding: 0,
+            resource: params.as_entire_binding(),
+        },
+        wgpu::BindGroupEntry {
+            binding: MARKS_BINDING,
+            resource: wgpu::BindingResource::TextureView(marks),
+        },
+    ];
+    entries.extend(color.map(|view| wgpu::BindGroupEntry {
+        binding: COLOR_BINDING,
+        resource: wgpu::BindingResource::TextureView(view),
+    }));
+    shared.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("sliced shade"),
+        layout,
+        entries: &entries,
+    })
+}
+
+impl Shade {
+    /// `params`: the slicer's footprint uniform (its slice count).
+    pub fn new(shared: &Shared, params: &wgpu::Buffer) -> anyhow::Result<Self> {
+        let device = &shared.device;
+        let fragment_layout = layout(device, "sliced shade", false);
+        let fragment = fullscreen_pipeline_colour_only(
+            shared,
+            "sliced shade",
+            "sliced_shade.wgsl",
+            &shared.pipeline_layout("sliced shade", &[&fragment_layout]),
+            "fs_sliced_shade",
+        )?;
+        let compute = if shared.caps.compute && shared.caps.storage_textures {
+            let compute_layout = layout(device, "sliced shade compute", true);
+            let pipeline = compute_pipeline(
+                shared,
+                "sliced shade",
+                "sliced_shade_compute.wgsl",
+                &shared.pipeline_layout("sliced shade compute", &[&compute_layout]),
+                "cs_sliced_shade",
+            )?;
+            Some((pipeline, compute_layout))
+        } else {
+            None
+        };
+        let targets = Self::targets(shared, params, &fragment_layout, compute.as_ref());
+        Ok(Shade {
+            fragment: (fragment, fragment_layout),
+            compute,
+            targets,
+        })
+    }
+
+    fn targets(
+        shared: &Shared,
+        params: &wgpu::Buffer,
+        fragment_layout: &wgpu::BindGroupLayout,
+        compute: Option<&(wgpu::ComputePipeline, wgpu::BindGroupLayout)>,
+    ) -> Targets {
+        let (_, marks) = shared.target_texture(
+            "sliced marks",
+            MARK_FORMAT,
+            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+        );
+        Targets {
+            fragment_group: group(shared, fragment_layout, params, &marks, None),
+            compute_group: compute.map(|(_, layout)| {
+                group(shared, layout, params, &marks, Some(&shared.color_view))
+            }),
+            marks,
+            bytes: u64::from(shared.width) * u64::from(shared.height) * 4,
+        }
+    }
+
+    /// A marks image at the shared targets' new size.
+    pub fn resize(&mut self, shared: &Shared, params: &wgpu::Buffer) {
+        self.targets = Self::targets(shared, params, &self.fragment.1, self.compute.as_ref());
+    }
+
+    /// The slice pass's colour target: the marks, cleared to 0 (no slice).
+    pub fn marks_attachment(&self) -> wgpu::RenderPassColorAttachment<'_> {
+        wgpu::RenderPassColorAttachment {
+            view: &self.targets.marks,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations {
+                load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                store: wgpu::StoreOp::Store,
+            },
+        }
+    }
+
+    /// After the slice pass: every pixel's colour (the sky where no slice
+    /// was kept), then `over` in a pass over the frame's colour and depth.
+    pub fn record(
+        &self,
+        shared: &Shared,
+        frame: &Frame<'_>,
+        encoder: &mut wgpu::CommandEncoder,
+        over: Option<DrawOver<'_>>,
+    ) {
+        let compute = self
+            .compute
+            .as_ref()
+            .zip(self.targets.compute_group.as_ref())
+            .filter(|_| frame.targets.color.is_none());
+        if let Some(((pipeline, _), group)) = compute {
+            dispatch_per_pixel(shared, frame, encoder, "sliced shade", pipeline, group);
+            if let Some(over) = over {
+                let mut pass = begin_pass_over(shared, frame, encoder, "sliced gaps");
+                pass.set_bind_group(0, &shared.frame_group, &[]);
+                over(&mut pass);
+            }
+            return;
+        }
+        // The colour cleared to sky, the slices' depth kept.
+        let mut pass =
+            begin_pass_with_depth(shared, frame, encoder, "sliced shade", wgpu::LoadOp::Load);
+        pass.set_pipeline(&self.fragment.0);
+        pass.set_bind_group(0, &shared.frame_group, &[]);
+        pass.set_bind_group(1, &self.targets.fragment_group, &[]);
+        pass.draw(0..3, 0..1);
+        if let Some(over) = over {
+            over(&mut pass);
+        }
+    }
+
+    /// Bytes of the marks image.
+    pub fn gpu_bytes(&self) -> u64 {
+        self.targets.bytes
+    }
+}
