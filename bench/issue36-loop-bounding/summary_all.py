@@ -18,5 +18,5 @@ for v in sys.argv[1:]:
         for x in rs:
             for p in x.get("passes", []):
                 passes[p["label"]] = passes.get(p["label"], 0) + p["mean_ms"] / len(rs)
-        split = ", ".join(f"{k}: {t:.4f}" for k, t in passes.items()) if m.startswith("ray-exact") else ""
+        split = ", ".join(f"{k}: {t:.4f}" for k, t in passes.items()) if m.startswith(("ray-exact", "sliced")) else ""
         print(f"{os.path.basename(v.rstrip('/')):10s} {m:24s} ms {ms:8.4f} flip {flip:.4f} see-through max {st:.4f} {split}")
