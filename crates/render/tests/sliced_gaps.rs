@@ -208,7 +208,11 @@ fn deferred_shading_draws_what_forward_shading_draws() {
             }
         }
         // Not two blank pictures alike.
-        assert!(shades.len() >= 20, "{} colours in all the views", shades.len());
+        assert!(
+            shades.len() >= 20,
+            "{} colours in all the views",
+            shades.len()
+        );
         assert!(failures.is_empty(), "{}", failures.join("\n"));
         gpu.errors.check().unwrap();
     }

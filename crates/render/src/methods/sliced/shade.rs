@@ -143,9 +143,8 @@ impl Shade {
         );
         Targets {
             fragment_group: group(shared, fragment_layout, params, &marks, None),
-            compute_group: compute.map(|(_, layout)| {
-                group(shared, layout, params, &marks, Some(&shared.color_view))
-            }),
+            compute_group: compute
+                .map(|(_, layout)| group(shared, layout, params, &marks, Some(&shared.color_view))),
             marks,
             bytes: u64::from(shared.width) * u64::from(shared.height) * 4,
         }
