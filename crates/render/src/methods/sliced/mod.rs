@@ -391,48 +391,41 @@ impl Method for Sliced {
     }
 
     fn record(&self, shared: &Shared, frame: &Frame<'_>, encoder: &mut wgpu::CommandEncoder) {
-        let Some(refine) = &self.refine else {
-            // The beam's pyramid follows every frame's edits; the beam and
-            // the gap pass run on frames with walking rows only.
-            let walks = !self.walking_rows.is_empty();
-            if let Some(gaps) = &self.gaps {
-                gaps.record_beam(shared, frame, encoder, walks);
-            }
-            let gaps = self.gaps.as_ref().filter(|_| walks && !self.empty);
-            let draw_gaps = |pass: &mut wgpu::RenderPass<'_>| {
-                for rows in &self.walking_rows {
-                    gaps.expect("walking rows").draw(shared, pass, rows.clone());
-                }
-            };
-            if let Some(shade) = &self.shade {
-                {
-                    let mut pass =
-                        begin_pass_into(shared, frame, encoder, "sliced", shade.marks_attachment());
-                    if !self.empty {
-                        self.draw_slices(shared, &mut pass);
+        if let Some(refine) = &self.refine {
+            self.record_marks(shared, frame, encoder, refine.marks_attachment());
+            refine.record(shared, frame, encoder);
+            return;
+        }
+        // The beam's pyramid follows every frame's edits; the beam and the
+        // gap pass run on frames with walking rows only.
+        let walks = !self.walking_rows.is_empty();
+        if let Some(gaps) = &self.gaps {
+            gaps.record_beam(shared, frame, encoder, walks);
+        }
+        let draw_gaps = self
+            .gaps
+            .as_ref()
+            .filter(|_| walks && !self.empty)
+            .map(|gaps| {
+                move |pass: &mut wgpu::RenderPass<'_>| {
+                    for rows in &self.walking_rows {
+                        gaps.draw(shared, pass, rows.clone());
                     }
                 }
-                shade.record(shared, frame, encoder, gaps.map(|_| &draw_gaps as _));
-                return;
-            }
-            let mut pass = begin_pass(shared, frame, encoder, "sliced");
-            if self.empty {
-                return;
-            }
-            self.draw_slices(shared, &mut pass);
-            if gaps.is_some() {
-                draw_gaps(&mut pass);
-            }
+            });
+        if let Some(shade) = &self.shade {
+            self.record_marks(shared, frame, encoder, shade.marks_attachment());
+            shade.record(shared, frame, encoder, draw_gaps.as_ref().map(|f| f as _));
             return;
-        };
-        {
-            let mut pass =
-                begin_pass_into(shared, frame, encoder, "sliced", refine.marks_attachment());
-            if !self.empty {
-                self.draw_slices(shared, &mut pass);
-            }
         }
-        refine.record(shared, frame, encoder);
+        let mut pass = begin_pass(shared, frame, encoder, "sliced");
+        if self.empty {
+            return;
+        }
+        self.draw_slices(shared, &mut pass);
+        if let Some(draw_gaps) = &draw_gaps {
+            draw_gaps(&mut pass);
+        }
     }
 
     fn retained_bytes(&self) -> RetainedBytes {
@@ -455,6 +448,21 @@ impl Method for Sliced {
 }
 
 impl Sliced {
+    /// The slices' pass into a marks image (`marks`, the refined slicer's
+    /// or the deferred shading's) and the depth target.
+    fn record_marks(
+        &self,
+        shared: &Shared,
+        frame: &Frame<'_>,
+        encoder: &mut wgpu::CommandEncoder,
+        marks: wgpu::RenderPassColorAttachment<'_>,
+    ) {
+        let mut pass = begin_pass_into(shared, frame, encoder, "sliced", marks);
+        if !self.empty {
+            self.draw_slices(shared, &mut pass);
+        }
+    }
+
     /// The slices, one instanced draw of a quad per slice and tile (slices
     /// nearest the eye's altitude first).
     fn draw_slices(&self, shared: &Shared, pass: &mut wgpu::RenderPass<'_>) {
