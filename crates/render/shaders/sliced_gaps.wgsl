@@ -13,17 +13,10 @@
 #include "shading.wgsl"
 #include "forward.wgsl"
 #include "fullscreen.wgsl"
-#include "sliced_walk.wgsl"
+#include "sliced_gap_walk.wgsl"
 
 // count.y: slices N.
 @group(1) @binding(0) var<uniform> footprint: Footprint;
-
-// Top of the sliced range (Rust: `forward::Z_MAX`).
-const SLICE_TOP: f32 = 256.0;
-// Twin of `sliced.wgsl`'s GAP_MIN (Rust: `sliced::rows::GAP_MIN`).
-const GAP_MIN: f32 = 2.0;
-// Most blocks one walk crosses (far 600 crosses at most ~1300 columns).
-const GAP_BLOCKS: u32 = 512u;
 
 struct GapOut {
     @location(0) color: vec4<f32>,
@@ -33,29 +26,13 @@ struct GapOut {
 // The first solid point of the pixel's ray from `t_start` on, where its ray
 // crosses the slices more than GAP_MIN texels apart; else nothing (discard).
 fn walk_pixel(pos: vec4<f32>, t_start: f32) -> GapOut {
-    let d = camera_ray(pos.x, pos.y);
-    let e = globals.eye.xyz;
-    // As `sliced.wgsl::slice_hit`: edge-on rays and steep ones keep the
-    // slices' point tests.
-    let gap = SLICE_TOP / f32(footprint.count.y) / abs(d.z);
-    if (abs(d.z) < 1e-6 * length(d) || gap * length(d.xy) <= GAP_MIN) {
+    let g = gap_walk(pos.xy, t_start, footprint.count.y);
+    if (!g.hit) {
         discard;
     }
-    let t_near = globals.forward.w / globals.eye.w;
-    let t_far = globals.right.w / globals.eye.w;
-    let t0 = max(t_start, t_near);
-    if (t0 >= t_far) {
-        discard;
-    }
-    let x = walk_gap(e, d, t0, t_far, GAP_BLOCKS, true);
-    if (!x.hit) {
-        discard;
-    }
-    let q = e + d * x.t;
-    let clip = globals.view_proj * vec4<f32>(q, 1.0);
     var out: GapOut;
-    out.depth = clamp(clip.z / clip.w, 0.0, 1.0);
-    out.color = vec4<f32>(shade_column(q, x.column.x, x.column.y, q - e), 1.0);
+    out.depth = g.depth;
+    out.color = vec4<f32>(shade_column(g.q, g.column.x, g.column.y, g.q - globals.eye.xyz), 1.0);
     return out;
 }
 

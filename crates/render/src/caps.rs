@@ -66,6 +66,10 @@ pub struct Capabilities {
     /// Per-pass GPU timestamps; without them frames are timed on the CPU
     /// (submit until done).
     pub timestamps: bool,
+    /// A shader reads a depth texture's texels (WGSL `textureLoad` on a
+    /// `texture_depth_2d`): not through wgpu's GL backend, whose GLSL has
+    /// no such load.
+    pub depth_loads: bool,
     /// Largest 2D texture side, texels.
     pub max_texture_2d: u32,
     /// Most layers of a texture array.
@@ -114,6 +118,7 @@ impl Capabilities {
                 .contains(wgpu::TextureUsages::RENDER_ATTACHMENT),
             depth_copies: flags.contains(D::DEPTH_TEXTURE_AND_BUFFER_COPIES),
             timestamps: features.contains(wgpu::Features::TIMESTAMP_QUERY),
+            depth_loads: info.backend != wgpu::Backend::Gl,
             max_texture_2d: limits.max_texture_dimension_2d,
             max_texture_layers: limits.max_texture_array_layers,
             max_storage_binding: limits.max_storage_buffer_binding_size,
@@ -161,6 +166,7 @@ impl Capabilities {
             float32_targets: true,
             depth_copies: true,
             timestamps: true,
+            depth_loads: true,
             max_texture_2d: limits.max_texture_dimension_2d,
             max_texture_layers: limits.max_texture_array_layers,
             max_storage_binding: limits.max_storage_buffer_binding_size,
@@ -180,6 +186,7 @@ impl Capabilities {
             float32_targets: true,
             depth_copies: false,
             timestamps: false,
+            depth_loads: false,
             max_texture_2d: limits.max_texture_dimension_2d,
             max_texture_layers: limits.max_texture_array_layers,
             max_storage_binding: 0,

@@ -138,6 +138,14 @@ pub const SOURCES: &[(&str, &str)] = &[
         "sliced_shade_compute.wgsl",
         include_str!("../shaders/sliced_shade_compute.wgsl"),
     ),
+    (
+        "sliced_gap_walk.wgsl",
+        include_str!("../shaders/sliced_gap_walk.wgsl"),
+    ),
+    (
+        "sliced_shade_walk.wgsl",
+        include_str!("../shaders/sliced_shade_walk.wgsl"),
+    ),
     ("mesh.wgsl", include_str!("../shaders/mesh.wgsl")),
     (
         "mesh_colour.wgsl",
@@ -218,6 +226,7 @@ pub const ENTRY_SHADERS: &[&str] = &[
     "sliced_gaps_beam.wgsl",
     "sliced_shade.wgsl",
     "sliced_shade_compute.wgsl",
+    "sliced_shade_walk.wgsl",
     "mesh.wgsl",
     "mesh_deferred.wgsl",
     "scattered.wgsl",

@@ -645,9 +645,22 @@ impl DepthCopy {
         label: &str,
         points: bool,
     ) {
-        if !frame.depth_attachment {
-            return;
+        if frame.depth_attachment {
+            self.copy_into_target(shared, frame, encoder, label, points);
         }
+    }
+
+    /// The copy into the frame's depth target whether or not the frame asks
+    /// for it: for a method whose depth target is its frame's depth (the
+    /// depth image holds only what a compute pass changed it to).
+    pub(crate) fn copy_into_target(
+        &self,
+        shared: &Shared,
+        frame: &Frame<'_>,
+        encoder: &mut wgpu::CommandEncoder,
+        label: &str,
+        points: bool,
+    ) {
         let mut attachment = depth_attachment(shared, frame);
         attachment.depth_ops = Some(wgpu::Operations {
             load: wgpu::LoadOp::Load,

@@ -170,6 +170,12 @@ impl MarchBeam {
         storage_entry(STARTS_BINDING, wgpu::ShaderStages::FRAGMENT, true)
     }
 
+    /// A compute pass's layout entry for the starts (`sliced`'s deferred
+    /// shading walks its gaps from them).
+    pub(crate) fn compute_layout_entry() -> wgpu::BindGroupLayoutEntry {
+        storage_entry(STARTS_BINDING, wgpu::ShaderStages::COMPUTE, true)
+    }
+
     /// The fragment's group entry for the starts.
     pub(crate) fn binding(&self) -> wgpu::BindGroupEntry<'_> {
         wgpu::BindGroupEntry {

@@ -127,6 +127,11 @@ impl Gaps {
         pass.draw(0..3, 0..1);
     }
 
+    /// The tiles' starts the walks begin at (none: from the near plane).
+    pub fn beam(&self) -> Option<&MarchBeam> {
+        self.beam.as_ref()
+    }
+
     pub fn gpu_bytes(&self) -> u64 {
         self.beam.as_ref().map_or(0, MarchBeam::gpu_bytes)
     }

@@ -277,7 +277,8 @@ pub fn create(
         if settings.sliced_forward_shading {
             (plain("fs_sliced_steep")?, None, Some(gaps), None)
         } else {
-            shade = Some(Shade::new(shared, &params)?);
+            let walk = gaps.beam().map(|beam| (&tiles, beam));
+            shade = Some(Shade::new(shared, &params, walk)?);
             (marks("fs_slice_mark_steep")?, None, Some(gaps), None)
         }
     };
@@ -357,7 +358,8 @@ impl Method for Sliced {
             gaps.resize(shared, &self.params, &self.tiles);
         }
         if let Some(shade) = &mut self.shade {
-            shade.resize(shared, &self.params);
+            let walk = self.gaps.as_ref().and_then(Gaps::beam);
+            shade.resize(shared, &self.params, walk.map(|beam| (&self.tiles, beam)));
         }
         Ok(())
     }

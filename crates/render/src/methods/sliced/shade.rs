@@ -13,24 +13,33 @@
 //! `sliced:N/forward` keeps the shading in the slice fragments, for A/B.
 //!
 //! The shading runs as a compute pass where the adapter has compute and
-//! storage textures and the frame's colour is the shared target (the whole
+//! storage textures and the frame's targets are the shared ones (the whole
 //! chip, not the graphics path's few SMs); otherwise as a full-screen
-//! triangle in the pass that then draws the gaps.
+//! triangle in the pass that then draws the gaps. Where the gap pass has
+//! its beam, the compute pass walks the gaps itself on frames whose rows
+//! walk (`sliced_shade_walk.wgsl`) and a depth copy puts the walks' depths
+//! in the depth target: no gap pass on the graphics path.
 
 use super::super::common::{
-    begin_pass_over, begin_pass_with_depth, compute_pipeline, dispatch_per_pixel,
+    DepthCopy, begin_pass_over, begin_pass_with_depth, compute_pipeline, dispatch_per_pixel,
     fullscreen_pipeline_colour_only,
 };
 use super::super::contract::Frame;
+use super::super::march_beam::MarchBeam;
 use super::refine::MARK_FORMAT;
+use super::tiles::SliceTiles;
 use crate::frame::{
     COLOR_FORMAT, Shared, storage_texture_entry, texture_entry, uniform_layout_entry,
 };
 
 /// Bindings of the shading's group 1: the footprint uniform (slice count),
-/// the marks, and (compute) the colour target.
+/// the marks, and (compute) the colour target; the walking pass adds the
+/// tile grid (1), the beam's starts (2), the block maxima (3), the slices'
+/// depth (6) and the depth image it writes (7).
 const MARKS_BINDING: u32 = 4;
 const COLOR_BINDING: u32 = 5;
+const DEPTH_BINDING: u32 = 6;
+const DEPTH_OUT_BINDING: u32 = 7;
 
 /// What draws over the shaded slices in the same frame (the gap pass's rows).
 pub type DrawOver<'a> = &'a dyn Fn(&mut wgpu::RenderPass<'_>);
@@ -40,8 +49,24 @@ pub struct Shade {
     fragment: (wgpu::RenderPipeline, wgpu::BindGroupLayout),
     /// The compute pipeline and its layout, where the adapter has both.
     compute: Option<(wgpu::ComputePipeline, wgpu::BindGroupLayout)>,
+    /// The compute pass that also walks the gaps (with `compute`, where the
+    /// gap pass has a beam).
+    walk: Option<ComputeWalk>,
     targets: Targets,
 }
+
+/// `cs_sliced_shade_walk`: its pipeline, layout and group, and the depth
+/// image it writes with the copy that puts it in the depth target.
+struct ComputeWalk {
+    pipeline: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+    group: wgpu::BindGroup,
+    depth: DepthCopy,
+}
+
+/// What the walking pass reads besides the marks: the slicer's tiles (the
+/// grid uniform, the block maxima) and the gap pass's beam (the starts).
+pub type WalkInputs<'a> = (&'a SliceTiles, &'a MarchBeam);
 
 /// The marks image and the groups that read it, at the targets' size.
 struct Targets {
@@ -97,9 +122,106 @@ fn group(
     })
 }
 
+impl ComputeWalk {
+    fn new(
+        shared: &Shared,
+        params: &wgpu::Buffer,
+        marks: &wgpu::TextureView,
+        inputs: WalkInputs<'_>,
+    ) -> anyhow::Result<Self> {
+        let device = &shared.device;
+        let uint_texture = |binding| {
+            texture_entry(
+                binding,
+                wgpu::TextureSampleType::Uint,
+                wgpu::TextureViewDimension::D2,
+            )
+        };
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("sliced shade walk"),
+            entries: &[
+                uniform_layout_entry(0),
+                uniform_layout_entry(1),
+                MarchBeam::compute_layout_entry(),
+                uint_texture(3),
+                uint_texture(MARKS_BINDING),
+                storage_texture_entry(COLOR_BINDING, COLOR_FORMAT),
+                texture_entry(
+                    DEPTH_BINDING,
+                    wgpu::TextureSampleType::Depth,
+                    wgpu::TextureViewDimension::D2,
+                ),
+                storage_texture_entry(DEPTH_OUT_BINDING, wgpu::TextureFormat::R32Float),
+            ],
+        });
+        let pipeline = compute_pipeline(
+            shared,
+            "sliced shade",
+            "sliced_shade_walk.wgsl",
+            &shared.pipeline_layout("sliced shade walk", &[&layout]),
+            "cs_sliced_shade_walk",
+        )?;
+        let depth = DepthCopy::new(shared, "sliced", "sliced depth copy")?;
+        let group = Self::group(shared, &layout, params, marks, inputs, &depth);
+        Ok(ComputeWalk {
+            pipeline,
+            layout,
+            group,
+            depth,
+        })
+    }
+
+    fn group(
+        shared: &Shared,
+        layout: &wgpu::BindGroupLayout,
+        params: &wgpu::Buffer,
+        marks: &wgpu::TextureView,
+        (tiles, beam): WalkInputs<'_>,
+        depth: &DepthCopy,
+    ) -> wgpu::BindGroup {
+        let view = |binding, view| wgpu::BindGroupEntry {
+            binding,
+            resource: wgpu::BindingResource::TextureView(view),
+        };
+        // The depth copy's bindings are the colour target (the shared one)
+        // and its depth image.
+        let [color, depth_out] = depth.bindings(shared, COLOR_BINDING);
+        let depth_out = wgpu::BindGroupEntry {
+            binding: DEPTH_OUT_BINDING,
+            ..depth_out
+        };
+        shared.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("sliced shade walk"),
+            layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: params.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: tiles.params.as_entire_binding(),
+                },
+                beam.binding(),
+                view(3, tiles.blocks_view()),
+                view(MARKS_BINDING, marks),
+                color,
+                view(DEPTH_BINDING, &shared.depth_view),
+                depth_out,
+            ],
+        })
+    }
+}
+
 impl Shade {
-    /// `params`: the slicer's footprint uniform (its slice count).
-    pub fn new(shared: &Shared, params: &wgpu::Buffer) -> anyhow::Result<Self> {
+    /// `params`: the slicer's footprint uniform (its slice count); `walk`:
+    /// what the compute pass needs to walk the gaps too (none: the gap pass
+    /// walks them).
+    pub fn new(
+        shared: &Shared,
+        params: &wgpu::Buffer,
+        walk: Option<WalkInputs<'_>>,
+    ) -> anyhow::Result<Self> {
         let device = &shared.device;
         let fragment_layout = layout(device, "sliced shade", false);
         let fragment = fullscreen_pipeline_colour_only(
@@ -123,9 +245,14 @@ impl Shade {
             None
         };
         let targets = Self::targets(shared, params, &fragment_layout, compute.as_ref());
+        let walk = match walk.filter(|_| compute.is_some() && shared.caps.depth_loads) {
+            Some(inputs) => Some(ComputeWalk::new(shared, params, &targets.marks, inputs)?),
+            None => None,
+        };
         Ok(Shade {
             fragment: (fragment, fragment_layout),
             compute,
+            walk,
             targets,
         })
     }
@@ -150,9 +277,21 @@ impl Shade {
         }
     }
 
-    /// A marks image at the shared targets' new size.
-    pub fn resize(&mut self, shared: &Shared, params: &wgpu::Buffer) {
+    /// A marks image at the shared targets' new size (`walk`: the walking
+    /// pass's inputs, resized before).
+    pub fn resize(&mut self, shared: &Shared, params: &wgpu::Buffer, walk: Option<WalkInputs<'_>>) {
         self.targets = Self::targets(shared, params, &self.fragment.1, self.compute.as_ref());
+        if let (Some(w), Some(inputs)) = (&mut self.walk, walk) {
+            w.depth.resize(shared);
+            w.group = ComputeWalk::group(
+                shared,
+                &w.layout,
+                params,
+                &self.targets.marks,
+                inputs,
+                &w.depth,
+            );
+        }
     }
 
     /// The slice pass's colour target: the marks, cleared to 0 (no slice).
@@ -169,14 +308,31 @@ impl Shade {
     }
 
     /// After the slice pass: every pixel's colour (the sky where no slice
-    /// was kept), then `over` in a pass over the frame's colour and depth.
+    /// was kept), then the gaps: walked in the compute pass where it can
+    /// (`gaps`, the gap pass's drawing, is then not called), else `gaps` in
+    /// a pass over the frame's colour and depth.
     pub fn record(
         &self,
         shared: &Shared,
         frame: &Frame<'_>,
         encoder: &mut wgpu::CommandEncoder,
-        over: Option<DrawOver<'_>>,
+        gaps: Option<DrawOver<'_>>,
     ) {
+        let own_targets = frame.targets.color.is_none() && frame.targets.depth.is_none();
+        if let Some(walk) = self.walk.as_ref().filter(|_| own_targets && gaps.is_some()) {
+            dispatch_per_pixel(
+                shared,
+                frame,
+                encoder,
+                "sliced shade",
+                &walk.pipeline,
+                &walk.group,
+            );
+            walk.depth
+                .copy_into_target(shared, frame, encoder, "sliced depth copy", false);
+            return;
+        }
+        let over = gaps;
         let compute = self
             .compute
             .as_ref()
@@ -203,8 +359,8 @@ impl Shade {
         }
     }
 
-    /// Bytes of the marks image.
+    /// Bytes of the marks image and the walking pass's depth image.
     pub fn gpu_bytes(&self) -> u64 {
-        self.targets.bytes
+        self.targets.bytes + self.walk.as_ref().map_or(0, |w| w.depth.bytes())
     }
 }
