@@ -10,6 +10,11 @@
 //! 11.56 ms a frame against 8.09 without the walks). One walk per pixel, from
 //! its tile's beam start where the adapter has compute
 //! (`methods::march_beam`), covers every gap of the ray, long ones included.
+//!
+//! Where the deferred shading's compute pass can load the slices' depth and
+//! the walks have their beam, it walks the same rays itself
+//! (`shade.rs`, `sliced_shade_walk.wgsl`) and this pass draws nothing: on
+//! the H100 this pass took 0.9-1.8 ms on the graphics path.
 
 use super::super::common::fullscreen_pipeline_depth_tested;
 use super::super::contract::Frame;

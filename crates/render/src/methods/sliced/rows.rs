@@ -146,8 +146,8 @@ mod tests {
         for (name, source) in [
             ("sliced.wgsl", include_str!("../../../shaders/sliced.wgsl")),
             (
-                "sliced_gaps.wgsl",
-                include_str!("../../../shaders/sliced_gaps.wgsl"),
+                "sliced_gap_walk.wgsl",
+                include_str!("../../../shaders/sliced_gap_walk.wgsl"),
             ),
         ] {
             assert!(
