@@ -332,7 +332,6 @@ impl Shade {
                 .copy_into_target(shared, frame, encoder, "sliced depth copy", false);
             return;
         }
-        let over = gaps;
         let compute = self
             .compute
             .as_ref()
@@ -340,10 +339,10 @@ impl Shade {
             .filter(|_| frame.targets.color.is_none());
         if let Some(((pipeline, _), group)) = compute {
             dispatch_per_pixel(shared, frame, encoder, "sliced shade", pipeline, group);
-            if let Some(over) = over {
+            if let Some(gaps) = gaps {
                 let mut pass = begin_pass_over(shared, frame, encoder, "sliced gaps");
                 pass.set_bind_group(0, &shared.frame_group, &[]);
-                over(&mut pass);
+                gaps(&mut pass);
             }
             return;
         }
@@ -354,8 +353,8 @@ impl Shade {
         pass.set_bind_group(0, &shared.frame_group, &[]);
         pass.set_bind_group(1, &self.targets.fragment_group, &[]);
         pass.draw(0..3, 0..1);
-        if let Some(over) = over {
-            over(&mut pass);
+        if let Some(gaps) = gaps {
+            gaps(&mut pass);
         }
     }
 
