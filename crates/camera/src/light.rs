@@ -8,6 +8,25 @@ use glam::Vec3;
 
 /// Side of the shared shadow map, texels.
 pub const SHADOW_SIZE: u32 = 1024;
+/// The map's square moves over the light's lattice of texels in steps of
+/// this many texels, so its 8x8-texel blocks are lattice blocks (a cast
+/// block can be kept by a later frame).
+pub const SHADOW_BLOCK: u32 = 8;
+/// The map's plane lies a multiple of this many units along the light.
+pub const SHADOW_PLANE_STEP: f32 = 256.0;
+/// Texel sizes come in steps of 2^(1/8) (9 %), so a moving view keeps its
+/// texel size, and so its lattice, across most frames.
+const TEXEL_STEPS_PER_OCTAVE: f32 = 8.0;
+
+/// The texel size of a map whose square must span `side` units about its
+/// middle, when the middle may sit up to a block off: the next step of
+/// [`TEXEL_STEPS_PER_OCTAVE`] up.
+fn shadow_texel_size(side: f32) -> f32 {
+    let needed = side / (SHADOW_SIZE - 2 * SHADOW_BLOCK) as f32;
+    let step = (needed.log2() * TEXEL_STEPS_PER_OCTAVE).ceil();
+    (step / TEXEL_STEPS_PER_OCTAVE).exp2()
+}
+
 /// Background colour where rays miss (linear 0..1 RGB).
 pub const SKY: [f32; 3] = [0.62, 0.74, 0.86];
 
@@ -24,8 +43,19 @@ pub struct ShadowFrame {
     pub enabled: bool,
     /// Unit direction the light travels ([`light_direction`]).
     pub light: Vec3,
-    /// Corner of the map's square (texel (0, 0)'s outer corner).
+    /// Corner of the map's square (texel (0, 0)'s outer corner):
+    /// `anchor + (u lattice.x + v lattice.y) texel`.
     pub origin: Vec3,
+    /// The point of the map's plane the lattice counts from: the light times
+    /// the plane's distance along it, a multiple of [`SHADOW_PLANE_STEP`].
+    pub anchor: Vec3,
+    /// Texel (0, 0)'s index on the light's world-fixed lattice of texels of
+    /// this size: multiples of [`SHADOW_BLOCK`]. A lattice texel's centre,
+    /// and so what it holds, is the same in every frame of the same texel
+    /// size and plane ([`ShadowFrame::texel_centre`]), which lets a frame keep
+    /// the texels an earlier one cast; the map stores texel (i, j) at
+    /// [`ShadowFrame::slot`].
+    pub lattice: [i32; 2],
     /// Unit vector along the map's texel x axis, perpendicular to the light.
     pub u: Vec3,
     /// Unit vector along the map's texel y axis, perpendicular to `u` and the light.
@@ -76,14 +106,27 @@ impl ShadowFrame {
         // A margin for casters just outside the footprint; a square map.
         let side = (hi - lo).max_element() + 32.0;
         let centre = 0.5 * (lo + hi);
-        let texel = side / SHADOW_SIZE as f32;
-        // Put the plane well above every altitude: 600 units up the light.
+        let texel = shadow_texel_size(side);
+        // Texel (0, 0) on the lattice, a block corner, so that the map's
+        // middle lies within a block of the footprint's centre; the texel
+        // size leaves a block's slack for it.
+        let block = (SHADOW_BLOCK as f32) * texel;
+        let half = 0.5 * SHADOW_SIZE as f32 * texel;
+        let lattice = [
+            ((centre.x - half) / block).floor() as i32 * SHADOW_BLOCK as i32,
+            ((centre.y - half) / block).floor() as i32 * SHADOW_BLOCK as i32,
+        ];
+        // Put the plane well above every altitude: at least 600 units up the
+        // light, on a step, so it moves only when the view moves far.
         let along = points.iter().map(|p| p.dot(light)).fold(f32::MAX, f32::min) - 600.0;
-        let origin = u * (centre.x - 0.5 * side) + v * (centre.y - 0.5 * side) + light * along;
+        let anchor = light * ((along / SHADOW_PLANE_STEP).floor() * SHADOW_PLANE_STEP);
+        let origin = anchor + u * (lattice[0] as f32 * texel) + v * (lattice[1] as f32 * texel);
         let mut frame = ShadowFrame {
             enabled,
             light,
             origin,
+            anchor,
+            lattice,
             u,
             v,
             texel,
@@ -94,6 +137,22 @@ impl ShadowFrame {
         };
         frame.cover = ShadowCover::of_view(camera, &frame);
         frame
+    }
+
+    /// Texel (i, j)'s centre on the map's plane, from its lattice index (in
+    /// f32, as `frame.wgsl`'s `shadow_texel_centre` computes it): the same
+    /// point in every frame with this texel size and plane.
+    pub fn texel_centre(&self, i: u32, j: u32) -> Vec3 {
+        let at = |n: u32, first: i32| (first.wrapping_add(n as i32) as f32 + 0.5) * self.texel;
+        self.anchor + self.u * at(i, self.lattice[0]) + self.v * at(j, self.lattice[1])
+    }
+
+    /// Where the map's texture stores texel (i, j): its lattice index
+    /// wrapped to the map's side, so a texel keeps its place in the texture
+    /// while the map's square moves over the lattice with the view.
+    pub fn slot(&self, i: u32, j: u32) -> (u32, u32) {
+        let wrap = |n: u32, first: i32| (first.wrapping_add(n as i32) as u32) & (SHADOW_SIZE - 1);
+        (wrap(i, self.lattice[0]), wrap(j, self.lattice[1]))
     }
 
     /// The map's texel coordinates of world point `p` (texel (i, j) spans

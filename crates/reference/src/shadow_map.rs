@@ -41,9 +41,7 @@ impl ShadowMap {
                         continue;
                     }
                     // The texel centre as the GPU computes it (f32), then exact.
-                    let o = frame.origin
-                        + frame.u * ((i as f32 + 0.5) * frame.texel)
-                        + frame.v * ((j as f32 + 0.5) * frame.texel);
+                    let o = frame.texel_centre(i as u32, j as u32);
                     let hit = tracer.trace_in(
                         &mut state,
                         o.as_dvec3(),

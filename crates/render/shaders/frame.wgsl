@@ -31,6 +31,10 @@ struct Globals {
     // the shadow texels this frame casts: half-planes (nx, ny, d, 0) in texel
     // coordinates, inside when nx cx + ny cy + d <= 0 (`ShadowCover`)
     shadow_cover: array<vec4<f32>, 16>,
+    // xyz the shadow map lattice's anchor on its plane, w unused
+    shadow_anchor: vec4<f32>,
+    // xy shadow texel (0, 0)'s index on the light's lattice, zw unused
+    shadow_lattice: vec4<i32>,
 }
 
 struct ShadingParams {
@@ -59,6 +63,28 @@ fn shadow_texel_cast(ij: vec2<u32>) -> bool {
         }
     }
     return true;
+}
+
+// Texel `ij`'s centre on the shadow map's plane, from its lattice index
+// (twin of `ShadowFrame::texel_centre`): the same point in every frame with
+// this texel size and plane, so a texel cast by an earlier frame holds what
+// casting it now would store.
+fn shadow_texel_centre(ij: vec2<u32>) -> vec3<f32> {
+    let texel = globals.shadow_origin.w;
+    let at = (vec2<f32>(globals.shadow_lattice.xy + vec2<i32>(ij)) + vec2<f32>(0.5)) * texel;
+    return globals.shadow_anchor.xyz + globals.shadow_u.xyz * at.x + globals.shadow_v.xyz * at.y;
+}
+
+// Where the shadow map's texture stores texel `ij` (twin of
+// `ShadowFrame::slot`): its lattice index wrapped to the map's side.
+fn shadow_slot(ij: vec2<i32>) -> vec2<i32> {
+    return (ij + globals.shadow_lattice.xy) & vec2<i32>(i32(globals.shadow_u.w) - 1);
+}
+
+// The shadow texel a slot of the texture holds this frame (`shadow_slot`'s
+// inverse): for passes that run over the texture's texels.
+fn shadow_texel_of_slot(slot: vec2<u32>) -> vec2<u32> {
+    return vec2<u32>((vec2<i32>(slot) - globals.shadow_lattice.xy) & vec2<i32>(i32(globals.shadow_u.w) - 1));
 }
 
 // Unnormalised ray through the image point (px, py) in pixels from the top-left

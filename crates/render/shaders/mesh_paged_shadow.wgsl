@@ -13,5 +13,5 @@ fn cs_shadow_paged(@builtin(global_invocation_id) id: vec3<u32>) {
     page_pixel_begin();
     let d = shadow_distance(id.xy);
     page_shadow_end(page_pixel_missed());
-    textureStore(shadow_out, id.xy, vec4<f32>(d, 0.0, 0.0, 0.0));
+    textureStore(shadow_out, shadow_slot(vec2<i32>(id.xy)), vec4<f32>(d, 0.0, 0.0, 0.0));
 }

@@ -334,10 +334,7 @@ struct ShadowRay {
 }
 
 fn exact_shadow_ray(id: vec2<u32>) -> ShadowRay {
-    let texel = globals.shadow_origin.w;
-    let o = globals.shadow_origin.xyz
-        + globals.shadow_u.xyz * ((f32(id.x) + 0.5) * texel)
-        + globals.shadow_v.xyz * ((f32(id.y) + 0.5) * texel);
+    let o = shadow_texel_centre(id);
     let d = globals.light_dir.xyz;
     // The light travels down: from altitude 255 to below 0, where every
     // column is solid.

@@ -33,7 +33,7 @@ fn cast_texel_from(id: vec2<u32>, start: f32, level: u32) {
     lod_shadow_rays();
     let h = exact_march_at(rel, base, d, max(start, 0.0), ray.span, level);
     page_shadow_end(page_pixel_missed());
-    textureStore(shadow_out, id, vec4<f32>(select(SHADOW_MISS, ray.t_in + h.t, h.hit), 0.0, 0.0, 0.0));
+    textureStore(shadow_out, shadow_slot(vec2<i32>(id)), vec4<f32>(select(SHADOW_MISS, ray.t_in + h.t, h.hit), 0.0, 0.0, 0.0));
     if (h.capped) {
         atomicAdd(&xstats[2], 1u);
     }
@@ -54,7 +54,7 @@ fn cs_exact_shadow(
             cast_texel(id.xy);
         } else {
             // No visible point samples this texel this frame.
-            textureStore(shadow_out, id.xy, vec4<f32>(SHADOW_MISS, 0.0, 0.0, 0.0));
+            textureStore(shadow_out, shadow_slot(vec2<i32>(id.xy)), vec4<f32>(SHADOW_MISS, 0.0, 0.0, 0.0));
         }
     }
     if (EXACT_ITERATION_STATS) {

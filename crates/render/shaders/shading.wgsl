@@ -100,7 +100,7 @@ fn shadow_tap(ij: vec2<i32>, t: f32) -> f32 {
     if (any(ij < vec2<i32>(0)) || any(ij >= vec2<i32>(side))) {
         return 1.0;
     }
-    let blocker = textureLoad(shadow_map, ij, 0).r;
+    let blocker = textureLoad(shadow_map, shadow_slot(ij), 0).r;
     return select(0.0, 1.0, t <= blocker);
 }
 

@@ -23,10 +23,7 @@ fn shadow_distance(id: vec2<u32>) -> f32 {
     if (!shadow_texel_cast(id)) {
         return SHADOW_MISS;
     }
-    let texel = globals.shadow_origin.w;
-    let o = globals.shadow_origin.xyz
-        + globals.shadow_u.xyz * ((f32(id.x) + 0.5) * texel)
-        + globals.shadow_v.xyz * ((f32(id.y) + 0.5) * texel);
+    let o = shadow_texel_centre(id);
     let d = globals.light_dir.xyz;
     let seg = clip_to_altitudes(o, d, 0.0, 1e6);
     let h = march(o, d, seg.x, seg.y, SHADOW_STEPS, false);
@@ -39,10 +36,11 @@ fn cs_shadow(@builtin(global_invocation_id) id: vec3<u32>) {
     if (id.x >= side || id.y >= side) {
         return;
     }
-    textureStore(shadow_out, id.xy, vec4<f32>(shadow_distance(id.xy), 0.0, 0.0, 0.0));
+    textureStore(shadow_out, shadow_slot(vec2<i32>(id.xy)), vec4<f32>(shadow_distance(id.xy), 0.0, 0.0, 0.0));
 }
 
 @fragment
 fn fs_shadow(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
-    return vec4<f32>(shadow_distance(vec2<u32>(pos.xy)), 0.0, 0.0, 1.0);
+    // The fragment lands on a slot of the texture: cast the texel it holds.
+    return vec4<f32>(shadow_distance(shadow_texel_of_slot(vec2<u32>(pos.xy))), 0.0, 0.0, 1.0);
 }

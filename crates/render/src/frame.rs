@@ -111,6 +111,10 @@ pub struct Globals {
     ///
     /// [`ShadowCover`]: strata_camera::light::ShadowCover
     pub shadow_cover: [[f32; 4]; MAX_COVER_EDGES],
+    /// Shadow map: the lattice's anchor on its plane (xyz, `ShadowFrame::anchor`).
+    pub shadow_anchor: [f32; 4],
+    /// Shadow map: texel (0, 0)'s lattice index (xy, `ShadowFrame::lattice`).
+    pub shadow_lattice: [i32; 4],
 }
 
 /// Twin of `ShadingParams` in `frame.wgsl`.
@@ -198,6 +202,8 @@ impl Globals {
             ],
             shadow_cover_count: [shadow.cover.count, 0, 0, 0],
             shadow_cover: shadow.cover.planes.map(|[nx, ny, d]| [nx, ny, d, 0.0]),
+            shadow_anchor: v4(shadow.anchor, 0.0),
+            shadow_lattice: [shadow.lattice[0], shadow.lattice[1], 0, 0],
         }
     }
 }

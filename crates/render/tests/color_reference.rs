@@ -5,7 +5,7 @@
 mod common;
 
 use strata_camera::Camera;
-use strata_camera::light::ShadowFrame;
+use strata_camera::light::{SHADOW_SIZE, ShadowFrame};
 use strata_reference::{ShadowMap, TerrainRamps, Tracer, render_color};
 use strata_render::{MethodSettings, Renderer, TerrainColors};
 
@@ -65,8 +65,16 @@ fn gpu_shadow_map_and_shading_match_the_cpu_colour_reference() {
             wgpu::TextureAspect::All,
         )
         .unwrap();
-        let gpu_map: Vec<f32> = bytemuck::cast_slice(&bytes).to_vec();
+        let texture: Vec<f32> = bytemuck::cast_slice(&bytes).to_vec();
         let frame = ShadowFrame::fit(&camera, true);
+        // The texture holds texel (i, j) at its slot: put the map in order.
+        let side = SHADOW_SIZE;
+        let gpu_map: Vec<f32> = (0..side * side)
+            .map(|k| {
+                let (i, j) = frame.slot(k % side, k / side);
+                texture[(j * side + i) as usize]
+            })
+            .collect();
         let cpu = ShadowMap::cast(&tracer, &frame);
         // A texel agrees when the march's depth is within the map's own bias
         // (a texel plus the bisection's half unit) of the exact depth. Both

@@ -578,10 +578,12 @@ impl<'a> Replay<'a> {
     /// (i, j)'s ray comes down to altitude 255, and the ray parameter it
     /// leaves the map at below 0.
     fn shadow_start(&self, g: &Globals, i: u32, j: u32) -> (Vec3, f32) {
+        // `shadow_texel_centre` of `frame.wgsl`: from the texel's lattice index.
         let texel = g.shadow_origin[3];
-        let o = Vec3::from_slice(&g.shadow_origin[..3])
-            + Vec3::from_slice(&g.shadow_u[..3]) * ((i as f32 + 0.5) * texel)
-            + Vec3::from_slice(&g.shadow_v[..3]) * ((j as f32 + 0.5) * texel);
+        let at = |n: u32, first: i32| (first.wrapping_add(n as i32) as f32 + 0.5) * texel;
+        let o = Vec3::from_slice(&g.shadow_anchor[..3])
+            + Vec3::from_slice(&g.shadow_u[..3]) * at(i, g.shadow_lattice[0])
+            + Vec3::from_slice(&g.shadow_v[..3]) * at(j, g.shadow_lattice[1]);
         let d = Vec3::from_slice(&g.light_dir[..3]);
         let t_in = (MAX_ALTITUDE - o.z) / d.z;
         let t_out = (-1.0 - o.z) / d.z;
