@@ -24,6 +24,9 @@ struct ExactParams {
     // - 1, w tiles down - 1; index 0 the texel plane's, if any
     // (`texel_block_rows`)
     levels: array<vec4<u32>, 9>,
+    // x the key of the shadow blocks kept from earlier frames (0: keep
+    // none; `ray_exact_deferred.wgsl`), yzw unused
+    shadow_keep: vec4<u32>,
 }
 
 @group(1) @binding(0) var<uniform> xparams: ExactParams;

@@ -24,6 +24,7 @@
 #include "ray_exact_core.wgsl"
 #include "ray_exact_pixel.wgsl"
 #include "ray_exact_beam.wgsl"
+#include "shadow_keep.wgsl"
 
 @group(1) @binding(3) var color_out: texture_storage_2d<rgba8unorm, write>;
 // The depth-buffer value of each pixel (the shading writes it).
@@ -38,7 +39,8 @@
 // pixel of this frame may sample the block. (One binding for both: paged
 // terrain's frame binds as many storage buffers as WebGPU allows.)
 @group(1) @binding(6) var<storage, read_write> shadow_marks: array<atomic<u32>>;
-// The blocks stamped this frame, in the order they were first stamped.
+// The blocks stamped this frame, in the order they were first stamped; then
+// the kept blocks' tags (`shadow_keep.wgsl`).
 @group(1) @binding(7) var<storage, read_write> shadow_blocks: array<u32>;
 
 const HIT_NONE: u32 = 0xffffffffu;
@@ -71,6 +73,11 @@ fn mark_shadow_blocks(p: vec3<f32>) {
     for (var by = b0.y; by <= b1.y; by = by + 1) {
         // Bounded: as `by` is.
         for (var bx = b0.x; bx <= b1.x; bx = bx + 1) {
+            // A block an earlier frame cast for this lattice block, with
+            // nothing changed since, holds what casting it now would.
+            if (shadow_block_kept(vec2<i32>(bx, by))) {
+                continue;
+            }
             // Most pixels of a block find it stamped: read before the
             // exchange; the one exchange that changes the stamp lists it.
             let i = u32(by * blocks + bx);

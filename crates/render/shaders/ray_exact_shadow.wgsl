@@ -6,6 +6,7 @@
 #include "surface.wgsl"
 #include "ray_exact_core.wgsl"
 #include "ray_exact_beam.wgsl"
+#include "shadow_keep.wgsl"
 
 const SHADOW_MISS: f32 = 1e9;
 
@@ -13,7 +14,9 @@ const SHADOW_MISS: f32 = 1e9;
 // The 8x8-texel blocks the deferred frame's pixels sample, listed by its
 // march (`ray_exact_deferred.wgsl`): `cs_exact_shadow_blocks` casts one per
 // workgroup, dispatched indirectly by their count.
-@group(1) @binding(4) var<storage, read> shadow_blocks: array<u32>;
+// Then the kept blocks' tags: the pass tags each block it casts
+// (`shadow_keep.wgsl`).
+@group(1) @binding(4) var<storage, read_write> shadow_blocks: array<u32>;
 
 var<workgroup> group_most: atomic<u32>;
 
@@ -81,6 +84,10 @@ fn cs_exact_shadow_blocks(
     // at once (`ray_exact_beam.wgsl`).
     let start = exact_shadow_block_start(first, li);
     cast_texel_from(first + local.xy, start, exact_tile_level());
+    if (li == 0u) {
+        // Read by later frames' marches only, after this pass.
+        shadow_block_keep(first / 8u);
+    }
     if (EXACT_ITERATION_STATS) {
         workgroupBarrier();
         if (li == 0u) {

@@ -333,6 +333,10 @@ pub struct Shared {
     pub shadow_map: wgpu::Texture,
     /// Its view.
     pub shadow_view: wgpu::TextureView,
+    /// How many frames have written `shadow_map` ([`Shared::shadow_map_written`]):
+    /// a method that keeps texels it cast in an earlier frame (`ray-exact`)
+    /// sees from it whether anyone wrote the map since.
+    shadow_writes: std::sync::atomic::AtomicU64,
     /// Strata's colour target ([`COLOR_FORMAT`], `width` x `height`).
     pub color: wgpu::Texture,
     /// Its view: stable, for drawing your objects over a `render_frame`.
@@ -470,6 +474,20 @@ pub fn uniform_layout_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
 }
 
 impl Shared {
+    /// Note that a frame's commands write the shadow map; returns the new
+    /// count of such frames. Every writer calls it once per frame it writes.
+    pub fn shadow_map_written(&self) -> u64 {
+        self.shadow_writes
+            .fetch_add(1, std::sync::atomic::Ordering::Relaxed)
+            + 1
+    }
+
+    /// How many frames have written the shadow map.
+    pub fn shadow_map_writes(&self) -> u64 {
+        self.shadow_writes
+            .load(std::sync::atomic::Ordering::Relaxed)
+    }
+
     /// A 2D texture (and its view) of the shared targets' size.
     pub fn target_texture(
         &self,
@@ -597,6 +615,7 @@ impl Shared {
             shading,
             shadow_map,
             shadow_view,
+            shadow_writes: std::sync::atomic::AtomicU64::new(0),
             color,
             color_view,
             depth,

@@ -656,6 +656,7 @@ impl Renderer {
             // The method may fill the map itself (the exact march does).
             if !method.record_shadow_map(&self.shared, &frame, &mut encoder) {
                 self.shadow.record(&mut encoder, &self.timer);
+                self.shared.shadow_map_written();
             }
             // A map cast only where this method's pixels sample it is not
             // another method's to reuse.

@@ -173,6 +173,10 @@ pub const SOURCES: &[(&str, &str)] = &[
         include_str!("../shaders/ray_exact_beam.wgsl"),
     ),
     (
+        "shadow_keep.wgsl",
+        include_str!("../shaders/shadow_keep.wgsl"),
+    ),
+    (
         "paged_beam.wgsl",
         include_str!("../shaders/paged_beam.wgsl"),
     ),

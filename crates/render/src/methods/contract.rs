@@ -230,7 +230,9 @@ pub trait Method: Send {
     /// Fill the shared shadow map (`Shared::shadow_view`) this frame, in
     /// place of the renderer's own pass, and say so with `true`. Called before
     /// `record` on frames that need a new map; the default leaves it to the
-    /// renderer (`shadow.wgsl`).
+    /// renderer (`shadow.wgsl`). A method that fills it calls
+    /// `Shared::shadow_map_written` (methods that keep texels across frames
+    /// read the count).
     fn record_shadow_map(
         &self,
         _shared: &Shared,

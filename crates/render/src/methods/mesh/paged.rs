@@ -607,13 +607,14 @@ impl Method for PagedMesh {
 
     fn record_shadow_map(
         &self,
-        _shared: &Shared,
+        shared: &Shared,
         frame: &Frame<'_>,
         encoder: &mut wgpu::CommandEncoder,
     ) -> bool {
         let Some(shadow) = &self.shadow else {
             return false;
         };
+        shared.shadow_map_written();
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("paged mesh shadow"),
             timestamp_writes: frame.timer.compute("shadow"),

@@ -111,6 +111,7 @@ use pyramid::GpuMaxMip;
 use serde::Serialize;
 use std::cell::Cell;
 use strata_camera::Camera;
+use strata_camera::light::ShadowFrame;
 use strata_level::{DirtyRect, Level};
 
 /// The pyramid level the whole map's compute traversals start at
@@ -135,6 +136,8 @@ pub const ITERATION_CAP: u32 = 4096;
 pub(crate) struct ExactParams {
     config: [u32; 4],
     levels: [[u32; 4]; 9],
+    /// x: the kept shadow blocks' key ([`ShadowKeep`]); 0 keeps none.
+    shadow_keep: [u32; 4],
 }
 
 /// What the march counted since creation (or the last [`RayExact::reset_stats`]).
@@ -183,6 +186,8 @@ pub struct RayExact {
     marks: ShadowMarks,
     /// This frame's stamp (`ExactParams::config[2]`), never 0.
     stamp: u32,
+    /// Which shadow blocks of earlier frames this frame keeps.
+    keep: ShadowKeep,
     /// The renderer asked for the shadow map this frame; the deferred frame
     /// casts it between march and shading.
     shadow_due: Cell<bool>,
@@ -236,6 +241,7 @@ pub(crate) fn exact_params(layout: &strata_maxmip::Layout) -> ExactParams {
         // w: the cave pyramid's first byte, after the maxima (`GpuMaxMip`).
         config: [layout.top(), ITERATION_CAP, 0, layout.bytes],
         levels: [[0; 4]; 9],
+        shadow_keep: [0; 4],
     };
     for info in &layout.levels {
         table.levels[info.log2_tile as usize] = [
@@ -285,6 +291,7 @@ pub fn build_paged(
     let table = ExactParams {
         config: [strata_maxmip::MAX_LEVEL, ITERATION_CAP, 0, 0],
         levels: [[0; 4]; 9],
+        shadow_keep: [0; 4],
     };
     build_on(shared, Levels::Paged(Box::new(paged)), table, options)
 }
@@ -401,6 +408,7 @@ fn build_on(
         stats,
         marks,
         stamp: 0,
+        keep: ShadowKeep::new(),
         shadow_due: Cell::new(false),
         layout,
         group,
@@ -433,10 +441,11 @@ fn exact_shadow(
         crate::shadow::frame_without_shadow_map(shared, "ray-exact shadow frame");
     let mut entries = core_entries(wgpu::ShaderStages::COMPUTE, levels.is_paged());
     entries.push(storage_texture_entry(3, wgpu::TextureFormat::R32Float));
+    // The listed blocks, and their tags to write (`shadow_keep.wgsl`).
     entries.push(buffer_entry(
         4,
         wgpu::ShaderStages::COMPUTE,
-        wgpu::BufferBindingType::Storage { read_only: true },
+        wgpu::BufferBindingType::Storage { read_only: false },
     ));
     let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("ray-exact shadow"),
@@ -516,6 +525,18 @@ impl RayExact {
     }
 
     /// The march's counters since creation or the last reset.
+    /// How many shadow blocks the last deferred frame cast (waits for the
+    /// GPU): those its pixels read that no earlier frame's cast was kept for.
+    pub fn shadow_blocks_cast(&self) -> anyhow::Result<u32> {
+        let words = read_words(
+            &self.device,
+            &self.queue,
+            &self.marks.stamps,
+            "shadow blocks cast",
+        )?;
+        Ok(words[0])
+    }
+
     pub fn stats(&self) -> anyhow::Result<ExactStats> {
         let w = read_words(&self.device, &self.queue, &self.stats, "ray-exact stats")?;
         Ok(ExactStats {
@@ -563,6 +584,8 @@ impl RayExact {
             pass.set_pipeline(&shadow.blocks);
             pass.dispatch_workgroups_indirect(&self.marks.stamps, 0);
         } else {
+            // Every texel of the cover, none tagged: no block is kept.
+            self.keep.forget();
             pass.set_pipeline(&shadow.pipeline);
             pass.dispatch_workgroups(SHADOW_SIZE.div_ceil(8), SHADOW_SIZE.div_ceil(8), 1);
         }
@@ -639,6 +662,8 @@ impl Method for RayExact {
         match &mut self.levels {
             Levels::Whole(pyramid) => {
                 pyramid.enqueue(rects);
+                // Shadow rays may cross the edited columns anywhere.
+                self.keep.forget();
                 Ok(())
             }
             Levels::Paged(_) => anyhow::bail!(
@@ -702,6 +727,16 @@ impl Method for RayExact {
         shared
             .queue
             .write_buffer(&self.params, 8, bytemuck::bytes_of(&self.stamp));
+        // The texel size and plane this frame's map has (the renderer fits
+        // the same frame; whether shadows are on changes neither).
+        let fit = ShadowFrame::fit(camera, true);
+        let keep = matches!(self.levels, Levels::Whole(_)) && self.defers();
+        let key = self.keep.key(&fit, shared.shadow_map_writes(), keep);
+        shared.queue.write_buffer(
+            &self.params,
+            std::mem::offset_of!(ExactParams, shadow_keep) as u64,
+            bytemuck::bytes_of(&key),
+        );
         // No block listed yet: the march lists them and the shadow pass
         // dispatches one workgroup per listed block.
         shared
@@ -712,7 +747,7 @@ impl Method for RayExact {
 
     fn record_shadow_map(
         &self,
-        _shared: &Shared,
+        shared: &Shared,
         frame: &Frame<'_>,
         encoder: &mut wgpu::CommandEncoder,
     ) -> bool {
@@ -720,6 +755,7 @@ impl Method for RayExact {
             return false;
         }
         self.record_update(frame, encoder);
+        self.keep.wrote(shared.shadow_map_written());
         if self.defers() {
             // Cast in `record`, between the march and the shading.
             self.shadow_due.set(true);
@@ -852,7 +888,7 @@ use crate::paged::PagedTerrain;
 use beam::Beam;
 pub use bindings::Levels;
 use bindings::{buffer_entry, core_bindings, core_entries, exact_pipeline, march_group};
-use deferred::{Deferred, MARK_BLOCK, ShadowMarks};
+use deferred::{Deferred, MARK_BLOCK, ShadowKeep, ShadowMarks};
 
 #[cfg(test)]
 mod tests;

@@ -738,3 +738,118 @@ fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
 
 mod pyramid;
 mod replay;
+
+/// Shadow blocks kept from earlier frames draw what casting them again
+/// draws: a camera walking and turning over the generated world, an edit on
+/// the way, and another writer of the shadow map between two frames. Each
+/// frame, bit for bit, against a method built fresh for it (which casts every
+/// block it reads) on a shared frame of its own; and the kept frames cast
+/// fewer blocks than the fresh ones, or nothing was kept.
+#[test]
+fn kept_shadow_blocks_draw_what_casting_every_block_draws() {
+    for gpu in common::gpus() {
+        let w = common::generated_world();
+        let mut level = w.level.clone();
+        let site = w.edit.clone().expect("an edit site");
+        let sized = |level: &Level| {
+            Shared::new(
+                &gpu.device,
+                &gpu.queue,
+                &gpu.caps,
+                level,
+                &TerrainColors::test_ramps(),
+                W,
+                H,
+            )
+            .unwrap()
+        };
+        let kept_shared = sized(&level);
+        let mut kept = build(&kept_shared, &level, ExactOptions::DEFAULT).unwrap();
+        assert!(kept.defers());
+        let timer = crate::timing::PassTimer::new(&gpu.device, &gpu.queue, false);
+        let read = |shared: &Shared, m: &RayExact| {
+            let color = crate::gpu::read_texture(
+                &shared.device,
+                &shared.queue,
+                &gpu.errors,
+                &shared.color,
+                wgpu::TextureAspect::All,
+            )
+            .unwrap();
+            let depth = crate::gpu::read_texture(
+                &shared.device,
+                &shared.queue,
+                &gpu.errors,
+                m.depth_image().unwrap(),
+                wgpu::TextureAspect::All,
+            )
+            .unwrap();
+            (color, depth)
+        };
+        let start = Camera::from_view(&level, &site.camera, W, H).unwrap();
+        let (mut kept_total, mut fresh_total) = (0u64, 0u64);
+        for step in 0..10u32 {
+            // A walk of a few units a frame, turning a degree.
+            let mut camera = start.clone();
+            let forward = camera.basis().forward;
+            camera.position += Vec3::new(forward.x, forward.y, 0.0) * (3.0 * step as f32);
+            camera.yaw_deg += step as f32;
+            if step == 5 {
+                let rects = dig(&w, &mut level);
+                kept_shared
+                    .terrain
+                    .upload(&gpu.queue, &level, &rects)
+                    .unwrap();
+                kept.apply_edit(&kept_shared, &level, &rects).unwrap();
+            }
+            if step == 7 {
+                // Another writer: the map is no longer what `kept` left.
+                kept_shared.shadow_map_written();
+            }
+            let shadow = crate::shadow::ShadowFrame::fit(&camera, true);
+            let globals =
+                crate::frame::Globals::new(&camera, &crate::frame::LevelShape::of(&level), &shadow);
+            record_frame(
+                &kept_shared,
+                &mut kept,
+                &camera,
+                &globals,
+                &timer,
+                step as usize,
+            );
+            let kept_picture = read(&kept_shared, &kept);
+            let kept_cast = kept.shadow_blocks_cast().unwrap();
+
+            let fresh_shared = sized(&level);
+            let mut fresh = build(&fresh_shared, &level, ExactOptions::DEFAULT).unwrap();
+            record_frame(&fresh_shared, &mut fresh, &camera, &globals, &timer, 0);
+            let fresh_picture = read(&fresh_shared, &fresh);
+            let fresh_cast = fresh.shadow_blocks_cast().unwrap();
+            eprintln!("frame {step}: blocks cast {kept_cast} kept against {fresh_cast} fresh");
+            assert!(
+                kept_picture.0 == fresh_picture.0,
+                "frame {step}: colour differs"
+            );
+            assert!(
+                kept_picture.1 == fresh_picture.1,
+                "frame {step}: depth differs"
+            );
+            assert!(kept_cast <= fresh_cast && fresh_cast > 0, "frame {step}");
+            if matches!(step, 0 | 5 | 7) {
+                // The first frame, the edit and the other writer keep nothing.
+                assert_eq!(
+                    kept_cast, fresh_cast,
+                    "frame {step} kept blocks it must not"
+                );
+            } else {
+                kept_total += u64::from(kept_cast);
+                fresh_total += u64::from(fresh_cast);
+            }
+        }
+        assert!(
+            kept_total * 2 < fresh_total,
+            "walking frames kept too little: {kept_total} cast against {fresh_total}"
+        );
+        gpu.errors.check().unwrap();
+    }
+}
