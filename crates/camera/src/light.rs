@@ -14,9 +14,11 @@ pub const SHADOW_SIZE: u32 = 1024;
 pub const SHADOW_BLOCK: u32 = 8;
 /// The map's plane lies a multiple of this many units along the light.
 pub const SHADOW_PLANE_STEP: f32 = 256.0;
-/// Texel sizes come in steps of 2^(1/8) (9 %), so a moving view keeps its
-/// texel size, and so its lattice, across most frames.
-const TEXEL_STEPS_PER_OCTAVE: f32 = 8.0;
+/// Texel sizes come in steps of 2^(1/32) (2.2 %), so a moving view keeps
+/// its texel size, and so its lattice, across most frames. (Steps of 9 %
+/// made the square so much wider than the footprint that a paged horizon
+/// view's shadow rays outgrew the test's 64-page budget.)
+const TEXEL_STEPS_PER_OCTAVE: f32 = 32.0;
 
 /// The texel size of a map whose square must span `side` units about its
 /// middle, when the middle may sit up to a block off: the next step of
@@ -62,6 +64,11 @@ pub struct ShadowFrame {
     pub v: Vec3,
     /// World units per texel.
     pub texel: f32,
+    /// World units per texel of a map fitted to the footprint exactly (the
+    /// footprint's side / [`SHADOW_SIZE`]), before `texel`'s rounding up to
+    /// a step: paged terrain's shadow rays take their level of detail from
+    /// it, so the level does not jump by a step as the view moves.
+    pub lod_texel: f32,
     /// Depth bias, world units: how far behind the blocker a point must be to be in shadow.
     pub bias: f32,
     /// The texels a visible point can sample: the rest are never cast.
@@ -130,6 +137,7 @@ impl ShadowFrame {
             u,
             v,
             texel,
+            lod_texel: side / SHADOW_SIZE as f32,
             // With the normal offset in `shading.wgsl`, a texel plus half a
             // unit (the march's bisection error) keeps lit surfaces lit.
             bias: texel + 0.5,

@@ -31,7 +31,8 @@ struct Globals {
     // the shadow texels this frame casts: half-planes (nx, ny, d, 0) in texel
     // coordinates, inside when nx cx + ny cy + d <= 0 (`ShadowCover`)
     shadow_cover: array<vec4<f32>, 16>,
-    // xyz the shadow map lattice's anchor on its plane, w unused
+    // xyz the shadow map lattice's anchor on its plane, w the texel size
+    // paged shadow rays take their level of detail from (`lod_texel`)
     shadow_anchor: vec4<f32>,
     // xy shadow texel (0, 0)'s index on the light's lattice, zw unused
     shadow_lattice: vec4<i32>,

@@ -27,7 +27,7 @@ fn lod_camera_rays() {
 // Shadow rays: one shadow-map texel wide wherever they go.
 fn lod_shadow_rays() {
     lod_per_t = 0.0;
-    lod_fixed = paged.lod.y * globals.shadow_origin.w;
+    lod_fixed = paged.lod.y * globals.shadow_anchor.w;
 }
 
 // The coarsest level whose texels a ray at `t` may take for columns: the

@@ -111,7 +111,8 @@ pub struct Globals {
     ///
     /// [`ShadowCover`]: strata_camera::light::ShadowCover
     pub shadow_cover: [[f32; 4]; MAX_COVER_EDGES],
-    /// Shadow map: the lattice's anchor on its plane (xyz, `ShadowFrame::anchor`).
+    /// Shadow map: the lattice's anchor on its plane (xyz,
+    /// `ShadowFrame::anchor`); w: `ShadowFrame::lod_texel`.
     pub shadow_anchor: [f32; 4],
     /// Shadow map: texel (0, 0)'s lattice index (xy, `ShadowFrame::lattice`).
     pub shadow_lattice: [i32; 4],
@@ -202,7 +203,7 @@ impl Globals {
             ],
             shadow_cover_count: [shadow.cover.count, 0, 0, 0],
             shadow_cover: shadow.cover.planes.map(|[nx, ny, d]| [nx, ny, d, 0.0]),
-            shadow_anchor: v4(shadow.anchor, 0.0),
+            shadow_anchor: v4(shadow.anchor, shadow.lod_texel),
             shadow_lattice: [shadow.lattice[0], shadow.lattice[1], 0, 0],
         }
     }
