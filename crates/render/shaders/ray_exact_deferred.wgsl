@@ -4,14 +4,20 @@
 // sample: on the default views 25-86 % of the map, where the visible surface
 // samples 2-17 %.)
 //
-// 1. `cs_exact_march_hits`: the exact march per pixel; writes the hit's
-//    column (relative to the eye's 256-texel tile) and `t` into `hits`, and
-//    stamps the 8x8-texel blocks of the shadow map its shading can read in
-//    `shadow_marks`.
+// 1. `cs_exact_march_hits`: the exact march per pixel. A pixel whose
+//    shading reads only shadow blocks kept from earlier frames
+//    (`shadow_keep.wgsl`), or the sky, is shaded there and then. Any other
+//    writes the hit's column (relative to the eye's 256-texel tile) and `t`
+//    into `hits`, and stamps the 8x8-texel blocks of the shadow map its
+//    shading can read in `shadow_marks`; its 8x8 tile of pixels is listed
+//    for the shading pass.
 // 2. `ray_exact_shadow.wgsl` casts the texels of stamped blocks.
-// 3. `cs_exact_shade`: shades each hit exactly as the one-pass march does
+// 3. `cs_exact_shade`: one workgroup per listed tile (an indirect dispatch)
+//    shades each of its hits exactly as the one-pass march does
 //    (`exact_pixel_shade`: same `t`, same column) and writes the
 //    depth-buffer value into `depth_out`.
+// On a still or walking view nearly every block is kept, so the shadow pass
+// and the shading dispatch nearly nothing.
 //
 // The hits are one storage buffer (8 bytes a pixel) rather than two
 // images. Measured on the H100 only together with the shading's four
@@ -36,25 +42,45 @@
 // Words 0-2: the shadow pass's indirect dispatch (x the number of listed
 // blocks, 0 at the frame's start; y and z 1). From word MARK_STAMPS, one
 // stamp per 8x8-texel block of the shadow map: `xparams.config.z` when a
-// pixel of this frame may sample the block. (One binding for both: paged
-// terrain's frame binds as many storage buffers as WebGPU allows.)
+// pixel of this frame may sample the block. After the stamps, the shading
+// pass's indirect dispatch (x the number of listed tiles). (One binding for
+// all: paged terrain's frame binds as many storage buffers as WebGPU
+// allows.)
 @group(1) @binding(6) var<storage, read_write> shadow_marks: array<atomic<u32>>;
 // The blocks stamped this frame, in the order they were first stamped; then
-// the kept blocks' tags (`shadow_keep.wgsl`).
+// the kept blocks' tags (`shadow_keep.wgsl`); then, from word 4 x blocks,
+// the pixel tiles the shading pass shades, in the order listed.
 @group(1) @binding(7) var<storage, read_write> shadow_blocks: array<u32>;
 
 const HIT_NONE: u32 = 0xffffffffu;
+// `hits.y` of a pixel the march shaded (`hits.x` HIT_NONE); 0 for the sky.
+const HIT_SHADED: u32 = 1u;
 const MARK_BLOCK: i32 = 8;
 // Twin of `deferred::MARK_STAMPS`.
 const MARK_STAMPS: u32 = 4u;
 
 var<workgroup> group_most: atomic<u32>;
+// Some pixel of the workgroup's tile left its shading to the shading pass.
+var<workgroup> group_defers: atomic<u32>;
+
+// The shading pass's dispatch: after the stamps.
+fn shade_dispatch_word() -> u32 {
+    let blocks = u32(globals.shadow_u.w) / u32(MARK_BLOCK);
+    return MARK_STAMPS + blocks * blocks;
+}
+
+// The first listed tile's word in `shadow_blocks`: after the list and tags.
+fn shade_tiles_word() -> u32 {
+    let blocks = u32(globals.shadow_u.w) / u32(MARK_BLOCK);
+    return 4u * blocks * blocks;
+}
 
 // Stamp the shadow-map blocks shading point `p` can read: `shadow_factor`
 // moves the point up to 1.5 texels along its normal, then reads the 2x2 texels
 // around it less half a texel, so every tap lies within 2 texels of p's own
-// map coordinates (2.5 here, for rounding).
-fn mark_shadow_blocks(p: vec3<f32>) {
+// map coordinates (2.5 here, for rounding). Whether every one of them is
+// kept from an earlier frame (then the point can be shaded now).
+fn mark_shadow_blocks(p: vec3<f32>) -> bool {
     let texel = globals.shadow_origin.w;
     let rel = p - globals.shadow_origin.xyz;
     let uv = vec2<f32>(dot(rel, globals.shadow_u.xyz), dot(rel, globals.shadow_v.xyz)) / texel;
@@ -63,8 +89,9 @@ fn mark_shadow_blocks(p: vec3<f32>) {
     let hi = vec2<i32>(floor(uv + vec2<f32>(2.5)));
     if (any(hi < vec2<i32>(0)) || any(lo >= vec2<i32>(side))) {
         // Off the map: shading reads nothing (taps outside are lit).
-        return;
+        return true;
     }
+    var kept = true;
     let blocks = side / MARK_BLOCK;
     let b0 = clamp(lo, vec2<i32>(0), vec2<i32>(side - 1)) / MARK_BLOCK;
     let b1 = clamp(hi, vec2<i32>(0), vec2<i32>(side - 1)) / MARK_BLOCK;
@@ -78,6 +105,7 @@ fn mark_shadow_blocks(p: vec3<f32>) {
             if (shadow_block_kept(vec2<i32>(bx, by))) {
                 continue;
             }
+            kept = false;
             // Most pixels of a block find it stamped: read before the
             // exchange; the one exchange that changes the stamp lists it.
             let i = u32(by * blocks + bx);
@@ -88,6 +116,7 @@ fn mark_shadow_blocks(p: vec3<f32>) {
             }
         }
     }
+    return kept;
 }
 
 // Casting the whole map (`ShadowCover` of every texel, how the tests check the
@@ -117,18 +146,39 @@ fn cs_exact_march_hits(
     let start = exact_group_start(group.xy, li);
     if (all(id.xy < size)) {
         page_pixel_begin();
-        let h = exact_pixel_hit_from(f32(id.x) + 0.5, f32(id.y) + 0.5, start, exact_tile_level());
+        let px = vec2<f32>(id.xy) + vec2<f32>(0.5);
+        let h = exact_pixel_hit_from(px.x, px.y, start, exact_tile_level());
         var hit = vec2<u32>(HIT_NONE, 0u);
+        // Shaded here: only where blocks are kept at all (the whole map's
+        // deferred frame; paged terrain keeps its pending marks in the
+        // shading pass).
+        var now = xparams.shadow_keep.x != 0u;
         if (h.hit) {
             let rel = h.column - exact_base(globals.eye.xy) + vec2<i32>(32768);
             // A hit on a missing page's box carries its pending mark to the
             // shading as a negative t (t >= 0 otherwise).
             let t_kept = select(h.t, -1.0 - h.t, page_pixel_missed());
             hit = vec2<u32>(u32(rel.x) | (u32(rel.y) << 16u), bitcast<u32>(t_kept));
-            if (globals.light_dir.w != 0.0 && globals.shadow_cover_count.x != 0u) {
-                let d = camera_ray(f32(id.x) + 0.5, f32(id.y) + 0.5);
-                mark_shadow_blocks(globals.eye.xyz + d * h.t);
+            if (globals.light_dir.w != 0.0) {
+                if (globals.shadow_cover_count.x != 0u) {
+                    let d = camera_ray(px.x, px.y);
+                    now = mark_shadow_blocks(globals.eye.xyz + d * h.t) && now;
+                } else {
+                    // Every block is cast this frame (`list_every_block`).
+                    now = false;
+                }
             }
+        }
+        if (now) {
+            var s = exact_pixel_sky();
+            if (h.hit) {
+                s = exact_pixel_shade(px.x, px.y, h.t, h.column);
+            }
+            textureStore(color_out, id.xy, s.color);
+            textureStore(depth_out, id.xy, vec4<f32>(s.depth, 0.0, 0.0, 0.0));
+            hit = vec2<u32>(HIT_NONE, HIT_SHADED);
+        } else {
+            atomicStore(&group_defers, 1u);
         }
         hits[id.y * size.x + id.x] = hit;
         if (globals.shadow_cover_count.x == 0u) {
@@ -141,22 +191,38 @@ fn cs_exact_march_hits(
             atomicMax(&group_most, h.iterations);
         }
     }
-    if (EXACT_ITERATION_STATS) {
-        workgroupBarrier();
-        if (li == 0u) {
+    workgroupBarrier();
+    if (li == 0u) {
+        if (EXACT_ITERATION_STATS) {
             atomicMax(&xstats[1], atomicLoad(&group_most));
+        }
+        if (atomicLoad(&group_defers) != 0u) {
+            // List the tile for the shading pass.
+            let k = atomicAdd(&shadow_marks[shade_dispatch_word()], 1u);
+            let across = (size.x + 7u) / 8u;
+            shadow_blocks[shade_tiles_word() + k] = group.y * across + group.x;
         }
     }
 }
 
+// Workgroup k shades listed tile k's pixels the march left to it.
 @compute @workgroup_size(8, 8, 1)
-fn cs_exact_shade(@builtin(global_invocation_id) id: vec3<u32>) {
+fn cs_exact_shade(
+    @builtin(workgroup_id) group: vec3<u32>,
+    @builtin(local_invocation_id) local: vec3<u32>,
+) {
     let size = vec2<u32>(globals.screen.xy);
-    if (any(id.xy >= size)) {
+    let tile = shadow_blocks[shade_tiles_word() + group.x];
+    let across = (size.x + 7u) / 8u;
+    let id = vec2<u32>(tile % across, tile / across) * 8u + local.xy;
+    if (any(id >= size)) {
         return;
     }
     let hit = hits[id.y * size.x + id.x];
     let packed = hit.x;
+    if (packed == HIT_NONE && hit.y == HIT_SHADED) {
+        return;
+    }
     var s = exact_pixel_sky();
     page_pixel_begin();
     var marched_missing = false;

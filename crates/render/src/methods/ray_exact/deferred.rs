@@ -24,7 +24,12 @@ pub(super) struct Deferred {
     pub(super) march: wgpu::ComputePipeline,
     pub(super) shade: wgpu::ComputePipeline,
     pub(super) layout: wgpu::BindGroupLayout,
+    /// The march's group.
     pub(super) group: wgpu::BindGroup,
+    /// The shading pass's: the march's with the hits bound again in the
+    /// stamps' place. It reads no stamp, and the stamps' buffer holds its
+    /// indirect dispatch, which one dispatch may not also bind as storage.
+    pub(super) shade_group: wgpu::BindGroup,
     /// Each pixel's hit: its column relative to the eye's tile and its `t`
     /// (`hits` in `ray_exact_deferred.wgsl`, [`HIT_BYTES`] a pixel).
     pub(super) hits: wgpu::Buffer,
@@ -44,9 +49,15 @@ pub(super) const MARK_BLOCK: u32 = 8;
 /// stamped this frame.
 pub(super) struct ShadowMarks {
     /// Words 0-2: the indirect dispatch (x the number of listed blocks);
-    /// from word [`MARK_STAMPS`]: block k's stamp.
+    /// from word [`MARK_STAMPS`]: block k's stamp; after the stamps, the
+    /// shading pass's indirect dispatch (x the number of listed tiles).
     pub(super) stamps: wgpu::Buffer,
+    /// The listed blocks, their tags ([`ShadowKeep`]), then the listed
+    /// pixel tiles.
     pub(super) list: wgpu::Buffer,
+    blocks: u32,
+    /// Pixel tiles the list has room for.
+    pub(super) tiles: u32,
 }
 
 /// Which shadow blocks cast by earlier frames a frame may keep
@@ -114,8 +125,14 @@ impl ShadowKeep {
 /// `ray_exact_deferred.wgsl`), after the dispatch's three.
 pub(super) const MARK_STAMPS: u32 = 4;
 
+/// 8x8-pixel tiles of the shared targets (the shading pass's unit).
+pub(super) fn pixel_tiles(shared: &Shared) -> u32 {
+    shared.width.div_ceil(8) * shared.height.div_ceil(8)
+}
+
 impl ShadowMarks {
-    pub(super) fn new(device: &wgpu::Device, blocks: u32) -> Self {
+    /// For `blocks` shadow blocks and `tiles` pixel tiles.
+    pub(super) fn new(device: &wgpu::Device, blocks: u32, tiles: u32) -> Self {
         let buffer = |label: &str, size: u64, usage: wgpu::BufferUsages| {
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
@@ -127,18 +144,26 @@ impl ShadowMarks {
         ShadowMarks {
             stamps: buffer(
                 "ray-exact shadow stamps",
-                u64::from(MARK_STAMPS + blocks) * 4,
+                u64::from(MARK_STAMPS + blocks + 4) * 4,
                 wgpu::BufferUsages::INDIRECT
                     | wgpu::BufferUsages::COPY_DST
                     | wgpu::BufferUsages::COPY_SRC,
             ),
-            // The list, then three words of tag per block (`shadow_keep.wgsl`).
+            // The list, three words of tag per block (`shadow_keep.wgsl`),
+            // then the tiles.
             list: buffer(
                 "ray-exact shadow blocks",
-                u64::from(blocks) * 4 * 4,
+                (u64::from(blocks) * 4 + u64::from(tiles)) * 4,
                 wgpu::BufferUsages::empty(),
             ),
+            blocks,
+            tiles,
         }
+    }
+
+    /// Byte offset of the shading pass's indirect dispatch in `stamps`.
+    pub(super) fn shade_dispatch(&self) -> u64 {
+        u64::from(MARK_STAMPS + self.blocks) * 4
     }
 
     pub(super) fn bytes(&self) -> u64 {
@@ -187,31 +212,49 @@ impl Deferred {
         let march = pipeline("ray-exact march", "cs_exact_march_hits")?;
         let shade = pipeline("ray-exact shade", "cs_exact_shade")?;
         let hits = hits_buffer(shared);
-        let group = Self::group(
-            shared,
-            &layout,
-            (params, levels, stats, marks),
-            depth,
-            &hits,
-            beam,
-        );
+        let buffers = (params, levels, stats, marks);
+        let group = |shading| Self::group(shared, &layout, buffers, depth, &hits, beam, shading);
         Ok(Deferred {
             fits: hits_fit(shared),
             march,
             shade,
+            group: group(false),
+            shade_group: group(true),
             layout,
-            group,
             hits,
         })
     }
 
-    pub(super) fn group(
+    /// Both groups again, over the current hits and `marks`.
+    pub(super) fn rebind(
+        &mut self,
+        shared: &Shared,
+        buffers: (&wgpu::Buffer, &Levels, &wgpu::Buffer, &ShadowMarks),
+        depth: &DepthCopy,
+        beam: Option<&wgpu::Buffer>,
+    ) {
+        self.group = Self::group(
+            shared,
+            &self.layout,
+            buffers,
+            depth,
+            &self.hits,
+            beam,
+            false,
+        );
+        self.shade_group =
+            Self::group(shared, &self.layout, buffers, depth, &self.hits, beam, true);
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn group(
         shared: &Shared,
         layout: &wgpu::BindGroupLayout,
         (params, levels, stats, marks): (&wgpu::Buffer, &Levels, &wgpu::Buffer, &ShadowMarks),
         depth: &DepthCopy,
         hits: &wgpu::Buffer,
         beam: Option<&wgpu::Buffer>,
+        shading: bool,
     ) -> wgpu::BindGroup {
         let mut entries = core_bindings(params, levels, stats);
         entries.extend(depth.bindings(shared, 3));
@@ -219,7 +262,8 @@ impl Deferred {
             binding: 5,
             resource: hits.as_entire_binding(),
         });
-        for (binding, buffer) in [(6, &marks.stamps), (7, &marks.list)] {
+        let stamps = if shading { hits } else { &marks.stamps };
+        for (binding, buffer) in [(6, stamps), (7, &marks.list)] {
             entries.push(wgpu::BindGroupEntry {
                 binding,
                 resource: buffer.as_entire_binding(),

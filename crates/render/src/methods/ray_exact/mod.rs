@@ -174,6 +174,7 @@ struct ExactShadow {
     /// The deferred frame's listed blocks (indirect).
     blocks: wgpu::ComputePipeline,
     frame_group: wgpu::BindGroup,
+    layout: wgpu::BindGroupLayout,
     group: wgpu::BindGroup,
 }
 
@@ -308,7 +309,7 @@ fn build_on(
     let deferred_frame = compute && options.exact_shadow && shared.caps.compute;
     let params = shared.uniform_buffer("ray-exact params", bytemuck::bytes_of(&table));
     let blocks = SHADOW_SIZE / MARK_BLOCK;
-    let marks = ShadowMarks::new(device, blocks * blocks);
+    let marks = ShadowMarks::new(device, blocks * blocks, deferred::pixel_tiles(shared));
     let stats = device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("ray-exact stats"),
         size: 16,
@@ -451,20 +452,7 @@ fn exact_shadow(
         label: Some("ray-exact shadow"),
         entries: &entries,
     });
-    let mut bindings = core_bindings(params, levels, stats);
-    bindings.push(wgpu::BindGroupEntry {
-        binding: 3,
-        resource: wgpu::BindingResource::TextureView(&shared.shadow_view),
-    });
-    bindings.push(wgpu::BindGroupEntry {
-        binding: 4,
-        resource: marks.list.as_entire_binding(),
-    });
-    let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("ray-exact shadow"),
-        layout: &layout,
-        entries: &bindings,
-    });
+    let group = exact_shadow_group(shared, &layout, (params, levels, stats, marks));
     let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some("ray-exact shadow"),
         bind_group_layouts: &[Some(&frame_layout), Some(&layout)],
@@ -485,7 +473,31 @@ fn exact_shadow(
         pipeline: pipeline("cs_exact_shadow")?,
         blocks: pipeline("cs_exact_shadow_blocks")?,
         frame_group,
+        layout,
         group,
+    })
+}
+
+/// The exact shadow pass's group 1: the core's bindings, the map as storage
+/// and the listed blocks.
+fn exact_shadow_group(
+    shared: &Shared,
+    layout: &wgpu::BindGroupLayout,
+    (params, levels, stats, marks): (&wgpu::Buffer, &Levels, &wgpu::Buffer, &ShadowMarks),
+) -> wgpu::BindGroup {
+    let mut bindings = core_bindings(params, levels, stats);
+    bindings.push(wgpu::BindGroupEntry {
+        binding: 3,
+        resource: wgpu::BindingResource::TextureView(&shared.shadow_view),
+    });
+    bindings.push(wgpu::BindGroupEntry {
+        binding: 4,
+        resource: marks.list.as_entire_binding(),
+    });
+    shared.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("ray-exact shadow"),
+        layout,
+        entries: &bindings,
     })
 }
 
@@ -524,19 +536,22 @@ impl RayExact {
         }
     }
 
-    /// The march's counters since creation or the last reset.
-    /// How many shadow blocks the last deferred frame cast (waits for the
-    /// GPU): those its pixels read that no earlier frame's cast was kept for.
-    pub fn shadow_blocks_cast(&self) -> anyhow::Result<u32> {
+    /// What the last deferred frame left to its later passes (waits for
+    /// the GPU): the shadow blocks it cast (those its pixels read that no
+    /// earlier frame's cast was kept for) and the pixel tiles the shading
+    /// pass shaded (those with a pixel that read such a block).
+    pub fn deferred_work(&self) -> anyhow::Result<(u32, u32)> {
         let words = read_words(
             &self.device,
             &self.queue,
             &self.marks.stamps,
-            "shadow blocks cast",
+            "deferred work",
         )?;
-        Ok(words[0])
+        let shade = (self.marks.shade_dispatch() / 4) as usize;
+        Ok((words[0], words[shade]))
     }
 
+    /// The march's counters since creation or the last reset.
     pub fn stats(&self) -> anyhow::Result<ExactStats> {
         let w = read_words(&self.device, &self.queue, &self.stats, "ray-exact stats")?;
         Ok(ExactStats {
@@ -616,7 +631,7 @@ impl RayExact {
         let beam = self.beam.as_ref().map(|b| &b.buffer);
         if let Some(d) = deferred {
             let buffers = (&self.params, &self.levels, &self.stats, &self.marks);
-            d.group = Deferred::group(shared, &d.layout, buffers, depth, &d.hits, beam);
+            d.rebind(shared, buffers, depth, beam);
         }
         self.group = march_group(
             shared,
@@ -691,6 +706,18 @@ impl Method for RayExact {
                 d.hits = deferred::hits_buffer(shared);
                 d.fits = deferred::hits_fit(shared);
             }
+            let tiles = deferred::pixel_tiles(shared);
+            if tiles > self.marks.tiles {
+                // Room for the new frame's tiles (the tags go with the old
+                // list: nothing is kept).
+                let blocks = SHADOW_SIZE / MARK_BLOCK;
+                self.marks = ShadowMarks::new(&shared.device, blocks * blocks, tiles);
+                self.keep.forget();
+                if let Some(shadow) = &mut self.shadow {
+                    let buffers = (&self.params, &self.levels, &self.stats, &self.marks);
+                    shadow.group = exact_shadow_group(shared, &shadow.layout, buffers);
+                }
+            }
             self.rebind(shared);
         }
         Ok(())
@@ -737,11 +764,12 @@ impl Method for RayExact {
             std::mem::offset_of!(ExactParams, shadow_keep) as u64,
             bytemuck::bytes_of(&key),
         );
-        // No block listed yet: the march lists them and the shadow pass
-        // dispatches one workgroup per listed block.
-        shared
-            .queue
-            .write_buffer(&self.marks.stamps, 0, bytemuck::cast_slice(&[0u32, 1, 1]));
+        // No block or tile listed yet: the march lists them, and the shadow
+        // and shading passes dispatch one workgroup per listed one.
+        let none = bytemuck::cast_slice(&[0u32, 1, 1]);
+        shared.queue.write_buffer(&self.marks.stamps, 0, none);
+        let shade = self.marks.shade_dispatch();
+        shared.queue.write_buffer(&self.marks.stamps, shade, none);
         Ok(())
     }
 
@@ -787,7 +815,18 @@ impl Method for RayExact {
                         dispatch_per_pixel(shared, frame, encoder, label, &d.march, &d.group);
                         self.record_shadow_pass(frame, encoder, true);
                         let label = "ray-exact shade";
-                        dispatch_per_pixel(shared, frame, encoder, label, &d.shade, &d.group);
+                        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                            label: Some(label),
+                            timestamp_writes: frame.timer.compute(label),
+                        });
+                        pass.set_pipeline(&d.shade);
+                        pass.set_bind_group(0, &shared.frame_group, &[]);
+                        pass.set_bind_group(1, &d.shade_group, &[]);
+                        // The tiles the march left to it.
+                        pass.dispatch_workgroups_indirect(
+                            &self.marks.stamps,
+                            self.marks.shade_dispatch(),
+                        );
                     }
                     _ => dispatch_per_pixel(
                         shared,

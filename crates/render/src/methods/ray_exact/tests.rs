@@ -744,7 +744,8 @@ mod replay;
 /// the way, and another writer of the shadow map between two frames. Each
 /// frame, bit for bit, against a method built fresh for it (which casts every
 /// block it reads) on a shared frame of its own; and the kept frames cast
-/// fewer blocks than the fresh ones, or nothing was kept.
+/// fewer blocks, and leave fewer pixel tiles to the shading pass (their
+/// pixels are shaded in the march), than the fresh ones.
 #[test]
 fn kept_shadow_blocks_draw_what_casting_every_block_draws() {
     for gpu in common::gpus() {
@@ -788,6 +789,7 @@ fn kept_shadow_blocks_draw_what_casting_every_block_draws() {
         };
         let start = Camera::from_view(&level, &site.camera, W, H).unwrap();
         let (mut kept_total, mut fresh_total) = (0u64, 0u64);
+        let mut tiles_total = (0u64, 0u64);
         for step in 0..10u32 {
             // A walk of a few units a frame, turning a degree.
             let mut camera = start.clone();
@@ -818,14 +820,16 @@ fn kept_shadow_blocks_draw_what_casting_every_block_draws() {
                 step as usize,
             );
             let kept_picture = read(&kept_shared, &kept);
-            let kept_cast = kept.shadow_blocks_cast().unwrap();
+            let (kept_cast, kept_tiles) = kept.deferred_work().unwrap();
 
             let fresh_shared = sized(&level);
             let mut fresh = build(&fresh_shared, &level, ExactOptions::DEFAULT).unwrap();
             record_frame(&fresh_shared, &mut fresh, &camera, &globals, &timer, 0);
             let fresh_picture = read(&fresh_shared, &fresh);
-            let fresh_cast = fresh.shadow_blocks_cast().unwrap();
-            eprintln!("frame {step}: blocks cast {kept_cast} kept against {fresh_cast} fresh");
+            let (fresh_cast, fresh_tiles) = fresh.deferred_work().unwrap();
+            eprintln!(
+                "frame {step}: blocks cast {kept_cast} kept against {fresh_cast} fresh, tiles left to the shading {kept_tiles} against {fresh_tiles}"
+            );
             assert!(
                 kept_picture.0 == fresh_picture.0,
                 "frame {step}: colour differs"
@@ -835,6 +839,9 @@ fn kept_shadow_blocks_draw_what_casting_every_block_draws() {
                 "frame {step}: depth differs"
             );
             assert!(kept_cast <= fresh_cast && fresh_cast > 0, "frame {step}");
+            // A fresh method keeps nothing: every tile is left to the
+            // shading; a kept frame shades most of its pixels in the march.
+            assert!(kept_tiles <= fresh_tiles && fresh_tiles > 0, "frame {step}");
             if matches!(step, 0 | 5 | 7) {
                 // The first frame, the edit and the other writer keep nothing.
                 assert_eq!(
@@ -844,11 +851,17 @@ fn kept_shadow_blocks_draw_what_casting_every_block_draws() {
             } else {
                 kept_total += u64::from(kept_cast);
                 fresh_total += u64::from(fresh_cast);
+                tiles_total.0 += u64::from(kept_tiles);
+                tiles_total.1 += u64::from(fresh_tiles);
             }
         }
         assert!(
             kept_total * 2 < fresh_total,
             "walking frames kept too little: {kept_total} cast against {fresh_total}"
+        );
+        assert!(
+            tiles_total.0 * 2 < tiles_total.1,
+            "walking frames shaded too little in the march: {tiles_total:?} tiles left to the shading"
         );
         gpu.errors.check().unwrap();
     }
