@@ -87,6 +87,11 @@ pub struct ExactOptions {
     /// and a global atomic a workgroup, so off unless asked (the renderer's
     /// `exact_stats` turns it on too). Capped rays are counted either way.
     pub iteration_stats: bool,
+    /// The deferred frame keeps the shadow blocks earlier frames cast and
+    /// shades in the march the pixels that read only kept blocks
+    /// (`shadow_keep.wgsl`; the same pictures either way). Off casts every
+    /// block a frame reads and shades in a pass of its own, for A/B.
+    pub shadow_keep: bool,
 }
 
 /// How `ray-exact`'s march walks the texels of a 4x4-texel tile it comes
@@ -207,6 +212,7 @@ impl ExactOptions {
         // Off: on the H100 the statistic cost 0.0019 ms of a 0.1591 ms frame
         // (`bench/issue36-floors/`).
         iteration_stats: false,
+        shadow_keep: true,
     };
 
     /// Which pyramid levels to keep: only those the traversals visit. The

@@ -88,7 +88,12 @@ fn gpu_shadow_map_and_shading_match_the_cpu_colour_reference() {
             .filter(|&&k| (gpu_map[k] - cpu.depth[k]).abs() > frame.bias)
             .count();
         let off_pct = 100.0 * off as f64 / cast.len().max(1) as f64;
-        // The march can only find a caster late or miss it, never early.
+        // The march can only find a caster late or miss it, never early:
+        // but for a ray that grazes a column's edge, where the GPU's f32
+        // texel centre (a fused multiply-add of lattice coordinates some
+        // thousand units long) and the CPU's differ by a thousandth of a
+        // unit (seen: 2 of 175,842 texels). A wrong frame, axis or centre
+        // puts thousands early.
         let early = gpu_map
             .iter()
             .zip(&cpu.depth)
@@ -111,7 +116,11 @@ fn gpu_shadow_map_and_shading_match_the_cpu_colour_reference() {
             "{}: {off_pct} % of shadow texels off",
             view.name
         );
-        assert_eq!(early, 0, "{}: texels where the march is early", view.name);
+        assert!(
+            early * 20_000 <= cast.len(),
+            "{}: {early} texels where the march is early",
+            view.name
+        );
 
         // Shading: the exact march hits what the CPU hits, so ꟻLIP measures
         // only the shading (and the GPU's f32 hit point).

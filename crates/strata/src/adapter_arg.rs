@@ -54,7 +54,9 @@ pub fn parse_backend(s: &str) -> anyhow::Result<BackendChoice> {
 /// (the beams' finest test on 4-texel tiles),
 /// `STRATA_EXACT_TEXEL_BLOCKS=plane|beside` (a 4x4 tile's texels walked
 /// from the texel plane, its words loaded on the way down or beside the
-/// tile's maximum) configure `ray-exact`;
+/// tile's maximum), `STRATA_EXACT_KEEP=off` (cast every shadow block a
+/// frame reads and shade in a pass of its own, keeping nothing from earlier
+/// frames) configure `ray-exact`;
 /// `STRATA_EXACT_STATS=1` prints its statistics;
 /// `STRATA_TEST_OVERSIZE_BUILD=METHOD` makes that method's build ask for a
 /// buffer over the device's limit (the README's way to see a refused build).
@@ -109,6 +111,7 @@ fn render_options_from(var: impl Fn(&str) -> Option<String>) -> RenderOptions {
             },
             cave_skip: !is("STRATA_EXACT_CAVE_SKIP", "off"),
             beam_texels: !is("STRATA_EXACT_BEAM_TEXELS", "off"),
+            shadow_keep: !is("STRATA_EXACT_KEEP", "off"),
             texel_walk: match var("STRATA_EXACT_TEXEL_BLOCKS").as_deref() {
                 Some("off") => TexelWalk::Terrain,
                 Some("plane") => TexelWalk::Plane,
@@ -138,6 +141,7 @@ mod tests {
             "STRATA_EXACT_FUSED_DESCENT" => Some("on".into()),
             "STRATA_EXACT_CAVE_SKIP" => Some("off".into()),
             "STRATA_EXACT_BEAM_TEXELS" => Some("off".into()),
+            "STRATA_EXACT_KEEP" => Some("off".into()),
             "STRATA_EXACT_TEXEL_BLOCKS" => Some("beside".into()),
             "STRATA_TEST_OVERSIZE_BUILD" => Some("voxel".into()),
             _ => None,
@@ -149,7 +153,8 @@ mod tests {
             render_options_from(|_| None).exact.texel_walk,
             TexelWalk::Terrain
         );
-        assert!(!o.exact.cave_skip && !o.exact.beam_texels);
+        assert!(!o.exact.cave_skip && !o.exact.beam_texels && !o.exact.shadow_keep);
+        assert!(render_options_from(|_| None).exact.shadow_keep);
         assert!(render_options_from(|_| None).exact.beam_texels);
         assert!(render_options_from(|_| None).exact.cave_skip);
         assert!(render_options_from(|_| None).exact.beam);

@@ -37,6 +37,17 @@
 //! no other method reuses it. Frames that reuse a map, or have shadows off,
 //! march and shade in one pass.
 //!
+//! Over the whole map the deferred frame also keeps the blocks earlier
+//! frames cast (`shadow_keep.wgsl`, `deferred::ShadowKeep`): the map's texels
+//! lie on a lattice fixed to the light and sit in the texture at their
+//! lattice index wrapped ([`strata_camera::light::ShadowFrame::slot`]), so a
+//! block cast while the texel size and the plane were the same, and with no
+//! edit or other writer of the map since, holds what casting it again would.
+//! The march lists only blocks that are not kept, and shades on the spot every
+//! pixel whose blocks all are; the shading pass runs only over the 8x8 tiles
+//! with a pixel left. A still view casts and shades nothing after its first
+//! frame; a walking one casts the blocks that come into view.
+//!
 //! The compute variant over the whole map first searches a beam per 8x8-pixel
 //! tile (`beam.rs`, `ray_exact_beam.wgsl`, issue 36): the least `t` at which
 //! any ray of the tile may meet a solid point, and the march starts each of
@@ -189,6 +200,8 @@ pub struct RayExact {
     stamp: u32,
     /// Which shadow blocks of earlier frames this frame keeps.
     keep: ShadowKeep,
+    /// [`ExactOptions::shadow_keep`].
+    keep_shadow: bool,
     /// The renderer asked for the shadow map this frame; the deferred frame
     /// casts it between march and shading.
     shadow_due: Cell<bool>,
@@ -410,6 +423,7 @@ fn build_on(
         marks,
         stamp: 0,
         keep: ShadowKeep::new(),
+        keep_shadow: options.shadow_keep,
         shadow_due: Cell::new(false),
         layout,
         group,
@@ -757,7 +771,7 @@ impl Method for RayExact {
         // The texel size and plane this frame's map has (the renderer fits
         // the same frame; whether shadows are on changes neither).
         let fit = ShadowFrame::fit(camera, true);
-        let keep = matches!(self.levels, Levels::Whole(_)) && self.defers();
+        let keep = self.keep_shadow && matches!(self.levels, Levels::Whole(_)) && self.defers();
         let key = self.keep.key(&fit, shared.shadow_map_writes(), keep);
         shared.queue.write_buffer(
             &self.params,

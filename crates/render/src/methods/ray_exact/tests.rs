@@ -556,6 +556,10 @@ fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
             },
             ExactOptions { beam: false, ..d },
             ExactOptions {
+                shadow_keep: false,
+                ..d
+            },
+            ExactOptions {
                 beam: false,
                 exact_shadow: false,
                 ..d
