@@ -106,7 +106,8 @@ pub const REFERENCE_VERSION: u32 = 1;
 
 /// Bumped whenever the colour reference (`shading`, `shadow_map`) can change
 /// for the same level, camera and colours; part of every colour cache key.
-pub const COLOR_VERSION: u32 = 1;
+/// 2: the shadow map's texels on the light's lattice, in steps of size.
+pub const COLOR_VERSION: u32 = 2;
 
 /// What a pixel's ray hit.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
