@@ -43,9 +43,10 @@
 // blocks, 0 at the frame's start; y and z 1). From word MARK_STAMPS, one
 // stamp per 8x8-texel block of the shadow map: `xparams.config.z` when a
 // pixel of this frame may sample the block. After the stamps, the shading
-// pass's indirect dispatch (x the number of listed tiles). (One binding for
-// all: paged terrain's frame binds as many storage buffers as WebGPU
-// allows.)
+// pass's indirect dispatch (x the number of listed tiles), a word of
+// padding, and a stamp per 8x8-pixel tile: `xparams.config.z` when a pixel
+// of the tile left its shading to the shading pass. (One binding for all:
+// paged terrain's frame binds as many storage buffers as WebGPU allows.)
 @group(1) @binding(6) var<storage, read_write> shadow_marks: array<atomic<u32>>;
 // The blocks stamped this frame, in the order they were first stamped; then
 // the kept blocks' tags (`shadow_keep.wgsl`); then, from word 4 x blocks,
@@ -60,8 +61,6 @@ const MARK_BLOCK: i32 = 8;
 const MARK_STAMPS: u32 = 4u;
 
 var<workgroup> group_most: atomic<u32>;
-// Some pixel of the workgroup's tile left its shading to the shading pass.
-var<workgroup> group_defers: atomic<u32>;
 
 // The shading pass's dispatch: after the stamps.
 fn shade_dispatch_word() -> u32 {
@@ -178,7 +177,17 @@ fn cs_exact_march_hits(
             textureStore(depth_out, id.xy, vec4<f32>(s.depth, 0.0, 0.0, 0.0));
             hit = vec2<u32>(HIT_NONE, HIT_SHADED);
         } else {
-            atomicStore(&group_defers, 1u);
+            // The first of the tile's pixels to find it unstamped lists it
+            // (a stamp, not a workgroup flag and barrier: llvmpipe pays for
+            // a barrier after the walk over the whole walk).
+            let across = (size.x + 7u) / 8u;
+            let tile = group.y * across + group.x;
+            let word = shade_dispatch_word() + 4u + tile;
+            let stamp = xparams.config.z;
+            if (atomicLoad(&shadow_marks[word]) != stamp && atomicExchange(&shadow_marks[word], stamp) != stamp) {
+                let k = atomicAdd(&shadow_marks[shade_dispatch_word()], 1u);
+                shadow_blocks[shade_tiles_word() + k] = tile;
+            }
         }
         hits[id.y * size.x + id.x] = hit;
         if (globals.shadow_cover_count.x == 0u) {
@@ -191,16 +200,10 @@ fn cs_exact_march_hits(
             atomicMax(&group_most, h.iterations);
         }
     }
-    workgroupBarrier();
-    if (li == 0u) {
-        if (EXACT_ITERATION_STATS) {
+    if (EXACT_ITERATION_STATS) {
+        workgroupBarrier();
+        if (li == 0u) {
             atomicMax(&xstats[1], atomicLoad(&group_most));
-        }
-        if (atomicLoad(&group_defers) != 0u) {
-            // List the tile for the shading pass.
-            let k = atomicAdd(&shadow_marks[shade_dispatch_word()], 1u);
-            let across = (size.x + 7u) / 8u;
-            shadow_blocks[shade_tiles_word() + k] = group.y * across + group.x;
         }
     }
 }

@@ -50,7 +50,8 @@ pub(super) const MARK_BLOCK: u32 = 8;
 pub(super) struct ShadowMarks {
     /// Words 0-2: the indirect dispatch (x the number of listed blocks);
     /// from word [`MARK_STAMPS`]: block k's stamp; after the stamps, the
-    /// shading pass's indirect dispatch (x the number of listed tiles).
+    /// shading pass's indirect dispatch (x the number of listed tiles), a
+    /// word of padding and a stamp per pixel tile.
     pub(super) stamps: wgpu::Buffer,
     /// The listed blocks, their tags ([`ShadowKeep`]), then the listed
     /// pixel tiles.
@@ -144,7 +145,7 @@ impl ShadowMarks {
         ShadowMarks {
             stamps: buffer(
                 "ray-exact shadow stamps",
-                u64::from(MARK_STAMPS + blocks + 4) * 4,
+                (u64::from(MARK_STAMPS + blocks + 4) + u64::from(tiles)) * 4,
                 wgpu::BufferUsages::INDIRECT
                     | wgpu::BufferUsages::COPY_DST
                     | wgpu::BufferUsages::COPY_SRC,
