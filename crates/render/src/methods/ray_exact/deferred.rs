@@ -26,10 +26,13 @@ pub(super) struct Deferred {
     pub(super) layout: wgpu::BindGroupLayout,
     /// The march's group.
     pub(super) group: wgpu::BindGroup,
-    /// The shading pass's: the march's with the hits bound again in the
+    /// The shading pass's: the march's with [`Deferred::stand_in`] in the
     /// stamps' place. It reads no stamp, and the stamps' buffer holds its
     /// indirect dispatch, which one dispatch may not also bind as storage.
     pub(super) shade_group: wgpu::BindGroup,
+    /// A word of storage bound as the shading pass's stamps (WebGPU also
+    /// refuses one buffer bound writable at two bindings of a dispatch).
+    stand_in: wgpu::Buffer,
     /// Each pixel's hit: its column relative to the eye's tile and its `t`
     /// (`hits` in `ray_exact_deferred.wgsl`, [`HIT_BYTES`] a pixel).
     pub(super) hits: wgpu::Buffer,
@@ -213,14 +216,21 @@ impl Deferred {
         let march = pipeline("ray-exact march", "cs_exact_march_hits")?;
         let shade = pipeline("ray-exact shade", "cs_exact_shade")?;
         let hits = hits_buffer(shared);
+        let stand_in = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("ray-exact shading's stamps stand-in"),
+            size: 16,
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        });
         let buffers = (params, levels, stats, marks);
-        let group = |shading| Self::group(shared, &layout, buffers, depth, &hits, beam, shading);
+        let group = |stamps| Self::group(shared, &layout, buffers, depth, &hits, beam, stamps);
         Ok(Deferred {
             fits: hits_fit(shared),
             march,
             shade,
-            group: group(false),
-            shade_group: group(true),
+            group: group(&marks.stamps),
+            shade_group: group(&stand_in),
+            stand_in,
             layout,
             hits,
         })
@@ -234,17 +244,11 @@ impl Deferred {
         depth: &DepthCopy,
         beam: Option<&wgpu::Buffer>,
     ) {
-        self.group = Self::group(
-            shared,
-            &self.layout,
-            buffers,
-            depth,
-            &self.hits,
-            beam,
-            false,
-        );
-        self.shade_group =
-            Self::group(shared, &self.layout, buffers, depth, &self.hits, beam, true);
+        let stamps = &buffers.3.stamps;
+        let (layout, hits) = (&self.layout, &self.hits);
+        self.group = Self::group(shared, layout, buffers, depth, hits, beam, stamps);
+        let stand_in = &self.stand_in;
+        self.shade_group = Self::group(shared, layout, buffers, depth, hits, beam, stand_in);
     }
 
     #[allow(clippy::too_many_arguments)]
@@ -255,7 +259,7 @@ impl Deferred {
         depth: &DepthCopy,
         hits: &wgpu::Buffer,
         beam: Option<&wgpu::Buffer>,
-        shading: bool,
+        stamps: &wgpu::Buffer,
     ) -> wgpu::BindGroup {
         let mut entries = core_bindings(params, levels, stats);
         entries.extend(depth.bindings(shared, 3));
@@ -263,7 +267,6 @@ impl Deferred {
             binding: 5,
             resource: hits.as_entire_binding(),
         });
-        let stamps = if shading { hits } else { &marks.stamps };
         for (binding, buffer) in [(6, stamps), (7, &marks.list)] {
             entries.push(wgpu::BindGroupEntry {
                 binding,
