@@ -797,7 +797,7 @@ fn kept_shadow_blocks_draw_what_casting_every_block_draws() {
         let mut tiles_total = (0u64, 0u64);
         for step in 0..10u32 {
             // A walk of a few units a frame, turning a degree.
-            let mut camera = start.clone();
+            let mut camera = start;
             let forward = camera.basis().forward;
             camera.position += Vec3::new(forward.x, forward.y, 0.0) * (3.0 * step as f32);
             camera.yaw_deg += step as f32;
