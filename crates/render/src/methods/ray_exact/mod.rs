@@ -116,7 +116,7 @@
 use super::common::{DepthCopy, dispatch_per_pixel, fullscreen_pipeline};
 pub mod pyramid;
 use super::contract::{Frame, Method, MethodSettings, RetainedBytes};
-use crate::frame::{SHADOW_SIZE, Shared, storage_texture_entry};
+use crate::frame::{SHADOW_SIZE, Shared};
 use crate::gpu::read_words;
 use pyramid::GpuMaxMip;
 use serde::Serialize;
@@ -176,17 +176,6 @@ enum Variant {
         deferred: Option<Box<Deferred>>,
     },
     Fragment(wgpu::RenderPipeline),
-}
-
-/// The exact shadow-map pass.
-struct ExactShadow {
-    /// Every texel of the view's cover.
-    pipeline: wgpu::ComputePipeline,
-    /// The deferred frame's listed blocks (indirect).
-    blocks: wgpu::ComputePipeline,
-    frame_group: wgpu::BindGroup,
-    layout: wgpu::BindGroupLayout,
-    group: wgpu::BindGroup,
 }
 
 pub struct RayExact {
@@ -409,8 +398,10 @@ fn build_on(
         )?),
     };
     let shadow = if shared.caps.compute && options.exact_shadow {
-        Some(exact_shadow(
-            shared, &params, &levels, &stats, &marks, options,
+        Some(ExactShadow::new(
+            shared,
+            (&params, &levels, &stats, &marks),
+            options,
         )?)
     } else {
         None
@@ -438,80 +429,6 @@ fn build_on(
             .then(|| crate::timing::PassTimer::new(device, &shared.queue, true)),
         update_timed: Cell::new(false),
         update_ms: Vec::new(),
-    })
-}
-
-/// The shadow map by the exact march: group 0 without the shadow map (it is
-/// written here), group 1 the core's bindings and the map as storage.
-fn exact_shadow(
-    shared: &Shared,
-    params: &wgpu::Buffer,
-    levels: &Levels,
-    stats: &wgpu::Buffer,
-    marks: &ShadowMarks,
-    options: ExactOptions,
-) -> anyhow::Result<ExactShadow> {
-    let device = &shared.device;
-    let (frame_layout, frame_group) =
-        crate::shadow::frame_without_shadow_map(shared, "ray-exact shadow frame");
-    let mut entries = core_entries(wgpu::ShaderStages::COMPUTE, levels.is_paged());
-    entries.push(storage_texture_entry(3, wgpu::TextureFormat::R32Float));
-    // The listed blocks, and their tags to write (`shadow_keep.wgsl`).
-    entries.push(buffer_entry(
-        4,
-        wgpu::ShaderStages::COMPUTE,
-        wgpu::BufferBindingType::Storage { read_only: false },
-    ));
-    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("ray-exact shadow"),
-        entries: &entries,
-    });
-    let group = exact_shadow_group(shared, &layout, (params, levels, stats, marks));
-    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some("ray-exact shadow"),
-        bind_group_layouts: &[Some(&frame_layout), Some(&layout)],
-        immediate_size: 0,
-    });
-    let pipeline = |entry: &str| {
-        exact_pipeline(
-            shared,
-            "ray-exact shadow",
-            levels,
-            "ray_exact_shadow.wgsl",
-            &pipeline_layout,
-            entry,
-            options,
-        )
-    };
-    Ok(ExactShadow {
-        pipeline: pipeline("cs_exact_shadow")?,
-        blocks: pipeline("cs_exact_shadow_blocks")?,
-        frame_group,
-        layout,
-        group,
-    })
-}
-
-/// The exact shadow pass's group 1: the core's bindings, the map as storage
-/// and the listed blocks.
-fn exact_shadow_group(
-    shared: &Shared,
-    layout: &wgpu::BindGroupLayout,
-    (params, levels, stats, marks): (&wgpu::Buffer, &Levels, &wgpu::Buffer, &ShadowMarks),
-) -> wgpu::BindGroup {
-    let mut bindings = core_bindings(params, levels, stats);
-    bindings.push(wgpu::BindGroupEntry {
-        binding: 3,
-        resource: wgpu::BindingResource::TextureView(&shared.shadow_view),
-    });
-    bindings.push(wgpu::BindGroupEntry {
-        binding: 4,
-        resource: marks.list.as_entire_binding(),
-    });
-    shared.device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("ray-exact shadow"),
-        layout,
-        entries: &bindings,
     })
 }
 
@@ -603,20 +520,12 @@ impl RayExact {
         let Some(shadow) = &self.shadow else {
             return;
         };
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("ray-exact shadow"),
-            timestamp_writes: frame.timer.compute("shadow"),
-        });
-        pass.set_bind_group(0, &shadow.frame_group, &[]);
-        pass.set_bind_group(1, &shadow.group, &[]);
         if listed {
-            pass.set_pipeline(&shadow.blocks);
-            pass.dispatch_workgroups_indirect(&self.marks.stamps, 0);
+            shadow.record_listed(frame, encoder, &self.marks);
         } else {
             // Every texel of the cover, none tagged: no block is kept.
             self.keep.forget();
-            pass.set_pipeline(&shadow.pipeline);
-            pass.dispatch_workgroups(SHADOW_SIZE.div_ceil(8), SHADOW_SIZE.div_ceil(8), 1);
+            shadow.record_cover(frame, encoder);
         }
     }
 
@@ -729,7 +638,7 @@ impl Method for RayExact {
                 self.keep.forget();
                 if let Some(shadow) = &mut self.shadow {
                     let buffers = (&self.params, &self.levels, &self.stats, &self.marks);
-                    shadow.group = exact_shadow_group(shared, &shadow.layout, buffers);
+                    shadow.rebind(shared, buffers);
                 }
             }
             self.rebind(shared);
@@ -937,11 +846,13 @@ mod beam;
 mod bindings;
 mod deferred;
 pub mod replay;
+mod shadow;
 use crate::paged::PagedTerrain;
 use beam::Beam;
 pub use bindings::Levels;
-use bindings::{buffer_entry, core_bindings, core_entries, exact_pipeline, march_group};
+use bindings::{core_entries, exact_pipeline, march_group};
 use deferred::{Deferred, MARK_BLOCK, ShadowKeep, ShadowMarks};
+use shadow::ExactShadow;
 
 #[cfg(test)]
 mod tests;

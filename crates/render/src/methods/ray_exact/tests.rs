@@ -6,6 +6,7 @@
 //! the first frame after the crater against a fresh build. Small images:
 //! lavapipe is slow.
 
+use super::bindings::{buffer_entry, core_bindings};
 use super::pyramid::GpuMaxMip;
 use super::*;
 use crate::frame::{Shared, TerrainColors};
