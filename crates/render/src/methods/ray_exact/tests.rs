@@ -45,14 +45,19 @@ fn dig(world: &World, level: &mut Level) -> Vec<DirtyRect> {
 }
 
 fn shared_for(gpu: &crate::Gpu, level: &Level) -> Shared {
+    shared_sized(gpu, level, (8, 8))
+}
+
+/// A shared frame of `level` with targets of `width` x `height`.
+fn shared_sized(gpu: &crate::Gpu, level: &Level, (width, height): (u32, u32)) -> Shared {
     Shared::new(
         &gpu.device,
         &gpu.queue,
         &gpu.caps,
         level,
         &TerrainColors::test_ramps(),
-        8,
-        8,
+        width,
+        height,
     )
     .unwrap()
 }
@@ -758,18 +763,7 @@ fn kept_shadow_blocks_draw_what_casting_every_block_draws() {
         let w = common::generated_world();
         let mut level = w.level.clone();
         let site = w.edit.clone().expect("an edit site");
-        let sized = |level: &Level| {
-            Shared::new(
-                &gpu.device,
-                &gpu.queue,
-                &gpu.caps,
-                level,
-                &TerrainColors::test_ramps(),
-                W,
-                H,
-            )
-            .unwrap()
-        };
+        let sized = |level: &Level| shared_sized(&gpu, level, (W, H));
         let kept_shared = sized(&level);
         let mut kept = build(&kept_shared, &level, ExactOptions::DEFAULT).unwrap();
         assert!(kept.defers());
