@@ -92,6 +92,12 @@ pub struct ExactOptions {
     /// (`shadow_keep.wgsl`; the same pictures either way). Off casts every
     /// block a frame reads and shades in a pass of its own, for A/B.
     pub shadow_keep: bool,
+    /// With [`ExactOptions::shadow_keep`]: once the kept blocks' key has held
+    /// for a frame, the shadow pass casts up to this many blocks of the
+    /// view's cover ahead of the march each frame, and a frame whose whole
+    /// cover is cast marches and shades in one pass, with no stamps and no
+    /// shadow or shading pass (`ray_exact/cover.rs`). 0: never.
+    pub cover_budget: u32,
 }
 
 /// How `ray-exact`'s march walks the texels of a 4x4-texel tile it comes
@@ -213,6 +219,10 @@ impl ExactOptions {
         // (`bench/issue36-floors/`).
         iteration_stats: false,
         shadow_keep: true,
+        // A still view's cover (4,000-14,000 blocks at 1280x800) is whole
+        // within a few dozen frames; a moving one casts at most this much
+        // more a frame (~0.006 ms on the H100).
+        cover_budget: 256,
     };
 
     /// Which pyramid levels to keep: only those the traversals visit. The

@@ -56,7 +56,8 @@ pub fn parse_backend(s: &str) -> anyhow::Result<BackendChoice> {
 /// from the texel plane, its words loaded on the way down or beside the
 /// tile's maximum), `STRATA_EXACT_KEEP=off` (cast every shadow block a
 /// frame reads and shade in a pass of its own, keeping nothing from earlier
-/// frames) configure `ray-exact`;
+/// frames), `STRATA_EXACT_COVER=off|N` (never cast the view's cover ahead
+/// of the march, or up to N blocks a frame) configure `ray-exact`;
 /// `STRATA_EXACT_STATS=1` prints its statistics;
 /// `STRATA_TEST_OVERSIZE_BUILD=METHOD` makes that method's build ask for a
 /// buffer over the device's limit (the README's way to see a refused build).
@@ -112,6 +113,11 @@ fn render_options_from(var: impl Fn(&str) -> Option<String>) -> RenderOptions {
             cave_skip: !is("STRATA_EXACT_CAVE_SKIP", "off"),
             beam_texels: !is("STRATA_EXACT_BEAM_TEXELS", "off"),
             shadow_keep: !is("STRATA_EXACT_KEEP", "off"),
+            cover_budget: match var("STRATA_EXACT_COVER").as_deref() {
+                Some("off") => 0,
+                Some(n) => n.parse().unwrap_or(e.cover_budget),
+                None => e.cover_budget,
+            },
             texel_walk: match var("STRATA_EXACT_TEXEL_BLOCKS").as_deref() {
                 Some("off") => TexelWalk::Terrain,
                 Some("plane") => TexelWalk::Plane,
@@ -142,6 +148,7 @@ mod tests {
             "STRATA_EXACT_CAVE_SKIP" => Some("off".into()),
             "STRATA_EXACT_BEAM_TEXELS" => Some("off".into()),
             "STRATA_EXACT_KEEP" => Some("off".into()),
+            "STRATA_EXACT_COVER" => Some("off".into()),
             "STRATA_EXACT_TEXEL_BLOCKS" => Some("beside".into()),
             "STRATA_TEST_OVERSIZE_BUILD" => Some("voxel".into()),
             _ => None,
@@ -155,6 +162,10 @@ mod tests {
         );
         assert!(!o.exact.cave_skip && !o.exact.beam_texels && !o.exact.shadow_keep);
         assert!(render_options_from(|_| None).exact.shadow_keep);
+        assert_eq!(o.exact.cover_budget, 0);
+        let n = render_options_from(|n| (n == "STRATA_EXACT_COVER").then(|| "4096".into()));
+        assert_eq!(n.exact.cover_budget, 4096);
+        assert_eq!(render_options_from(|_| None).exact.cover_budget, 256);
         assert!(render_options_from(|_| None).exact.beam_texels);
         assert!(render_options_from(|_| None).exact.cave_skip);
         assert!(render_options_from(|_| None).exact.beam);

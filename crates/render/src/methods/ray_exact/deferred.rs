@@ -155,10 +155,11 @@ impl ShadowMarks {
             ),
             // The list, three words of tag per block (`shadow_keep.wgsl`),
             // then the tiles.
+            // (Written by the CPU too: the cover's blocks, `cover.rs`.)
             list: buffer(
                 "ray-exact shadow blocks",
                 (u64::from(blocks) * 4 + u64::from(tiles)) * 4,
-                wgpu::BufferUsages::empty(),
+                wgpu::BufferUsages::COPY_DST,
             ),
             blocks,
             tiles,

@@ -120,7 +120,7 @@ use crate::frame::{SHADOW_SIZE, Shared};
 use crate::gpu::read_words;
 use pyramid::GpuMaxMip;
 use serde::Serialize;
-use std::cell::Cell;
+use std::cell::{Cell, RefCell};
 use strata_camera::Camera;
 use strata_camera::light::ShadowFrame;
 use strata_level::{DirtyRect, Level};
@@ -191,6 +191,16 @@ pub struct RayExact {
     keep: ShadowKeep,
     /// [`ExactOptions::shadow_keep`].
     keep_shadow: bool,
+    /// The cover blocks this method's listed casts hold (`cover.rs`).
+    cover: RefCell<CoverKeep>,
+    /// This frame's plan for them (recorded with the shadow map, if cast)
+    /// and the map it is for.
+    cover_plan: RefCell<Option<(CoverPlan, ShadowFrame)>>,
+    /// [`ExactOptions::cover_budget`].
+    cover_budget: u32,
+    /// The last frame that cast the map found its cover whole and marched
+    /// in one pass.
+    covered: Cell<bool>,
     /// The renderer asked for the shadow map this frame; the deferred frame
     /// casts it between march and shading.
     shadow_due: Cell<bool>,
@@ -415,6 +425,10 @@ fn build_on(
         stamp: 0,
         keep: ShadowKeep::new(),
         keep_shadow: options.shadow_keep,
+        cover: RefCell::new(CoverKeep::new()),
+        cover_plan: RefCell::new(None),
+        cover_budget: options.cover_budget,
+        covered: Cell::new(false),
         shadow_due: Cell::new(false),
         layout,
         group,
@@ -480,6 +494,12 @@ impl RayExact {
         )?;
         let shade = (self.marks.shade_dispatch() / 4) as usize;
         Ok((words[0], words[shade]))
+    }
+
+    /// Whether the last frame that cast the shadow map found every block of
+    /// its cover cast and marched and shaded in one pass (`cover.rs`).
+    pub fn covered(&self) -> bool {
+        self.covered.get()
     }
 
     /// The march's counters since creation or the last reset.
@@ -682,6 +702,12 @@ impl Method for RayExact {
         let fit = ShadowFrame::fit(camera, true);
         let keep = self.keep_shadow && matches!(self.levels, Levels::Whole(_)) && self.defers();
         let key = self.keep.key(&fit, shared.shadow_map_writes(), keep);
+        let plan = if self.shadow.is_some() {
+            self.cover.get_mut().plan(key, &fit, self.cover_budget)
+        } else {
+            CoverPlan::default()
+        };
+        *self.cover_plan.get_mut() = (key != 0).then_some((plan, fit));
         shared.queue.write_buffer(
             &self.params,
             std::mem::offset_of!(ExactParams, shadow_keep) as u64,
@@ -708,8 +734,25 @@ impl Method for RayExact {
         self.record_update(frame, encoder);
         self.keep.wrote(shared.shadow_map_written());
         if self.defers() {
-            // Cast in `record`, between the march and the shading.
-            self.shadow_due.set(true);
+            let (plan, map) = match self.cover_plan.borrow_mut().take() {
+                Some((plan, map)) => (plan, Some(map)),
+                None => (CoverPlan::default(), None),
+            };
+            if let (Some(shadow), false) = (&self.shadow, plan.cast.is_empty()) {
+                // The cover's blocks not cast yet, ahead of the march.
+                let list = bytemuck::cast_slice(&plan.cast);
+                shared.queue.write_buffer(&self.marks.list, 0, list);
+                shadow.record_blocks(frame, encoder, plan.cast.len() as u32);
+                self.cover.borrow_mut().cast(&plan);
+            }
+            self.covered.set(plan.covered);
+            if !plan.covered {
+                // Cast in `record`, between the march and the shading.
+                self.shadow_due.set(true);
+                if let Some(map) = map {
+                    self.cover.borrow_mut().after_deferred_frame(&map);
+                }
+            }
         } else {
             self.record_shadow_pass(frame, encoder, false);
         }
@@ -844,6 +887,7 @@ impl Drop for RayExact {
 
 mod beam;
 mod bindings;
+mod cover;
 mod deferred;
 pub mod replay;
 mod shadow;
@@ -851,6 +895,7 @@ use crate::paged::PagedTerrain;
 use beam::Beam;
 pub use bindings::Levels;
 use bindings::{core_entries, exact_pipeline, march_group};
+use cover::{CoverKeep, CoverPlan};
 use deferred::{Deferred, MARK_BLOCK, ShadowKeep, ShadowMarks};
 use shadow::ExactShadow;
 

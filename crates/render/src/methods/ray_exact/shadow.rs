@@ -103,7 +103,7 @@ impl ExactShadow {
 
     /// Cast every texel of the view's cover.
     pub(super) fn record_cover(&self, frame: &Frame<'_>, encoder: &mut wgpu::CommandEncoder) {
-        let mut pass = self.begin(frame, encoder);
+        let mut pass = self.begin(frame, encoder, "shadow");
         pass.set_pipeline(&self.pipeline);
         pass.dispatch_workgroups(SHADOW_SIZE.div_ceil(8), SHADOW_SIZE.div_ceil(8), 1);
     }
@@ -115,19 +115,35 @@ impl ExactShadow {
         encoder: &mut wgpu::CommandEncoder,
         marks: &ShadowMarks,
     ) {
-        let mut pass = self.begin(frame, encoder);
+        let mut pass = self.begin(frame, encoder, "shadow");
         pass.set_pipeline(&self.blocks);
         pass.dispatch_workgroups_indirect(&marks.stamps, 0);
+    }
+
+    /// Cast the first `count` blocks of the list (written by the CPU: the
+    /// view's cover, `cover.rs`), ahead of the march. Labelled a build: it
+    /// fills a cache the later frames of a still view need no pass for, and
+    /// the harness warms a method up until its frames stop building.
+    pub(super) fn record_blocks(
+        &self,
+        frame: &Frame<'_>,
+        encoder: &mut wgpu::CommandEncoder,
+        count: u32,
+    ) {
+        let mut pass = self.begin(frame, encoder, "shadow cover build");
+        pass.set_pipeline(&self.blocks);
+        pass.dispatch_workgroups(count, 1, 1);
     }
 
     fn begin<'e>(
         &self,
         frame: &Frame<'_>,
         encoder: &'e mut wgpu::CommandEncoder,
+        label: &str,
     ) -> wgpu::ComputePass<'e> {
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("ray-exact shadow"),
-            timestamp_writes: frame.timer.compute("shadow"),
+            label: Some(label),
+            timestamp_writes: frame.timer.compute(label),
         });
         pass.set_bind_group(0, &self.frame_group, &[]);
         pass.set_bind_group(1, &self.group, &[]);

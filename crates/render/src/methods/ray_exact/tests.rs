@@ -866,3 +866,88 @@ fn kept_shadow_blocks_draw_what_casting_every_block_draws() {
         gpu.errors.check().unwrap();
     }
 }
+
+/// A still view's frames once its whole cover is cast (`cover.rs`): the
+/// march shades in one pass with no stamps, and every frame equals, bit for
+/// bit, a method built fresh for it. The cover is cast ahead once the key
+/// has held a frame, in budgets; an edit and another writer of the map
+/// start it over.
+#[test]
+fn a_still_view_with_its_cover_cast_draws_what_a_fresh_method_draws() {
+    for gpu in common::gpus() {
+        let w = common::generated_world();
+        let mut level = w.level.clone();
+        let site = w.edit.clone().expect("an edit site");
+        let sized = |level: &Level| shared_sized(&gpu, level, (W, H));
+        let timer = crate::timing::PassTimer::new(&gpu.device, &gpu.queue, false);
+        let read = |shared: &Shared, m: &RayExact| {
+            let texture = |t: &wgpu::Texture| {
+                crate::gpu::read_texture(
+                    &shared.device,
+                    &shared.queue,
+                    &gpu.errors,
+                    t,
+                    wgpu::TextureAspect::All,
+                )
+                .unwrap()
+            };
+            (texture(&shared.color), texture(m.depth_image().unwrap()))
+        };
+        let camera = Camera::from_view(&level, &site.camera, W, H).unwrap();
+        // A budget that casts the cover in a few frames, so that some
+        // deferred marches keep blocks cast ahead of them.
+        let blocks = {
+            let shadow = crate::shadow::ShadowFrame::fit(&camera, true);
+            (0..128 * 128)
+                .filter(|b| super::cover::block_in_cover(&shadow.cover, b % 128, b / 128))
+                .count() as u32
+        };
+        let options = ExactOptions {
+            cover_budget: blocks.div_ceil(3),
+            ..ExactOptions::DEFAULT
+        };
+        let still_shared = sized(&level);
+        let mut still = build(&still_shared, &level, options).unwrap();
+        let mut covered = Vec::new();
+        for step in 0..14u32 {
+            if step == 6 {
+                let rects = dig(&w, &mut level);
+                still_shared
+                    .terrain
+                    .upload(&gpu.queue, &level, &rects)
+                    .unwrap();
+                still.apply_edit(&still_shared, &level, &rects).unwrap();
+            }
+            if step == 10 {
+                still_shared.shadow_map_written();
+            }
+            let shadow = crate::shadow::ShadowFrame::fit(&camera, true);
+            let globals =
+                crate::frame::Globals::new(&camera, &crate::frame::LevelShape::of(&level), &shadow);
+            record_frame(
+                &still_shared,
+                &mut still,
+                &camera,
+                &globals,
+                &timer,
+                step as usize,
+            );
+            let picture = read(&still_shared, &still);
+            covered.push(still.covered());
+            let fresh_shared = sized(&level);
+            let mut fresh = build(&fresh_shared, &level, ExactOptions::DEFAULT).unwrap();
+            record_frame(&fresh_shared, &mut fresh, &camera, &globals, &timer, 0);
+            assert!(!fresh.covered(), "a fresh method's first frame defers");
+            let fresh_picture = read(&fresh_shared, &fresh);
+            assert!(picture.0 == fresh_picture.0, "frame {step}: colour differs");
+            assert!(picture.1 == fresh_picture.1, "frame {step}: depth differs");
+        }
+        eprintln!("{blocks} cover blocks; covered frames {covered:?}");
+        // Frame 0: a new key; 1-3 cast a third of the cover each, the third
+        // finishing it; the edit (6) and the other writer (10) start over.
+        let (f, t) = (false, true);
+        let expect = [f, f, f, t, t, t, f, f, f, t, f, f, f, t];
+        assert_eq!(covered, expect);
+        gpu.errors.check().unwrap();
+    }
+}
