@@ -7,12 +7,19 @@
 //! CPU never learns which blocks a frame cast. This module keeps its own
 //! record instead: the blocks *it* listed for the shadow pass, by slot of
 //! the map's texture, with the key (`deferred::ShadowKeep`) and the lattice
-//! block each was cast for. A frame whose key held since the last one
-//! lists up to a budget of the cover's blocks not yet recorded, and the
-//! shadow pass casts them before the march (tagging them, so a deferred
-//! march keeps them too). When none is left, the frame is *covered*: every
-//! texel its shading can read (`ShadowCover`, which holds every texel within
-//! reach of a visible point) holds what casting it now would store.
+//! block each was cast for. Once the view has been still for
+//! [`STILL_FRAMES`] frames (the same camera and key), a frame lists up to a
+//! budget of the cover's blocks not yet recorded, and the shadow pass casts
+//! them before the march (tagging them, so a deferred march keeps them
+//! too). When none is left, the frame is *covered*: every texel its shading
+//! can read (`ShadowCover`, which holds every texel within reach of a
+//! visible point) holds what casting it now would store.
+//!
+//! Only a still view: a moving one changes its texel size every few frames
+//! (on the video's path the key changes in 270 of 600 frames), so its cover
+//! would seldom be whole before the key changes, and the casts ahead would
+//! be work no frame reads (on the H100, 256 blocks a frame ahead made that
+//! path's frame 0.151 -> 0.177 ms at p50: `bench/cover-whole/`).
 //!
 //! The record stays true because only two things write the map's blocks
 //! while the key holds: these listed casts, and the deferred frame's own,
@@ -25,7 +32,13 @@
 
 use super::deferred::MARK_BLOCK;
 use crate::frame::SHADOW_SIZE;
+use strata_camera::Camera;
 use strata_camera::light::{ShadowCover, ShadowFrame};
+
+/// Frames a view must have been the same (camera and key) before the
+/// cover is cast ahead: a game that draws a frame twice (the gameplay
+/// protocol's frame alone) casts nothing ahead.
+pub(super) const STILL_FRAMES: u32 = 2;
 
 /// Blocks of the map a side.
 const BLOCKS: u32 = SHADOW_SIZE / MARK_BLOCK;
@@ -53,38 +66,53 @@ pub(super) struct CoverKeep {
     /// Per slot block of the texture: the key and lattice block of its last
     /// listed cast (key 0: none).
     slots: Vec<(u32, [i32; 2])>,
-    /// The key of the last frame planned, and for how many frames in a row.
-    last_key: u32,
-    held: u32,
+    /// The key and camera of the last frame planned, and for how many
+    /// frames before it they were the same.
+    last: Option<(u32, Camera)>,
+    still: u32,
+    /// The cover of the still view was found whole: nothing to scan until
+    /// the view, the key or the record changes.
+    whole: bool,
 }
 
 impl CoverKeep {
     pub(super) fn new() -> Self {
         CoverKeep {
             slots: vec![(0, [0, 0]); (BLOCKS * BLOCKS) as usize],
-            last_key: 0,
-            held: 0,
+            last: None,
+            still: 0,
+            whole: false,
         }
     }
 
-    /// This frame's plan for key `key` (0: nothing is kept) and map `frame`:
-    /// once the key has held for a frame, up to `budget` cover blocks not
-    /// yet cast, and whether the cover is then whole. Nothing is recorded
-    /// until [`CoverKeep::cast`] says the casts were recorded.
-    pub(super) fn plan(&mut self, key: u32, frame: &ShadowFrame, budget: u32) -> CoverPlan {
-        if key == self.last_key {
-            self.held = self.held.saturating_add(1);
+    /// This frame's plan for key `key` (0: nothing is kept), `camera` and
+    /// its map `frame`: once the view has been still for [`STILL_FRAMES`]
+    /// frames, up to `budget` cover blocks not yet cast, and whether the
+    /// cover is then whole. Nothing is recorded until [`CoverKeep::cast`]
+    /// says the casts were recorded.
+    pub(super) fn plan(
+        &mut self,
+        key: u32,
+        camera: &Camera,
+        frame: &ShadowFrame,
+        budget: u32,
+    ) -> CoverPlan {
+        if self.last == Some((key, *camera)) {
+            self.still = self.still.saturating_add(1);
         } else {
-            (self.last_key, self.held) = (key, 0);
+            (self.last, self.still, self.whole) = (Some((key, *camera)), 0, false);
         }
         let mut plan = CoverPlan {
             key,
             ..CoverPlan::default()
         };
-        // A key that just changed casts nothing ahead: a moving view may
-        // change it again next frame, and the deferred frame casts what its
-        // pixels read anyway.
-        if key == 0 || budget == 0 || self.held == 0 {
+        // A moving view casts nothing ahead: the deferred frame casts what
+        // its pixels read.
+        if key == 0 || budget == 0 || self.still < STILL_FRAMES {
+            return plan;
+        }
+        if self.whole {
+            plan.covered = true;
             return plan;
         }
         let mut missing = 0usize;
@@ -113,11 +141,13 @@ impl CoverKeep {
         for &lb in &plan.lattice {
             self.slots[slot(lb)] = (plan.key, lb);
         }
+        self.whole = plan.covered;
     }
 
     /// A deferred frame over map `frame` ran: its march may have cast any
     /// block of its square, so only records of the square's own blocks stay.
     pub(super) fn after_deferred_frame(&mut self, frame: &ShadowFrame) {
+        self.whole = false;
         for by in 0..BLOCKS {
             for bx in 0..BLOCKS {
                 let lb = lattice_block(frame, bx, by);
@@ -169,9 +199,12 @@ mod tests {
     use glam::Vec3;
     use strata_camera::Camera;
 
+    fn camera_at(x: f32, yaw: f32, pitch: f32) -> Camera {
+        Camera::new(Vec3::new(x, 8000.0, 300.0), yaw, pitch, 320, 200).unwrap()
+    }
+
     fn frame_at(x: f32, yaw: f32, pitch: f32) -> ShadowFrame {
-        let camera = Camera::new(Vec3::new(x, 8000.0, 300.0), yaw, pitch, 320, 200).unwrap();
-        ShadowFrame::fit(&camera, true)
+        ShadowFrame::fit(&camera_at(x, yaw, pitch), true)
     }
 
     #[test]
@@ -201,16 +234,19 @@ mod tests {
     }
 
     #[test]
-    fn a_held_key_lists_the_cover_in_budgets_and_then_nothing() {
-        let frame = frame_at(1000.0, 37.0, -30.0);
+    fn a_still_view_lists_the_cover_in_budgets_and_then_nothing() {
+        let camera = camera_at(1000.0, 37.0, -30.0);
+        let frame = ShadowFrame::fit(&camera, true);
         let mut keep = CoverKeep::new();
-        // The key's first frame casts nothing ahead.
-        let first = keep.plan(5, &frame, 1000);
-        assert!(first.cast.is_empty() && !first.covered);
+        // The view's first frames cast nothing ahead.
+        for _ in 0..STILL_FRAMES {
+            let first = keep.plan(5, &camera, &frame, 1000);
+            assert!(first.cast.is_empty() && !first.covered);
+        }
         let mut total = 0;
         let mut frames = 0;
         loop {
-            let plan = keep.plan(5, &frame, 1000);
+            let plan = keep.plan(5, &camera, &frame, 1000);
             assert!(plan.cast.len() <= 1000);
             keep.cast(&plan);
             total += plan.cast.len();
@@ -224,32 +260,40 @@ mod tests {
             .filter(|b| block_in_cover(&frame.cover, b % BLOCKS, b / BLOCKS))
             .count();
         assert_eq!(total, cover_blocks);
-        let again = keep.plan(5, &frame, 1000);
+        let again = keep.plan(5, &camera, &frame, 1000);
         assert!(again.covered && again.cast.is_empty());
-        // An unrecorded plan records nothing: a new key starts over.
-        assert!(!keep.plan(6, &frame, 1000).covered);
-        let next = keep.plan(6, &frame, 100_000);
+        keep.cast(&again);
+        // A moved camera, then a new key, start over.
+        let moved = camera_at(1001.0, 37.0, -30.0);
+        assert!(!keep.plan(5, &moved, &frame, 1000).covered);
+        for _ in 0..STILL_FRAMES {
+            assert!(!keep.plan(6, &camera, &frame, 1000).covered);
+        }
+        let next = keep.plan(6, &camera, &frame, 100_000);
         assert_eq!(next.cast.len(), cover_blocks);
         assert!(next.covered);
     }
 
     #[test]
     fn a_deferred_frame_drops_records_of_blocks_outside_its_square() {
-        let here = frame_at(1000.0, 37.0, -30.0);
+        let camera = camera_at(1000.0, 37.0, -30.0);
+        let here = ShadowFrame::fit(&camera, true);
         let mut keep = CoverKeep::new();
-        keep.plan(1, &here, 100_000);
-        let plan = keep.plan(1, &here, 100_000);
+        for _ in 0..STILL_FRAMES {
+            keep.plan(1, &camera, &here, 100_000);
+        }
+        let plan = keep.plan(1, &camera, &here, 100_000);
         keep.cast(&plan);
-        assert!(keep.plan(1, &here, 100_000).covered);
+        assert!(keep.plan(1, &camera, &here, 100_000).covered);
         // A deferred frame over the same square keeps every record.
         keep.after_deferred_frame(&here);
-        assert!(keep.plan(1, &here, 100_000).covered);
+        assert!(keep.plan(1, &camera, &here, 100_000).covered);
         // One over a square far away (same texel size and plane: same key)
         // may have cast its blocks into every slot.
         let mut away = here.clone();
         away.lattice = [here.lattice[0] + 8 * 300, here.lattice[1] + 8 * 77];
         keep.after_deferred_frame(&away);
-        let back = keep.plan(1, &here, 100_000);
+        let back = keep.plan(1, &camera, &here, 100_000);
         assert!(!back.cast.is_empty());
     }
 }

@@ -48,6 +48,17 @@
 //! with a pixel left. A still view casts and shades nothing after its first
 //! frame; a walking one casts the blocks that come into view.
 //!
+//! Those lists live on the GPU, so the CPU cannot tell a frame that nothing
+//! is left to cast. `cover.rs` keeps a record of its own: once the key has
+//! held for a frame, the shadow pass casts up to
+//! [`ExactOptions::cover_budget`] blocks of the view's cover a frame ahead of
+//! the march once the view has been still for two frames, and when the
+//! record holds the whole cover (which holds every texel a visible point's
+//! shading can read) the frame marches and shades in one pass, as a frame
+//! with a reused map does: no stamps, no hits, no shadow or shading pass. A
+//! still view gets there within a few dozen frames; a moving one keeps the
+//! deferred frame.
+//!
 //! The compute variant over the whole map first searches a beam per 8x8-pixel
 //! tile (`beam.rs`, `ray_exact_beam.wgsl`, issue 36): the least `t` at which
 //! any ray of the tile may meet a solid point, and the march starts each of
@@ -703,7 +714,9 @@ impl Method for RayExact {
         let keep = self.keep_shadow && matches!(self.levels, Levels::Whole(_)) && self.defers();
         let key = self.keep.key(&fit, shared.shadow_map_writes(), keep);
         let plan = if self.shadow.is_some() {
-            self.cover.get_mut().plan(key, &fit, self.cover_budget)
+            self.cover
+                .get_mut()
+                .plan(key, camera, &fit, self.cover_budget)
         } else {
             CoverPlan::default()
         };
@@ -743,6 +756,8 @@ impl Method for RayExact {
                 let list = bytemuck::cast_slice(&plan.cast);
                 shared.queue.write_buffer(&self.marks.list, 0, list);
                 shadow.record_blocks(frame, encoder, plan.cast.len() as u32);
+            }
+            if map.is_some() {
                 self.cover.borrow_mut().cast(&plan);
             }
             self.covered.set(plan.covered);

@@ -869,8 +869,8 @@ fn kept_shadow_blocks_draw_what_casting_every_block_draws() {
 
 /// A still view's frames once its whole cover is cast (`cover.rs`): the
 /// march shades in one pass with no stamps, and every frame equals, bit for
-/// bit, a method built fresh for it. The cover is cast ahead once the key
-/// has held a frame, in budgets; an edit and another writer of the map
+/// bit, a method built fresh for it. The cover is cast ahead once the view
+/// has been still for two frames, in budgets; an edit and another writer of the map
 /// start it over.
 #[test]
 fn a_still_view_with_its_cover_cast_draws_what_a_fresh_method_draws() {
@@ -909,7 +909,7 @@ fn a_still_view_with_its_cover_cast_draws_what_a_fresh_method_draws() {
         let still_shared = sized(&level);
         let mut still = build(&still_shared, &level, options).unwrap();
         let mut covered = Vec::new();
-        for step in 0..14u32 {
+        for step in 0..16u32 {
             if step == 6 {
                 let rects = dig(&w, &mut level);
                 still_shared
@@ -918,7 +918,7 @@ fn a_still_view_with_its_cover_cast_draws_what_a_fresh_method_draws() {
                     .unwrap();
                 still.apply_edit(&still_shared, &level, &rects).unwrap();
             }
-            if step == 10 {
+            if step == 11 {
                 still_shared.shadow_map_written();
             }
             let shadow = crate::shadow::ShadowFrame::fit(&camera, true);
@@ -943,10 +943,11 @@ fn a_still_view_with_its_cover_cast_draws_what_a_fresh_method_draws() {
             assert!(picture.1 == fresh_picture.1, "frame {step}: depth differs");
         }
         eprintln!("{blocks} cover blocks; covered frames {covered:?}");
-        // Frame 0: a new key; 1-3 cast a third of the cover each, the third
-        // finishing it; the edit (6) and the other writer (10) start over.
+        // Frames 0-1: the view is new; 2-4 cast a third of the cover each,
+        // the third finishing it; the edit (6) and the other writer (11)
+        // start over.
         let (f, t) = (false, true);
-        let expect = [f, f, f, t, t, t, f, f, f, t, f, f, f, t];
+        let expect = [f, f, f, f, t, t, f, f, f, f, t, f, f, f, f, t];
         assert_eq!(covered, expect);
         gpu.errors.check().unwrap();
     }
