@@ -47,6 +47,10 @@ pub enum EditMode {
     Off,
 }
 
+/// Most frames a view after the first adds to its warm-up while the method
+/// still reports build passes (with timestamps only).
+pub const VIEW_BUILD_FRAMES: u32 = 64;
+
 #[derive(Clone, Debug)]
 pub struct Options {
     pub out: PathBuf,
@@ -661,8 +665,15 @@ impl Plan {
             bar.set_message(format!("{} / {label}", view.name));
             // The renderer's first view covers its incremental build (view 0
             // in a fresh run; the first view left in a resumed one).
+            // Later views keep warming up while the method still builds
+            // (`ray-exact` casts a still view's shadow cover over its first
+            // frames there), up to `VIEW_BUILD_FRAMES` more; without
+            // timestamps the builds are not seen and every frame up to the
+            // cap would run, so there the cap stays.
             let warmup = if i == 0 {
                 self.warmup_first
+            } else if session.results.adapter.timestamps {
+                self.opts.min_warmup.saturating_add(VIEW_BUILD_FRAMES)
             } else {
                 self.opts.min_warmup
             };
