@@ -11,6 +11,16 @@ const AMBIENT: f32 = 0.45;
 const CAVE_AMBIENT: f32 = 0.25;
 const FOG_RANGE: f32 = 50.0;
 
+// The shading's terrain fetches (the normal's neighbours) and shadow taps
+// one after another rather than all in flight at once (a pipeline constant;
+// the same values either way): each fetch's address takes a zero computed
+// from the fetch before it (a terrain byte's bit 31; a shadow distance's
+// sign bit, never set: every stored distance is positive), which the
+// compiler cannot see is zero. Fewer values live at once, so a kernel that
+// shades after a march may fit fewer registers (on NVIDIA, 32 a thread
+// keeps every warp an SM can hold resident).
+override SHADE_FETCH_CHAIN: bool = false;
+
 const SURFACE_FLOOR: u32 = 0u;
 const SURFACE_SLAB_TOP: u32 = 1u;
 const SURFACE_CEILING: u32 = 2u;
@@ -84,24 +94,38 @@ fn surface_normal_in(level: u32, x: i32, y: i32, kind: u32, here: f32, pair: vec
     let odd = (x & 1) == 1;
     // The pair holding the neighbour that is not in `pair`.
     let other = terrain_pair_at(level, select(x - 1, x + 1, odd), y);
+    let north = terrain_pair_at(level, x, y + 1 + chain_zero(other.x));
+    let south = terrain_pair_at(level, x, y - 1 + chain_zero(north.x));
     let east = interval_of(decode_pair(select(pair, other, odd), x + 1), kind, here);
     let west = interval_of(decode_pair(select(other, pair, odd), x - 1), kind, here);
     let gx = 0.5 * (east - west) / spacing;
-    let gy = 0.5 * (interval_field_at(level, x, y + 1, kind, here) - interval_field_at(level, x, y - 1, kind, here)) / spacing;
+    let gy = 0.5 * (interval_of(decode_pair(north, x), kind, here) - interval_of(decode_pair(south, x), kind, here)) / spacing;
     if (kind == SURFACE_CEILING) {
         return normalize(vec3<f32>(gx, gy, -1.0));
     }
     return normalize(vec3<f32>(-gx, -gy, 1.0));
 }
 
-// One shadow-map test: 1 lit, 0 shadowed. `t` already includes the bias.
-fn shadow_tap(ij: vec2<i32>, t: f32) -> f32 {
+// 0, from word `w` of a fetch whose bit 31 is never set, as a dependency
+// on that fetch where `SHADE_FETCH_CHAIN` (a plain 0 otherwise).
+fn chain_zero(w: u32) -> i32 {
+    return select(0, i32(w >> 31u), SHADE_FETCH_CHAIN);
+}
+
+// One shadow-map test: x 1 lit, 0 shadowed (`t` already includes the
+// bias); y `chain_zero` of the distance read (0 where none was).
+fn shadow_tap_chained(ij: vec2<i32>, t: f32) -> ShadowTap {
     let side = i32(globals.shadow_u.w);
     if (any(ij < vec2<i32>(0)) || any(ij >= vec2<i32>(side))) {
-        return 1.0;
+        return ShadowTap(1.0, 0);
     }
     let blocker = textureLoad(shadow_map, shadow_slot(ij), 0).r;
-    return select(0.0, 1.0, t <= blocker);
+    return ShadowTap(select(0.0, 1.0, t <= blocker), chain_zero(bitcast<u32>(blocker)));
+}
+
+struct ShadowTap {
+    lit: f32,
+    zero: i32,
 }
 
 // 4-tap PCF with bilinear weights over the shadow map. Against acne on the
@@ -122,11 +146,11 @@ fn shadow_factor(p_surface: vec3<f32>, n: vec3<f32>) -> f32 {
     let base = floor(uv);
     let f = uv - base;
     let ij = vec2<i32>(base);
-    let s00 = shadow_tap(ij, t);
-    let s10 = shadow_tap(ij + vec2<i32>(1, 0), t);
-    let s01 = shadow_tap(ij + vec2<i32>(0, 1), t);
-    let s11 = shadow_tap(ij + vec2<i32>(1, 1), t);
-    return mix(mix(s00, s10, f.x), mix(s01, s11, f.x), f.y);
+    let s00 = shadow_tap_chained(ij, t);
+    let s10 = shadow_tap_chained(ij + vec2<i32>(1 + s00.zero, 0), t);
+    let s01 = shadow_tap_chained(ij + vec2<i32>(0, 1 + s10.zero), t);
+    let s11 = shadow_tap_chained(ij + vec2<i32>(1, 1 + s01.zero), t);
+    return mix(mix(s00.lit, s10.lit, f.x), mix(s01.lit, s11.lit, f.x), f.y);
 }
 
 // Fog factor: 0 up to 50 units before the far plane, 1 at it.

@@ -98,6 +98,10 @@ pub struct ExactOptions {
     /// cover is cast marches and shades in one pass, with no stamps and no
     /// shadow or shading pass (`ray_exact/cover.rs`). 0: never.
     pub cover_budget: u32,
+    /// The shading's fetches one after another (`SHADE_FETCH_CHAIN` in
+    /// `shading.wgsl`; the same pictures): fewer registers a thread for the
+    /// pipelines that shade after the march.
+    pub shade_fetch_chain: bool,
 }
 
 /// How `ray-exact`'s march walks the texels of a 4x4-texel tile it comes
@@ -223,6 +227,7 @@ impl ExactOptions {
         // within a few dozen frames; a moving one casts at most this much
         // more a frame (~0.006 ms on the H100).
         cover_budget: 256,
+        shade_fetch_chain: false,
     };
 
     /// Which pyramid levels to keep: only those the traversals visit. The

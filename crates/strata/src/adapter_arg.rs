@@ -57,7 +57,8 @@ pub fn parse_backend(s: &str) -> anyhow::Result<BackendChoice> {
 /// tile's maximum), `STRATA_EXACT_KEEP=off` (cast every shadow block a
 /// frame reads and shade in a pass of its own, keeping nothing from earlier
 /// frames), `STRATA_EXACT_COVER=off|N` (never cast the view's cover ahead
-/// of the march, or up to N blocks a frame) configure `ray-exact`;
+/// of the march, or up to N blocks a frame), `STRATA_EXACT_SHADE_CHAIN=on|off`
+/// (the shading's fetches one after another) configure `ray-exact`;
 /// `STRATA_EXACT_STATS=1` prints its statistics;
 /// `STRATA_TEST_OVERSIZE_BUILD=METHOD` makes that method's build ask for a
 /// buffer over the device's limit (the README's way to see a refused build).
@@ -113,6 +114,11 @@ fn render_options_from(var: impl Fn(&str) -> Option<String>) -> RenderOptions {
             cave_skip: !is("STRATA_EXACT_CAVE_SKIP", "off"),
             beam_texels: !is("STRATA_EXACT_BEAM_TEXELS", "off"),
             shadow_keep: !is("STRATA_EXACT_KEEP", "off"),
+            shade_fetch_chain: match var("STRATA_EXACT_SHADE_CHAIN").as_deref() {
+                Some("on") => true,
+                Some("off") => false,
+                _ => e.shade_fetch_chain,
+            },
             cover_budget: match var("STRATA_EXACT_COVER").as_deref() {
                 Some("off") => 0,
                 Some(n) => n.parse().unwrap_or(e.cover_budget),

@@ -225,6 +225,13 @@ pub(super) fn exact_pipeline(
             f64::from(u8::from(options.beam_texels)),
         ));
     }
+    if matches!(shader, "ray_exact.wgsl" | "ray_exact_deferred.wgsl") {
+        // The pipelines that shade (`shading.wgsl`).
+        constants.push((
+            "SHADE_FETCH_CHAIN",
+            f64::from(u8::from(options.shade_fetch_chain)),
+        ));
+    }
     super::super::common::compute_pipeline_with_constants(
         shared,
         label,

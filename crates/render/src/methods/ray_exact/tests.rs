@@ -633,6 +633,15 @@ fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
                 shadow_keep: false,
                 ..d
             },
+            ExactOptions {
+                shade_fetch_chain: true,
+                ..d
+            },
+            ExactOptions {
+                shade_fetch_chain: true,
+                exact_shadow: false,
+                ..d
+            },
         ];
         assert_eq!(d.beam_search, BeamSearch::Wide);
         assert!(
@@ -665,9 +674,9 @@ fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
         // a descent into the texels fused with the texel's test, or no tile
         // skipped between floors and slabs, or the beams' finest test on
         // 4-texel tiles, or a 4x4 tile's texels walked from the texel
-        // plane, or keeping no shadow block from earlier frames, changes
-        // nothing but the work.
-        for other in [3, 4, 5, 6, 8, 10, 12, 13, 15, 16, 18, 20, 22] {
+        // plane, or keeping no shadow block from earlier frames, or the
+        // shading's fetches chained, changes nothing but the work.
+        for other in [3, 4, 5, 6, 8, 10, 12, 13, 15, 16, 18, 20, 22, 23] {
             for (v, (a, b)) in images[1].iter().zip(&images[other]).enumerate() {
                 assert!(
                     a.0 == b.0 && a.1 == b.1,
@@ -679,8 +688,8 @@ fn depth_and_shadow_variants_agree_and_the_cap_is_never_hit() {
         // beam in a pre-pass, without a beam, with the serial one and with
         // the wide one in the march, with the fused descent, and without
         // the cave skip and the beams' texel test, and with the texel
-        // plane: the same image.
-        for other in [7, 9, 11, 14, 17, 19, 21] {
+        // plane, and with the shading's fetches chained: the same image.
+        for other in [7, 9, 11, 14, 17, 19, 21, 24] {
             for (v, (a, b)) in images[2].iter().zip(&images[other]).enumerate() {
                 assert!(
                     a.0 == b.0 && a.1 == b.1,
