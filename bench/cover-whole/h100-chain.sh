@@ -5,7 +5,8 @@
 # default, and the cover off; the driver's register counts of the
 # pipelines that shade; the moving camera with the still-view rule.
 # `devbin/strata-cover.xz` and `devbin/pipeline_stats` are this tree's
-# release builds. Carry `.gl` and `devbin`.   OUT=$OUT bash this
+# release builds. Carry `.gl` and `devbin`.
+#   OUT=$OUT [REPS=2] [OFF=1] [GAMEPLAY=1] bash this
 set -u
 for f in .gl/*.deb; do dpkg -x "$f" /; done; ldconfig
 python3 -c 'import lzma, sys; sys.stdout.buffer.write(lzma.open(sys.argv[1]).read())' devbin/strata-cover.xz > /tmp/strata
@@ -24,13 +25,13 @@ run() {
     env $2 timeout 150 /tmp/strata compare --level "$W/world" --frames 20 --no-edits \
         --methods ray-exact --out "$W/$1" > "$W/$1.log" 2>&1 || echo "$1 failed: $(tail -2 "$W/$1.log")"
 }
-for k in 1 2; do
+for k in $(seq 1 "${REPS:-2}"); do
     run cover-$k X=1
     run chain-$k STRATA_EXACT_SHADE_CHAIN=on
-    run off-$k STRATA_EXACT_COVER=off
+    [ "${OFF:-1}" = 1 ] && run off-$k STRATA_EXACT_COVER=off
 done
-python3 bench/issue36-loop-bounding/summary_all.py "$W"/cover-*/ "$W"/chain-*/ "$W"/off-*/ | tee "$OUT/summary.txt"
-for v in on off; do
+python3 bench/issue36-loop-bounding/summary_all.py "$W"/*-[0-9]/ | tee "$OUT/summary.txt"
+[ "${GAMEPLAY:-1}" = 1 ] && for v in on off; do
     env STRATA_EXACT_COVER=$([ $v = on ] && echo 256 || echo off) timeout 150 /tmp/strata compare \
         --level "$W/world" --gameplay --view-names hangar \
         --methods ray-exact --out "$W/gameplay-$v" > "$OUT/gameplay-$v.log" 2>&1 \
