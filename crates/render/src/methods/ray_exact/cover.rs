@@ -290,7 +290,7 @@ mod tests {
         assert!(keep.plan(1, &camera, &here, 100_000).covered);
         // One over a square far away (same texel size and plane: same key)
         // may have cast its blocks into every slot.
-        let mut away = here.clone();
+        let mut away = here;
         away.lattice = [here.lattice[0] + 8 * 300, here.lattice[1] + 8 * 77];
         keep.after_deferred_frame(&away);
         let back = keep.plan(1, &camera, &here, 100_000);
