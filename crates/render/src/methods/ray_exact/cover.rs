@@ -31,7 +31,8 @@
 //! record stale at once.
 
 use super::deferred::MARK_BLOCK;
-use crate::frame::SHADOW_SIZE;
+use crate::frame::{SHADOW_SIZE, Shared};
+use crate::methods::contract::Frame;
 use strata_camera::Camera;
 use strata_camera::light::{ShadowCover, ShadowFrame};
 
@@ -157,6 +158,51 @@ impl CoverKeep {
                 }
             }
         }
+    }
+}
+
+impl super::RayExact {
+    /// This frame's plan for key `key` and `camera`, whose map is `fit`
+    /// (`prepare`); recorded with the shadow map, if it is cast.
+    pub(super) fn plan_cover(&mut self, key: u32, camera: &Camera, fit: ShadowFrame) {
+        let plan = if self.shadow.is_some() {
+            self.cover
+                .get_mut()
+                .plan(key, camera, &fit, self.cover_budget)
+        } else {
+            CoverPlan::default()
+        };
+        *self.cover_plan.get_mut() = (key != 0).then_some((plan, fit));
+    }
+
+    /// The deferred route's shadow map: cast the plan's cover blocks ahead
+    /// of the march. Whether the cover is then whole, so that the frame
+    /// marches and shades in one pass (else the march lists what else its
+    /// pixels read).
+    pub(super) fn record_cover_ahead(
+        &self,
+        shared: &Shared,
+        frame: &Frame<'_>,
+        encoder: &mut wgpu::CommandEncoder,
+    ) -> bool {
+        let (plan, map) = match self.cover_plan.borrow_mut().take() {
+            Some((plan, map)) => (plan, Some(map)),
+            None => (CoverPlan::default(), None),
+        };
+        if let (Some(shadow), false) = (&self.shadow, plan.cast.is_empty()) {
+            let list = bytemuck::cast_slice(&plan.cast);
+            shared.queue.write_buffer(&self.marks.list, 0, list);
+            shadow.record_blocks(frame, encoder, plan.cast.len() as u32);
+        }
+        let mut keep = self.cover.borrow_mut();
+        if let Some(map) = map {
+            keep.cast(&plan);
+            if !plan.covered {
+                keep.after_deferred_frame(&map);
+            }
+        }
+        self.covered.set(plan.covered);
+        plan.covered
     }
 }
 

@@ -713,14 +713,7 @@ impl Method for RayExact {
         let fit = ShadowFrame::fit(camera, true);
         let keep = self.keep_shadow && matches!(self.levels, Levels::Whole(_)) && self.defers();
         let key = self.keep.key(&fit, shared.shadow_map_writes(), keep);
-        let plan = if self.shadow.is_some() {
-            self.cover
-                .get_mut()
-                .plan(key, camera, &fit, self.cover_budget)
-        } else {
-            CoverPlan::default()
-        };
-        *self.cover_plan.get_mut() = (key != 0).then_some((plan, fit));
+        self.plan_cover(key, camera, fit);
         shared.queue.write_buffer(
             &self.params,
             std::mem::offset_of!(ExactParams, shadow_keep) as u64,
@@ -747,26 +740,9 @@ impl Method for RayExact {
         self.record_update(frame, encoder);
         self.keep.wrote(shared.shadow_map_written());
         if self.defers() {
-            let (plan, map) = match self.cover_plan.borrow_mut().take() {
-                Some((plan, map)) => (plan, Some(map)),
-                None => (CoverPlan::default(), None),
-            };
-            if let (Some(shadow), false) = (&self.shadow, plan.cast.is_empty()) {
-                // The cover's blocks not cast yet, ahead of the march.
-                let list = bytemuck::cast_slice(&plan.cast);
-                shared.queue.write_buffer(&self.marks.list, 0, list);
-                shadow.record_blocks(frame, encoder, plan.cast.len() as u32);
-            }
-            if map.is_some() {
-                self.cover.borrow_mut().cast(&plan);
-            }
-            self.covered.set(plan.covered);
-            if !plan.covered {
+            if !self.record_cover_ahead(shared, frame, encoder) {
                 // Cast in `record`, between the march and the shading.
                 self.shadow_due.set(true);
-                if let Some(map) = map {
-                    self.cover.borrow_mut().after_deferred_frame(&map);
-                }
             }
         } else {
             self.record_shadow_pass(frame, encoder, false);
