@@ -74,6 +74,9 @@ pub(super) struct CoverKeep {
     /// The cover of the still view was found whole: nothing to scan until
     /// the view, the key or the record changes.
     whole: bool,
+    /// The key of the last casts recorded: records of any other key are
+    /// stale already.
+    recorded_key: u32,
 }
 
 impl CoverKeep {
@@ -83,6 +86,7 @@ impl CoverKeep {
             last: None,
             still: 0,
             whole: false,
+            recorded_key: 0,
         }
     }
 
@@ -142,13 +146,21 @@ impl CoverKeep {
         for &lb in &plan.lattice {
             self.slots[slot(lb)] = (plan.key, lb);
         }
+        if !plan.lattice.is_empty() {
+            self.recorded_key = plan.key;
+        }
         self.whole = plan.covered;
     }
 
     /// A deferred frame over map `frame` ran: its march may have cast any
     /// block of its square, so only records of the square's own blocks stay.
-    pub(super) fn after_deferred_frame(&mut self, frame: &ShadowFrame) {
+    /// (`key`: the frame's; a moving view's frames, whose key is seldom
+    /// that of any record, skip the scan.)
+    pub(super) fn after_deferred_frame(&mut self, frame: &ShadowFrame, key: u32) {
         self.whole = false;
+        if key != self.recorded_key {
+            return;
+        }
         for by in 0..BLOCKS {
             for bx in 0..BLOCKS {
                 let lb = lattice_block(frame, bx, by);
@@ -198,7 +210,7 @@ impl super::RayExact {
         if let Some(map) = map {
             keep.cast(&plan);
             if !plan.covered {
-                keep.after_deferred_frame(&map);
+                keep.after_deferred_frame(&map, plan.key);
             }
         }
         self.covered.set(plan.covered);
@@ -332,13 +344,13 @@ mod tests {
         keep.cast(&plan);
         assert!(keep.plan(1, &camera, &here, 100_000).covered);
         // A deferred frame over the same square keeps every record.
-        keep.after_deferred_frame(&here);
+        keep.after_deferred_frame(&here, 1);
         assert!(keep.plan(1, &camera, &here, 100_000).covered);
         // One over a square far away (same texel size and plane: same key)
         // may have cast its blocks into every slot.
         let mut away = here;
         away.lattice = [here.lattice[0] + 8 * 300, here.lattice[1] + 8 * 77];
-        keep.after_deferred_frame(&away);
+        keep.after_deferred_frame(&away, 1);
         let back = keep.plan(1, &camera, &here, 100_000);
         assert!(!back.cast.is_empty());
     }
