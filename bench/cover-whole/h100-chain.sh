@@ -31,21 +31,6 @@ for k in $(seq 1 "${REPS:-2}"); do
     [ "${OFF:-1}" = 1 ] && run off-$k STRATA_EXACT_COVER=off
 done
 python3 bench/issue36-loop-bounding/summary_all.py "$W"/*-[0-9]/ | tee "$OUT/summary.txt"
-[ "${GAMEPLAY:-1}" = 1 ] && for v in on off; do
-    env STRATA_EXACT_COVER=$([ $v = on ] && echo 256 || echo off) timeout 150 /tmp/strata compare \
-        --level "$W/world" --gameplay --view-names hangar \
-        --methods ray-exact --out "$W/gameplay-$v" > "$OUT/gameplay-$v.log" 2>&1 \
-        || echo "gameplay $v failed: $(tail -2 "$OUT/gameplay-$v.log")"
-    python3 - "$W/gameplay-$v" <<'PY' | tee -a "$OUT/summary.txt"
-import glob, json, sys
-r = json.load(open(glob.glob(sys.argv[1] + "/results-*.json")[0]))["gameplay"]["rows"][0]
-f = lambda k: "/".join(f"{r[k][q]:.4f}" for q in ("p50", "p99", "max"))
-print(sys.argv[1].rsplit("/", 1)[1], "frame alone GPU p50/p99/max", f("alone_gpu_ms"), "with edits", f("with_edits_gpu_ms"), "alone CPU", f("alone_cpu_ms"))
-PY
-done
-mkdir -p "$OUT/runs"
-for d in "$W"/*/; do
-    n=$(basename "$d"); case $n in world|cache) continue ;; esac
-    for f in "$d"/*.json; do [ -e "$f" ] && cp "$f" "$OUT/runs/$n-$(basename "$f")"; done
-done
-(cd "$OUT" && tar czf runs.tgz runs && rm -rf runs)
+. bench/cover-whole/lib.sh
+[ "${GAMEPLAY:-1}" = 1 ] && gameplay_on_off
+collect_runs

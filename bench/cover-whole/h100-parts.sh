@@ -5,7 +5,7 @@
 # (`bench/ray-exact-ablation/round2/shader-sed-hook.patch`, also in
 # `pipeline_stats`), and the rule files `devhook/sed/*.txt` (diagnostics:
 # pictures change). Per rule: the driver's register count, then two timed
-# protocol runs. Carry `.gl` and `devhook`.   OUT=$OUT bash this
+# protocol runs (the moving camera is `h100-chain.sh`'s). Carry `.gl` and `devhook`.   OUT=$OUT bash this
 set -u
 for f in .gl/*.deb; do dpkg -x "$f" /; done; ldconfig
 python3 -c 'import lzma, sys; sys.stdout.buffer.write(lzma.open(sys.argv[1]).read())' devhook/strata.xz > /tmp/strata
@@ -27,23 +27,5 @@ for k in 1 2; do
     done
 done
 python3 bench/issue36-loop-bounding/summary_all.py $(for r in $RULES; do echo "$W/$r-1/ $W/$r-2/"; done) | tee "$OUT/summary.txt"
-# The moving camera with the still-view rule (`cover.rs`): the video's path,
-# 64 edits a frame and the frame alone, cover on (default) and off.
-for v in on off; do
-    env STRATA_EXACT_COVER=$([ $v = on ] && echo 256 || echo off) timeout 150 /tmp/strata compare \
-        --level "$W/world" --gameplay --view-names hangar \
-        --methods ray-exact --out "$W/gameplay-$v" > "$OUT/gameplay-$v.log" 2>&1 \
-        || echo "gameplay $v failed: $(tail -2 "$OUT/gameplay-$v.log")"
-    python3 - "$W/gameplay-$v" <<'PY' | tee -a "$OUT/summary.txt"
-import glob, json, sys
-r = json.load(open(glob.glob(sys.argv[1] + "/results-*.json")[0]))["gameplay"]["rows"][0]
-f = lambda k: "/".join(f"{r[k][q]:.4f}" for q in ("p50", "p99", "max"))
-print(sys.argv[1].rsplit("/", 1)[1], "frame alone GPU p50/p99/max", f("alone_gpu_ms"), "with edits", f("with_edits_gpu_ms"), "alone CPU", f("alone_cpu_ms"))
-PY
-done
-mkdir -p "$OUT/runs"
-for d in "$W"/*/; do
-    n=$(basename "$d"); case $n in world|cache) continue ;; esac
-    for f in "$d"/*.json; do [ -e "$f" ] && cp "$f" "$OUT/runs/$n-$(basename "$f")"; done
-done
-(cd "$OUT" && tar czf runs.tgz runs && rm -rf runs)
+. bench/cover-whole/lib.sh
+collect_runs
