@@ -6,7 +6,9 @@
 # `pipeline-stats-sed-hook.patch` for `pipeline_stats`); without
 # STRATA_SHADER_SED_FILE it is this tree's binary. Rules (`sed/*.txt`):
 # `none` the shipped shader; `chain` none with STRATA_EXACT_SHADE_CHAIN=on
-# (same pictures); the rest are diagnostics whose pictures change
+# (same pictures); `sellevels` the pyramid levels' table read at constant
+# indices 0-8 and picked by `select` (same pictures where every visited
+# level is even, as with EXACT_LOG_RATIO 2), not at a lane's own index; the rest are diagnostics whose pictures change
 # (`noshade` no shading at all, `notaps` no shadow taps, `flatnormal` no
 # normal fetches, `nopalette` no palette read, `noranges` no ramp read,
 # `nodepth` no depth store, `nomarch` the beam and the stores only: every pixel sky). Per rule: the driver's register count, then
@@ -19,7 +21,7 @@ chmod +x /tmp/strata
 nvidia-smi --query-gpu=name,driver_version --format=csv,noheader | tee "$OUT/gpu.txt"
 S=bench/cover-whole/sed
 C="EXACT_CLIMB=1,EXACT_LOG_RATIO=2,EXACT_START_LEVEL=6,EXACT_FUSED_DESCENT=0,EXACT_ITERATION_STATS=0,EXACT_CAVE_SKIP=1,EXACT_TEXEL_BLOCKS=0,EXACT_BEAM=1,EXACT_BEAM_SEARCH=1,EXACT_SHADOW_ROUNDS=8,EXACT_BEAM_LEVEL=2,EXACT_BEAM_TEXELS=1"
-RULES=${RULES:-none chain noshade notaps flatnormal nopalette noranges nodepth nomarch}
+RULES=${RULES:-none chain sellevels noshade notaps flatnormal nopalette noranges nodepth nomarch}
 rule_file() { [ "$1" = chain ] && echo $S/none.txt || echo $S/$1.txt; }
 rule_env() { [ "$1" = chain ] && echo STRATA_EXACT_SHADE_CHAIN=on || echo X=1; }
 for r in $RULES; do
