@@ -6,7 +6,7 @@
 //! The deferred frame lists the blocks its pixels read, on the GPU, so the
 //! CPU never learns which blocks a frame cast. This module keeps its own
 //! record instead: the blocks *it* listed for the shadow pass, by slot of
-//! the map's texture, with the key (`deferred::ShadowKeep`) and the lattice
+//! the map's texture, with the key (`keep::ShadowKeep`) and the lattice
 //! block each was cast for. Once the view has been still for
 //! [`STILL_FRAMES`] frames (the same camera and key), a frame lists up to a
 //! budget of the cover's blocks not yet recorded, and the shadow pass casts
@@ -150,6 +150,15 @@ impl CoverKeep {
             self.recorded_key = plan.key;
         }
         self.whole = plan.covered;
+    }
+
+    /// The map's slot blocks `slots` may hold something else now (an edit:
+    /// `keep.rs`): their records go.
+    pub(super) fn drop_slots(&mut self, slots: &[u32]) {
+        for &s in slots {
+            self.slots[s as usize].0 = 0;
+        }
+        self.whole &= slots.is_empty();
     }
 
     /// A deferred frame over map `frame` ran: its march may have cast any

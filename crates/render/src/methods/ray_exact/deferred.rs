@@ -10,7 +10,6 @@ use super::bindings::{
 use crate::frame::{Shared, storage_texture_entry};
 use crate::methods::common::DepthCopy;
 use crate::options::ExactOptions;
-use strata_camera::light::ShadowFrame;
 
 /// The compute variant's frame on frames that cast the shadow map
 /// (`ray_exact_deferred.wgsl`): march (each pixel's hit column and `t` into
@@ -56,73 +55,12 @@ pub(super) struct ShadowMarks {
     /// shading pass's indirect dispatch (x the number of listed tiles), a
     /// word of padding and a stamp per pixel tile.
     pub(super) stamps: wgpu::Buffer,
-    /// The listed blocks, their tags ([`ShadowKeep`]), then the listed
+    /// The listed blocks, their tags ([`super::keep::ShadowKeep`]), then the listed
     /// pixel tiles.
     pub(super) list: wgpu::Buffer,
     blocks: u32,
     /// Pixel tiles the list has room for.
     pub(super) tiles: u32,
-}
-
-/// Which shadow blocks cast by earlier frames a frame may keep
-/// (`shadow_keep.wgsl`): the key of the blocks tagged since the last change
-/// that alters what a block holds. The key changes when the texel size or
-/// the map's plane changes, when the terrain is edited, when anything but
-/// this method's block pass writes the map, and is 0 (keep nothing) over
-/// paged terrain, whose texels depend on the pages resident.
-///
-/// Within one key, a slot of the map's texture holds one lattice block at a
-/// time and its tag says which; so a tag that matches is the block's. The key
-/// is a frame counter of sorts: 2^32 changes, at one a frame, take two years
-/// at 60 frames a second, and a wrapped key could only match a tag that old.
-pub(super) struct ShadowKeep {
-    key: u32,
-    /// Texel size and plane of the key's frames (f32 bits).
-    fit: Option<[u32; 4]>,
-    /// `Shared::shadow_map_writes` after this method's last write.
-    writes_seen: std::cell::Cell<Option<u64>>,
-    /// Something since the last frame changed what blocks hold.
-    stale: std::cell::Cell<bool>,
-}
-
-impl ShadowKeep {
-    pub(super) fn new() -> Self {
-        ShadowKeep {
-            key: 0,
-            fit: None,
-            writes_seen: std::cell::Cell::new(None),
-            stale: std::cell::Cell::new(true),
-        }
-    }
-
-    /// The terrain or the map changed under the kept blocks.
-    pub(super) fn forget(&self) {
-        self.stale.set(true);
-    }
-
-    /// This method's block pass wrote the map this frame (`writes`: the
-    /// count it brought `Shared::shadow_map_writes` to).
-    pub(super) fn wrote(&self, writes: u64) {
-        self.writes_seen.set(Some(writes));
-    }
-
-    /// This frame's key: the last one when nothing changed, a new one else;
-    /// 0 where blocks cannot be kept (`keep` false).
-    pub(super) fn key(&mut self, frame: &ShadowFrame, writes: u64, keep: bool) -> u32 {
-        let a = frame.anchor;
-        let fit = [
-            frame.texel.to_bits(),
-            a.x.to_bits(),
-            a.y.to_bits(),
-            a.z.to_bits(),
-        ];
-        let same = self.fit == Some(fit) && self.writes_seen.get() == Some(writes);
-        if self.stale.replace(false) || !same || self.key == 0 {
-            self.key = self.key.wrapping_add(1).max(1);
-        }
-        self.fit = Some(fit);
-        if keep { self.key } else { 0 }
-    }
 }
 
 /// The first stamp's word in [`ShadowMarks::stamps`] (`MARK_STAMPS` in
@@ -173,6 +111,23 @@ impl ShadowMarks {
 
     pub(super) fn bytes(&self) -> u64 {
         self.stamps.size() + self.list.size()
+    }
+
+    /// Clear the tags of the texture's slot blocks `slots` (sorted), so that
+    /// no frame keeps what they hold (`shadow_keep.wgsl`: three words a slot
+    /// after the list; a zero key matches none). One write per run of
+    /// consecutive slots.
+    pub(super) fn clear_tags(&self, queue: &wgpu::Queue, slots: &[u32]) {
+        let mut i = 0;
+        while i < slots.len() {
+            let mut n = 1;
+            while i + n < slots.len() && slots[i + n] == slots[i] + n as u32 {
+                n += 1;
+            }
+            let word = u64::from(self.blocks + 3 * slots[i]);
+            queue.write_buffer(&self.list, word * 4, &vec![0u8; 12 * n]);
+            i += n;
+        }
     }
 }
 

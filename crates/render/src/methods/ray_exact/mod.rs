@@ -38,11 +38,13 @@
 //! march and shade in one pass.
 //!
 //! Over the whole map the deferred frame also keeps the blocks earlier
-//! frames cast (`shadow_keep.wgsl`, `deferred::ShadowKeep`): the map's texels
+//! frames cast (`shadow_keep.wgsl`, `keep::ShadowKeep`): the map's texels
 //! lie on a lattice fixed to the light and sit in the texture at their
 //! lattice index wrapped ([`strata_camera::light::ShadowFrame::slot`]), so a
 //! block cast while the texel size and the plane were the same, and with no
-//! edit or other writer of the map since, holds what casting it again would.
+//! other writer of the map since, holds what casting it again would. An edit
+//! spoils only the blocks whose shadow rays cross the edited columns; the
+//! next frame clears their tags (`keep.rs`).
 //! The march lists only blocks that are not kept, and shades on the spot every
 //! pixel whose blocks all are; the shading pass runs only over the 8x8 tiles
 //! with a pixel left. A still view casts and shades nothing after its first
@@ -625,14 +627,15 @@ impl Method for RayExact {
     fn apply_edit(
         &mut self,
         _shared: &Shared,
-        _level: &Level,
+        level: &Level,
         rects: &[DirtyRect],
     ) -> anyhow::Result<()> {
         match &mut self.levels {
             Levels::Whole(pyramid) => {
                 pyramid.enqueue(rects);
-                // Shadow rays may cross the edited columns anywhere.
-                self.keep.forget();
+                // The next frame clears the kept blocks whose shadow rays
+                // cross the edited columns.
+                self.keep.edited(rects, (level.width(), level.height()));
                 Ok(())
             }
             Levels::Paged(_) => anyhow::bail!(
@@ -712,7 +715,13 @@ impl Method for RayExact {
         // the same frame; whether shadows are on changes neither).
         let fit = ShadowFrame::fit(camera, true);
         let keep = self.keep_shadow && matches!(self.levels, Levels::Whole(_)) && self.defers();
-        let key = self.keep.key(&fit, shared.shadow_map_writes(), keep);
+        let keyed = self.keep.key(&fit, shared.shadow_map_writes(), keep);
+        let key = keyed.key;
+        if !keyed.spoiled.is_empty() {
+            // Before anything of this frame reads the tags.
+            self.marks.clear_tags(&shared.queue, &keyed.spoiled);
+            self.cover.get_mut().drop_slots(&keyed.spoiled);
+        }
         self.plan_cover(key, camera, fit);
         shared.queue.write_buffer(
             &self.params,
@@ -880,6 +889,7 @@ mod beam;
 mod bindings;
 mod cover;
 mod deferred;
+mod keep;
 pub mod replay;
 mod shadow;
 use crate::paged::PagedTerrain;
@@ -887,7 +897,8 @@ use beam::Beam;
 pub use bindings::Levels;
 use bindings::{core_entries, exact_pipeline, march_group};
 use cover::{CoverKeep, CoverPlan};
-use deferred::{Deferred, MARK_BLOCK, ShadowKeep, ShadowMarks};
+use deferred::{Deferred, MARK_BLOCK, ShadowMarks};
+use keep::ShadowKeep;
 use shadow::ExactShadow;
 
 #[cfg(test)]
