@@ -12,7 +12,8 @@
 # (`noshade` no shading at all, `notaps` no shadow taps, `flatnormal` no
 # normal fetches, `nopalette` no palette read, `noranges` no ramp read,
 # `nodepth` no depth store, `nomarch` the beam and the stores only: every pixel sky). Per rule: the driver's register count, then
-# REPS timed protocol runs; then the moving camera, cover on and off.
+# REPS timed protocol runs; then the moving camera, cover on and off,
+# and against `devhook/base.xz` where there is one.
 # Carry `.gl` and `devhook`.   OUT=$OUT [REPS=2] [GAMEPLAY=1] bash this
 set -u
 for f in .gl/*.deb; do dpkg -x "$f" /; done; ldconfig
@@ -46,4 +47,14 @@ done
 python3 bench/issue36-loop-bounding/summary_all.py $(for r in $RULES; do for k in $(seq 1 "${REPS:-2}"); do echo "$W/$r-$k/"; done; done) | tee "$OUT/summary.txt"
 . bench/cover-whole/lib.sh
 [ "${GAMEPLAY:-1}" = 1 ] && gameplay_on_off
+# A baseline binary (`devhook/base.xz`, e.g. before an edit-path change):
+# the moving camera with edits, it and this tree, twice each.
+if [ -e devhook/base.xz ]; then
+    python3 -c 'import lzma, sys; sys.stdout.buffer.write(lzma.open(sys.argv[1]).read())' devhook/base.xz > /tmp/strata-base
+    chmod +x /tmp/strata-base
+    for k in 1 2; do
+        gameplay_run /tmp/strata-base base-$k X=1
+        gameplay_run /tmp/strata this-$k X=1
+    done
+fi
 collect_runs

@@ -176,7 +176,7 @@ fn slot_of(x: i32, y: i32) -> u32 {
 /// The slots of every lattice block within `spanned` (x0, y0, x1, y1,
 /// blocks) whose texels' shadow rays may cross a column of `edits` or of
 /// its images on the map of `map` columns, which wraps; sorted. `None` when
-/// the test would take too long or spoil most of the map (then the key
+/// the test would take too long or spoil nearly all the map (then the key
 /// changes instead).
 pub(super) fn spoiled_slots(
     frame: &ShadowFrame,
@@ -196,7 +196,8 @@ pub(super) fn spoiled_slots(
                 }
             }
         }
-        if count * 2 > spoiled.len() {
+        // Most of the map: as cheap to start over.
+        if count * 8 > spoiled.len() * 7 {
             return None;
         }
     }
