@@ -155,6 +155,9 @@ impl ShadowKeep {
                 spoiled,
             }
         } else {
+            // Nothing clears the spoiled tags this frame: the next frame
+            // that keeps starts over.
+            self.forget();
             KeyedFrame::default()
         }
     }
@@ -490,6 +493,23 @@ mod tests {
         let whole = keep.key(&frame, 3, true);
         assert!(whole.key != next.key && whole.spoiled.is_empty());
         // Another writer, as before.
-        assert_ne!(keep.key(&frame, 4, true).key, whole.key);
+        let other = keep.key(&frame, 4, true);
+        assert_ne!(other.key, whole.key);
+        // A frame that keeps nothing clears no tag: an edit before it
+        // makes the next frame that keeps start over.
+        keep.wrote(4);
+        assert_eq!(keep.key(&frame, 4, true).key, other.key);
+        keep.edited(
+            &[DirtyRect {
+                x: 1010,
+                y: 820,
+                width: 12,
+                height: 9,
+            }],
+            (2048, 2048),
+        );
+        assert_eq!(keep.key(&frame, 4, false), KeyedFrame::default());
+        let after = keep.key(&frame, 4, true);
+        assert!(after.key != other.key && after.spoiled.is_empty());
     }
 }
