@@ -12,8 +12,8 @@
 # (`noshade` no shading at all, `notaps` no shadow taps, `flatnormal` no
 # normal fetches, `nopalette` no palette read, `noranges` no ramp read,
 # `nodepth` no depth store, `nomarch` the beam and the stores only: every pixel sky). Per rule: the driver's register count, then
-# REPS timed protocol runs; then the moving camera, cover on and off,
-# and against `devhook/base.xz` where there is one.
+# REPS timed protocol runs; then the moving camera, cover on and off, and
+# with edits, edit keep on and off.
 # Carry `.gl` and `devhook`.   OUT=$OUT [REPS=2] [GAMEPLAY=1] bash this
 set -u
 for f in .gl/*.deb; do dpkg -x "$f" /; done; ldconfig
@@ -47,14 +47,13 @@ done
 python3 bench/issue36-loop-bounding/summary_all.py $(for r in $RULES; do for k in $(seq 1 "${REPS:-2}"); do echo "$W/$r-$k/"; done; done) | tee "$OUT/summary.txt"
 . bench/cover-whole/lib.sh
 [ "${GAMEPLAY:-1}" = 1 ] && gameplay_on_off
-# A baseline binary (`devhook/base.xz`, e.g. before an edit-path change):
-# the moving camera with edits, it and this tree, twice each.
-if [ -e devhook/base.xz ]; then
-    python3 -c 'import lzma, sys; sys.stdout.buffer.write(lzma.open(sys.argv[1]).read())' devhook/base.xz > /tmp/strata-base
-    chmod +x /tmp/strata-base
+# The moving camera with edits: an edit spoils only the blocks it reaches
+# (the default) or every kept block (STRATA_EXACT_EDIT_KEEP=off, as before
+# `fe6462f`; `bench/edit-keep/`), twice each.
+if [ "${GAMEPLAY:-1}" = 1 ]; then
     for k in 1 2; do
-        gameplay_run /tmp/strata-base base-$k X=1
-        gameplay_run /tmp/strata this-$k X=1
+        gameplay_run /tmp/strata editkeep-on-$k X=1
+        gameplay_run /tmp/strata editkeep-off-$k STRATA_EXACT_EDIT_KEEP=off
     done
 fi
 collect_runs

@@ -102,6 +102,10 @@ pub struct ExactOptions {
     /// `shading.wgsl`; the same pictures): fewer registers a thread for the
     /// pipelines that shade after the march.
     pub shade_fetch_chain: bool,
+    /// With [`ExactOptions::shadow_keep`]: an edit spoils only the kept
+    /// blocks whose shadow rays cross the edited columns (`ray_exact/keep.rs`;
+    /// the same pictures). Off, an edit forgets every kept block, for A/B.
+    pub edit_keep: bool,
 }
 
 /// How `ray-exact`'s march walks the texels of a 4x4-texel tile it comes
@@ -228,6 +232,7 @@ impl ExactOptions {
         // more a frame (~0.006 ms on the H100).
         cover_budget: 256,
         shade_fetch_chain: false,
+        edit_keep: true,
     };
 
     /// Which pyramid levels to keep: only those the traversals visit. The

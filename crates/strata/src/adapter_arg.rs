@@ -58,7 +58,8 @@ pub fn parse_backend(s: &str) -> anyhow::Result<BackendChoice> {
 /// frame reads and shade in a pass of its own, keeping nothing from earlier
 /// frames), `STRATA_EXACT_COVER=off|N` (never cast the view's cover ahead
 /// of the march, or up to N blocks a frame), `STRATA_EXACT_SHADE_CHAIN=on|off`
-/// (the shading's fetches one after another) configure `ray-exact`;
+/// (the shading's fetches one after another), `STRATA_EXACT_EDIT_KEEP=off`
+/// (an edit forgets every kept shadow block) configure `ray-exact`;
 /// `STRATA_EXACT_STATS=1` prints its statistics;
 /// `STRATA_TEST_OVERSIZE_BUILD=METHOD` makes that method's build ask for a
 /// buffer over the device's limit (the README's way to see a refused build).
@@ -119,6 +120,7 @@ fn render_options_from(var: impl Fn(&str) -> Option<String>) -> RenderOptions {
                 Some("off") => false,
                 _ => e.shade_fetch_chain,
             },
+            edit_keep: !is("STRATA_EXACT_EDIT_KEEP", "off"),
             cover_budget: match var("STRATA_EXACT_COVER").as_deref() {
                 Some("off") => 0,
                 Some(n) => n.parse().unwrap_or(e.cover_budget),
@@ -155,6 +157,7 @@ mod tests {
             "STRATA_EXACT_BEAM_TEXELS" => Some("off".into()),
             "STRATA_EXACT_KEEP" => Some("off".into()),
             "STRATA_EXACT_COVER" => Some("off".into()),
+            "STRATA_EXACT_EDIT_KEEP" => Some("off".into()),
             "STRATA_EXACT_TEXEL_BLOCKS" => Some("beside".into()),
             "STRATA_TEST_OVERSIZE_BUILD" => Some("voxel".into()),
             _ => None,
@@ -169,6 +172,7 @@ mod tests {
         assert!(!o.exact.cave_skip && !o.exact.beam_texels && !o.exact.shadow_keep);
         assert!(render_options_from(|_| None).exact.shadow_keep);
         assert_eq!(o.exact.cover_budget, 0);
+        assert!(!o.exact.edit_keep && render_options_from(|_| None).exact.edit_keep);
         let n = render_options_from(|n| (n == "STRATA_EXACT_COVER").then(|| "4096".into()));
         assert_eq!(n.exact.cover_budget, 4096);
         assert_eq!(render_options_from(|_| None).exact.cover_budget, 256);

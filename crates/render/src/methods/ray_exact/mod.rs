@@ -211,6 +211,8 @@ pub struct RayExact {
     cover_plan: RefCell<Option<(CoverPlan, ShadowFrame)>>,
     /// [`ExactOptions::cover_budget`].
     cover_budget: u32,
+    /// [`ExactOptions::edit_keep`].
+    edit_keep: bool,
     /// The last frame that cast the map found its cover whole and marched
     /// in one pass.
     covered: Cell<bool>,
@@ -441,6 +443,7 @@ fn build_on(
         cover: RefCell::new(CoverKeep::new()),
         cover_plan: RefCell::new(None),
         cover_budget: options.cover_budget,
+        edit_keep: options.edit_keep,
         covered: Cell::new(false),
         shadow_due: Cell::new(false),
         layout,
@@ -634,8 +637,12 @@ impl Method for RayExact {
             Levels::Whole(pyramid) => {
                 pyramid.enqueue(rects);
                 // The next frame clears the kept blocks whose shadow rays
-                // cross the edited columns.
-                self.keep.edited(rects, (level.width(), level.height()));
+                // cross the edited columns (or, for A/B, forgets them all).
+                if self.edit_keep {
+                    self.keep.edited(rects, (level.width(), level.height()));
+                } else {
+                    self.keep.forget();
+                }
                 Ok(())
             }
             Levels::Paged(_) => anyhow::bail!(
