@@ -365,20 +365,11 @@ mod tests {
 
     #[test]
     fn every_texel_whose_ray_crosses_an_edit_is_in_a_spoiled_block() {
-        let map = (2048, 2048);
+        let map = MAP;
         let cases = [
             // Near the camera; at the map's corner (its images matter); a
             // wider span of squares and a long thin edit.
-            (
-                frame_at(1000.0, 800.0, 37.0, -30.0),
-                DirtyRect {
-                    x: 1010,
-                    y: 820,
-                    width: 12,
-                    height: 9,
-                },
-                0,
-            ),
+            (frame_at(1000.0, 800.0, 37.0, -30.0), NEAR_EDIT, 0),
             (
                 frame_at(30.0, 2030.0, 200.0, -60.0),
                 DirtyRect {
@@ -445,6 +436,16 @@ mod tests {
         }
     }
 
+    /// A small edit in front of `frame_at(1000.0, 800.0, ..)`'s camera, on a
+    /// map of `MAP` columns.
+    const NEAR_EDIT: DirtyRect = DirtyRect {
+        x: 1010,
+        y: 820,
+        width: 12,
+        height: 9,
+    };
+    const MAP: (u32, u32) = (2048, 2048);
+
     #[test]
     fn an_edit_keeps_the_key_and_spoils_its_slots_only() {
         let frame = frame_at(1000.0, 800.0, 37.0, -30.0);
@@ -453,15 +454,7 @@ mod tests {
         let first = keep.key(&frame, 3, true);
         assert!(first.key != 0 && first.spoiled.is_empty());
         assert_eq!(keep.key(&frame, 3, true), first);
-        keep.edited(
-            &[DirtyRect {
-                x: 1010,
-                y: 820,
-                width: 12,
-                height: 9,
-            }],
-            (2048, 2048),
-        );
+        keep.edited(&[NEAR_EDIT], MAP);
         let edited = keep.key(&frame, 3, true);
         assert_eq!(edited.key, first.key);
         assert!(!edited.spoiled.is_empty());
@@ -477,7 +470,7 @@ mod tests {
                 height: 1,
             })
             .collect();
-        keep.edited(&many, (2048, 2048));
+        keep.edited(&many, MAP);
         let next = keep.key(&frame, 3, true);
         assert!(next.key != first.key && next.spoiled.is_empty());
         // An edit over most of the map does too.
@@ -488,7 +481,7 @@ mod tests {
                 width: 2048,
                 height: 2048,
             }],
-            (2048, 2048),
+            MAP,
         );
         let whole = keep.key(&frame, 3, true);
         assert!(whole.key != next.key && whole.spoiled.is_empty());
@@ -499,15 +492,7 @@ mod tests {
         // makes the next frame that keeps start over.
         keep.wrote(4);
         assert_eq!(keep.key(&frame, 4, true).key, other.key);
-        keep.edited(
-            &[DirtyRect {
-                x: 1010,
-                y: 820,
-                width: 12,
-                height: 9,
-            }],
-            (2048, 2048),
-        );
+        keep.edited(&[NEAR_EDIT], MAP);
         assert_eq!(keep.key(&frame, 4, false), KeyedFrame::default());
         let after = keep.key(&frame, 4, true);
         assert!(after.key != other.key && after.spoiled.is_empty());
