@@ -154,16 +154,6 @@ pub const BEAM_LEVEL: u32 = 2;
 /// reached on the protocol's views (counted in [`ExactStats`]).
 pub const ITERATION_CAP: u32 = 4096;
 
-/// Twin of `ExactParams` in `ray_exact_core.wgsl`.
-#[repr(C)]
-#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-pub(crate) struct ExactParams {
-    config: [u32; 4],
-    levels: [[u32; 4]; 9],
-    /// x: the kept shadow blocks' key ([`ShadowKeep`]); 0 keeps none.
-    shadow_keep: [u32; 4],
-}
-
 /// What the march counted since creation (or the last [`RayExact::reset_stats`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
 pub struct ExactStats {
@@ -261,25 +251,6 @@ pub fn create_fragment(
         ..shared.options.exact
     };
     Ok(Box::new(build(shared, level, options)?))
-}
-
-/// The traversal's level table for `layout`.
-pub(crate) fn exact_params(layout: &strata_maxmip::Layout) -> ExactParams {
-    let mut table = ExactParams {
-        // w: the cave pyramid's first byte, after the maxima (`GpuMaxMip`).
-        config: [layout.top(), ITERATION_CAP, 0, layout.bytes],
-        levels: [[0; 4]; 9],
-        shadow_keep: [0; 4],
-    };
-    for info in &layout.levels {
-        table.levels[info.log2_tile as usize] = [
-            info.offset,
-            info.width.trailing_zeros(),
-            info.width - 1,
-            info.height - 1,
-        ];
-    }
-    table
 }
 
 /// Build the method with explicit options.
@@ -897,6 +868,7 @@ mod bindings;
 mod cover;
 mod deferred;
 mod keep;
+mod params;
 pub mod replay;
 mod shadow;
 use crate::paged::PagedTerrain;
@@ -906,6 +878,7 @@ use bindings::{core_entries, exact_pipeline, march_group};
 use cover::{CoverKeep, CoverPlan};
 use deferred::{Deferred, MARK_BLOCK, ShadowMarks};
 use keep::ShadowKeep;
+pub(crate) use params::{ExactParams, exact_params};
 use shadow::ExactShadow;
 
 #[cfg(test)]
